@@ -1,0 +1,55 @@
+#pragma once
+// Typed errors of libinsitu. Every error names the offending value and where it came from
+// (argument, config key, field name, file, kernel), so a user can act on the message alone.
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace insitu {
+
+/// Base of every exception libinsitu throws.
+class Error : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+/// An argument, configuration value or input that is outside what the API accepts.
+class InvalidArgument : public Error {
+public:
+    using Error::Error;
+};
+
+/// JSON or another text format that cannot be parsed or has the wrong shape.
+class ParseError : public Error {
+public:
+    using Error::Error;
+};
+
+/// OpenCL: no platform, device selection failed, build failed, launch failed.
+class ComputeError : public Error {
+public:
+    using Error::Error;
+};
+
+/// Files: cannot open, read, write or decode.
+class IoError : public Error {
+public:
+    using Error::Error;
+};
+
+namespace detail {
+template <typename... Parts>
+std::string concat(const Parts&... parts) {
+    std::ostringstream out;
+    (out << ... << parts);
+    return out.str();
+}
+}  // namespace detail
+
+/// Throws `ErrorType` with the parts streamed together: `fail<InvalidArgument>("spacing.x = ", v)`.
+template <typename ErrorType, typename... Parts>
+[[noreturn]] void fail(const Parts&... parts) {
+    throw ErrorType(detail::concat(parts...));
+}
+
+}  // namespace insitu

@@ -1,0 +1,111 @@
+#pragma once
+// Field: a non-owning view of one scalar array of a simulation on a uniform grid.
+// Nothing is copied when a Field is made; the simulation keeps ownership of its memory and
+// the view must not outlive it. Sample (i, j, k) of the interior lives at world position
+// origin + (i, j, k) * spacing (node-centred samples, x fastest).
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace insitu {
+
+enum class ScalarType { uint8, uint16, int16, float32, float64 };
+
+/// Bytes per sample of a ScalarType.
+std::size_t scalar_size_bytes(ScalarType type);
+/// "uint8", "uint16", "int16", "float32", "float64".
+std::string to_string(ScalarType type);
+/// Inverse of to_string; throws InvalidArgument naming the unknown text.
+ScalarType parse_scalar_type(const std::string& text);
+
+using Index3 = std::array<std::int64_t, 3>;
+
+/// Finite value range of a field and how many samples were NaN or +-Inf (treated as empty).
+struct ValueRange {
+    double min = 0.0;
+    double max = 0.0;
+    std::int64_t finite_count = 0;
+    std::int64_t nonfinite_count = 0;
+    bool empty() const { return finite_count == 0; }
+};
+std::ostream& operator<<(std::ostream& out, const ValueRange& range);
+
+/// Axis-aligned world-space box.
+struct Bounds {
+    glm::dvec3 lower{0.0};
+    glm::dvec3 upper{0.0};
+    glm::dvec3 center() const { return 0.5 * (lower + upper); }
+    /// Radius of the bounding sphere around center().
+    double radius() const;
+};
+std::ostream& operator<<(std::ostream& out, const Bounds& bounds);
+
+class Field {
+public:
+    /// A view of a contiguous x-fastest array of `allocated_dims` samples.
+    /// Throws InvalidArgument for a null pointer or a non-positive dimension.
+    Field(std::string name, const void* data, ScalarType type, Index3 allocated_dims);
+
+    /// World position of the first interior sample (world units). Default (0, 0, 0).
+    Field& set_origin(glm::dvec3 origin_world);
+    /// Distance between samples along each axis (world units, > 0 and finite). Default (1, 1, 1).
+    Field& set_spacing(glm::dvec3 spacing_world);
+    /// Ghost layers to skip on the low and high side of each axis (samples, >= 0).
+    /// The interior is allocated_dims - low - high and must keep at least one sample per axis.
+    Field& set_ghost_layers(Index3 low, Index3 high);
+    /// Same number of ghost layers on every side.
+    Field& set_ghost_layers(std::int64_t layers);
+    /// Distance between neighbours along x, y, z in samples (not bytes), for arrays that are
+    /// padded, transposed or interleaved. Default: x-fastest contiguous, {1, nx, nx*ny}.
+    /// Strides must be positive; the whole allocated extent must not address memory twice
+    /// along one axis (|stride| checks are left to the simulation; we check positivity).
+    Field& set_strides(Index3 strides_samples);
+
+    const std::string& name() const { return name_; }
+    ScalarType type() const { return type_; }
+    const void* data() const { return data_; }
+    Index3 allocated_dims() const { return allocated_dims_; }
+    /// Samples per axis after the ghost layers are skipped.
+    Index3 dims() const;
+    std::int64_t sample_count() const;
+    glm::dvec3 origin() const { return origin_; }
+    glm::dvec3 spacing() const { return spacing_; }
+    Index3 ghost_low() const { return ghost_low_; }
+    Index3 ghost_high() const { return ghost_high_; }
+    Index3 strides() const { return strides_; }
+    /// World box spanned by the interior samples.
+    Bounds bounds() const;
+
+    /// Interior sample (i, j, k) as double, read through the type, ghosts and strides.
+    double value(std::int64_t i, std::int64_t j, std::int64_t k) const;
+
+    /// Scans the interior once: finite min/max and the number of NaN/Inf samples.
+    ValueRange value_range() const;
+
+    /// Packs the interior into `out` as x-fastest float32 (resized to sample_count()).
+    /// Non-finite samples become NaN: renderers treat NaN as empty space.
+    /// Returns the value range found on the way, so callers need not scan twice.
+    ValueRange copy_interior_as_float(std::vector<float>& out) const;
+
+private:
+    std::int64_t offset_of(std::int64_t i, std::int64_t j, std::int64_t k) const;
+
+    std::string name_;
+    const void* data_;
+    ScalarType type_;
+    Index3 allocated_dims_;
+    glm::dvec3 origin_{0.0};
+    glm::dvec3 spacing_{1.0};
+    Index3 ghost_low_{0, 0, 0};
+    Index3 ghost_high_{0, 0, 0};
+    Index3 strides_;
+};
+
+std::ostream& operator<<(std::ostream& out, const Field& field);
+
+}  // namespace insitu

@@ -1,0 +1,47 @@
+#pragma once
+// Images: row-major, pixel (0, 0) at the top-left, linear float, premultiplied alpha (DESIGN.md).
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace insitu {
+
+/// An image of `channels` floats per pixel.
+struct Image {
+    int width = 0;
+    int height = 0;
+    int channels = 0;
+    std::vector<float> pixels;  ///< width * height * channels, row-major, top row first
+
+    Image() = default;
+    Image(int width_pixels, int height_pixels, int channel_count, float fill = 0.0f);
+    std::size_t pixel_count() const { return static_cast<std::size_t>(width) * height; }
+    float& at(int x, int y, int channel) {
+        return pixels[(static_cast<std::size_t>(y) * width + x) * channels + channel];
+    }
+    float at(int x, int y, int channel) const {
+        return pixels[(static_cast<std::size_t>(y) * width + x) * channels + channel];
+    }
+};
+
+/// Linear -> sRGB transfer curve for one component in [0, 1] (IEC 61966-2-1).
+float linear_to_srgb(float linear);
+
+/// Writes a 1-channel (grey), 3-channel (RGB) or 4-channel (premultiplied RGBA) linear image as
+/// an 8-bit sRGB PNG via libpng. RGBA is un-premultiplied into PNG's straight alpha.
+/// Throws IoError naming the path on failure, InvalidArgument for other channel counts.
+void write_png(const std::string& path, const Image& image);
+
+/// Writes float channels to an OpenEXR file (ZIP compression). `channel_names` must have
+/// image.channels entries, e.g. {"R","G","B","A"} or {"Z"}.
+void write_exr(const std::string& path, const Image& image,
+               const std::vector<std::string>& channel_names);
+
+/// Reads the named float channels of a single-part EXR into one image (channel order as given).
+Image read_exr(const std::string& path, const std::vector<std::string>& channel_names);
+
+/// Writes `path` as PNG or EXR by its extension (".png" / ".exr"); RGBA images go to EXR as
+/// R, G, B, A. Throws InvalidArgument naming the path for other extensions.
+void write_image(const std::string& path, const Image& image);
+
+}  // namespace insitu

@@ -1,0 +1,101 @@
+#pragma once
+// The ground-truth volume renderer (seed 002): emission-absorption ray casting.
+//
+// The definition every accuracy figure depends on, and which tests/reference_renderer.cpp
+// implements independently:
+//  * Rays come from Camera::ray at pixel centres. They are clipped to the field's world bounds;
+//    sample i (i = 0, 1, ...) lies at t = t_near + (i + 0.5) * step while t < t_far, where
+//    step = step_voxels * min(spacing) in world units.
+//  * Samples are trilinear in voxel coordinates (p - origin) / spacing, clamped to the grid.
+//    NaN (non-finite input) samples are empty: they add nothing and stop nothing.
+//  * Gradients (for shading and 2D transfer functions): central differences of trilinear samples
+//    one voxel apart along each axis, divided by 2 * spacing (field units per world unit).
+//  * Classification: rgba = tf(value[, |gradient|]); opacity corrected for the step:
+//    alpha = 1 - (1 - a)^(step / unit_length).
+//  * Shading (Phong, optional): light along -ray direction (a headlight); n = gradient / |gradient|
+//    turned to face the light; colour = rgb * (ambient + diffuse * max(n.l, 0))
+//    + specular * max(n.h, 0)^shininess, h = l (headlight, so the half vector is l). Samples whose
+//    |gradient| is below 1e-12 field units per world unit stay unshaded.
+//  * Compositing front to back, premultiplied: C += T * alpha * colour; T *= 1 - alpha.
+//    Output RGBA = (C, 1 - T). The march stops once 1 - T >= early_termination_opacity
+//    (set it above 1 to disable).
+//  * Depth: depth (Camera::depth_of) of the first sample with alpha > 0; +inf where none.
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include "insitu/camera.hpp"
+#include "insitu/compute_device.hpp"
+#include "insitu/field.hpp"
+#include "insitu/image.hpp"
+#include "insitu/transfer_function.hpp"
+
+namespace insitu {
+
+struct PhongParameters {
+    float ambient = 0.3f;
+    float diffuse = 0.7f;
+    float specular = 0.3f;
+    float shininess = 32.0f;
+};
+
+struct RenderSettings {
+    /// Distance between samples along a ray, in units of the smallest grid spacing (> 0).
+    double step_voxels = 1.0;
+    /// Stop a ray once its accumulated opacity reaches this (in (0, 1]; > 1 disables).
+    double early_termination_opacity = 0.99;
+    bool shading = false;
+    PhongParameters phong;
+    /// Resolution of the transfer-function table on the device.
+    int tf_value_bins = 1024;
+    int tf_gradient_bins = 64;
+};
+
+/// What one render produces: premultiplied RGBA and first-hit depth (+inf where nothing).
+struct Rendering {
+    Image rgba;   ///< 4 channels
+    Image depth;  ///< 1 channel, world units from the camera plane
+};
+
+class VolumeRenderer {
+public:
+    explicit VolumeRenderer(std::shared_ptr<ComputeDevice> device = ComputeDevice::shared());
+
+    /// Copies the field's interior to the device (as float). Reuses the device buffer when the
+    /// new field fits, so successive timesteps allocate nothing. Throws InvalidArgument when an
+    /// axis has fewer than 2 samples.
+    void upload(const Field& field);
+
+    /// Renders the uploaded field. Throws InvalidArgument for bad settings, Error if nothing has
+    /// been uploaded.
+    Rendering render(const Camera& camera, const TransferFunction& tf,
+                     const RenderSettings& settings = {});
+
+    /// Value range of the uploaded field (from the upload scan).
+    const ValueRange& value_range() const { return range_; }
+    const Bounds& bounds() const { return bounds_; }
+    /// Bytes of device memory currently held for the volume.
+    std::size_t volume_capacity_bytes() const { return volume_capacity_; }
+
+private:
+    std::shared_ptr<ComputeDevice> device_;
+    cl::Kernel kernel_;
+    cl::Buffer volume_;
+    std::size_t volume_capacity_ = 0;
+    cl::Buffer table_;
+    std::size_t table_capacity_ = 0;
+    cl::Buffer rgba_out_;
+    std::size_t rgba_capacity_ = 0;
+    cl::Buffer depth_out_;
+    std::size_t depth_capacity_ = 0;
+    std::vector<float> staging_;
+    Index3 dims_{0, 0, 0};
+    glm::dvec3 origin_{0.0};
+    glm::dvec3 spacing_{1.0};
+    Bounds bounds_;
+    ValueRange range_;
+};
+
+void validate(const RenderSettings& settings);
+
+}  // namespace insitu
