@@ -5,19 +5,11 @@
 #include <limits>
 
 #include "insitu/error.hpp"
+#include "kernel_args.hpp"
 
 namespace insitu {
 
-namespace {
-cl_float4 to_float4(const glm::dvec3& v, double w = 0.0) {
-    return {{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z),
-             static_cast<float>(w)}};
-}
-cl_float4 to_float4(double x, double y, double z, double w) {
-    return {{static_cast<float>(x), static_cast<float>(y), static_cast<float>(z),
-             static_cast<float>(w)}};
-}
-}  // namespace
+using detail::to_float4;
 
 void validate(const RenderSettings& settings) {
     if (!(settings.step_voxels > 0.0) || !std::isfinite(settings.step_voxels)) {
@@ -40,49 +32,61 @@ void validate(const RenderSettings& settings) {
     }
 }
 
-VolumeRenderer::VolumeRenderer(std::shared_ptr<ComputeDevice> device)
-    : device_(std::move(device)) {
-    if (!device_) fail<InvalidArgument>("VolumeRenderer: compute device is null");
-    kernel_ = device_->kernel("volume_render", "render_volume");
+TransferTable step_corrected_table(const TransferFunction& tf, double step_world,
+                                   const RenderSettings& settings) {
+    TransferTable table = tf.sample(settings.tf_value_bins, settings.tf_gradient_bins);
+    // alpha_step = 1 - (1 - a)^(step / unit_length); correcting the table rather than every
+    // sample differs from the exact order by O(bin width^2), far below float precision here.
+    const double exponent = step_world / tf.unit_length();
+    for (std::size_t i = 3; i < table.rgba.size(); i += 4) {
+        table.rgba[i] = static_cast<float>(1.0 - std::pow(1.0 - table.rgba[i], exponent));
+    }
+    return table;
 }
 
-void VolumeRenderer::upload(const Field& field) {
-    const Index3 dims = field.dims();
+double DeviceVolume::step_world(double step_voxels) const {
+    return step_voxels * std::min({spacing.x, spacing.y, spacing.z});
+}
+
+void DeviceVolume::upload(ComputeDevice& device, const Field& field) {
+    const Index3 field_dims = field.dims();
     for (int axis = 0; axis < 3; ++axis) {
-        if (dims[axis] < 2) {
+        if (field_dims[axis] < 2) {
             fail<InvalidArgument>("field \"", field.name(), "\": ", "xyz"[axis], " has ",
-                                  dims[axis], " interior samples (volume rendering needs >= 2)");
+                                  field_dims[axis],
+                                  " interior samples (volume rendering needs >= 2)");
         }
     }
     if (field.sample_count() > std::numeric_limits<std::uint32_t>::max()) {
         fail<InvalidArgument>("field \"", field.name(), "\": ", field.sample_count(),
                               " samples exceed the 2^32 a device buffer index can address");
     }
-    range_ = field.copy_interior_as_float(staging_);
-    const std::size_t bytes = staging_.size() * sizeof(float);
-    device_->ensure_buffer(volume_, volume_capacity_, bytes, CL_MEM_READ_ONLY);
-    device_->upload(volume_, staging_.data(), bytes, "volume");
-    dims_ = dims;
-    origin_ = field.origin();
-    spacing_ = field.spacing();
-    bounds_ = field.bounds();
+    range = field.copy_interior_as_float(host_values);
+    const std::size_t bytes = host_values.size() * sizeof(float);
+    device.ensure_buffer(buffer, capacity_bytes, bytes, CL_MEM_READ_ONLY);
+    device.upload(buffer, host_values.data(), bytes, "volume");
+    dims = field_dims;
+    origin = field.origin();
+    spacing = field.spacing();
+    bounds = field.bounds();
+    ++generation;
 }
+
+VolumeRenderer::VolumeRenderer(std::shared_ptr<ComputeDevice> device)
+    : device_(std::move(device)) {
+    if (!device_) fail<InvalidArgument>("VolumeRenderer: compute device is null");
+    kernel_ = device_->kernel("volume_render", "render_volume");
+}
+
+void VolumeRenderer::upload(const Field& field) { volume_.upload(*device_, field); }
 
 Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& tf,
                                  const RenderSettings& settings) {
     validate(settings);
-    if (dims_[0] == 0) fail<Error>("VolumeRenderer::render called before upload()");
+    if (volume_.empty()) fail<Error>("VolumeRenderer::render called before upload()");
 
-    const double step_world =
-        settings.step_voxels * std::min({spacing_.x, spacing_.y, spacing_.z});
-
-    // The table carries opacity already corrected for the step, so the kernel needs no pow per
-    // sample: alpha_step = 1 - (1 - a)^(step / unit_length).
-    TransferTable table = tf.sample(settings.tf_value_bins, settings.tf_gradient_bins);
-    const double exponent = step_world / tf.unit_length();
-    for (std::size_t i = 3; i < table.rgba.size(); i += 4) {
-        table.rgba[i] = static_cast<float>(1.0 - std::pow(1.0 - table.rgba[i], exponent));
-    }
+    const double step_world = volume_.step_world(settings.step_voxels);
+    const TransferTable table = step_corrected_table(tf, step_world, settings);
     const std::size_t table_bytes = table.rgba.size() * sizeof(float);
     device_->ensure_buffer(table_, table_capacity_, table_bytes, CL_MEM_READ_ONLY);
     device_->upload(table_, table.rgba.data(), table_bytes, "transfer-function table");
@@ -95,13 +99,10 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
     device_->ensure_buffer(depth_out_, depth_capacity_, pixels * sizeof(float), CL_MEM_WRITE_ONLY);
 
     const bool needs_gradient = settings.shading || tf.is_2d();
-    const cl_int4 dims = {{static_cast<cl_int>(dims_[0]), static_cast<cl_int>(dims_[1]),
-                           static_cast<cl_int>(dims_[2]), 0}};
+    const Index3& d = volume_.dims;
+    const cl_int4 dims = {{static_cast<cl_int>(d[0]), static_cast<cl_int>(d[1]),
+                           static_cast<cl_int>(d[2]), 0}};
     const cl_int2 tf_bins = {{table.value_bins, table.gradient_bins}};
-    const cl_float4 tf_domain =
-        to_float4(table.value_min, 1.0 / (table.value_max - table.value_min),
-                  table.gradient_max > 0.0 ? 1.0 / table.gradient_max : 0.0, 0.0);
-    const bool perspective = camera.projection() == Projection::perspective;
     const cl_int2 size = {{width, height}};
     const cl_float4 march = to_float4(step_world, settings.early_termination_opacity,
                                       settings.shading ? 1.0 : 0.0, needs_gradient ? 1.0 : 0.0);
@@ -109,17 +110,15 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
     const cl_float4 phong_parameters =
         to_float4(phong.ambient, phong.diffuse, phong.specular, phong.shininess);
 
-    // Work-groups of 8x8 pixels: neighbouring rays touch neighbouring voxels.
-    const cl::NDRange local(8, 8);
-    const cl::NDRange global((width + 7) / 8 * 8, (height + 7) / 8 * 8);
-    device_->launch(kernel_, global, local, volume_, dims, to_float4(origin_),
-                    to_float4(1.0 / spacing_), to_float4(0.5 / spacing_),
-                    to_float4(bounds_.lower), to_float4(bounds_.upper), table_, tf_bins, tf_domain,
-                    to_float4(camera.position()), to_float4(camera.forward()),
-                    to_float4(camera.right()), to_float4(camera.up()),
-                    to_float4(camera.half_width(), camera.half_height(), perspective ? 1.0 : 0.0,
-                              0.0),
-                    size, march, phong_parameters, rgba_out_, depth_out_);
+    device_->launch(kernel_, detail::image_global_range(width, height),
+                    detail::image_local_range(), volume_.buffer, dims,
+                    to_float4(volume_.origin), to_float4(1.0 / volume_.spacing),
+                    to_float4(0.5 / volume_.spacing), to_float4(volume_.bounds.lower),
+                    to_float4(volume_.bounds.upper), table_, tf_bins,
+                    detail::transfer_domain(table), to_float4(camera.position()),
+                    to_float4(camera.forward()), to_float4(camera.right()),
+                    to_float4(camera.up()), detail::camera_extent(camera), size, march,
+                    phong_parameters, rgba_out_, depth_out_);
 
     Rendering result;
     result.rgba = Image(width, height, 4);

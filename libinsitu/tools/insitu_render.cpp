@@ -1,1 +1,424 @@
-int main() { return 0; }
+// insitu-render: renders a raw scalar volume with the ground-truth volume renderer (seed 002)
+// into a PNG or EXR image, optionally with its first-hit depth.
+//
+// Exit status: 0 on success; 2 for bad arguments and bad input (unknown flag, malformed number,
+// wrong raw file size, unreadable or malformed transfer function, unsupported extension);
+// 1 for anything else (no OpenCL platform, a failed kernel launch, out of memory).
+// Every failure is reported as one line on stderr that names the offending flag or value.
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "insitu/camera.hpp"
+#include "insitu/error.hpp"
+#include "insitu/field.hpp"
+#include "insitu/image.hpp"
+#include "insitu/transfer_function.hpp"
+#include "insitu/volume_renderer.hpp"
+
+namespace {
+
+constexpr const char* kProgram = "insitu-render";
+constexpr int kExitRuntimeError = 1;
+constexpr int kExitBadInput = 2;
+
+/// A command line that cannot be acted on; the message names the flag and the value.
+class UsageError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+struct Arguments {
+    std::string raw_path;
+    insitu::Index3 dims{0, 0, 0};
+    insitu::ScalarType type = insitu::ScalarType::float32;
+    glm::dvec3 spacing_world{1.0};
+    glm::dvec3 origin_world{0.0};
+    std::string tf_path;
+    insitu::OrbitView view;
+    insitu::RenderSettings settings;
+    std::string out_path;
+    std::string depth_out_path;
+    bool help = false;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Value parsers. Each takes the whole token or fails, so "10x" or "1e" are errors, not 10 and 1.
+
+double parse_number(const std::string& flag, const std::string& text) {
+    double value = 0.0;
+    const char* end = text.data() + text.size();
+    const auto [stop, error] = std::from_chars(text.data(), end, value);
+    if (text.empty() || error != std::errc() || stop != end || !std::isfinite(value)) {
+        throw UsageError(flag + ": expected a finite number, got \"" + text + "\"");
+    }
+    return value;
+}
+
+std::int64_t parse_positive_integer(const std::string& flag, const std::string& text,
+                                    const std::string& full_value) {
+    std::int64_t value = 0;
+    const char* end = text.data() + text.size();
+    const auto [stop, error] = std::from_chars(text.data(), end, value);
+    if (text.empty() || error != std::errc() || stop != end || value < 1) {
+        throw UsageError(flag + ": expected a positive integer, got \"" + text + "\" in \"" +
+                         full_value + "\"");
+    }
+    return value;
+}
+
+std::vector<std::string> split(const std::string& text, char separator) {
+    std::vector<std::string> parts;
+    std::string::size_type begin = 0;
+    for (;;) {
+        const auto end = text.find(separator, begin);
+        parts.push_back(text.substr(begin, end - begin));
+        if (end == std::string::npos) return parts;
+        begin = end + 1;
+    }
+}
+
+std::vector<std::string> split_exactly(const std::string& flag, const std::string& text,
+                                       char separator, std::size_t count, const char* shape) {
+    std::vector<std::string> parts = split(text, separator);
+    if (parts.size() != count) {
+        throw UsageError(flag + ": expected " + shape + ", got \"" + text + "\"");
+    }
+    return parts;
+}
+
+insitu::Index3 parse_dims(const std::string& flag, const std::string& text) {
+    const auto parts = split_exactly(flag, text, ',', 3, "NX,NY,NZ");
+    return {parse_positive_integer(flag, parts[0], text),
+            parse_positive_integer(flag, parts[1], text),
+            parse_positive_integer(flag, parts[2], text)};
+}
+
+glm::dvec3 parse_vec3(const std::string& flag, const std::string& text, const char* shape) {
+    const auto parts = split_exactly(flag, text, ',', 3, shape);
+    return {parse_number(flag, parts[0]), parse_number(flag, parts[1]),
+            parse_number(flag, parts[2])};
+}
+
+void parse_size(const std::string& flag, const std::string& text, insitu::OrbitView& view) {
+    const auto parts = split_exactly(flag, text, 'x', 2, "WxH (e.g. 512x512)");
+    const std::int64_t width = parse_positive_integer(flag, parts[0], text);
+    const std::int64_t height = parse_positive_integer(flag, parts[1], text);
+    // Kernels index pixels as int (y * width + x): 2^15 per side keeps that below 2^31.
+    constexpr std::int64_t kMaxSide = 1 << 15;
+    if (width > kMaxSide || height > kMaxSide) {
+        throw UsageError(flag + ": " + text + " is larger than " + std::to_string(kMaxSide) +
+                         " pixels per side");
+    }
+    view.width = static_cast<int>(width);
+    view.height = static_cast<int>(height);
+}
+
+/// Library parse errors (unknown type or projection) become usage errors naming the flag.
+template <typename Parse>
+auto parse_with_library(const std::string& flag, const std::string& text, Parse parse) {
+    try {
+        return parse(text);
+    } catch (const insitu::Error& error) {
+        throw UsageError(flag + ": " + error.what());
+    }
+}
+
+std::string lowercase_extension(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return ext;
+}
+
+void require_extension(const std::string& flag, const std::string& path,
+                       const std::vector<std::string>& allowed) {
+    const std::string ext = lowercase_extension(path);
+    if (std::find(allowed.begin(), allowed.end(), ext) != allowed.end()) return;
+    std::string list;
+    for (const std::string& a : allowed) list += (list.empty() ? "" : " or ") + a;
+    throw UsageError(flag + ": \"" + path + "\" has an unsupported extension (expected " + list +
+                     ")");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The option table: one row per flag; help text and parsing both come from it.
+
+struct Option {
+    const char* name;
+    const char* value_name;  ///< nullptr for switches that take no value
+    bool required;
+    const char* help;
+    std::function<void(Arguments&, const std::string& flag, const std::string& value)> apply;
+};
+
+const std::vector<Option>& options() {
+    using V = const std::string&;
+    static const std::vector<Option> table = {
+        {"--raw", "FILE", true, "raw volume, x fastest, little-endian",
+         [](Arguments& a, V, V v) { a.raw_path = v; }},
+        {"--dims", "NX,NY,NZ", true, "samples per axis",
+         [](Arguments& a, V f, V v) { a.dims = parse_dims(f, v); }},
+        {"--type", "TYPE", true, "float32, float64, uint8, uint16 or int16",
+         [](Arguments& a, V f, V v) {
+             a.type = parse_with_library(f, v, insitu::parse_scalar_type);
+         }},
+        {"--spacing", "SX,SY,SZ", false, "distance between samples in world units (default 1,1,1)",
+         [](Arguments& a, V f, V v) { a.spacing_world = parse_vec3(f, v, "SX,SY,SZ"); }},
+        {"--origin", "OX,OY,OZ", false, "world position of the first sample (default 0,0,0)",
+         [](Arguments& a, V f, V v) { a.origin_world = parse_vec3(f, v, "OX,OY,OZ"); }},
+        {"--tf", "TF.json", true, "transfer function JSON (see below)",
+         [](Arguments& a, V, V v) { a.tf_path = v; }},
+        {"--camera", "ortho|perspective", false, "projection (default ortho)",
+         [](Arguments& a, V f, V v) {
+             a.view.projection = parse_with_library(f, v, insitu::parse_projection);
+         }},
+        {"--azimuth", "DEG", false, "orbit azimuth in degrees (default 0: looking down -z)",
+         [](Arguments& a, V f, V v) { a.view.azimuth_deg = parse_number(f, v); }},
+        {"--elevation", "DEG", false, "orbit elevation in degrees, [-90, 90] (default 0)",
+         [](Arguments& a, V f, V v) { a.view.elevation_deg = parse_number(f, v); }},
+        {"--fov", "DEG", false, "vertical field of view in degrees, perspective (default 30)",
+         [](Arguments& a, V f, V v) { a.view.fov_y_deg = parse_number(f, v); }},
+        {"--size", "WxH", false, "image size in pixels (default 512x512)",
+         [](Arguments& a, V f, V v) { parse_size(f, v, a.view); }},
+        {"--step", "VOXELS", false, "ray step in units of the smallest spacing (default 1)",
+         [](Arguments& a, V f, V v) { a.settings.step_voxels = parse_number(f, v); }},
+        {"--early-termination", "OPACITY", false,
+         "stop a ray at this opacity (default 0.99; > 1: never)",
+         [](Arguments& a, V f, V v) { a.settings.early_termination_opacity = parse_number(f, v); }},
+        {"--shade", nullptr, false, "Phong shading with a headlight",
+         [](Arguments& a, V, V) { a.settings.shading = true; }},
+        {"--out", "OUT.png|OUT.exr", true, "image: 8-bit sRGB PNG or linear premultiplied EXR",
+         [](Arguments& a, V f, V v) {
+             require_extension(f, v, {".png", ".exr"});
+             a.out_path = v;
+         }},
+        {"--depth-out", "DEPTH.exr", false, "first-hit depth (world units, +inf: no hit) as EXR Z",
+         [](Arguments& a, V f, V v) {
+             require_extension(f, v, {".exr"});
+             a.depth_out_path = v;
+         }},
+        {"--help", nullptr, false, "print this help and exit",
+         [](Arguments& a, V, V) { a.help = true; }},
+    };
+    return table;
+}
+
+void print_help(std::ostream& out) {
+    out << "usage: " << kProgram << " --raw FILE --dims NX,NY,NZ --type TYPE --tf TF.json "
+        << "--out OUT.png|OUT.exr [options]\n\n"
+        << "Renders a raw scalar volume by emission-absorption ray casting (libinsitu's ground "
+           "truth).\n\n";
+    for (const Option& option : options()) {
+        std::string left = std::string("  ") + option.name;
+        if (option.value_name) left += std::string(" ") + option.value_name;
+        out << left;
+        constexpr std::size_t kHelpColumn = 34;
+        out << (left.size() < kHelpColumn ? std::string(kHelpColumn - left.size(), ' ')
+                                          : std::string("\n") + std::string(kHelpColumn, ' '))
+            << option.help << (option.required ? " [required]" : "") << "\n";
+    }
+    out << "\nTF.json: {\"points\": [[value, r, g, b, a], ...], \"unit_length\": 1.0}, a = "
+           "opacity per unit_length world units.\n"
+        << "Exit status: 0 success, 2 bad arguments or input, 1 other failures.\n";
+}
+
+Arguments parse_arguments(int argc, char** argv) {
+    Arguments arguments;
+    std::map<std::string, bool> seen;
+    for (int i = 1; i < argc; ++i) {
+        std::string token = argv[i];
+        std::string value;
+        bool has_inline_value = false;
+        // Both "--flag value" and "--flag=value".
+        if (const auto equals = token.find('=');
+            token.rfind("--", 0) == 0 && equals != token.npos) {
+            value = token.substr(equals + 1);
+            token.resize(equals);
+            has_inline_value = true;
+        }
+        const auto& table = options();
+        const auto option = std::find_if(table.begin(), table.end(),
+                                         [&](const Option& o) { return token == o.name; });
+        if (option == table.end()) {
+            throw UsageError(token.rfind('-', 0) == 0 ? "unknown option \"" + token + "\""
+                                                      : "unexpected argument \"" + token + "\"");
+        }
+        if (seen[token]) throw UsageError(token + ": given more than once");
+        seen[token] = true;
+        if (!option->value_name) {
+            if (has_inline_value) throw UsageError(token + ": takes no value");
+        } else if (!has_inline_value) {
+            // A following flag is not a value: "--out --shade" means the value was forgotten.
+            // Negative numbers ("--elevation -30") are values.
+            const bool next_is_flag = i + 1 < argc && std::string(argv[i + 1]).rfind("--", 0) == 0;
+            if (i + 1 >= argc || next_is_flag) {
+                throw UsageError(token + ": missing value " + option->value_name);
+            }
+            value = argv[++i];
+        }
+        option->apply(arguments, token, value);
+    }
+    if (arguments.help) return arguments;
+    for (const Option& option : options()) {
+        if (option.required && !seen[option.name]) {
+            throw UsageError(std::string("missing required option ") + option.name + " " +
+                             option.value_name + " (see --help)");
+        }
+    }
+    return arguments;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+bool host_is_little_endian() {
+    const std::uint16_t probe = 1;
+    unsigned char first_byte = 0;
+    std::copy_n(reinterpret_cast<const unsigned char*>(&probe), 1, &first_byte);
+    return first_byte == 1;
+}
+
+/// Reads the whole raw file. The returned buffer comes from operator new, so it is aligned for
+/// every scalar type, and the Field view made over it copies nothing.
+std::vector<std::byte> read_raw_volume(const Arguments& arguments) {
+    const std::size_t sample_bytes = insitu::scalar_size_bytes(arguments.type);
+    std::uint64_t samples = 1;
+    for (std::int64_t n : arguments.dims) {
+        if (samples > std::numeric_limits<std::uint64_t>::max() / sample_bytes / n) {
+            insitu::fail<insitu::InvalidArgument>("--dims ", arguments.dims[0], ",",
+                                                  arguments.dims[1], ",", arguments.dims[2],
+                                                  ": the volume size overflows 64 bits");
+        }
+        samples *= static_cast<std::uint64_t>(n);
+    }
+    const std::uint64_t expected_bytes = samples * sample_bytes;
+
+    std::error_code error;
+    const std::uint64_t actual_bytes = std::filesystem::file_size(arguments.raw_path, error);
+    if (error) {
+        insitu::fail<insitu::IoError>("--raw \"", arguments.raw_path, "\": ", error.message());
+    }
+    if (actual_bytes != expected_bytes) {
+        insitu::fail<insitu::InvalidArgument>(
+            "--raw \"", arguments.raw_path, "\" has ", actual_bytes, " bytes but --dims ",
+            arguments.dims[0], ",", arguments.dims[1], ",", arguments.dims[2], " --type ",
+            insitu::to_string(arguments.type), " needs ", expected_bytes, " (", samples, " x ",
+            sample_bytes, " bytes)");
+    }
+
+    std::vector<std::byte> bytes(expected_bytes);
+    std::ifstream in(arguments.raw_path, std::ios::binary);
+    in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    if (!in) {
+        insitu::fail<insitu::IoError>("--raw \"", arguments.raw_path, "\": read failed after ",
+                                      in.gcount(), " of ", expected_bytes, " bytes");
+    }
+    // Raw files are little-endian by convention; swap each sample on a big-endian host.
+    if (sample_bytes > 1 && !host_is_little_endian()) {
+        for (std::byte* sample = bytes.data(); sample != bytes.data() + bytes.size();
+             sample += sample_bytes) {
+            std::reverse(sample, sample + sample_bytes);
+        }
+    }
+    return bytes;
+}
+
+double milliseconds_since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+        .count();
+}
+
+int run(const Arguments& arguments) {
+    // Everything cheap is checked before the volume is read and OpenCL is started.
+    insitu::validate(arguments.settings);
+    const insitu::TransferFunction tf = insitu::TransferFunction::from_json_file(arguments.tf_path);
+
+    const std::vector<std::byte> raw = read_raw_volume(arguments);
+    insitu::Field field(std::filesystem::path(arguments.raw_path).stem().string(), raw.data(),
+                        arguments.type, arguments.dims);
+    field.set_spacing(arguments.spacing_world).set_origin(arguments.origin_world);
+    const insitu::Camera camera = insitu::Camera::orbit(arguments.view, field.bounds());
+
+    insitu::VolumeRenderer renderer;
+    const auto upload_start = std::chrono::steady_clock::now();
+    renderer.upload(field);
+    const double upload_ms = milliseconds_since(upload_start);
+    const auto render_start = std::chrono::steady_clock::now();
+    const insitu::Rendering rendering = renderer.render(camera, tf, arguments.settings);
+    const double render_ms = milliseconds_since(render_start);
+
+    insitu::write_image(arguments.out_path, rendering.rgba);
+    if (!arguments.depth_out_path.empty()) {
+        insitu::write_exr(arguments.depth_out_path, rendering.depth, {"Z"});
+    }
+
+    std::ostringstream summary;
+    summary.setf(std::ios::fixed);
+    summary.precision(1);
+    summary << kProgram << ": " << camera.width() << "x" << camera.height() << " rendered in "
+            << render_ms << " ms (upload " << upload_ms << " ms) -> " << arguments.out_path;
+    if (!arguments.depth_out_path.empty()) summary << ", depth -> " << arguments.depth_out_path;
+    std::cout << summary.str() << "\n";
+    return 0;
+}
+
+/// Messages must stay one line (build logs and nested errors may span several).
+std::string one_line(const std::string& message) {
+    std::string line;
+    for (char c : message) {
+        const bool is_break = c == '\n' || c == '\r';
+        if (is_break && (line.empty() || line.back() == ' ')) continue;
+        line += is_break ? ' ' : c;
+    }
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    return line;
+}
+
+int report(const std::string& message, int status) {
+    std::cerr << kProgram << ": " << one_line(message) << "\n";
+    return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    Arguments arguments;
+    try {
+        arguments = parse_arguments(argc, argv);
+    } catch (const UsageError& error) {
+        return report(error.what(), kExitBadInput);
+    }
+    if (arguments.help) {
+        print_help(std::cout);
+        return 0;
+    }
+    try {
+        return run(arguments);
+    } catch (const insitu::InvalidArgument& error) {
+        return report(error.what(), kExitBadInput);
+    } catch (const insitu::ParseError& error) {
+        return report(error.what(), kExitBadInput);
+    } catch (const insitu::IoError& error) {
+        return report(error.what(), kExitBadInput);
+    } catch (const std::exception& error) {
+        // ComputeError, other insitu::Error, std::bad_alloc: not the user's input.
+        return report(error.what(), kExitRuntimeError);
+    }
+}

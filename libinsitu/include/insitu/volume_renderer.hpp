@@ -21,6 +21,7 @@
 //    (set it above 1 to disable).
 //  * Depth: depth (Camera::depth_of) of the first sample with alpha > 0; +inf where none.
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -57,6 +58,28 @@ struct Rendering {
     Image depth;  ///< 1 channel, world units from the camera plane
 };
 
+/// A field's interior resident on the device as float32, x fastest. Re-uploading a field that
+/// fits reuses the buffer, so successive timesteps allocate nothing.
+struct DeviceVolume {
+    cl::Buffer buffer;
+    std::size_t capacity_bytes = 0;
+    Index3 dims{0, 0, 0};
+    glm::dvec3 origin{0.0};
+    glm::dvec3 spacing{1.0};
+    Bounds bounds;
+    ValueRange range;
+    /// The host copy that was uploaded (kept: histograms and interval choices read it).
+    std::vector<float> host_values;
+    /// Incremented by every upload, so derived data (block ranges) knows when it is stale.
+    std::uint64_t generation = 0;
+
+    bool empty() const { return dims[0] == 0; }
+    /// Distance between ray samples in world units for a step given in voxels.
+    double step_world(double step_voxels) const;
+    /// Uploads `field`; throws InvalidArgument when an axis has fewer than 2 samples.
+    void upload(ComputeDevice& device, const Field& field);
+};
+
 class VolumeRenderer {
 public:
     explicit VolumeRenderer(std::shared_ptr<ComputeDevice> device = ComputeDevice::shared());
@@ -72,30 +95,30 @@ public:
                      const RenderSettings& settings = {});
 
     /// Value range of the uploaded field (from the upload scan).
-    const ValueRange& value_range() const { return range_; }
-    const Bounds& bounds() const { return bounds_; }
+    const ValueRange& value_range() const { return volume_.range; }
+    const Bounds& bounds() const { return volume_.bounds; }
     /// Bytes of device memory currently held for the volume.
-    std::size_t volume_capacity_bytes() const { return volume_capacity_; }
+    std::size_t volume_capacity_bytes() const { return volume_.capacity_bytes; }
+    const DeviceVolume& volume() const { return volume_; }
+    const std::shared_ptr<ComputeDevice>& device() const { return device_; }
 
 private:
     std::shared_ptr<ComputeDevice> device_;
     cl::Kernel kernel_;
-    cl::Buffer volume_;
-    std::size_t volume_capacity_ = 0;
+    DeviceVolume volume_;
     cl::Buffer table_;
     std::size_t table_capacity_ = 0;
     cl::Buffer rgba_out_;
     std::size_t rgba_capacity_ = 0;
     cl::Buffer depth_out_;
     std::size_t depth_capacity_ = 0;
-    std::vector<float> staging_;
-    Index3 dims_{0, 0, 0};
-    glm::dvec3 origin_{0.0};
-    glm::dvec3 spacing_{1.0};
-    Bounds bounds_;
-    ValueRange range_;
 };
 
 void validate(const RenderSettings& settings);
+
+/// The transfer function as the device reads it: a table whose opacity is already corrected for
+/// a step of `step_world` world units, so kernels need no pow per sample.
+TransferTable step_corrected_table(const TransferFunction& tf, double step_world,
+                                   const RenderSettings& settings);
 
 }  // namespace insitu

@@ -1,0 +1,47 @@
+#pragma once
+// Intensity intervals I_1..I_L that partition a value range (seed 000 §6.1, DESIGN.md).
+// Interval j holds values in [edges[j], edges[j+1]); the last one is closed, and values outside
+// [edges.front(), edges.back()] belong to the nearest end interval, so every finite sample lands
+// in exactly one interval and Σ_j a_j = 1 - T_end holds.
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+namespace insitu {
+
+enum class IntervalMode { uniform, histogram_equalized };
+std::string to_string(IntervalMode mode);
+/// "uniform" or "histogram" / "histogram_equalized"; InvalidArgument names other text.
+IntervalMode parse_interval_mode(const std::string& text);
+
+constexpr int kMaxIntervals = 64;
+
+class IntervalSet {
+public:
+    /// `edges` must hold 2..65 finite, non-decreasing values.
+    explicit IntervalSet(std::vector<double> edges);
+
+    /// L equal intervals over [min, max]. A degenerate range (min == max, e.g. a constant field)
+    /// is widened to [min - 0.5, min + 0.5] so interval widths stay positive.
+    static IntervalSet uniform(double min, double max, int count);
+    /// L intervals holding about equally many of the finite `values` (quantiles of their
+    /// histogram); NaN values are ignored. Falls back to uniform where quantiles coincide.
+    static IntervalSet histogram_equalized(const std::vector<float>& values, double min,
+                                           double max, int count);
+
+    int count() const { return static_cast<int>(edges_.size()) - 1; }
+    const std::vector<double>& edges() const { return edges_; }
+    /// Interval index of `value` under the rule above.
+    int index_of(double value) const;
+
+    nlohmann::json to_json() const;
+
+private:
+    std::vector<double> edges_;
+};
+
+std::ostream& operator<<(std::ostream& out, const IntervalSet& intervals);
+
+}  // namespace insitu
