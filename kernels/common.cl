@@ -5,26 +5,25 @@
 // Trilinear sample at a position in voxel coordinates, clamped to the grid. dims must be >= 2 on
 // every axis (the host checks). NaN samples propagate, which callers treat as empty space.
 inline float sample_trilinear(__global const float* volume, int4 dims, float3 position_voxels) {
-    const float3 upper = (float3)(dims.x - 1, dims.y - 1, dims.z - 1);
-    const float3 p = clamp(position_voxels, (float3)(0.0f), upper);
-    const int3 i0 = min(convert_int3(floor(p)), (int3)(dims.x - 2, dims.y - 2, dims.z - 2));
-    const float3 f = p - convert_float3(i0);
+    // Scalar code on purpose: PoCL compiles float3 clamp/floor/convert into padded 4-wide
+    // sequences that cost more than the arithmetic they replace.
+    const float px = clamp(position_voxels.x, 0.0f, (float)(dims.x - 1));
+    const float py = clamp(position_voxels.y, 0.0f, (float)(dims.y - 1));
+    const float pz = clamp(position_voxels.z, 0.0f, (float)(dims.z - 1));
+    const int ix = min((int)px, dims.x - 2);
+    const int iy = min((int)py, dims.y - 2);
+    const int iz = min((int)pz, dims.z - 2);
+    const float fx = px - (float)ix;
+    const float fy = py - (float)iy;
+    const float fz = pz - (float)iz;
     const uint stride_y = (uint)dims.x;
     const uint stride_z = (uint)dims.x * (uint)dims.y;
-    const uint base = (uint)i0.z * stride_z + (uint)i0.y * stride_y + (uint)i0.x;
-    const float c000 = volume[base];
-    const float c100 = volume[base + 1];
-    const float c010 = volume[base + stride_y];
-    const float c110 = volume[base + stride_y + 1];
-    const float c001 = volume[base + stride_z];
-    const float c101 = volume[base + stride_z + 1];
-    const float c011 = volume[base + stride_z + stride_y];
-    const float c111 = volume[base + stride_z + stride_y + 1];
-    const float c00 = mix(c000, c100, f.x);
-    const float c10 = mix(c010, c110, f.x);
-    const float c01 = mix(c001, c101, f.x);
-    const float c11 = mix(c011, c111, f.x);
-    return mix(mix(c00, c10, f.y), mix(c01, c11, f.y), f.z);
+    __global const float* c = volume + ((uint)iz * stride_z + (uint)iy * stride_y + (uint)ix);
+    const float c00 = mix(c[0], c[1], fx);
+    const float c10 = mix(c[stride_y], c[stride_y + 1], fx);
+    const float c01 = mix(c[stride_z], c[stride_z + 1], fx);
+    const float c11 = mix(c[stride_z + stride_y], c[stride_z + stride_y + 1], fx);
+    return mix(mix(c00, c10, fy), mix(c01, c11, fy), fz);
 }
 
 // Central differences of trilinear samples one voxel apart, in field units per world unit.

@@ -3,10 +3,12 @@
 // is framed.
 #include "insitu/camera.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -41,7 +43,8 @@ OrbitView make_view(double azimuth, double elevation, Projection projection, int
     return view;
 }
 
-void expect_near(glm::dvec3 actual, glm::dvec3 expected, double tolerance, const std::string& what) {
+void expect_near(glm::dvec3 actual, glm::dvec3 expected, double tolerance,
+                 const std::string& what) {
     for (int axis = 0; axis < 3; ++axis) {
         EXPECT_NEAR(actual[axis], expected[axis], tolerance) << what << " axis " << axis;
     }
@@ -122,8 +125,8 @@ TEST(Camera, PolesAreDefined) {
         for (Projection projection : {Projection::orthographic, Projection::perspective}) {
             const Camera camera = Camera::orbit(make_view(30.0, elevation, projection), kBounds);
             SCOPED_TRACE(::testing::Message() << camera);
-            for (const glm::dvec3& v : {camera.position(), camera.forward(), camera.right(),
-                                        camera.up()}) {
+            for (const glm::dvec3& v :
+                 {camera.position(), camera.forward(), camera.right(), camera.up()}) {
                 for (int axis = 0; axis < 3; ++axis) ASSERT_TRUE(std::isfinite(v[axis]));
             }
             expect_near(camera.forward(), glm::dvec3(0.0, elevation > 0 ? -1.0 : 1.0, 0.0),
@@ -157,7 +160,8 @@ TEST(Camera, RaysThroughPixelsProjectBackToThosePixels) {
 
 TEST(Camera, RayOriginsAndDirectionsMatchTheProjection) {
     const Camera ortho = Camera::orbit(make_view(40.0, 10.0, Projection::orthographic), kBounds);
-    const Camera perspective = Camera::orbit(make_view(40.0, 10.0, Projection::perspective), kBounds);
+    const Camera perspective =
+        Camera::orbit(make_view(40.0, 10.0, Projection::perspective), kBounds);
     for (double x : {0.5, 20.0, 63.5}) {
         for (double y : {0.5, 30.0, 47.5}) {
             // Orthographic: parallel rays from the camera plane (depth 0).
@@ -193,7 +197,8 @@ TEST(Camera, DepthIsDistanceAlongTheViewDirectionFromTheCameraPlane) {
 
 TEST(Camera, OrthographicPlaneTouchesTheBoundingSphereAndSmallerSideSpansItsDiameter) {
     const double radius = kBounds.radius();
-    for (const auto& [width, height] : std::vector<std::pair<int, int>>{{64, 48}, {30, 70}, {20, 20}}) {
+    for (const auto& [width, height] :
+         std::vector<std::pair<int, int>>{{64, 48}, {30, 70}, {20, 20}}) {
         const Camera camera =
             Camera::orbit(make_view(25.0, -15.0, Projection::orthographic, width, height), kBounds);
         SCOPED_TRACE(::testing::Message() << camera);
@@ -244,7 +249,8 @@ TEST(Camera, BoundingSphereFitsTheSmallerSideOfTheImage) {
 }
 
 TEST(Camera, PerspectiveUsesTheVerticalFieldOfView) {
-    const Camera camera = Camera::orbit(make_view(0.0, 0.0, Projection::perspective, 64, 48, 60.0), kBounds);
+    const Camera camera =
+        Camera::orbit(make_view(0.0, 0.0, Projection::perspective, 64, 48, 60.0), kBounds);
     EXPECT_NEAR(camera.half_height(), std::tan(glm::radians(30.0)), kWorldTolerance);
     EXPECT_NEAR(camera.half_width(), camera.half_height() * 64.0 / 48.0, kWorldTolerance);
     // The top edge ray makes half the field of view with the view direction.

@@ -3,6 +3,7 @@
 // developer gets for a bad hand-over.
 #include "insitu/field.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -223,7 +224,7 @@ TEST(Field, InterleavedComponentWithGhostsAndStrides) {
         for (std::int64_t j = 0; j < 4; ++j) {
             for (std::int64_t i = 0; i < 5; ++i) {
                 const std::size_t n = static_cast<std::size_t>((k * 4 + j) * 5 + i);
-                data[2 * n] = -1.0f;                                        // u
+                data[2 * n] = -1.0f;                                              // u
                 data[2 * n + 1] = static_cast<float>(code(i - 1, j - 1, k - 1));  // v
             }
         }
@@ -298,32 +299,59 @@ TEST(Field, BoundsFromOriginSpacingAndInteriorDims) {
 
 TEST(Field, NullDataIsRejectedNamingTheField) {
     expect_error_naming<InvalidArgument>(
-        [] { Field("pressure", nullptr, ScalarType::float32, {2, 2, 2}); }, "pressure");
+        [] {
+            Field("pressure", nullptr, ScalarType::float32, {2, 2, 2});
+        },
+        "pressure");
     expect_error_naming<InvalidArgument>(
-        [] { Field("pressure", nullptr, ScalarType::float32, {2, 2, 2}); }, "null");
+        [] {
+            Field("pressure", nullptr, ScalarType::float32, {2, 2, 2});
+        },
+        "null");
 }
 
 TEST(Field, NonPositiveDimsAreRejectedNamingTheValue) {
     const float data[8] = {};
     expect_error_naming<InvalidArgument>(
-        [&] { Field("f", data, ScalarType::float32, {2, 0, 2}); }, "dims.y = 0");
+        [&] {
+            Field("f", data, ScalarType::float32, {2, 0, 2});
+        },
+        "dims.y = 0");
     expect_error_naming<InvalidArgument>(
-        [&] { Field("f", data, ScalarType::float32, {2, 2, -5}); }, "dims.z = -5");
+        [&] {
+            Field("f", data, ScalarType::float32, {2, 2, -5});
+        },
+        "dims.z = -5");
 }
 
 TEST(Field, BadSpacingAndOriginAreRejectedNamingTheValue) {
     const float data[8] = {};
     Field field("f", data, ScalarType::float32, {2, 2, 2});
-    expect_error_naming<InvalidArgument>([&] { field.set_spacing({0.0, 1.0, 1.0}); },
-                                         "spacing.x = 0");
-    expect_error_naming<InvalidArgument>([&] { field.set_spacing({1.0, -0.5, 1.0}); },
-                                         "spacing.y = -0.5");
-    expect_error_naming<InvalidArgument>([&] { field.set_spacing({1.0, 1.0, kNaN}); },
-                                         "spacing.z = nan");
-    expect_error_naming<InvalidArgument>([&] { field.set_spacing({kInf, 1.0, 1.0}); },
-                                         "spacing.x = inf");
-    expect_error_naming<InvalidArgument>([&] { field.set_origin({0.0, 0.0, kNaN}); },
-                                         "origin.z = nan");
+    expect_error_naming<InvalidArgument>(
+        [&] {
+            field.set_spacing({0.0, 1.0, 1.0});
+        },
+        "spacing.x = 0");
+    expect_error_naming<InvalidArgument>(
+        [&] {
+            field.set_spacing({1.0, -0.5, 1.0});
+        },
+        "spacing.y = -0.5");
+    expect_error_naming<InvalidArgument>(
+        [&] {
+            field.set_spacing({1.0, 1.0, kNaN});
+        },
+        "spacing.z = nan");
+    expect_error_naming<InvalidArgument>(
+        [&] {
+            field.set_spacing({kInf, 1.0, 1.0});
+        },
+        "spacing.x = inf");
+    expect_error_naming<InvalidArgument>(
+        [&] {
+            field.set_origin({0.0, 0.0, kNaN});
+        },
+        "origin.z = nan");
     // A rejected setting leaves the field as it was.
     EXPECT_EQ(field.spacing(), glm::dvec3(1.0));
     EXPECT_EQ(field.origin(), glm::dvec3(0.0));
@@ -332,14 +360,26 @@ TEST(Field, BadSpacingAndOriginAreRejectedNamingTheValue) {
 TEST(Field, GhostLayersThatLeaveNoInteriorAreRejectedNamingTheValues) {
     const float data[4 * 3 * 3] = {};
     Field field("f", data, ScalarType::float32, {4, 3, 3});
-    expect_error_naming<InvalidArgument>([&] { field.set_ghost_layers({2, 0, 0}, {2, 0, 0}); },
-                                         "(2, 2)");
-    expect_error_naming<InvalidArgument>([&] { field.set_ghost_layers({2, 0, 0}, {2, 0, 0}); },
-                                         "dims.x = 4");
-    expect_error_naming<InvalidArgument>([&] { field.set_ghost_layers({0, 2, 0}, {0, 1, 0}); },
-                                         "dims.y = 3");
-    expect_error_naming<InvalidArgument>([&] { field.set_ghost_layers({0, 0, -1}, {0, 0, 0}); },
-                                         "-1");
+    expect_error_naming<InvalidArgument>(
+        [&] {
+            field.set_ghost_layers({2, 0, 0}, {2, 0, 0});
+        },
+        "(2, 2)");
+    expect_error_naming<InvalidArgument>(
+        [&] {
+            field.set_ghost_layers({2, 0, 0}, {2, 0, 0});
+        },
+        "dims.x = 4");
+    expect_error_naming<InvalidArgument>(
+        [&] {
+            field.set_ghost_layers({0, 2, 0}, {0, 1, 0});
+        },
+        "dims.y = 3");
+    expect_error_naming<InvalidArgument>(
+        [&] {
+            field.set_ghost_layers({0, 0, -1}, {0, 0, 0});
+        },
+        "-1");
     EXPECT_EQ(field.dims(), (Index3{4, 3, 3}));
     // Leaving exactly one sample is fine.
     field.set_ghost_layers(1);
@@ -350,8 +390,7 @@ TEST(Field, NonPositiveStridesAreRejectedNamingTheValue) {
     const float data[8] = {};
     Field field("f", data, ScalarType::float32, {2, 2, 2});
     expect_error_naming<InvalidArgument>([&] { field.set_strides({1, 0, 4}); }, "strides.y = 0");
-    expect_error_naming<InvalidArgument>([&] { field.set_strides({-3, 2, 4}); },
-                                         "strides.x = -3");
+    expect_error_naming<InvalidArgument>([&] { field.set_strides({-3, 2, 4}); }, "strides.x = -3");
     EXPECT_EQ(field.strides(), (Index3{1, 2, 4}));
 }
 

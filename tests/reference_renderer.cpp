@@ -185,7 +185,9 @@ Rendering render_reference(const Field& field, const Camera& camera, const Trans
         for (int x = 0; x < camera.width(); ++x) {
             const Ray ray = camera.ray(x + 0.5, y + 0.5);  // pixel centre
             const PixelResult pixel = march(ray, grid, field, camera, tf, settings, step_world);
-            for (int c = 0; c < 3; ++c) rendering.rgba.at(x, y, c) = static_cast<float>(pixel.colour[c]);
+            for (int c = 0; c < 3; ++c) {
+                rendering.rgba.at(x, y, c) = static_cast<float>(pixel.colour[c]);
+            }
             rendering.rgba.at(x, y, 3) = static_cast<float>(pixel.opacity);
             rendering.depth.at(x, y, 0) = static_cast<float>(pixel.depth);
         }

@@ -2,11 +2,13 @@
 // configs and archives write it, errors naming the offending key or value, and the device table.
 #include "insitu/transfer_function.hpp"
 
-#include <cstdio>
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gmock/gmock.h>
@@ -45,9 +47,10 @@ void expect_error_naming(Function&& function, const std::string& expected_text) 
 
 // Three points over [-1, 3] with unequal segment lengths.
 TransferFunction three_points() {
-    return TransferFunction({point(-1.0, 0.0f, 0.2f, 1.0f, 0.0f), point(0.0, 1.0f, 0.4f, 0.0f, 0.5f),
-                             point(3.0, 0.25f, 1.0f, 0.5f, 1.0f)},
-                            0.5);
+    return TransferFunction(
+        {point(-1.0, 0.0f, 0.2f, 1.0f, 0.0f), point(0.0, 1.0f, 0.4f, 0.0f, 0.5f),
+         point(3.0, 0.25f, 1.0f, 0.5f, 1.0f)},
+        0.5);
 }
 
 // Two gradient rows at |grad| = 1 and 3 plus a single-point row at 5.
@@ -108,9 +111,10 @@ TEST(TransferFunction, TwoDimensionalFunctionInterpolatesAcrossGradientRows) {
     expect_rgba_near(tf.evaluate(1.0, -4.0), low, "negative gradient");
     expect_rgba_near(tf.evaluate(1.0, 99.0), {0.5f, 0.5f, 0.5f, 1.0f}, "above rows");
     // Between rows 1 and 2 (a constant row).
-    expect_rgba_near(tf.evaluate(2.0, 4.0), 0.5f * glm::vec4(0.0f, 0.0f, 1.0f, 0.0f) +
-                                                0.5f * glm::vec4(0.5f, 0.5f, 0.5f, 1.0f),
-                     "between rows 1 and 2");
+    expect_rgba_near(
+        tf.evaluate(2.0, 4.0),
+        0.5f * glm::vec4(0.0f, 0.0f, 1.0f, 0.0f) + 0.5f * glm::vec4(0.5f, 0.5f, 0.5f, 1.0f),
+        "between rows 1 and 2");
 }
 
 void expect_same_function(const TransferFunction& a, const TransferFunction& b) {
@@ -163,19 +167,25 @@ TEST(TransferFunction, MalformedJsonTextIsAParseError) {
 
 TEST(TransferFunction, WrongShapesAreParseErrors) {
     expect_error_naming<ParseError>(
-        [] { TransferFunction::from_json_text(R"({"points": [[0, 1, 1, 1, 1]], "colour_space": 1})"); },
+        [] {
+            TransferFunction::from_json_text(R"({"points": [[0, 1, 1, 1, 1]], "colour_space": 1})");
+        },
         "colour_space");
     expect_error_naming<ParseError>(
         [] { TransferFunction::from_json_text(R"({"points": [[0, 1, 1, 1]]})"); }, "[0,1,1,1]");
     expect_error_naming<ParseError>(
-        [] { TransferFunction::from_json_text(R"({"points": [[0, 1, "red", 1, 1]]})"); }, "\"red\"");
+        [] { TransferFunction::from_json_text(R"({"points": [[0, 1, "red", 1, 1]]})"); },
+        "\"red\"");
     EXPECT_THROW(TransferFunction::from_json_text(R"([[0, 1, 1, 1, 1]])"), ParseError);
     EXPECT_THROW(TransferFunction::from_json_text(R"({"unit_length": 1})"), ParseError);
-    EXPECT_THROW(TransferFunction::from_json_text(
-                     R"({"points": [[0, 1, 1, 1, 1]], "gradient_rows": []})"),
-                 ParseError);
+    EXPECT_THROW(
+        TransferFunction::from_json_text(R"({"points": [[0, 1, 1, 1, 1]], "gradient_rows": []})"),
+        ParseError);
     expect_error_naming<ParseError>(
-        [] { TransferFunction::from_json_text(R"({"points": [[0, 1, 1, 1, 1]], "unit_length": "1"})"); },
+        [] {
+            TransferFunction::from_json_text(
+                R"({"points": [[0, 1, 1, 1, 1]], "unit_length": "1"})");
+        },
         "unit_length");
     expect_error_naming<ParseError>(
         [] { TransferFunction::from_json_text(R"({"gradient_rows": [{"points": []}]})"); },
@@ -184,29 +194,38 @@ TEST(TransferFunction, WrongShapesAreParseErrors) {
 
 TEST(TransferFunction, InvalidValuesAreRejectedNamingThem) {
     expect_error_naming<InvalidArgument>(
-        [] { TransferFunction({point(0.75, 0, 0, 0, 0), point(0.25, 0, 0, 0, 0)}); }, "0.25");
-    expect_error_naming<InvalidArgument>(
-        [] { TransferFunction({point(0.0, 1.5f, 0, 0, 0)}); }, "r = 1.5");
-    expect_error_naming<InvalidArgument>(
-        [] { TransferFunction({point(0.0, 0, 0, 0, -0.25f)}); }, "a = -0.25");
-    expect_error_naming<InvalidArgument>(
-        [] { TransferFunction({point(0.0, 0, 0, 0, 0)}, 0.0); }, "unit_length = 0");
-    expect_error_naming<InvalidArgument>(
-        [] { TransferFunction({point(0.0, 0, 0, 0, 0)}, -2.0); }, "unit_length = -2");
+        [] {
+            TransferFunction({point(0.75, 0, 0, 0, 0), point(0.25, 0, 0, 0, 0)});
+        },
+        "0.25");
+    expect_error_naming<InvalidArgument>([] { TransferFunction({point(0.0, 1.5f, 0, 0, 0)}); },
+                                         "r = 1.5");
+    expect_error_naming<InvalidArgument>([] { TransferFunction({point(0.0, 0, 0, 0, -0.25f)}); },
+                                         "a = -0.25");
+    expect_error_naming<InvalidArgument>([] { TransferFunction({point(0.0, 0, 0, 0, 0)}, 0.0); },
+                                         "unit_length = 0");
+    expect_error_naming<InvalidArgument>([] { TransferFunction({point(0.0, 0, 0, 0, 0)}, -2.0); },
+                                         "unit_length = -2");
     EXPECT_THROW(TransferFunction(std::vector<ControlPoint>{}), InvalidArgument);
     // The same checks apply to JSON input, as InvalidArgument.
     expect_error_naming<InvalidArgument>(
-        [] { TransferFunction::from_json_text(R"({"points": [[2, 1, 1, 1, 1], [1, 0, 0, 0, 0]]})"); },
+        [] {
+            TransferFunction::from_json_text(R"({"points": [[2, 1, 1, 1, 1], [1, 0, 0, 0, 0]]})");
+        },
         "value = 1");
     expect_error_naming<InvalidArgument>(
         [] { TransferFunction::from_json_text(R"({"points": [[0, 1, 1, 1, 3]]})"); }, "a = 3");
     expect_error_naming<InvalidArgument>(
-        [] { TransferFunction::from_json_text(R"({"points": [[0, 1, 1, 1, 1]], "unit_length": -0.5})"); },
+        [] {
+            TransferFunction::from_json_text(
+                R"({"points": [[0, 1, 1, 1, 1]], "unit_length": -0.5})");
+        },
         "-0.5");
 }
 
 TEST(TransferFunction, GradientRowsMustIncreaseStrictly) {
-    std::vector<TransferRow> rows = {{2.0, {point(0.0, 0, 0, 0, 0)}}, {2.0, {point(0.0, 0, 0, 0, 0)}}};
+    std::vector<TransferRow> rows = {{2.0, {point(0.0, 0, 0, 0, 0)}},
+                                     {2.0, {point(0.0, 0, 0, 0, 0)}}};
     expect_error_naming<InvalidArgument>([&] { TransferFunction(rows, 1.0); },
                                          "gradient_magnitude = 2");
     rows = {{-1.5, {point(0.0, 0, 0, 0, 0)}}};
@@ -242,7 +261,8 @@ TEST(TransferFunction, Sampled2dTableMatchesEvaluateAtTheBinPositions) {
             const double value = 2.0 * v / 4.0;
             const glm::vec4 expected = tf.evaluate(value, gradient);
             for (int c = 0; c < 4; ++c) {
-                EXPECT_EQ(table.rgba[(g * 5 + v) * 4 + c], expected[c]) << g << " " << v << " " << c;
+                EXPECT_EQ(table.rgba[(g * 5 + v) * 4 + c], expected[c])
+                    << g << " " << v << " " << c;
             }
         }
     }
@@ -255,8 +275,8 @@ TEST(TransferFunction, SampleRejectsTooFewBins) {
 }
 
 TEST(TransferFunction, FilesReportThePath) {
-    const std::filesystem::path directory = std::filesystem::temp_directory_path() /
-                                            ("insitu_tf_test_" + std::to_string(::getpid()));
+    const std::filesystem::path directory =
+        std::filesystem::temp_directory_path() / ("insitu_tf_test_" + std::to_string(::getpid()));
     std::filesystem::create_directories(directory);
     const std::string good = (directory / "good.json").string();
     const std::string bad = (directory / "bad.json").string();

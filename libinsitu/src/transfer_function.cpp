@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <ostream>
 #include <sstream>
@@ -168,6 +169,11 @@ TransferFunction TransferFunction::from_json_text(const std::string& text) {
 }
 
 TransferFunction TransferFunction::from_json_file(const std::string& path) {
+    // An ifstream opens a directory and then reads nothing, which would read as malformed JSON.
+    std::error_code ignored;
+    if (std::filesystem::is_directory(path, ignored)) {
+        fail<IoError>("transfer function file \"", path, "\" is a directory");
+    }
     std::ifstream in(path);
     if (!in) fail<IoError>("cannot open transfer function file \"", path, "\"");
     std::stringstream buffer;

@@ -10,6 +10,8 @@
 //    NaN (non-finite input) samples are empty: they add nothing and stop nothing.
 //  * Gradients (for shading and 2D transfer functions): central differences of trilinear samples
 //    one voxel apart along each axis, divided by 2 * spacing (field units per world unit).
+//    A gradient that touches an empty (NaN) sample counts as |gradient| = 0: classified there
+//    and left unshaded.
 //  * Classification: rgba = tf(value[, |gradient|]); opacity corrected for the step:
 //    alpha = 1 - (1 - a)^(step / unit_length).
 //  * Shading (Phong, optional): light along -ray direction (a headlight); n = gradient / |gradient|
