@@ -148,6 +148,19 @@ void run_scene(const char* name, const SampledVolume& volume, const TransferFunc
             else proxies.render(camera, request);
         });
     };
+    // The block min/max scan runs on the host once per upload (every timestep in situ).
+    {
+        request.skip_empty_space = true;
+        proxies.render(camera, request);  // kernel build and buffers, not timed
+        proxies.upload(volume.field());
+        const auto start = std::chrono::steady_clock::now();
+        proxies.render(camera, request);
+        const double first = std::chrono::duration<double, std::milli>(
+                                 std::chrono::steady_clock::now() - start).count();
+        const double warm = median_ms(1, [&] { proxies.render(camera, request); });
+        std::printf("  %-46s %9.1f ms\n", "first pass after an upload (block scan) minus next",
+                    first - warm);
+    }
     // 2.0: never stop; 1.0: stop where the ray is exactly opaque (exact, the default).
     for (bool multi : {false, true}) {
         const char* which = multi ? "multi-perspective (45 deg)" : "single perspective";

@@ -31,6 +31,7 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
                              float4 cam_up, float4 cam_half_extent, int2 size,
                              float4 march, int wanted, int layer_count,
                              __global const float* isovalues, int interval_count,
+                             float uniform_interval_scale,
                              __global const float* interval_edges, __global float* depth_out,
                              __global float* distortion_out,
                              __global float* attenuation_out,  // always given when accumulating
@@ -94,6 +95,7 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
         bool accumulating = accumulate;
         float previous_value = NAN;
         float previous_t = 0.0f;
+        float next_block_t = -INFINITY;  // t where the ray leaves the block looked up last
         for (int i = 0;; ++i) {
             const float t = span.x + ((float)i + 0.5f) * step;
             if (t >= span.y) break;
@@ -119,7 +121,12 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
             if (accumulating) {
                 const float alpha = lookup_transfer(tf_table, tf_bins, tf_domain, value, 0.0f).w;
                 if (alpha > 0.0f) {
-                    const int j = interval_of(interval_edges, interval_count, value);
+                    // Uniform intervals (the default) need no search: L / (max - min) > 0.
+                    const int j =
+                        uniform_interval_scale > 0.0f
+                            ? clamp((int)((value - interval_edges[0]) * uniform_interval_scale), 0,
+                                    interval_count - 1)
+                            : interval_of(interval_edges, interval_count, value);
                     const float weight = transmittance * alpha;  // seed 000 Eq. 7
                     attenuation[j] += weight;
                     if (want_mean_depth) {
@@ -138,21 +145,22 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
             // Empty-space skipping, exact: in a skippable block every sample has zero opacity and
             // lies on one side of every isovalue. Having evaluated this (first) sample of the
             // block, jump to its last sample, so crossings are still found between consecutive
-            // samples and nothing between them could have contributed.
-            if (block_size > 0) {
+            // samples and nothing between them could have contributed. Blocks are looked up once
+            // per block the ray enters, not per sample.
+            if (block_size > 0 && t >= next_block_t) {
                 const float3 p = start_voxels + t * direction_voxels;
                 const int3 block = clamp(convert_int3(floor(p / (float)block_size)), (int3)(0),
                                          block_counts.xyz - 1);
+                const float3 lower = convert_float3(block * block_size);
+                const float3 upper = lower + (float3)(block_size);
+                const float3 exit_plane = select(lower, upper, direction_voxels > 0.0f);
+                const float3 t_axis = select((exit_plane - start_voxels) / direction_voxels,
+                                             (float3)(INFINITY), direction_voxels == 0.0f);
+                next_block_t = fmin(fmin(t_axis.x, t_axis.y), t_axis.z);
                 const int block_index =
                     (block.z * block_counts.y + block.y) * block_counts.x + block.x;
                 if (skippable_blocks[block_index]) {
-                    const float3 lower = convert_float3(block * block_size);
-                    const float3 upper = lower + (float3)(block_size);
-                    const float3 exit_plane = select(lower, upper, direction_voxels > 0.0f);
-                    const float3 t_axis = select((exit_plane - start_voxels) / direction_voxels,
-                                                 (float3)(INFINITY), direction_voxels == 0.0f);
-                    const float t_exit = fmin(fmin(t_axis.x, t_axis.y), t_axis.z);
-                    const int last = (int)ceil((t_exit - span.x) / step - 0.5f) - 1;
+                    const int last = (int)ceil((next_block_t - span.x) / step - 0.5f) - 1;
                     if (last > i + 1) i = last - 1;
                 }
             }

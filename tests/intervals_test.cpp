@@ -31,6 +31,12 @@ TEST(IntervalSet, IndexOfIsHalfOpenLastClosedAndClampsOutside) {
     EXPECT_EQ(intervals.index_of(9.0), 3);
 }
 
+TEST(IntervalSet, KnowsWhetherItsIntervalsAreEqualWidth) {
+    EXPECT_TRUE(IntervalSet::uniform(-2.0, 7.0, 9).is_uniform());
+    EXPECT_FALSE(IntervalSet({0.0, 1.0, 3.0}).is_uniform());
+    EXPECT_FALSE(IntervalSet({1.0, 1.0}).is_uniform());  // zero width: no scale to compute
+}
+
 TEST(IntervalSet, DegenerateRangeIsWidenedSoWidthsStayPositive) {
     const IntervalSet intervals = IntervalSet::uniform(2.0, 2.0, 3);
     EXPECT_DOUBLE_EQ(intervals.edges().front(), 1.5);

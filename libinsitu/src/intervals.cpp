@@ -95,6 +95,16 @@ IntervalSet IntervalSet::histogram_equalized(const std::vector<float>& values, d
     return IntervalSet(std::move(edges));
 }
 
+bool IntervalSet::is_uniform() const {
+    const double range = edges_.back() - edges_.front();
+    if (!(range > 0.0)) return false;
+    const double width = range / count();
+    for (int j = 0; j < count(); ++j) {
+        if (std::abs(edges_[j + 1] - edges_[j] - width) > 1e-6 * range) return false;
+    }
+    return true;
+}
+
 int IntervalSet::index_of(double value) const {
     const auto upper = std::upper_bound(edges_.begin() + 1, edges_.end() - 1, value);
     return static_cast<int>(upper - (edges_.begin() + 1));

@@ -252,6 +252,11 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     std::vector<float> edges;
     if (want_accumulation) edges.assign(frame.intervals->edges().begin(), frame.intervals->edges().end());
     const cl::Buffer edge_buffer = upload_floats(edges_, edges, "interval edges");
+    // Equal-width intervals let the kernel compute the index instead of searching for it.
+    double uniform_scale = 0.0;
+    if (want_accumulation && frame.intervals->is_uniform()) {
+        uniform_scale = interval_count / (edges.back() - edges.front());
+    }
 
     cl::Buffer skippable_buffer;
     cl_int4 block_counts = {{1, 1, 1, 0}};
@@ -262,13 +267,17 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
         last_skippable_fraction_ =
             static_cast<double>(std::count(skippable.begin(), skippable.end(), 1)) /
             static_cast<double>(skippable.size());
-        device_->ensure_buffer(skippable_.buffer, skippable_.capacity, skippable.size(),
-                               CL_MEM_READ_ONLY);
-        device_->upload(skippable_.buffer, skippable.data(), skippable.size(), "skippable blocks");
-        skippable_buffer = skippable_.buffer;
-        block_counts = {{static_cast<cl_int>(blocks_.counts[0]),
-                         static_cast<cl_int>(blocks_.counts[1]),
-                         static_cast<cl_int>(blocks_.counts[2]), 0}};
+        // With nothing to skip, the per-block lookups would be pure overhead.
+        if (last_skippable_fraction_ > 0.0) {
+            device_->ensure_buffer(skippable_.buffer, skippable_.capacity, skippable.size(),
+                                   CL_MEM_READ_ONLY);
+            device_->upload(skippable_.buffer, skippable.data(), skippable.size(),
+                            "skippable blocks");
+            skippable_buffer = skippable_.buffer;
+            block_counts = {{static_cast<cl_int>(blocks_.counts[0]),
+                             static_cast<cl_int>(blocks_.counts[1]),
+                             static_cast<cl_int>(blocks_.counts[2]), 0}};
+        }
     }
 
     const Index3& d = volume.dims;
@@ -287,10 +296,11 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
                     to_float4(camera.forward()), to_float4(camera.right()),
                     to_float4(camera.up()), detail::camera_extent(camera), size, march,
                     static_cast<cl_int>(wanted), static_cast<cl_int>(layer_count),
-                    isovalue_buffer, static_cast<cl_int>(interval_count), edge_buffer, depth_out,
+                    isovalue_buffer, static_cast<cl_int>(interval_count),
+                    static_cast<cl_float>(uniform_scale), edge_buffer, depth_out,
                     distortion_out, attenuation_out, mean_depth_out, optical_depth_out,
                     skippable_buffer, block_counts,
-                    static_cast<cl_int>(request.skip_empty_space ? kBlockVoxels : 0));
+                    static_cast<cl_int>(skippable_buffer() ? kBlockVoxels : 0));
 
     std::vector<float> planar;
     auto fetch = [&](const cl::Buffer& buffer, int planes, const char* what) {

@@ -33,6 +33,8 @@ public:
 
     int count() const { return static_cast<int>(edges_.size()) - 1; }
     const std::vector<double>& edges() const { return edges_; }
+    /// True when all intervals have the same width (to 1e-6 of the range).
+    bool is_uniform() const;
     /// Interval index of `value` under the rule above.
     int index_of(double value) const;
 
