@@ -1,9 +1,12 @@
-// gray-scott: the Gray-Scott mini-app. Runs the 3D reaction-diffusion simulation and, every few
-// steps, hands its v array to libinsitu as it is (ghost layers included, no copy by the
-// simulation), renders it with the ground-truth volume renderer and writes a PNG.
+// gray-scott: the Gray-Scott mini-app. Runs the 3D reaction-diffusion simulation and hands its
+// arrays to libinsitu after every step through insitu::Instrument, as they are (ghost layers
+// included, no copy by the simulation). The Instrument's cadence picks the steps; it computes
+// their proxies and a ground-truth preview per view and writes them to a timestep proxy archive
+// (ARCHIVE/previews/*.png are the PNGs to look at).
 //
-// Exit status: 0 done, 1 a runtime failure (libinsitu, OpenCL, files), 2 a bad command line.
-// Every failure is reported as one line on stderr.
+// Exit status: 0 done, 1 a runtime failure (libinsitu, OpenCL, files, a step that failed to be
+// archived), 2 a bad command line or configuration. Every failure is reported as one line on
+// stderr.
 #include <algorithm>
 #include <charconv>
 #include <chrono>
@@ -16,6 +19,7 @@
 #include <iostream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -23,36 +27,42 @@
 #include <vector>
 
 #include "gray_scott_simulation.hpp"
-#include "insitu/camera.hpp"
 #include "insitu/compute_device.hpp"
+#include "insitu/config.hpp"
 #include "insitu/error.hpp"
 #include "insitu/field.hpp"
-#include "insitu/image.hpp"
+#include "insitu/instrument.hpp"
 #include "insitu/transfer_function.hpp"
-#include "insitu/volume_renderer.hpp"
 
 namespace {
 
 constexpr const char* kUsage = R"(usage: gray-scott [options]
 
 Simulates 3D Gray-Scott reaction-diffusion (explicit Euler, 7-point Laplacian, periodic box,
-dt = 1) and volume-renders the v field with libinsitu every few steps.
+dt = 1) and instruments itself with libinsitu: after every step it hands the fields u and v to an
+insitu::Instrument, which writes proxies and ground-truth previews of the selected steps to a
+timestep proxy archive (ARCHIVE/previews/stepNNNNNN_view0.png are the pictures).
 
   --size N          interior samples per axis (default 64; 4..1024)
-  --steps S         steps to simulate (default 200)
-  --every N         render every N steps and at the last step (default 50)
+  --steps S         steps to simulate (default 200); steps are numbered 1..S
+  --config FILE     libinsitu JSON configuration (see insitu/config.hpp); without it: field v,
+                    one orthographic view, gray-scott's transfer function, every 50 steps
+  --out ARCHIVE     archive directory (default gray-scott.cdb, or the configuration's
+                    "archive"); an existing archive is continued, so it must not hold these
+                    steps already
+  --every N         archive every N steps (overrides the configuration's cadence)
+  --image-size WxH  image size in pixels of every view (default 256x256)
+  --azimuth DEG     orbit camera azimuth in degrees of every view (default 30)
+  --elevation DEG   orbit camera elevation in degrees of every view, -90..90 (default 20)
   --F f             feed rate per time unit (default 0.025; 0..0.25)
   --k k             kill rate per time unit (default 0.055; 0..0.25)
   --Du d            diffusion of u in voxels^2 per time unit (default 0.12; <= 0.125)
   --Dv d            diffusion of v in voxels^2 per time unit (default 0.06; <= 0.125)
   --seed n          random seed of the initial cubes (default 1)
-  --image-size WxH  image size in pixels (default 256x256)
-  --azimuth DEG     orbit camera azimuth in degrees (default 30)
-  --elevation DEG   orbit camera elevation in degrees, -90..90 (default 20)
-  --out DIR         output folder for v_stepNNNNNN.png (default gray-scott-output)
   --help            this text
 
-Bad arguments: one line on stderr, exit status 2. Runtime failures: one line, exit status 1.
+Bad arguments or configuration: one line on stderr, exit status 2. Runtime failures, including
+steps that could not be archived: one line, exit status 1.
 )";
 
 /// A command-line mistake; main reports it in one line and exits with status 2.
@@ -64,12 +74,14 @@ public:
 struct Options {
     gray_scott::Parameters simulation;
     std::int64_t steps = 200;
-    std::int64_t every = 50;
-    int image_width = 256;
-    int image_height = 256;
-    double azimuth_deg = 30.0;
-    double elevation_deg = 20.0;
-    std::string out_dir = "gray-scott-output";
+    std::optional<std::string> config_path;
+    std::optional<std::string> archive;
+    // Set only when given, so that they override a configuration file and nothing else.
+    std::optional<std::int64_t> every;
+    std::optional<int> image_width;
+    std::optional<int> image_height;
+    std::optional<double> azimuth_deg;
+    std::optional<double> elevation_deg;
     bool help = false;
 };
 
@@ -147,14 +159,19 @@ Options parse_arguments(int argc, char** argv) {
         {"--elevation",
          [&](const auto& flag, const auto& value) {
              options.elevation_deg = parse_real(flag, value);
-             if (std::abs(options.elevation_deg) > 90.0) {
+             if (std::abs(*options.elevation_deg) > 90.0) {
                  throw UsageError(flag + " " + value + ": must be in [-90, 90] degrees");
              }
          }},
         {"--out",
          [&](const auto& flag, const auto& value) {
-             if (value.empty()) throw UsageError(flag + " needs a non-empty folder name");
-             options.out_dir = value;
+             if (value.empty()) throw UsageError(flag + " needs a non-empty archive name");
+             options.archive = value;
+         }},
+        {"--config",
+         [&](const auto& flag, const auto& value) {
+             if (value.empty()) throw UsageError(flag + " needs a file name");
+             options.config_path = value;
          }},
     };
 
@@ -196,26 +213,6 @@ insitu::TransferFunction v_transfer_function() {
         /*unit_length=*/1.0);
 }
 
-/// Composites premultiplied RGBA over an opaque dark background, so the PNG looks the same in any
-/// viewer (a transparent PNG would show whatever the viewer puts behind it).
-insitu::Image over_background(const insitu::Image& rgba) {
-    constexpr float kBackground[3] = {0.010f, 0.012f, 0.018f};  // linear
-    insitu::Image rgb(rgba.width, rgba.height, 3);
-    for (std::size_t p = 0; p < rgba.pixel_count(); ++p) {
-        const float transmittance = 1.0f - rgba.pixels[4 * p + 3];
-        for (int c = 0; c < 3; ++c) {
-            rgb.pixels[3 * p + c] = rgba.pixels[4 * p + c] + transmittance * kBackground[c];
-        }
-    }
-    return rgb;
-}
-
-std::string image_path(const std::string& out_dir, std::int64_t step) {
-    char name[32];
-    std::snprintf(name, sizeof(name), "v_step%06lld.png", static_cast<long long>(step));
-    return (std::filesystem::path(out_dir) / name).string();
-}
-
 double milliseconds_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
         .count();
@@ -228,84 +225,138 @@ std::string one_line(std::string text) {
     return text;
 }
 
-int run(const Options& options) {
-    std::filesystem::create_directories(options.out_dir);
+/// The configuration without --config: field v seen from one orbit view, gray-scott's transfer
+/// function, layers and intervals chosen from the data (the library's defaults).
+insitu::InstrumentConfig default_config() {
+    insitu::InstrumentConfig config;
+    config.fields = {"v"};
+    config.views[0].orbit.width = 256;
+    config.views[0].orbit.height = 256;
+    config.transfer_function = v_transfer_function();
+    // Half-voxel steps: at one voxel the fronts show sampling rings (checked by eye at 64^3; a
+    // quarter voxel looks the same as a half and costs twice as much).
+    config.step_voxels = 0.5;
+    config.every = 50;
+    config.archive = "gray-scott.cdb";
+    return config;
+}
 
+/// The configuration file (or the defaults) with the command line's overrides applied. Throws
+/// UsageError naming the file for anything libinsitu rejects.
+insitu::InstrumentConfig make_config(const Options& options) {
+    insitu::InstrumentConfig config;
+    if (options.config_path) {
+        std::vector<std::string> unknown;
+        try {
+            config = insitu::InstrumentConfig::from_json_file(*options.config_path, &unknown);
+        } catch (const insitu::Error& error) {
+            throw UsageError(std::string("--config: ") + error.what());  // names the file
+        }
+        for (const std::string& key : unknown) {
+            std::cerr << "gray-scott: warning: " << *options.config_path
+                      << ": unknown configuration key " << key << " ignored" << std::endl;
+        }
+    } else {
+        config = default_config();
+    }
+    if (options.archive) config.archive = *options.archive;
+    if (options.every) {
+        config.every = *options.every;
+        config.steps.clear();
+    }
+    for (insitu::ViewConfig& view : config.views) {
+        if (options.image_width) view.orbit.width = *options.image_width;
+        if (options.image_height) view.orbit.height = *options.image_height;
+        if (options.azimuth_deg) view.orbit.azimuth_deg = *options.azimuth_deg;
+        if (options.elevation_deg) view.orbit.elevation_deg = *options.elevation_deg;
+    }
+    try {
+        config.validate();
+    } catch (const insitu::Error& error) {
+        throw UsageError(error.what());
+    }
+    return config;
+}
+
+int run(const Options& options, const insitu::InstrumentConfig& config) {
     gray_scott::Simulation simulation(options.simulation);
-    insitu::VolumeRenderer renderer;
-    const insitu::TransferFunction transfer_function = v_transfer_function();
-    insitu::RenderSettings settings;
-    settings.shading = true;
-    // Half-voxel steps: at one voxel the shaded fronts still show sampling rings (checked by
-    // eye at 64^3; a quarter voxel looks the same as a half and costs twice as much).
-    settings.step_voxels = 0.5;
-    insitu::OrbitView view;
-    view.azimuth_deg = options.azimuth_deg;
-    view.elevation_deg = options.elevation_deg;
-    view.width = options.image_width;
-    view.height = options.image_height;
+    // Throws (exit 1) when the archive cannot be opened or no compute device exists: a
+    // simulation checks its instrumentation once, at start-up. The Instrument's own log is off:
+    // this program reports every step's status and the errors itself, in its one-line style.
+    insitu::InstrumentOptions instrument_options;
+    instrument_options.log = false;
+    insitu::Instrument instrument(config, instrument_options);
 
     const int n = simulation.size();
     std::cout << "gray-scott: " << n << "^3, F=" << options.simulation.feed
               << " k=" << options.simulation.kill << " Du=" << options.simulation.diffusion_u
               << " Dv=" << options.simulation.diffusion_v << " dt=" << options.simulation.dt
-              << ", seed " << options.simulation.seed << ", " << options.steps
-              << " steps, render every " << options.every << ", " << gray_scott::worker_threads()
-              << " thread(s); rendering on " << insitu::ComputeDevice::shared()->description()
-              << std::endl;
+              << ", seed " << options.simulation.seed << ", " << options.steps << " steps, "
+              << gray_scott::worker_threads() << " thread(s); field \"" << config.fields.front()
+              << "\", " << config.views.size() << " view(s), archive " << config.archive
+              << "; proxies on " << insitu::ComputeDevice::shared()->description() << std::endl;
 
     double simulation_ms_total = 0.0;
-    double render_ms_total = 0.0;
-    int renders = 0;
-    double simulation_ms_since_render = 0.0;
-    std::int64_t steps_since_render = 0;
+    double simulation_ms_since_output = 0.0;
+    std::int64_t steps_since_output = 0;
     for (std::int64_t step = 1; step <= options.steps; ++step) {
         const auto step_start = std::chrono::steady_clock::now();
         simulation.step();
         const double step_ms = milliseconds_since(step_start);
         simulation_ms_total += step_ms;
-        simulation_ms_since_render += step_ms;
-        ++steps_since_render;
-        if (step % options.every != 0 && step != options.steps) continue;
+        simulation_ms_since_output += step_ms;
+        ++steps_since_output;
 
-        // The in-situ hand-over: a view of the simulation's own array, ghosts skipped by the
-        // Field, not by a copy here. Made afresh each time because the step swaps buffers.
+        // The in-situ hand-over: views of the simulation's own arrays, ghosts skipped by the
+        // Field, not by a copy here. Made afresh each step because the step swaps buffers.
         const std::int64_t allocated = simulation.allocated_size();
-        insitu::Field v_field("v", simulation.v_data(), insitu::ScalarType::float64,
-                              {allocated, allocated, allocated});
+        const insitu::Index3 dims{allocated, allocated, allocated};
+        insitu::Field u_field("u", simulation.u_data(), insitu::ScalarType::float64, dims);
+        insitu::Field v_field("v", simulation.v_data(), insitu::ScalarType::float64, dims);
+        u_field.set_ghost_layers(1);
         v_field.set_ghost_layers(1);
 
-        const auto upload_start = std::chrono::steady_clock::now();
-        renderer.upload(v_field);  // reuses the device buffer from the previous render
-        const double upload_ms = milliseconds_since(upload_start);
-        const auto render_start = std::chrono::steady_clock::now();
-        const insitu::Camera camera = insitu::Camera::orbit(view, v_field.bounds());
-        const insitu::Rendering rendering = renderer.render(camera, transfer_function, settings);
-        const double render_ms = milliseconds_since(render_start);
-        render_ms_total += upload_ms + render_ms;
-        ++renders;
+        const auto execute_start = std::chrono::steady_clock::now();
+        const insitu::Status status = instrument.execute(
+            step, static_cast<double>(step) * options.simulation.dt, {u_field, v_field});
+        const double execute_ms = milliseconds_since(execute_start);
+        if (status == insitu::Status::not_selected) continue;
 
-        const std::string path = image_path(options.out_dir, step);
-        insitu::write_png(path, over_background(rendering.rgba));
-
-        const insitu::ValueRange& range = renderer.value_range();
         std::ostringstream line;
-        line << std::fixed << "step " << std::setw(6) << step << "  v in [" << std::setprecision(4)
-             << range.min << ", " << range.max << "]";
-        if (range.nonfinite_count > 0) line << " (" << range.nonfinite_count << " NaN/Inf)";
-        line << std::setprecision(2) << "  simulation "
-             << simulation_ms_since_render / static_cast<double>(steps_since_render)
-             << " ms/step  upload " << upload_ms << " ms  render " << render_ms << " ms  -> "
-             << path;
+        line << std::fixed << "step " << std::setw(6) << step << std::setprecision(2)
+             << "  simulation "
+             << simulation_ms_since_output / static_cast<double>(steps_since_output)
+             << " ms/step  execute " << execute_ms << " ms  " << insitu::to_string(status);
+        if (status == insitu::Status::error) line << ": " << one_line(instrument.last_error());
         std::cout << line.str() << std::endl;
-        simulation_ms_since_render = 0.0;
-        steps_since_render = 0;
+        simulation_ms_since_output = 0.0;
+        steps_since_output = 0;
     }
+
+    const auto finalize_start = std::chrono::steady_clock::now();
+    instrument.finalize();
+    const double finalize_ms = milliseconds_since(finalize_start);
+    const insitu::InstrumentStatistics statistics = instrument.statistics();
+    const double executed =
+        static_cast<double>(std::max<std::int64_t>(1, statistics.steps_executed));
     std::cout << std::fixed << std::setprecision(2) << "gray-scott: done, " << options.steps
               << " steps (simulation " << simulation_ms_total / static_cast<double>(options.steps)
-              << " ms/step), " << renders << " renders (upload + render "
-              << render_ms_total / renders << " ms each), images in " << options.out_dir
-              << std::endl;
+              << " ms/step); " << statistics.steps_written << " steps archived, "
+              << statistics.steps_dropped << " dropped, " << statistics.bytes_written
+              << " bytes (proxies " << 1e3 * statistics.compute_seconds / executed
+              << " ms/step, blocked " << 1e3 * statistics.blocked_seconds / executed
+              << " ms/step, finalize " << finalize_ms << " ms)";
+    if (statistics.nonfinite_samples > 0) {
+        std::cout << "; " << statistics.nonfinite_samples << " NaN/Inf samples seen as empty";
+    }
+    std::cout << std::endl;
+    std::cout << "gray-scott: archive " << config.archive << ", previews in "
+              << (std::filesystem::path(config.archive) / "previews").string() << std::endl;
+    if (statistics.errors > 0) {
+        std::cerr << "gray-scott: libinsitu: " << statistics.errors
+                  << " error(s), the last: " << one_line(instrument.last_error()) << std::endl;
+        return 1;
+    }
     return 0;
 }
 
@@ -313,18 +364,20 @@ int run(const Options& options) {
 
 int main(int argc, char** argv) {
     Options options;
+    insitu::InstrumentConfig config;
     try {
         options = parse_arguments(argc, argv);
+        if (options.help) {
+            std::cout << kUsage;
+            return 0;
+        }
+        config = make_config(options);
     } catch (const UsageError& error) {
         std::cerr << "gray-scott: " << one_line(error.what()) << " (see --help)" << std::endl;
         return 2;
     }
-    if (options.help) {
-        std::cout << kUsage;
-        return 0;
-    }
     try {
-        return run(options);
+        return run(options, config);
     } catch (const insitu::Error& error) {
         std::cerr << "gray-scott: libinsitu: " << one_line(error.what()) << std::endl;
     } catch (const std::exception& error) {

@@ -1,6 +1,7 @@
 #pragma once
 // Typed errors of libinsitu. Every error names the offending value and where it came from
 // (argument, config key, field name, file, kernel), so a user can act on the message alone.
+#include <exception>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -36,6 +37,18 @@ class IoError : public Error {
 public:
     using Error::Error;
 };
+
+/// A call in the wrong order, e.g. Instrument::execute after finalize.
+class StateError : public Error {
+public:
+    using Error::Error;
+};
+
+/// The kind of an error, for boundaries that turn exceptions into status (Instrument, C API).
+enum class ErrorKind { none, invalid_argument, parse, compute, io, state, unknown };
+
+/// Kind of the exception `error` points at (unknown for non-libinsitu exceptions).
+ErrorKind classify(const std::exception_ptr& error);
 
 namespace detail {
 template <typename... Parts>

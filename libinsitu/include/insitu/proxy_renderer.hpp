@@ -93,6 +93,13 @@ public:
     /// belong to the single-perspective view).
     ProxyFrame render(const DistortionCamera& camera, const ProxyRequest& request);
 
+    /// Ground-truth rendering (VolumeRenderer) of the uploaded field, sharing its device copy:
+    /// an Instrument's preview needs no second upload.
+    Rendering render_ground_truth(const Camera& camera, const TransferFunction& tf,
+                                  const RenderSettings& settings = {}) {
+        return renderer_.render(camera, tf, settings);
+    }
+
     /// Fraction of blocks the last pass was allowed to skip (0 when skipping was off).
     double last_skippable_fraction() const { return last_skippable_fraction_; }
 

@@ -1,0 +1,292 @@
+// The C API (insitu.h) over insitu::Instrument.
+//
+// The one place where libinsitu's typed exceptions become status codes (STYLE.md, the CLBlast
+// row): every extern "C" function runs its body through guarded(), which catches everything and
+// records the message in a thread_local string for insitu_last_error(). No exception may cross
+// into C or Fortran: unwinding through frames compiled without exception tables is undefined.
+#include <cstdint>
+#include <exception>
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "insitu.h"
+#include "insitu/error.hpp"
+#include "insitu/field.hpp"
+#include "insitu/instrument.hpp"
+
+// The opaque handle of insitu.h.
+struct insitu_instrument {
+    std::unique_ptr<insitu::Instrument> instrument;
+    // Views handed over by insitu_set_field since the last execute, by field name, so that
+    // setting a field twice before one execute replaces it instead of passing it twice.
+    std::map<std::string, insitu::Field> pending_fields;
+    // Set by insitu_finalize: later set_field/execute calls are a caller bug (INSITU_ERROR_STATE),
+    // caught here before a stale field pointer is stored.
+    bool finalized = false;
+};
+
+namespace {
+
+// Per thread, so that two threads driving two instruments do not overwrite each other's message.
+thread_local std::string last_error_message;
+
+using insitu::StateError;
+
+// Records `function: message` for insitu_last_error() and returns `code`. Never throws: if even
+// the message cannot be allocated, the code still reaches the caller (with an empty message).
+int fail_with(int code, const char* function, const char* message) noexcept {
+    try {
+        last_error_message = std::string(function) + ": " + message;
+    } catch (...) {
+        last_error_message.clear();
+    }
+    return code;
+}
+
+int fail_with(int code, const char* function, const std::string& message) noexcept {
+    return fail_with(code, function, message.c_str());
+}
+
+// Runs `body` (which returns a status code) and turns any exception into a code and a message
+// prefixed with the C function's name. Most derived classes are caught first.
+template <typename Body>
+int guarded(const char* function, Body&& body) noexcept {
+    try {
+        return body();
+    } catch (const insitu::InvalidArgument& error) {
+        return fail_with(INSITU_ERROR_INVALID_ARGUMENT, function, error.what());
+    } catch (const insitu::ParseError& error) {
+        return fail_with(INSITU_ERROR_PARSE, function, error.what());
+    } catch (const insitu::ComputeError& error) {
+        return fail_with(INSITU_ERROR_COMPUTE, function, error.what());
+    } catch (const insitu::IoError& error) {
+        return fail_with(INSITU_ERROR_IO, function, error.what());
+    } catch (const StateError& error) {
+        return fail_with(INSITU_ERROR_STATE, function, error.what());
+    } catch (const std::exception& error) {  // other insitu::Error, std::bad_alloc, ...
+        return fail_with(INSITU_ERROR_UNKNOWN, function, error.what());
+    } catch (...) {
+        return fail_with(INSITU_ERROR_UNKNOWN, function, "unknown exception");
+    }
+}
+
+template <typename Pointer>
+void require_not_null(Pointer* pointer, const char* argument) {
+    if (pointer == nullptr) insitu::fail<insitu::InvalidArgument>(argument, " is NULL");
+}
+
+insitu::ScalarType scalar_type_from_c(int scalar_type) {
+    switch (scalar_type) {
+        case INSITU_UINT8:
+            return insitu::ScalarType::uint8;
+        case INSITU_UINT16:
+            return insitu::ScalarType::uint16;
+        case INSITU_INT16:
+            return insitu::ScalarType::int16;
+        case INSITU_FLOAT32:
+            return insitu::ScalarType::float32;
+        case INSITU_FLOAT64:
+            return insitu::ScalarType::float64;
+        default:
+            insitu::fail<insitu::InvalidArgument>(
+                "scalar_type = ", scalar_type,
+                " is not one of INSITU_UINT8 (0), INSITU_UINT16 (1), INSITU_INT16 (2), "
+                "INSITU_FLOAT32 (3), INSITU_FLOAT64 (4)");
+    }
+}
+
+// Instrument::execute/finalize report failures as Status::error plus last_error() and
+// last_error_kind() (the Instrument is made with rethrow_errors = false: the simulation is sacred).
+int code_for_kind(insitu::ErrorKind kind) {
+    switch (kind) {
+        case insitu::ErrorKind::invalid_argument: return INSITU_ERROR_INVALID_ARGUMENT;
+        case insitu::ErrorKind::parse: return INSITU_ERROR_PARSE;
+        case insitu::ErrorKind::compute: return INSITU_ERROR_COMPUTE;
+        case insitu::ErrorKind::io: return INSITU_ERROR_IO;
+        case insitu::ErrorKind::state: return INSITU_ERROR_STATE;
+        case insitu::ErrorKind::none:
+        case insitu::ErrorKind::unknown: break;
+    }
+    return INSITU_ERROR_UNKNOWN;
+}
+
+enum class Call { execute, finalize };
+
+int code_for_status(insitu::Status status, const insitu::Instrument& instrument, Call call) {
+    switch (status) {
+        case insitu::Status::ok:
+            return INSITU_OK;
+        case insitu::Status::not_selected:
+            return INSITU_NOT_SELECTED;
+        case insitu::Status::dropped:
+            return INSITU_DROPPED;
+        case insitu::Status::error:
+            break;
+    }
+    std::string message = instrument.last_error();
+    if (message.empty()) message = "failed without a message";
+    const int code = code_for_kind(instrument.last_error_kind());
+    return fail_with(code, call == Call::execute ? "insitu_execute" : "insitu_finalize", message);
+}
+
+int create(const char* function, insitu_instrument** out,
+           std::unique_ptr<insitu::Instrument> (*make)(const std::string&,
+                                                       insitu::InstrumentOptions),
+           const char* argument_name, const char* argument) {
+    return guarded(function, [&]() -> int {
+        require_not_null(out, "out");
+        *out = nullptr;  // defined on failure too, so the caller may destroy it unconditionally
+        require_not_null(argument, argument_name);
+        insitu::InstrumentOptions options;
+        // The simulation is sacred: execute()/finalize() report status instead of throwing.
+        // The constructor still throws for a bad configuration; guarded() turns that into a code.
+        options.rethrow_errors = false;
+        auto handle = std::make_unique<insitu_instrument>();
+        handle->instrument = make(argument, options);
+        *out = handle.release();
+        return INSITU_OK;
+    });
+}
+
+int set_field(const char* function, insitu_instrument* instrument, const char* name,
+              const void* data, int scalar_type, const int64_t dims[3], const double origin[3],
+              const double spacing[3], const int64_t ghosts[3], const int64_t strides[3]) {
+    return guarded(function, [&]() -> int {
+        require_not_null(instrument, "instrument");
+        require_not_null(name, "name");
+        require_not_null(data, "data");
+        require_not_null(dims, "dims");
+        if (instrument->finalized) {
+            throw StateError(std::string("field \"") + name + "\" set after insitu_finalize");
+        }
+        // Checked here rather than left to execute, so the message points at the call that
+        // passed the wrong name and the run need not reach a selected step to find out.
+        const auto& configured = instrument->instrument->config().fields;
+        bool known = false;
+        std::string names;
+        for (const auto& field_name : configured) {
+            known = known || field_name == name;
+            names += (names.empty() ? "\"" : ", \"") + field_name + "\"";
+        }
+        if (!known) {
+            insitu::fail<insitu::InvalidArgument>(
+                "field \"", name, "\" is not in the configuration's fields (", names, ")");
+        }
+
+        const insitu::ScalarType type = scalar_type_from_c(scalar_type);
+        insitu::Field field(name, data, type, {dims[0], dims[1], dims[2]});
+        if (origin != nullptr) field.set_origin({origin[0], origin[1], origin[2]});
+        if (spacing != nullptr) field.set_spacing({spacing[0], spacing[1], spacing[2]});
+        if (strides != nullptr) field.set_strides({strides[0], strides[1], strides[2]});
+        if (ghosts != nullptr) {
+            const insitu::Index3 layers{ghosts[0], ghosts[1], ghosts[2]};
+            field.set_ghost_layers(layers, layers);
+        }
+        instrument->pending_fields.insert_or_assign(name, std::move(field));
+        return INSITU_OK;
+    });
+}
+
+}  // namespace
+
+extern "C" {
+
+int insitu_create_from_file(const char* path, insitu_instrument** out) {
+    return create("insitu_create_from_file", out, &insitu::Instrument::from_json_file, "path",
+                  path);
+}
+
+int insitu_create_from_json(const char* json_text, insitu_instrument** out) {
+    return create("insitu_create_from_json", out, &insitu::Instrument::from_json_text, "json_text",
+                  json_text);
+}
+
+int insitu_set_field(insitu_instrument* instrument, const char* name, const void* data,
+                     int scalar_type, const int64_t dims[3], const double origin[3],
+                     const double spacing[3], const int64_t ghosts[3]) {
+    return set_field("insitu_set_field", instrument, name, data, scalar_type, dims, origin, spacing,
+                     ghosts, nullptr);
+}
+
+int insitu_set_field_strided(insitu_instrument* instrument, const char* name, const void* data,
+                             int scalar_type, const int64_t dims[3], const double origin[3],
+                             const double spacing[3], const int64_t ghosts[3],
+                             const int64_t strides_samples[3]) {
+    return set_field("insitu_set_field_strided", instrument, name, data, scalar_type, dims, origin,
+                     spacing, ghosts, strides_samples);
+}
+
+int insitu_execute(insitu_instrument* instrument, int64_t step, double time) {
+    return guarded("insitu_execute", [&]() -> int {
+        require_not_null(instrument, "instrument");
+        // The views are only promised valid until this call returns: forget them whatever
+        // happens, so a later execute cannot read memory the simulation has since freed.
+        std::map<std::string, insitu::Field> pending;
+        pending.swap(instrument->pending_fields);
+        if (instrument->finalized) {
+            throw StateError("step " + std::to_string(step) + " executed after insitu_finalize");
+        }
+        std::vector<insitu::Field> fields;
+        fields.reserve(pending.size());
+        for (auto& entry : pending) fields.push_back(std::move(entry.second));
+        const insitu::Status status = instrument->instrument->execute(step, time, fields);
+        return code_for_status(status, *instrument->instrument, Call::execute);
+    });
+}
+
+int insitu_finalize(insitu_instrument* instrument) {
+    return guarded("insitu_finalize", [&]() -> int {
+        require_not_null(instrument, "instrument");
+        instrument->pending_fields.clear();
+        // A second finalize has nothing left to drain: harmless, so not an error.
+        if (instrument->finalized) return INSITU_OK;
+        instrument->finalized = true;
+        const insitu::Status status = instrument->instrument->finalize();
+        return code_for_status(status, *instrument->instrument, Call::finalize);
+    });
+}
+
+void insitu_destroy(insitu_instrument* instrument) {
+    if (instrument == nullptr) return;
+    // Finalize explicitly, inside guarded(), so that a failure while draining the writer is
+    // recorded for insitu_last_error() instead of being lost in ~Instrument.
+    if (!instrument->finalized) insitu_finalize(instrument);
+    guarded("insitu_destroy", [&]() -> int {
+        delete instrument;
+        return INSITU_OK;
+    });
+}
+
+const char* insitu_last_error(void) {
+    return last_error_message.c_str();
+}
+
+const char* insitu_status_name(int status) {
+    switch (status) {
+        case INSITU_OK:
+            return "INSITU_OK";
+        case INSITU_NOT_SELECTED:
+            return "INSITU_NOT_SELECTED";
+        case INSITU_DROPPED:
+            return "INSITU_DROPPED";
+        case INSITU_ERROR_INVALID_ARGUMENT:
+            return "INSITU_ERROR_INVALID_ARGUMENT";
+        case INSITU_ERROR_PARSE:
+            return "INSITU_ERROR_PARSE";
+        case INSITU_ERROR_COMPUTE:
+            return "INSITU_ERROR_COMPUTE";
+        case INSITU_ERROR_IO:
+            return "INSITU_ERROR_IO";
+        case INSITU_ERROR_STATE:
+            return "INSITU_ERROR_STATE";
+        case INSITU_ERROR_UNKNOWN:
+            return "INSITU_ERROR_UNKNOWN";
+        default:
+            return "INSITU_UNKNOWN_STATUS";
+    }
+}
+
+}  // extern "C"

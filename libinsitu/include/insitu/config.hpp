@@ -1,0 +1,98 @@
+#pragma once
+// The JSON configuration an Instrument (and insitu-capture) runs from. Key names are fixed by the
+// adaptor-API issue so that configurations, tools and docs agree:
+//
+// {"fields": ["v"],
+//  "views": [{"azimuth": 30, "elevation": 20, "camera": "perspective", "fov": 30,
+//             "size": [512, 512], "distortion_tilt": 45}],
+//  "transfer_function": {"points": [[0.0, 0, 0, 1, 0], [1.0, 1, 0, 0, 0.5]], "unit_length": 1.0},
+//  "training_transfer_functions": [],
+//  "layers": "auto", "intervals": {"count": 16, "mode": "uniform"},
+//  "proxies": ["depth", "distortion", "attenuation"], "step": 1.0, "every": 10,
+//  "archive": "run.cdb", "precision": "half", "compression": "zip",
+//  "writer": {"queue": 4, "when_full": "block"}}
+//
+// Every key is optional; defaults are listed on the members below. Unknown keys (at any level)
+// are collected by name, not silently ignored; invalid values raise InvalidArgument/ParseError
+// naming the key and the value. Cadence: "every": N (N >= 1) or "steps": [s0, s1, ...], not both.
+// A view's keys: "azimuth", "elevation" (degrees), "camera" ("ortho" | "orthographic" |
+// "perspective"), "fov" (degrees, perspective only), "size" ([width, height] pixels),
+// "distortion_tilt" (degrees).
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "insitu/camera.hpp"
+#include "insitu/intervals.hpp"
+#include "insitu/transfer_function.hpp"
+
+namespace insitu {
+
+/// One camera of the configuration: an orbit view plus the tilt of its multi-perspective twin.
+struct ViewConfig {
+    OrbitView orbit{30.0, 20.0};        ///< default: azimuth 30, elevation 20, ortho, 512x512
+    double distortion_tilt_deg = 45.0;  ///< "distortion_tilt", degrees in [0, 90)
+};
+
+enum class StoragePrecision { half, single };  ///< "half" / "float"
+enum class WhenFull { block, drop };            ///< writer policy when its queue is full
+
+/// Proxies a run emits ("proxies" list). "multi_attenuation" without "distortion" still makes a
+/// multi-perspective frame, holding only the attenuation proxies.
+struct ProxySelection {
+    bool depth = true;          ///< "depth": single-perspective depth layers
+    bool distortion = true;     ///< "distortion": multi-perspective depth + distortion layers
+    bool attenuation = true;    ///< "attenuation": a_j and mean depth, single perspective
+    bool multi_attenuation = false;  ///< "multi_attenuation": the same from the distortion camera
+    bool optical_depth = false;      ///< "optical_depth": tau_j as well
+};
+
+struct InstrumentConfig {
+    std::vector<std::string> fields{"v"};  ///< "fields": names of the fields to visualise
+    std::vector<ViewConfig> views{ViewConfig{}};
+    /// "transfer_function"; default: a blue-to-red ramp, transparent at the range's minimum,
+    /// over [0, 1] (set it to the data's units).
+    TransferFunction transfer_function{
+        std::vector<ControlPoint>{{0.0, {0, 0, 1, 0}}, {1.0, {1, 0, 0, 0.5}}}, 1.0};
+    std::vector<TransferFunction> training_transfer_functions;  ///< default none
+    /// "layers": explicit isovalues, or "auto" (empty here) = opacity peaks, at most max_layers.
+    std::optional<std::vector<double>> layers;  ///< nullopt = "auto"
+    int max_auto_layers = 4;                    ///< "max_layers"
+    int interval_count = 16;                    ///< "intervals": {"count": ..}
+    IntervalMode interval_mode = IntervalMode::uniform;  ///< "intervals": {"mode": ..}
+    ProxySelection proxies;
+    double step_voxels = 1.0;  ///< "step": ray step in voxels
+    /// "every": emit on steps divisible by N (default 1); or "steps": an explicit list.
+    std::int64_t every = 1;
+    std::vector<std::int64_t> steps;
+    std::string archive = "run.cdb";  ///< "archive": directory of the proxy archive
+    StoragePrecision precision = StoragePrecision::half;
+    std::string compression = "zip";  ///< "compression": none, rle, zips, zip, piz, pxr24, b44
+    int writer_queue = 4;             ///< "writer": {"queue": N}, steps held in memory at most
+    WhenFull when_full = WhenFull::block;  ///< "writer": {"when_full": "block" | "drop"}
+    bool keep_training_images = false;     ///< "keep_training_images"
+
+    /// Parses `json`; unknown keys are appended to `unknown_keys` as dotted paths
+    /// ("views[0].zoom"). Throws ParseError (wrong JSON type) or InvalidArgument (value out of
+    /// range) naming the key and value. With `unknown_keys` null, unknown keys raise ParseError
+    /// naming them all, so a caller that does not collect them cannot lose them silently.
+    static InstrumentConfig from_json(const nlohmann::json& json,
+                                      std::vector<std::string>* unknown_keys = nullptr);
+    static InstrumentConfig from_json_text(const std::string& text,
+                                           std::vector<std::string>* unknown_keys = nullptr);
+    static InstrumentConfig from_json_file(const std::string& path,
+                                           std::vector<std::string>* unknown_keys = nullptr);
+    /// Every key with its value (defaults included), so archives record what actually ran.
+    nlohmann::json to_json() const;
+    /// Whether `step` is one the cadence selects: listed in `steps` when that is non-empty,
+    /// otherwise divisible by `every`.
+    bool selects(std::int64_t step) const;
+    /// Throws InvalidArgument naming the configuration key and value of the first member that is
+    /// out of range (for configurations built in code; from_json checks the same).
+    void validate() const;
+};
+
+}  // namespace insitu

@@ -1,0 +1,94 @@
+#pragma once
+// insitu::Instrument — what a simulation holds. Once per timestep it calls execute() with
+// zero-copy Field views; the proxies are computed, copied off the simulation's memory, and handed
+// to a writer thread with a bounded queue; execute() returns then. finalize() drains the queue.
+//
+// The simulation is sacred: no exception leaves execute() or finalize() unless the Instrument was
+// made with `rethrow_errors` (for tests). Failures become a Status, are logged once to stderr,
+// and the run goes on; last_error() says what happened.
+#include <chrono>
+#include <cstdint>
+#include <iosfwd>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "insitu/config.hpp"
+#include "insitu/error.hpp"
+#include "insitu/field.hpp"
+
+namespace insitu {
+
+enum class Status {
+    ok,           ///< proxies computed and queued (or written)
+    not_selected, ///< the cadence skipped this step
+    dropped,      ///< writer queue full with when_full = drop: this step was not stored
+    error,        ///< see last_error(); nothing already written was lost
+};
+std::string to_string(Status status);
+
+struct InstrumentStatistics {
+    std::int64_t steps_executed = 0;   ///< execute() calls that computed proxies
+    std::int64_t steps_written = 0;
+    std::int64_t steps_dropped = 0;
+    std::int64_t errors = 0;
+    std::uint64_t bytes_written = 0;
+    double compute_seconds = 0.0;      ///< in execute(), computing proxies
+    double blocked_seconds = 0.0;      ///< in execute(), waiting for room in the writer queue
+    double write_seconds = 0.0;        ///< on the writer thread
+    /// NaN/Inf samples met in the visualised fields, summed over steps (treated as empty space).
+    std::int64_t nonfinite_samples = 0;
+};
+std::ostream& operator<<(std::ostream& out, const InstrumentStatistics& statistics);
+
+struct InstrumentOptions {
+    /// Let exceptions out of execute()/finalize() instead of turning them into Status (tests).
+    bool rethrow_errors = false;
+    /// Print warnings and the finalize() summary to stderr.
+    bool log = true;
+};
+
+class Instrument {
+public:
+    /// Validates the configuration and opens (or continues) the archive. Unlike execute(), the
+    /// constructor throws: a simulation checks its configuration once, at start-up.
+    explicit Instrument(InstrumentConfig config, InstrumentOptions options = {});
+    static std::unique_ptr<Instrument> from_json_file(const std::string& path,
+                                                      InstrumentOptions options = {});
+    static std::unique_ptr<Instrument> from_json_text(const std::string& text,
+                                                      InstrumentOptions options = {});
+    ~Instrument();  ///< finalize()s if the simulation did not
+
+    Instrument(const Instrument&) = delete;
+    Instrument& operator=(const Instrument&) = delete;
+
+    /// One timestep: fields are matched by name against the configuration's "fields". Only the
+    /// first configured field is visualised (and must be present); several fields per step are
+    /// future work. Checks, in order: not finalized; `step` greater than every step executed
+    /// before and not already in the archive (else error naming it, nothing written); the first
+    /// configured field present (else error naming it); the cadence (else not_selected, nothing
+    /// computed). Then computes the proxies and preview of every view and queues them; with the
+    /// queue full it waits (when_full = block, timed in blocked_seconds) or returns dropped.
+    /// The Fields are not referenced after execute() returns.
+    Status execute(std::int64_t step, double time, const std::vector<Field>& fields);
+    /// Drains the writer queue and stops the writer; later execute() calls return error.
+    /// Returns error when a write failed during the run (last_error() says which); calling it
+    /// again does nothing and returns ok.
+    Status finalize();
+
+    InstrumentStatistics statistics() const;
+    /// The most recent error message (empty if none).
+    std::string last_error() const;
+    /// The kind of that error (ErrorKind::none if none), so boundaries such as the C API can map
+    /// it to a code without reading the message.
+    ErrorKind last_error_kind() const;
+    const InstrumentConfig& config() const;
+    /// Unknown configuration keys found at construction (also logged).
+    const std::vector<std::string>& unknown_keys() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace insitu

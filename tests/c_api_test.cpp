@@ -1,0 +1,393 @@
+// The C API (adaptors/c/insitu.h): exception-free at the boundary, every failure a status code and
+// a message that names the offending argument or value (DESIGN.md "Errors and the host
+// simulation"). The success path is checked through the codes and the archive's index files;
+// the archive's contents are archive_test.cpp's business.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "insitu.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// A folder of its own per test (and per process, as ctest may run tests in parallel), emptied
+// first so that an archive left by an earlier run cannot be continued instead of written.
+fs::path fresh_directory() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    const fs::path directory =
+        fs::path(::testing::TempDir()) / ("insitu_c_api_" + std::string(info->test_suite_name()) +
+                                          "_" + info->name() + "_" + std::to_string(::getpid()));
+    fs::remove_all(directory);
+    fs::create_directories(directory);
+    return directory;
+}
+
+// Small enough for a CPU OpenCL device: one 16x16 view, few intervals, every second step.
+std::string small_config(const fs::path& archive, int every = 2) {
+    return R"({"fields": ["v"],
+               "views": [{"azimuth": 30, "elevation": 20, "size": [16, 16]}],
+               "intervals": {"count": 4, "mode": "uniform"},
+               "every": )" +
+           std::to_string(every) + R"(, "archive": ")" + archive.string() + R"("})";
+}
+
+bool contains(const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+}
+
+// A 12^3 field with one ghost layer on each side (10^3 interior): a ball of value 1 fading to 0,
+// in [0, 1] like the default transfer function.
+struct BallField {
+    static constexpr std::int64_t kAllocated = 12;
+    std::vector<float> samples;
+    const std::int64_t dims[3] = {kAllocated, kAllocated, kAllocated};
+    const std::int64_t ghosts[3] = {1, 1, 1};
+    const double origin[3] = {0.0, 0.0, 0.0};
+    const double spacing[3] = {0.1, 0.1, 0.1};
+
+    BallField() : samples(kAllocated * kAllocated * kAllocated) {
+        const double center = 0.5 * (kAllocated - 1);
+        for (std::int64_t k = 0; k < kAllocated; ++k) {
+            for (std::int64_t j = 0; j < kAllocated; ++j) {
+                for (std::int64_t i = 0; i < kAllocated; ++i) {
+                    const double r =
+                        std::sqrt((i - center) * (i - center) + (j - center) * (j - center) +
+                                  (k - center) * (k - center));
+                    samples[i + kAllocated * (j + kAllocated * k)] =
+                        static_cast<float>(std::max(0.0, 1.0 - r / center));
+                }
+            }
+        }
+    }
+};
+
+// Owns an instrument made from small_config(), for the tests that need a valid one.
+class CApiTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        directory_ = fresh_directory();
+        archive_ = directory_ / "run.cdb";
+        ASSERT_EQ(insitu_create_from_json(small_config(archive_).c_str(), &instrument_), INSITU_OK)
+            << insitu_last_error();
+        ASSERT_NE(instrument_, nullptr);
+    }
+    void TearDown() override {
+        insitu_destroy(instrument_);
+        fs::remove_all(directory_);
+    }
+
+    int set_ball(const char* name = "v", int scalar_type = INSITU_FLOAT32) {
+        return insitu_set_field(instrument_, name, ball_.samples.data(), scalar_type, ball_.dims,
+                                ball_.origin, ball_.spacing, ball_.ghosts);
+    }
+
+    fs::path directory_;
+    fs::path archive_;
+    insitu_instrument* instrument_ = nullptr;
+    BallField ball_;
+};
+
+// --- Null pointers: one code, and a message naming the argument. ---
+
+TEST(CApiCreate, NullOutIsNamed) {
+    EXPECT_EQ(insitu_create_from_json("{}", nullptr), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "out is NULL")) << insitu_last_error();
+    EXPECT_TRUE(contains(insitu_last_error(), "insitu_create_from_json")) << insitu_last_error();
+    EXPECT_EQ(insitu_create_from_file("insitu.json", nullptr), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "out is NULL")) << insitu_last_error();
+}
+
+TEST(CApiCreate, NullTextOrPathIsNamedAndOutIsNulled) {
+    // *out is written even on failure, so callers may destroy it unconditionally.
+    auto* out = reinterpret_cast<insitu_instrument*>(0x1);
+    EXPECT_EQ(insitu_create_from_json(nullptr, &out), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "json_text is NULL")) << insitu_last_error();
+    EXPECT_EQ(out, nullptr);
+
+    out = reinterpret_cast<insitu_instrument*>(0x1);
+    EXPECT_EQ(insitu_create_from_file(nullptr, &out), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "path is NULL")) << insitu_last_error();
+    EXPECT_EQ(out, nullptr);
+}
+
+TEST(CApiNullInstrument, EveryFunctionNamesIt) {
+    BallField ball;
+    EXPECT_EQ(insitu_set_field(nullptr, "v", ball.samples.data(), INSITU_FLOAT32, ball.dims,
+                               nullptr, nullptr, nullptr),
+              INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "instrument is NULL")) << insitu_last_error();
+    EXPECT_EQ(insitu_set_field_strided(nullptr, "v", ball.samples.data(), INSITU_FLOAT32, ball.dims,
+                                       nullptr, nullptr, nullptr, nullptr),
+              INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "instrument is NULL")) << insitu_last_error();
+    EXPECT_EQ(insitu_execute(nullptr, 0, 0.0), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "insitu_execute: instrument is NULL"))
+        << insitu_last_error();
+    EXPECT_EQ(insitu_finalize(nullptr), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "insitu_finalize: instrument is NULL"))
+        << insitu_last_error();
+}
+
+TEST(CApiDestroy, NullIsFine) {
+    insitu_destroy(nullptr);
+}
+
+TEST_F(CApiTest, NullNameIsNamed) {
+    EXPECT_EQ(insitu_set_field(instrument_, nullptr, ball_.samples.data(), INSITU_FLOAT32,
+                               ball_.dims, nullptr, nullptr, nullptr),
+              INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "name is NULL")) << insitu_last_error();
+}
+
+TEST_F(CApiTest, NullDataIsNamed) {
+    EXPECT_EQ(insitu_set_field(instrument_, "v", nullptr, INSITU_FLOAT32, ball_.dims, nullptr,
+                               nullptr, nullptr),
+              INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "data is NULL")) << insitu_last_error();
+}
+
+TEST_F(CApiTest, NullDimsIsNamed) {
+    EXPECT_EQ(insitu_set_field(instrument_, "v", ball_.samples.data(), INSITU_FLOAT32, nullptr,
+                               nullptr, nullptr, nullptr),
+              INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "dims is NULL")) << insitu_last_error();
+}
+
+// Origin, spacing, ghosts (and strides) may be NULL: defaults 0, 1, none (and x-fastest).
+TEST_F(CApiTest, OptionalArraysMayBeNull) {
+    EXPECT_EQ(insitu_set_field(instrument_, "v", ball_.samples.data(), INSITU_FLOAT32, ball_.dims,
+                               nullptr, nullptr, nullptr),
+              INSITU_OK)
+        << insitu_last_error();
+    EXPECT_EQ(insitu_set_field_strided(instrument_, "v", ball_.samples.data(), INSITU_FLOAT32,
+                                       ball_.dims, nullptr, nullptr, nullptr, nullptr),
+              INSITU_OK)
+        << insitu_last_error();
+}
+
+// --- Bad values: named in the message. ---
+
+TEST_F(CApiTest, UnknownScalarTypeIsNamed) {
+    EXPECT_EQ(set_ball("v", 7), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "scalar_type = 7")) << insitu_last_error();
+    EXPECT_EQ(set_ball("v", -1), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "scalar_type = -1")) << insitu_last_error();
+}
+
+TEST_F(CApiTest, FieldNotInTheConfigurationIsNamed) {
+    EXPECT_EQ(set_ball("pressure"), INSITU_ERROR_INVALID_ARGUMENT);
+    const std::string message = insitu_last_error();
+    EXPECT_TRUE(contains(message, "\"pressure\"")) << message;
+    EXPECT_TRUE(contains(message, "\"v\"")) << message;  // and says what is configured
+}
+
+TEST_F(CApiTest, BadDimsGhostsAndStridesAreInvalidArguments) {
+    const std::int64_t zero_dims[3] = {12, 0, 12};
+    EXPECT_EQ(insitu_set_field(instrument_, "v", ball_.samples.data(), INSITU_FLOAT32, zero_dims,
+                               nullptr, nullptr, nullptr),
+              INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_STRNE(insitu_last_error(), "");
+
+    // Six ghost layers on each side of 12 samples leave no interior.
+    const std::int64_t too_many_ghosts[3] = {6, 1, 1};
+    EXPECT_EQ(insitu_set_field(instrument_, "v", ball_.samples.data(), INSITU_FLOAT32, ball_.dims,
+                               nullptr, nullptr, too_many_ghosts),
+              INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_STRNE(insitu_last_error(), "");
+
+    const double negative_spacing[3] = {0.1, -0.1, 0.1};
+    EXPECT_EQ(insitu_set_field(instrument_, "v", ball_.samples.data(), INSITU_FLOAT32, ball_.dims,
+                               nullptr, negative_spacing, nullptr),
+              INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_STRNE(insitu_last_error(), "");
+
+    const std::int64_t zero_stride[3] = {1, 0, 144};
+    EXPECT_EQ(insitu_set_field_strided(instrument_, "v", ball_.samples.data(), INSITU_FLOAT32,
+                                       ball_.dims, nullptr, nullptr, nullptr, zero_stride),
+              INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_STRNE(insitu_last_error(), "");
+}
+
+TEST(CApiCreate, MalformedJsonIsAParseError) {
+    insitu_instrument* out = nullptr;
+    EXPECT_EQ(insitu_create_from_json(R"({"fields": ["v"], "every": )", &out), INSITU_ERROR_PARSE);
+    EXPECT_EQ(out, nullptr);
+    EXPECT_TRUE(contains(insitu_last_error(), "insitu_create_from_json: ")) << insitu_last_error();
+}
+
+TEST(CApiCreate, MalformedJsonFileIsAParseError) {
+    const fs::path directory = fresh_directory();
+    const fs::path path = directory / "broken.json";
+    {
+        std::FILE* file = std::fopen(path.c_str(), "w");
+        ASSERT_NE(file, nullptr);
+        std::fputs("{\"fields\": [\"v\"", file);
+        std::fclose(file);
+    }
+    insitu_instrument* out = nullptr;
+    EXPECT_EQ(insitu_create_from_file(path.c_str(), &out), INSITU_ERROR_PARSE);
+    EXPECT_EQ(out, nullptr);
+    fs::remove_all(directory);
+}
+
+TEST(CApiCreate, MissingConfigurationFileFailsWithItsPath) {
+    insitu_instrument* out = nullptr;
+    EXPECT_EQ(insitu_create_from_file("/nonexistent/insitu.json", &out), INSITU_ERROR_IO);
+    EXPECT_EQ(out, nullptr);
+    EXPECT_TRUE(contains(insitu_last_error(), "/nonexistent/insitu.json")) << insitu_last_error();
+}
+
+TEST(CApiCreate, ArchiveThatCannotBeMadeIsAnIoError) {
+    const fs::path directory = fresh_directory();
+    // A regular file where the archive's parent folder should be.
+    const fs::path blocker = directory / "blocker";
+    {
+        std::FILE* file = std::fopen(blocker.c_str(), "w");
+        ASSERT_NE(file, nullptr);
+        std::fclose(file);
+    }
+    insitu_instrument* out = nullptr;
+    EXPECT_EQ(insitu_create_from_json(small_config(blocker / "run.cdb").c_str(), &out),
+              INSITU_ERROR_IO);
+    EXPECT_EQ(out, nullptr);
+    EXPECT_TRUE(contains(insitu_last_error(), (blocker / "run.cdb").string()))
+        << insitu_last_error();
+    fs::remove_all(directory);
+}
+
+TEST(CApiCreate, InvalidConfigurationValueIsAnError) {
+    const fs::path directory = fresh_directory();
+    std::string config = small_config(directory / "run.cdb");
+    config.replace(config.find("\"every\": 2"), 10, "\"every\": 0");
+    insitu_instrument* out = nullptr;
+    EXPECT_EQ(insitu_create_from_json(config.c_str(), &out), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_EQ(out, nullptr);
+    EXPECT_TRUE(contains(insitu_last_error(), "every")) << insitu_last_error();
+    fs::remove_all(directory);
+}
+
+// --- Calling order ---
+
+TEST_F(CApiTest, ExecuteAfterFinalizeIsAStateError) {
+    ASSERT_EQ(insitu_finalize(instrument_), INSITU_OK) << insitu_last_error();
+    ASSERT_EQ(set_ball(), INSITU_ERROR_STATE);
+    EXPECT_TRUE(contains(insitu_last_error(), "after insitu_finalize")) << insitu_last_error();
+    EXPECT_EQ(insitu_execute(instrument_, 2, 0.2), INSITU_ERROR_STATE);
+    EXPECT_TRUE(contains(insitu_last_error(), "step 2")) << insitu_last_error();
+    EXPECT_TRUE(contains(insitu_last_error(), "after insitu_finalize")) << insitu_last_error();
+    // A second finalize has nothing to drain and is harmless.
+    EXPECT_EQ(insitu_finalize(instrument_), INSITU_OK);
+}
+
+// The views handed over are only promised valid until execute returns, so a selected step
+// without a new insitu_set_field must not reuse the previous step's pointer.
+TEST_F(CApiTest, FieldsAreForgottenAfterExecute) {
+    ASSERT_EQ(set_ball(), INSITU_OK) << insitu_last_error();
+    ASSERT_EQ(insitu_execute(instrument_, 2, 0.2), INSITU_OK) << insitu_last_error();
+    EXPECT_EQ(insitu_execute(instrument_, 4, 0.4), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "field \"v\" missing")) << insitu_last_error();
+}
+
+TEST_F(CApiTest, DuplicateOrDecreasingStepIsAnInvalidArgument) {
+    ASSERT_EQ(set_ball(), INSITU_OK) << insitu_last_error();
+    ASSERT_EQ(insitu_execute(instrument_, 2, 0.2), INSITU_OK) << insitu_last_error();
+    ASSERT_EQ(set_ball(), INSITU_OK) << insitu_last_error();
+    EXPECT_EQ(insitu_execute(instrument_, 2, 0.2), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "step 2")) << insitu_last_error();
+    ASSERT_EQ(set_ball(), INSITU_OK) << insitu_last_error();
+    EXPECT_EQ(insitu_execute(instrument_, 1, 0.1), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "step 1")) << insitu_last_error();
+    // The run goes on, and what was written is kept.
+    ASSERT_EQ(set_ball(), INSITU_OK) << insitu_last_error();
+    EXPECT_EQ(insitu_execute(instrument_, 4, 0.4), INSITU_OK) << insitu_last_error();
+    EXPECT_EQ(insitu_finalize(instrument_), INSITU_OK) << insitu_last_error();
+    EXPECT_TRUE(fs::is_regular_file(archive_ / "proxies" / "step000002_view0.exr"));
+    EXPECT_TRUE(fs::is_regular_file(archive_ / "proxies" / "step000004_view0.exr"));
+}
+
+// --- Success ---
+
+TEST_F(CApiTest, SmallRunFollowsTheCadenceAndWritesAnArchive) {
+    for (std::int64_t step = 1; step <= 6; ++step) {
+        ASSERT_EQ(set_ball(), INSITU_OK) << insitu_last_error();
+        const int status = insitu_execute(instrument_, step, 0.1 * step);
+        // "every": 2 selects the even steps.
+        EXPECT_EQ(status, step % 2 == 0 ? INSITU_OK : INSITU_NOT_SELECTED)
+            << "step " << step << ": " << insitu_status_name(status) << ": " << insitu_last_error();
+    }
+    ASSERT_EQ(insitu_finalize(instrument_), INSITU_OK) << insitu_last_error();
+    EXPECT_TRUE(fs::is_regular_file(archive_ / "manifest.json"));
+    EXPECT_TRUE(fs::is_regular_file(archive_ / "data.csv"));
+}
+
+TEST_F(CApiTest, EveryScalarTypeIsAccepted) {
+    std::vector<std::uint8_t> u8(ball_.samples.size(), 1);
+    std::vector<std::uint16_t> u16(ball_.samples.size(), 1);
+    std::vector<std::int16_t> i16(ball_.samples.size(), 1);
+    std::vector<double> f64(ball_.samples.begin(), ball_.samples.end());
+    const std::vector<std::pair<int, const void*>> arrays = {{INSITU_UINT8, u8.data()},
+                                                             {INSITU_UINT16, u16.data()},
+                                                             {INSITU_INT16, i16.data()},
+                                                             {INSITU_FLOAT32, ball_.samples.data()},
+                                                             {INSITU_FLOAT64, f64.data()}};
+    for (const auto& [type, data] : arrays) {
+        EXPECT_EQ(insitu_set_field(instrument_, "v", data, type, ball_.dims, ball_.origin,
+                                   ball_.spacing, ball_.ghosts),
+                  INSITU_OK)
+            << "scalar_type " << type << ": " << insitu_last_error();
+    }
+}
+
+TEST(CApiDestroy, FinalizesAnUnfinalizedInstrument) {
+    const fs::path directory = fresh_directory();
+    const fs::path archive = directory / "run.cdb";
+    insitu_instrument* instrument = nullptr;
+    ASSERT_EQ(insitu_create_from_json(small_config(archive, 1).c_str(), &instrument), INSITU_OK)
+        << insitu_last_error();
+    BallField ball;
+    ASSERT_EQ(insitu_set_field(instrument, "v", ball.samples.data(), INSITU_FLOAT32, ball.dims,
+                               ball.origin, ball.spacing, ball.ghosts),
+              INSITU_OK)
+        << insitu_last_error();
+    ASSERT_EQ(insitu_execute(instrument, 1, 0.1), INSITU_OK) << insitu_last_error();
+    insitu_destroy(instrument);  // no finalize: destroy drains the writer
+    EXPECT_TRUE(fs::is_regular_file(archive / "manifest.json"));
+    fs::remove_all(directory);
+}
+
+// --- insitu_last_error and insitu_status_name ---
+
+TEST(CApiLastError, IsPerThread) {
+    EXPECT_EQ(insitu_execute(nullptr, 0, 0.0), INSITU_ERROR_INVALID_ARGUMENT);
+    std::string other_thread_message = "unset";
+    std::thread([&] { other_thread_message = insitu_last_error(); }).join();
+    EXPECT_EQ(other_thread_message, "");
+    EXPECT_TRUE(contains(insitu_last_error(), "instrument is NULL"));
+}
+
+TEST(CApiStatusName, NamesEveryCode) {
+    EXPECT_STREQ(insitu_status_name(INSITU_OK), "INSITU_OK");
+    EXPECT_STREQ(insitu_status_name(INSITU_NOT_SELECTED), "INSITU_NOT_SELECTED");
+    EXPECT_STREQ(insitu_status_name(INSITU_DROPPED), "INSITU_DROPPED");
+    EXPECT_STREQ(insitu_status_name(INSITU_ERROR_INVALID_ARGUMENT),
+                 "INSITU_ERROR_INVALID_ARGUMENT");
+    EXPECT_STREQ(insitu_status_name(INSITU_ERROR_PARSE), "INSITU_ERROR_PARSE");
+    EXPECT_STREQ(insitu_status_name(INSITU_ERROR_COMPUTE), "INSITU_ERROR_COMPUTE");
+    EXPECT_STREQ(insitu_status_name(INSITU_ERROR_IO), "INSITU_ERROR_IO");
+    EXPECT_STREQ(insitu_status_name(INSITU_ERROR_STATE), "INSITU_ERROR_STATE");
+    EXPECT_STREQ(insitu_status_name(INSITU_ERROR_UNKNOWN), "INSITU_ERROR_UNKNOWN");
+    EXPECT_STREQ(insitu_status_name(42), "INSITU_UNKNOWN_STATUS");
+}
+
+}  // namespace

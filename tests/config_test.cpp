@@ -1,0 +1,299 @@
+#include "insitu/config.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "insitu/error.hpp"
+
+namespace insitu {
+namespace {
+
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+using ::testing::UnorderedElementsAre;
+
+/// Parses `text`, expecting `ErrorType` whose message names every one of `parts`.
+template <typename ErrorType>
+void expect_error(const std::string& text, const std::vector<std::string>& parts) {
+    SCOPED_TRACE(text);
+    std::vector<std::string> unknown;
+    try {
+        InstrumentConfig::from_json_text(text, &unknown);
+        ADD_FAILURE() << "no exception for " << text;
+    } catch (const ErrorType& error) {
+        for (const std::string& part : parts) EXPECT_THAT(error.what(), HasSubstr(part));
+    } catch (const std::exception& error) {
+        ADD_FAILURE() << "wrong exception type: " << error.what();
+    }
+}
+
+TEST(InstrumentConfig, EmptyObjectGivesTheDocumentedDefaults) {
+    std::vector<std::string> unknown;
+    const InstrumentConfig config = InstrumentConfig::from_json_text("{}", &unknown);
+    EXPECT_TRUE(unknown.empty());
+    EXPECT_THAT(config.fields, ElementsAre("v"));
+    ASSERT_EQ(config.views.size(), 1u);
+    const OrbitView& orbit = config.views[0].orbit;
+    EXPECT_EQ(orbit.azimuth_deg, 30.0);
+    EXPECT_EQ(orbit.elevation_deg, 20.0);
+    EXPECT_EQ(orbit.projection, Projection::orthographic);
+    EXPECT_EQ(orbit.width, 512);
+    EXPECT_EQ(orbit.height, 512);
+    EXPECT_EQ(config.views[0].distortion_tilt_deg, 45.0);
+    EXPECT_EQ(config.transfer_function.value_min(), 0.0);
+    EXPECT_EQ(config.transfer_function.value_max(), 1.0);
+    EXPECT_TRUE(config.training_transfer_functions.empty());
+    EXPECT_FALSE(config.layers.has_value());  // "auto"
+    EXPECT_EQ(config.max_auto_layers, 4);
+    EXPECT_EQ(config.interval_count, 16);
+    EXPECT_EQ(config.interval_mode, IntervalMode::uniform);
+    EXPECT_TRUE(config.proxies.depth);
+    EXPECT_TRUE(config.proxies.distortion);
+    EXPECT_TRUE(config.proxies.attenuation);
+    EXPECT_FALSE(config.proxies.multi_attenuation);
+    EXPECT_FALSE(config.proxies.optical_depth);
+    EXPECT_EQ(config.step_voxels, 1.0);
+    EXPECT_EQ(config.every, 1);
+    EXPECT_TRUE(config.steps.empty());
+    EXPECT_EQ(config.archive, "run.cdb");
+    EXPECT_EQ(config.precision, StoragePrecision::half);
+    EXPECT_EQ(config.compression, "zip");
+    EXPECT_EQ(config.writer_queue, 4);
+    EXPECT_EQ(config.when_full, WhenFull::block);
+    EXPECT_FALSE(config.keep_training_images);
+}
+
+TEST(InstrumentConfig, ParsesTheIssueExample) {
+    const std::string text = R"({"fields": ["v"],
+        "views": [{"azimuth": 30, "elevation": 20, "camera": "perspective", "fov": 30,
+                   "size": [512, 256], "distortion_tilt": 40}],
+        "transfer_function": {"points": [[0.0, 0, 0, 1, 0], [1.0, 1, 0, 0, 0.5]],
+                              "unit_length": 1.0},
+        "training_transfer_functions": [{"points": [[0.0, 1, 1, 1, 0.1]]}],
+        "layers": "auto", "intervals": {"count": 8, "mode": "histogram"},
+        "proxies": ["depth", "distortion", "attenuation", "optical_depth"], "step": 0.5,
+        "every": 10, "archive": "run.cdb", "precision": "float", "compression": "piz",
+        "writer": {"queue": 2, "when_full": "drop"}, "keep_training_images": true})";
+    std::vector<std::string> unknown;
+    const InstrumentConfig config = InstrumentConfig::from_json_text(text, &unknown);
+    EXPECT_TRUE(unknown.empty());
+    const ViewConfig& view = config.views.at(0);
+    EXPECT_EQ(view.orbit.projection, Projection::perspective);
+    EXPECT_EQ(view.orbit.fov_y_deg, 30.0);
+    EXPECT_EQ(view.orbit.width, 512);
+    EXPECT_EQ(view.orbit.height, 256);
+    EXPECT_EQ(view.distortion_tilt_deg, 40.0);
+    ASSERT_EQ(config.training_transfer_functions.size(), 1u);
+    EXPECT_EQ(config.interval_count, 8);
+    EXPECT_EQ(config.interval_mode, IntervalMode::histogram_equalized);
+    EXPECT_TRUE(config.proxies.optical_depth);
+    EXPECT_FALSE(config.proxies.multi_attenuation);
+    EXPECT_EQ(config.step_voxels, 0.5);
+    EXPECT_EQ(config.every, 10);
+    EXPECT_EQ(config.precision, StoragePrecision::single);
+    EXPECT_EQ(config.compression, "piz");
+    EXPECT_EQ(config.writer_queue, 2);
+    EXPECT_EQ(config.when_full, WhenFull::drop);
+    EXPECT_TRUE(config.keep_training_images);
+}
+
+TEST(InstrumentConfig, ExplicitLayersAndProxyListReplaceTheDefaults) {
+    const InstrumentConfig config = InstrumentConfig::from_json_text(
+        R"({"layers": [0.25, 0.5], "proxies": ["multi_attenuation"]})", nullptr);
+    ASSERT_TRUE(config.layers.has_value());
+    EXPECT_THAT(*config.layers, ElementsAre(0.25, 0.5));
+    EXPECT_FALSE(config.proxies.depth);
+    EXPECT_FALSE(config.proxies.distortion);
+    EXPECT_FALSE(config.proxies.attenuation);
+    EXPECT_TRUE(config.proxies.multi_attenuation);
+}
+
+TEST(InstrumentConfig, UnknownKeysAreCollectedAsDottedPathsAtEveryLevel) {
+    std::vector<std::string> unknown;
+    const InstrumentConfig config = InstrumentConfig::from_json_text(
+        R"({"views": [{"azimuth": 10}, {"zoom": 2}], "writer": {"speed": "fast"},
+            "intervals": {"count": 4, "bins": 9}, "colour": 1,
+            "transfer_function": {"points": [[0, 0, 0, 0, 0]], "gamma": 2},
+            "training_transfer_functions": [{"points": [[0, 0, 0, 0, 0]], "name": "a"}]})",
+        &unknown);
+    EXPECT_THAT(unknown, UnorderedElementsAre("views[1].zoom", "writer.speed", "intervals.bins",
+                                              "colour", "transfer_function.gamma",
+                                              "training_transfer_functions[0].name"));
+    // The known keys beside them still count.
+    EXPECT_EQ(config.views.at(0).orbit.azimuth_deg, 10.0);
+    EXPECT_EQ(config.interval_count, 4);
+}
+
+TEST(InstrumentConfig, UnknownKeysRaiseWhenTheCallerDoesNotCollectThem) {
+    try {
+        InstrumentConfig::from_json_text(R"({"views": [{"zoom": 2}], "writer": {"speed": 1}})");
+        FAIL() << "unknown keys were silently ignored";
+    } catch (const ParseError& error) {
+        EXPECT_THAT(error.what(), HasSubstr("views[0].zoom"));
+        EXPECT_THAT(error.what(), HasSubstr("writer.speed"));
+    }
+}
+
+TEST(InstrumentConfig, EachInvalidValueIsNamedWithItsKey) {
+    expect_error<InvalidArgument>(R"({"every": 0})", {"every", "0"});
+    expect_error<InvalidArgument>(R"({"every": -3})", {"every", "-3"});
+    expect_error<ParseError>(R"({"every": "ten"})", {"every", "ten"});
+    expect_error<ParseError>(R"({"every": 2.5})", {"every", "2.5"});
+    expect_error<InvalidArgument>(R"({"every": 2, "steps": [1]})", {"every", "steps"});
+    expect_error<ParseError>(R"({"steps": [1, "x"]})", {"steps[1]", "x"});
+    expect_error<InvalidArgument>(R"({"precision": "double"})", {"precision", "double"});
+    expect_error<InvalidArgument>(R"({"intervals": {"count": 65}})", {"intervals.count", "65"});
+    expect_error<InvalidArgument>(R"({"intervals": {"count": 0}})", {"intervals.count", "0"});
+    expect_error<InvalidArgument>(R"({"intervals": {"mode": "log"}})", {"intervals.mode", "log"});
+    expect_error<InvalidArgument>(R"({"views": [{"size": [0, 512]}]})",
+                                  {"views[0].size", "[0, 512]"});
+    expect_error<ParseError>(R"({"views": [{"size": [512]}]})", {"views[0].size", "[512]"});
+    expect_error<InvalidArgument>(R"({"views": [{}, {"camera": "fisheye"}]})",
+                                  {"views[1].camera", "fisheye"});
+    expect_error<InvalidArgument>(R"({"views": [{"distortion_tilt": 90}]})",
+                                  {"views[0].distortion_tilt", "90"});
+    expect_error<InvalidArgument>(R"({"views": [{"elevation": 91}]})",
+                                  {"views[0].elevation", "91"});
+    expect_error<InvalidArgument>(R"({"views": [{"fov": 180}]})", {"views[0].fov", "180"});
+    expect_error<ParseError>(R"({"views": [{"azimuth": "north"}]})", {"views[0].azimuth", "north"});
+    expect_error<InvalidArgument>(R"({"views": []})", {"views", "[]"});
+    expect_error<InvalidArgument>(R"({"layers": "sometimes"})", {"layers", "sometimes"});
+    expect_error<ParseError>(R"({"layers": 3})", {"layers", "3"});
+    expect_error<ParseError>(R"({"layers": [0.5, "high"]})", {"layers[1]", "high"});
+    expect_error<InvalidArgument>(
+        R"({"layers": [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17]})",
+        {"layers", "17"});
+    expect_error<InvalidArgument>(R"({"max_layers": 0})", {"max_layers", "0"});
+    expect_error<InvalidArgument>(R"({"writer": {"when_full": "maybe"}})",
+                                  {"writer.when_full", "maybe"});
+    expect_error<InvalidArgument>(R"({"writer": {"queue": 0}})", {"writer.queue", "0"});
+    expect_error<InvalidArgument>(R"({"proxies": ["depth", "normals"]})",
+                                  {"proxies[1]", "normals"});
+    expect_error<ParseError>(R"({"proxies": "depth"})", {"proxies", "depth"});
+    expect_error<InvalidArgument>(R"({"step": 0})", {"step", "0"});
+    expect_error<InvalidArgument>(R"({"compression": "lzma"})", {"compression", "lzma"});
+    expect_error<InvalidArgument>(R"({"archive": ""})", {"archive"});
+    expect_error<InvalidArgument>(R"({"fields": []})", {"fields"});
+    expect_error<ParseError>(R"({"fields": "v"})", {"fields", "v"});
+    expect_error<ParseError>(R"({"keep_training_images": "yes"})", {"keep_training_images", "yes"});
+    // Transfer-function errors keep their type and gain the key they came from.
+    expect_error<InvalidArgument>(R"({"transfer_function": {"points": [[0, 2, 0, 0, 0]]}})",
+                                  {"transfer_function", "2"});
+    expect_error<ParseError>(R"({"training_transfer_functions": [{"points": 7}]})",
+                             {"training_transfer_functions[0]", "points"});
+    expect_error<ParseError>(R"([1, 2])", {"expected a JSON object"});
+    expect_error<ParseError>(R"({"every": )", {"malformed JSON"});
+}
+
+TEST(InstrumentConfig, ToJsonEmitsEveryKeyAndRoundTrips) {
+    const InstrumentConfig defaults;
+    const nlohmann::json json = defaults.to_json();
+    for (const char* key :
+         {"fields", "views", "transfer_function", "training_transfer_functions", "layers",
+          "max_layers", "intervals", "proxies", "step", "every", "archive", "precision",
+          "compression", "writer", "keep_training_images"}) {
+        EXPECT_TRUE(json.contains(key)) << key;
+    }
+    EXPECT_EQ(json["layers"], "auto");
+    EXPECT_EQ(json["proxies"], nlohmann::json({"depth", "distortion", "attenuation"}));
+
+    InstrumentConfig custom;
+    custom.fields = {"u", "v"};
+    ViewConfig second;
+    second.orbit.projection = Projection::perspective;
+    second.orbit.fov_y_deg = 25.0;
+    second.orbit.width = 64;
+    second.orbit.height = 32;
+    second.distortion_tilt_deg = 12.5;
+    custom.views.push_back(second);
+    custom.training_transfer_functions.push_back(
+        TransferFunction({{0.0, {1, 0, 0, 0.25f}}, {2.0, {0, 1, 0, 0.75f}}}, 0.5));
+    custom.layers = std::vector<double>{0.1, 0.7};
+    custom.interval_count = 7;
+    custom.interval_mode = IntervalMode::histogram_equalized;
+    custom.proxies.multi_attenuation = true;
+    custom.proxies.optical_depth = true;
+    custom.step_voxels = 0.25;
+    custom.steps = {3, 5, 8};
+    custom.archive = "elsewhere.cdb";
+    custom.precision = StoragePrecision::single;
+    custom.compression = "none";
+    custom.writer_queue = 9;
+    custom.when_full = WhenFull::drop;
+    custom.keep_training_images = true;
+
+    for (const InstrumentConfig& config : {defaults, custom}) {
+        std::vector<std::string> unknown;
+        const InstrumentConfig again = InstrumentConfig::from_json(config.to_json(), &unknown);
+        EXPECT_TRUE(unknown.empty());
+        EXPECT_EQ(again.to_json(), config.to_json());
+    }
+    const InstrumentConfig again = InstrumentConfig::from_json(custom.to_json());
+    EXPECT_THAT(again.steps, ElementsAre(3, 5, 8));
+    EXPECT_EQ(again.views.at(1).orbit.fov_y_deg, 25.0);
+    EXPECT_EQ(again.when_full, WhenFull::drop);
+}
+
+TEST(InstrumentConfig, SelectsEveryNthStepOrTheListedSteps) {
+    InstrumentConfig config;
+    config.every = 5;
+    EXPECT_TRUE(config.selects(0));
+    EXPECT_FALSE(config.selects(4));
+    EXPECT_TRUE(config.selects(5));
+    EXPECT_TRUE(config.selects(100));
+    EXPECT_FALSE(config.selects(101));
+    config.steps = {2, 7};  // a list replaces "every"
+    EXPECT_TRUE(config.selects(2));
+    EXPECT_TRUE(config.selects(7));
+    EXPECT_FALSE(config.selects(5));
+    EXPECT_FALSE(config.selects(0));
+}
+
+TEST(InstrumentConfig, ValidateNamesTheKeyOfAProgrammaticMistake) {
+    InstrumentConfig config;
+    config.views[0].orbit.width = 0;
+    try {
+        config.validate();
+        FAIL() << "size 0 accepted";
+    } catch (const InvalidArgument& error) {
+        EXPECT_THAT(error.what(), HasSubstr("views[0].size"));
+    }
+    config = InstrumentConfig{};
+    config.layers = std::vector<double>{0.5, std::nan("")};
+    EXPECT_THROW(config.validate(), InvalidArgument);
+    EXPECT_NO_THROW(InstrumentConfig{}.validate());
+}
+
+TEST(InstrumentConfig, FromFileNamesTheFile) {
+    const std::filesystem::path path =
+        std::filesystem::temp_directory_path() /
+        ("insitu_config_test_" + std::to_string(::getpid()) + ".json");
+    {
+        std::ofstream out(path);
+        out << R"({"every": 0})";
+    }
+    try {
+        InstrumentConfig::from_json_file(path.string());
+        FAIL() << "every = 0 accepted";
+    } catch (const InvalidArgument& error) {
+        EXPECT_THAT(error.what(), HasSubstr(path.string()));
+        EXPECT_THAT(error.what(), HasSubstr("every"));
+    }
+    {
+        std::ofstream out(path);
+        out << R"({"every": 3})";
+    }
+    EXPECT_EQ(InstrumentConfig::from_json_file(path.string()).every, 3);
+    std::filesystem::remove(path);
+    EXPECT_THROW(InstrumentConfig::from_json_file(path.string()), IoError);
+    EXPECT_THROW(InstrumentConfig::from_json_file(path.parent_path().string()), IoError);
+}
+
+}  // namespace
+}  // namespace insitu

@@ -1,0 +1,485 @@
+// insitu::Instrument end to end (issue 4): a small analytic field through execute() into an
+// archive that ArchiveReader opens; the cadence; every way a simulation can misuse it (execute
+// after finalize, duplicate or decreasing steps, a missing field) giving Status::error and leaving
+// the archive intact; the writer's drop policy; an unwritable archive path; a full disk in a
+// child process that must keep running; and flat memory over 1000 steps.
+#include "insitu/instrument.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <malloc.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "insitu/analytic_fields.hpp"
+#include "insitu/archive.hpp"
+#include "insitu/error.hpp"
+
+namespace insitu {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+
+// Gaussian blobs: values in [0, ~1], matching the configuration's transfer function domain.
+SampledVolume small_volume(std::int64_t n = 24) {
+    return make_gaussian_blobs({n, n, n}, 3, /*seed=*/7);
+}
+
+InstrumentConfig small_config(const fs::path& archive, int image = 32) {
+    InstrumentConfig config;
+    config.fields = {"f"};  // SampledVolume's default name
+    config.views[0].orbit.width = image;
+    config.views[0].orbit.height = image;
+    config.transfer_function =
+        TransferFunction({{0.0, {0, 0, 1, 0}}, {0.2, {0, 0, 1, 0}}, {1.0, {1, 0, 0, 0.5}}}, 1.0);
+    config.layers = std::vector<double>{0.3, 0.6};
+    config.interval_count = 4;
+    config.archive = archive.string();
+    return config;
+}
+
+InstrumentOptions quiet() {
+    InstrumentOptions options;
+    options.log = false;
+    return options;
+}
+
+class InstrumentTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        directory_ = fs::temp_directory_path() /
+                     ("insitu_instrument_test_" + std::to_string(::getpid()) + "_" +
+                      ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::remove_all(directory_);
+        fs::create_directories(directory_);
+    }
+    void TearDown() override { fs::remove_all(directory_); }
+
+    fs::path archive() const { return directory_ / "run.cdb"; }
+
+    fs::path directory_;
+    SampledVolume volume_ = small_volume();
+};
+
+TEST_F(InstrumentTest, WritesEveryNthStepIntoAnArchiveTheReaderOpens) {
+    InstrumentConfig config = small_config(archive());
+    config.every = 2;
+    Instrument instrument(config, quiet());
+    const Field field = volume_.field();
+    for (std::int64_t step = 0; step <= 6; ++step) {
+        const Status status = instrument.execute(step, 0.5 * step, {field});
+        EXPECT_EQ(status, step % 2 == 0 ? Status::ok : Status::not_selected)
+            << "step " << step << ": " << instrument.last_error();
+    }
+    EXPECT_EQ(instrument.finalize(), Status::ok) << instrument.last_error();
+    const InstrumentStatistics statistics = instrument.statistics();
+    EXPECT_EQ(statistics.steps_executed, 4) << statistics;
+    EXPECT_EQ(statistics.steps_written, 4) << statistics;
+    EXPECT_EQ(statistics.steps_dropped, 0) << statistics;
+    EXPECT_EQ(statistics.errors, 0) << statistics;
+    EXPECT_GT(statistics.bytes_written, 0u);
+    EXPECT_GT(statistics.compute_seconds, 0.0);
+    EXPECT_TRUE(instrument.last_error().empty());
+
+    const ArchiveReader reader(archive().string());
+    EXPECT_THAT(reader.steps(), ElementsAre(0, 2, 4, 6));
+    EXPECT_EQ(reader.view_count(), 1);
+    EXPECT_THAT(reader.verify(), ElementsAre());
+    EXPECT_EQ(reader.entry(4, 0).time, 2.0);
+
+    const ProxyFrame single = reader.load(4, 0);
+    EXPECT_FALSE(single.multi_perspective);
+    EXPECT_THAT(single.isovalues, ElementsAre(0.3, 0.6));
+    ASSERT_EQ(single.depth_layers.size(), 2u);
+    EXPECT_EQ(single.depth_layers[0].width, 32);
+    ASSERT_TRUE(single.intervals.has_value());
+    EXPECT_EQ(single.intervals->count(), 4);
+    EXPECT_EQ(single.attenuation.channels, 4);
+    EXPECT_EQ(single.mean_depth.channels, 4);
+    // Some rays cross the blobs' 0.3 isosurface: the proxies hold the data, not just the format.
+    const auto& depth = single.depth_layers[0].pixels;
+    EXPECT_TRUE(std::any_of(depth.begin(), depth.end(), [](float d) { return std::isfinite(d); }));
+
+    const ProxyFrame multi = reader.load(4, 0, /*multi_perspective=*/true);
+    EXPECT_TRUE(multi.multi_perspective);
+    EXPECT_DOUBLE_EQ(multi.distortion_tilt_deg, 45.0);
+    EXPECT_EQ(multi.depth_layers.size(), 2u);
+    EXPECT_EQ(multi.distortion_layers.size(), 2u);
+
+    const Image preview = reader.load_preview(4, 0);
+    EXPECT_EQ(preview.width, 32);
+    EXPECT_EQ(preview.height, 32);
+}
+
+TEST_F(InstrumentTest, AutoLayersAndIntervalsAreChosenFromTheData) {
+    InstrumentConfig config = small_config(archive());
+    config.layers.reset();
+    config.interval_mode = IntervalMode::histogram_equalized;
+    Instrument instrument(config, quiet());
+    ASSERT_EQ(instrument.execute(0, 0.0, {volume_.field()}), Status::ok) << instrument.last_error();
+    ASSERT_EQ(instrument.finalize(), Status::ok) << instrument.last_error();
+    const ProxyFrame frame = ArchiveReader(archive().string()).load(0, 0);
+    // The function's opacity rises to its end at 1.0; the blobs peak below it, so one layer sits
+    // where opacity reaches half its largest value over the data (insitu/layers.hpp).
+    EXPECT_FALSE(frame.isovalues.empty());
+    const ValueRange range = volume_.field().value_range();
+    ASSERT_TRUE(frame.intervals.has_value());
+    EXPECT_NEAR(frame.intervals->edges().front(), range.min, 1e-6);
+    EXPECT_NEAR(frame.intervals->edges().back(), range.max, 1e-6);
+}
+
+TEST_F(InstrumentTest, ExplicitStepListSelectsOnlyThoseSteps) {
+    InstrumentConfig config = small_config(archive(), 16);
+    config.steps = {1, 4};
+    config.proxies.distortion = false;
+    Instrument instrument(config, quiet());
+    std::vector<Status> statuses;
+    for (std::int64_t step = 0; step < 6; ++step) {
+        statuses.push_back(instrument.execute(step, step, {volume_.field()}));
+    }
+    EXPECT_THAT(statuses, ElementsAre(Status::not_selected, Status::ok, Status::not_selected,
+                                      Status::not_selected, Status::ok, Status::not_selected));
+    ASSERT_EQ(instrument.finalize(), Status::ok);
+    EXPECT_THAT(ArchiveReader(archive().string()).steps(), ElementsAre(1, 4));
+}
+
+TEST_F(InstrumentTest, ExecuteAfterFinalizeIsAnError) {
+    Instrument instrument(small_config(archive(), 16), quiet());
+    ASSERT_EQ(instrument.execute(0, 0.0, {volume_.field()}), Status::ok);
+    ASSERT_EQ(instrument.finalize(), Status::ok);
+    EXPECT_EQ(instrument.finalize(), Status::ok);  // a second finalize() does nothing
+    EXPECT_EQ(instrument.execute(1, 1.0, {volume_.field()}), Status::error);
+    EXPECT_THAT(instrument.last_error(), HasSubstr("after finalize"));
+    EXPECT_EQ(instrument.statistics().errors, 1);
+    EXPECT_THAT(ArchiveReader(archive().string()).steps(), ElementsAre(0));
+}
+
+TEST_F(InstrumentTest, DuplicateAndDecreasingStepsAreErrorsAndTheArchiveStaysIntact) {
+    Instrument instrument(small_config(archive(), 16), quiet());
+    ASSERT_EQ(instrument.execute(2, 0.2, {volume_.field()}), Status::ok);
+    EXPECT_EQ(instrument.execute(2, 0.2, {volume_.field()}), Status::error);
+    EXPECT_THAT(instrument.last_error(), HasSubstr("step 2"));
+    EXPECT_THAT(instrument.last_error(), HasSubstr("duplicate"));
+    EXPECT_EQ(instrument.execute(1, 0.1, {volume_.field()}), Status::error);
+    EXPECT_THAT(instrument.last_error(), HasSubstr("step 1"));
+    EXPECT_EQ(instrument.execute(3, 0.3, {volume_.field()}), Status::ok);  // the run goes on
+    ASSERT_EQ(instrument.finalize(), Status::ok);
+    const InstrumentStatistics statistics = instrument.statistics();
+    EXPECT_EQ(statistics.errors, 2);
+    EXPECT_EQ(statistics.steps_written, 2);
+
+    const ArchiveReader reader(archive().string());
+    EXPECT_THAT(reader.steps(), ElementsAre(2, 3));
+    EXPECT_THAT(reader.verify(), ElementsAre());
+    EXPECT_EQ(reader.entry(2, 0).time, 0.2);
+}
+
+TEST_F(InstrumentTest, ARestartContinuesTheArchiveAndRefusesStepsItHolds) {
+    {
+        Instrument first(small_config(archive(), 16), quiet());
+        ASSERT_EQ(first.execute(0, 0.0, {volume_.field()}), Status::ok);
+        ASSERT_EQ(first.execute(1, 1.0, {volume_.field()}), Status::ok);
+    }  // the destructor finalizes
+    Instrument second(small_config(archive(), 16), quiet());
+    EXPECT_EQ(second.execute(1, 1.0, {volume_.field()}), Status::error);
+    EXPECT_THAT(second.last_error(), HasSubstr("step 1"));
+    EXPECT_EQ(second.execute(2, 2.0, {volume_.field()}), Status::ok) << second.last_error();
+    ASSERT_EQ(second.finalize(), Status::ok) << second.last_error();
+    const ArchiveReader reader(archive().string());
+    EXPECT_THAT(reader.steps(), ElementsAre(0, 1, 2));
+    EXPECT_THAT(reader.verify(), ElementsAre());
+}
+
+TEST_F(InstrumentTest, MissingFieldIsAnErrorNamingIt) {
+    Instrument instrument(small_config(archive(), 16), quiet());
+    SampledVolume other = small_volume(8);
+    other.name = "pressure";
+    EXPECT_EQ(instrument.execute(0, 0.0, {other.field()}), Status::error);
+    EXPECT_THAT(instrument.last_error(), HasSubstr("\"f\""));
+    EXPECT_THAT(instrument.last_error(), HasSubstr("missing"));
+    EXPECT_THAT(instrument.last_error(), HasSubstr("pressure"));  // what it got instead
+    // Nothing was used up: the same step with the field goes through.
+    EXPECT_EQ(instrument.execute(0, 0.0, {other.field(), volume_.field()}), Status::ok);
+    ASSERT_EQ(instrument.finalize(), Status::ok);
+    EXPECT_THAT(ArchiveReader(archive().string()).steps(), ElementsAre(0));
+}
+
+TEST_F(InstrumentTest, AFieldTheRendererRefusesIsAnErrorAndTheRunGoesOn) {
+    Instrument instrument(small_config(archive(), 16), quiet());
+    const std::vector<float> flat(8 * 8, 0.5f);
+    const Field slab("f", flat.data(), ScalarType::float32, {8, 8, 1});  // one sample along z
+    EXPECT_EQ(instrument.execute(0, 0.0, {slab}), Status::error);
+    EXPECT_FALSE(instrument.last_error().empty());
+    EXPECT_EQ(instrument.execute(1, 1.0, {volume_.field()}), Status::ok);
+    ASSERT_EQ(instrument.finalize(), Status::ok);
+    EXPECT_THAT(ArchiveReader(archive().string()).steps(), ElementsAre(1));
+}
+
+TEST_F(InstrumentTest, RethrowErrorsLetsTheTypedExceptionOut) {
+    InstrumentOptions options = quiet();
+    options.rethrow_errors = true;
+    Instrument instrument(small_config(archive(), 16), options);
+    SampledVolume other = small_volume(8);
+    other.name = "pressure";
+    EXPECT_THROW(instrument.execute(0, 0.0, {other.field()}), InvalidArgument);
+    EXPECT_EQ(instrument.execute(0, 0.0, {volume_.field()}), Status::ok);
+    EXPECT_THROW(instrument.execute(0, 0.0, {volume_.field()}), InvalidArgument);
+    EXPECT_EQ(instrument.finalize(), Status::ok);
+    EXPECT_THROW(instrument.execute(1, 1.0, {volume_.field()}), Error);
+    EXPECT_EQ(instrument.statistics().errors, 3);
+}
+
+TEST_F(InstrumentTest, NonfiniteSamplesAreCountedAndWarnedAboutOnce) {
+    SampledVolume volume = small_volume(8);
+    volume.at(1, 2, 3) = std::numeric_limits<float>::quiet_NaN();
+    volume.at(4, 4, 4) = std::numeric_limits<float>::infinity();
+    InstrumentOptions options;
+    options.log = true;
+    ::testing::internal::CaptureStderr();
+    {
+        Instrument instrument(small_config(archive(), 8), options);
+        for (std::int64_t step = 0; step < 3; ++step) {
+            EXPECT_EQ(instrument.execute(step, 0.0, {volume.field()}), Status::ok);
+        }
+        ASSERT_EQ(instrument.finalize(), Status::ok);
+        EXPECT_EQ(instrument.statistics().nonfinite_samples, 6);
+    }
+    const std::string log = ::testing::internal::GetCapturedStderr();
+    std::size_t warnings = 0;
+    for (std::size_t at = log.find("NaN/Inf samples,"); at != std::string::npos;
+         at = log.find("NaN/Inf samples,", at + 1)) {
+        ++warnings;
+    }
+    EXPECT_EQ(warnings, 1u) << log;
+    EXPECT_THAT(log, HasSubstr("2 NaN/Inf"));
+}
+
+TEST_F(InstrumentTest, UnknownConfigurationKeysAreReportedByName) {
+    const nlohmann::json json = {{"fields", {"f"}},
+                                 {"views", {{{"size", {8, 8}}, {"zoom", 2}}}},
+                                 {"writer", {{"speed", "fast"}}},
+                                 {"archive", archive().string()}};
+    InstrumentOptions options;
+    ::testing::internal::CaptureStderr();
+    const auto instrument = Instrument::from_json_text(json.dump(), options);
+    const std::string log = ::testing::internal::GetCapturedStderr();
+    EXPECT_THAT(instrument->unknown_keys(), ElementsAre("views[0].zoom", "writer.speed"));
+    EXPECT_THAT(log, HasSubstr("views[0].zoom"));
+    EXPECT_THAT(log, HasSubstr("writer.speed"));
+    EXPECT_EQ(instrument->config().views.at(0).orbit.width, 8);
+}
+
+TEST_F(InstrumentTest, InvalidConfigurationIsRejectedAtConstruction) {
+    InstrumentConfig config = small_config(archive());
+    config.every = 0;
+    try {
+        Instrument instrument(config, quiet());
+        FAIL() << "every = 0 accepted";
+    } catch (const InvalidArgument& error) {
+        EXPECT_THAT(error.what(), HasSubstr("every"));
+    }
+    EXPECT_FALSE(fs::exists(archive()));  // nothing was created
+}
+
+TEST_F(InstrumentTest, UnwritableArchivePathThrowsIoError) {
+    // A path under a regular file cannot be created even by root (chmod would not stop root).
+    const fs::path file = directory_ / "a_file";
+    std::ofstream(file) << "not a directory";
+    try {
+        Instrument instrument(small_config(file / "run.cdb"), quiet());
+        FAIL() << "no error";
+    } catch (const IoError& error) {
+        EXPECT_THAT(error.what(), HasSubstr("a_file"));
+    }
+}
+
+TEST_F(InstrumentTest, DropPolicyCountsEveryStepItCannotQueue) {
+    InstrumentConfig config = small_config(archive(), 8);
+    config.writer_queue = 1;
+    config.when_full = WhenFull::drop;
+    config.proxies.distortion = false;
+    const SampledVolume volume = small_volume(8);
+    Instrument instrument(config, quiet());
+    // Computing an 8^3 field into 8x8 images takes well under a millisecond; each write syncs
+    // several files to disk, so the one-record queue is full for most steps. The loop runs on
+    // past the first drop only up to a bound, so a disk faster than the compute cannot hang it.
+    int executed = 0;
+    int dropped = 0;
+    while (executed < 60 || (dropped == 0 && executed < 5000)) {
+        const Status status = instrument.execute(executed, executed, {volume.field()});
+        ASSERT_TRUE(status == Status::ok || status == Status::dropped) << to_string(status);
+        dropped += status == Status::dropped ? 1 : 0;
+        ++executed;
+    }
+    ASSERT_EQ(instrument.finalize(), Status::ok) << instrument.last_error();
+    const InstrumentStatistics statistics = instrument.statistics();
+    EXPECT_EQ(statistics.steps_executed, executed);
+    EXPECT_GT(statistics.steps_dropped, 0) << statistics;
+    EXPECT_EQ(statistics.steps_dropped, dropped);
+    EXPECT_EQ(statistics.steps_written + statistics.steps_dropped, statistics.steps_executed)
+        << statistics;
+    EXPECT_EQ(statistics.blocked_seconds, 0.0);
+    EXPECT_EQ(static_cast<std::int64_t>(ArchiveReader(archive().string()).steps().size()),
+              statistics.steps_written);
+}
+
+TEST_F(InstrumentTest, BlockPolicyWritesEveryStep) {
+    InstrumentConfig config = small_config(archive(), 8);
+    config.writer_queue = 1;
+    config.proxies.distortion = false;
+    const SampledVolume volume = small_volume(8);
+    Instrument instrument(config, quiet());
+    constexpr int kSteps = 12;
+    for (int step = 0; step < kSteps; ++step) {
+        ASSERT_EQ(instrument.execute(step, step, {volume.field()}), Status::ok);
+    }
+    ASSERT_EQ(instrument.finalize(), Status::ok) << instrument.last_error();
+    const InstrumentStatistics statistics = instrument.statistics();
+    EXPECT_EQ(statistics.steps_written, kSteps) << statistics;
+    EXPECT_EQ(statistics.steps_dropped, 0);
+    EXPECT_GE(statistics.blocked_seconds, 0.0);
+    EXPECT_EQ(ArchiveReader(archive().string()).steps().size(), static_cast<std::size_t>(kSteps));
+}
+
+// The child of the disk-full test: three steps written, then RLIMIT_FSIZE below the files the
+// archive writes (write() fails with EFBIG, SIGXFSZ ignored), three more steps. Exits 0 when
+// the simulation side saw what it should: execute() kept returning ok, finalize() reported the
+// failure, nothing was counted as written that was not.
+[[noreturn]] void run_into_full_disk(const std::string& archive) {
+    auto give_up = [](const std::string& why) {
+        std::cerr << "child: " << why << std::endl;
+        std::_Exit(1);
+    };
+    std::signal(SIGXFSZ, SIG_IGN);
+    const SampledVolume volume = small_volume(8);
+    InstrumentConfig config = small_config(archive, 32);
+    config.compression = "none";    // so that each EXR surely exceeds the limit below (~28 KB)
+    Instrument instrument(config);  // logging on: the parent counts the lines
+    for (int step = 0; step < 3; ++step) {
+        if (instrument.execute(step, step, {volume.field()}) != Status::ok) give_up("first steps");
+    }
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (instrument.statistics().steps_written < 3) {
+        if (std::chrono::steady_clock::now() > deadline) give_up("first steps never written");
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    // Bytes. Below every EXR (and the manifest), above this child's whole stderr, which gtest
+    // sends to a file that the limit caps too.
+    const rlimit limit{8192, 8192};
+    if (::setrlimit(RLIMIT_FSIZE, &limit) != 0) give_up("setrlimit failed");
+    for (int step = 3; step < 6; ++step) {
+        if (instrument.execute(step, step, {volume.field()}) != Status::ok) give_up("late steps");
+    }
+    if (instrument.finalize() != Status::error) give_up("finalize did not report the failure");
+    const InstrumentStatistics statistics = instrument.statistics();
+    if (statistics.steps_written != 3 || statistics.errors != 3) {
+        std::ostringstream text;
+        text << "statistics: " << statistics;
+        give_up(text.str());
+    }
+    if (instrument.last_error().find("writing step 5") == std::string::npos) {
+        give_up("last_error: " + instrument.last_error());
+    }
+    std::cerr << "child: simulation finished" << std::endl;
+    std::_Exit(0);
+}
+
+std::size_t count_of(const std::string& text, const std::string& part) {
+    std::size_t count = 0;
+    for (std::size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) {
+        ++count;
+    }
+    return count;
+}
+
+TEST(InstrumentDeathTest, FullDiskKeepsTheSimulationRunningAndTheArchiveReadable) {
+    // "threadsafe" re-executes this binary for the child, so it starts without the parent's
+    // OpenCL runtime threads (which a plain fork would leave behind, dead, in the child).
+    GTEST_FLAG_SET(death_test_style, "threadsafe");
+    // The child re-runs this body up to EXPECT_EXIT, so the path must not depend on the pid.
+    const fs::path archive = fs::path(::testing::TempDir()) / "insitu_instrument_full_disk.cdb";
+    fs::remove_all(archive);
+    EXPECT_EXIT(run_into_full_disk(archive.string()), ::testing::ExitedWithCode(0),
+                ::testing::Truly([](const std::string& log) {
+                    // Reported once (the finalize summary repeats it as "last error") and the
+                    // simulation got to its end.
+                    return count_of(log, "insitu: error:") == 1 &&
+                           count_of(log, "child: simulation finished") == 1;
+                }));
+    const ArchiveReader reader(archive.string());
+    EXPECT_THAT(reader.steps(), ElementsAre(0, 1, 2));
+    EXPECT_THAT(reader.verify(), ElementsAre());
+    EXPECT_EQ(reader.load_preview(2, 0).width, 32);
+    fs::remove_all(archive);
+}
+
+/// Resident set size in bytes, from /proc/self/statm (second field, in pages), after handing
+/// free heap pages back to the system so that only live memory counts.
+std::int64_t resident_bytes() {
+    ::malloc_trim(0);
+    std::ifstream statm("/proc/self/statm");
+    std::int64_t size_pages = 0;
+    std::int64_t resident_pages = 0;
+    statm >> size_pages >> resident_pages;
+    return resident_pages * static_cast<std::int64_t>(::sysconf(_SC_PAGESIZE));
+}
+
+TEST_F(InstrumentTest, ThousandStepsHoldNoMemoryPerStepBeyondTheArchiveIndex) {
+    // How this is checked: resident memory (/proc/self/statm, after malloc_trim so that only live
+    // heap counts) after step 100, once buffers, kernels and the writer have reached their steady
+    // state, against after step 1000. Everything execute() allocates per step (the staging copy,
+    // proxy images, preview, StepRecord) must be released or reused. What does grow, by design of
+    // the archive, is its index: the writer keeps manifest.json's per-step entries in memory
+    // (measured: about 6.5 KiB of live JSON per step with one view and both frames, 0.7 KiB of
+    // text on disk). So the bound is 10 KiB per step: a leaked record of these 32x32 views (about
+    // 70 KiB: 14 float planes plus the RGBA preview) or staging copy would exceed it many times.
+    const fs::path shm("/dev/shm");
+    // tmpfs makes the thousands of fsyncs free; the archive's pages are not this process's RSS.
+    const fs::path root = fs::is_directory(shm) ? shm : directory_;
+    const fs::path path = root / ("insitu_instrument_flat_" + std::to_string(::getpid()));
+    fs::remove_all(path);
+    const InstrumentConfig config = small_config(path / "run.cdb", 32);
+    const SampledVolume volume = small_volume(8);
+    {
+        Instrument instrument(config, quiet());
+        std::int64_t after_100 = 0;
+        for (int step = 1; step <= 1000; ++step) {
+            ASSERT_EQ(instrument.execute(step, step, {volume.field()}), Status::ok)
+                << instrument.last_error();
+            if (step == 100) after_100 = resident_bytes();
+        }
+        const std::int64_t after_1000 = resident_bytes();
+        ASSERT_EQ(instrument.finalize(), Status::ok) << instrument.last_error();
+        EXPECT_EQ(instrument.statistics().steps_written, 1000);
+        constexpr std::int64_t kBoundBytesPerStep = 10 << 10;
+        const std::int64_t growth = after_1000 - after_100;
+        EXPECT_LT(growth, 900 * kBoundBytesPerStep)
+            << "resident after step 100: " << after_100 << " bytes, after 1000: " << after_1000;
+        std::cout << "[ memory   ] resident after step 100: " << after_100 / 1024
+                  << " KiB, after step 1000: " << after_1000 / 1024 << " KiB (" << growth / 900
+                  << " bytes per step; manifest.json "
+                  << fs::file_size(path / "run.cdb" / "manifest.json") / 1024 << " KiB)\n";
+    }
+    fs::remove_all(path);
+}
+
+}  // namespace
+}  // namespace insitu
