@@ -11,6 +11,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "expect_error.hpp"
+
 #include "insitu/error.hpp"
 
 namespace insitu {
@@ -21,12 +23,7 @@ using ::testing::HasSubstr;
 
 template <typename Function>
 void expect_compute_error_naming(Function&& function, const std::string& expected_text) {
-    try {
-        function();
-        ADD_FAILURE() << "no exception; expected a ComputeError naming \"" << expected_text << "\"";
-    } catch (const ComputeError& error) {
-        EXPECT_THAT(error.what(), HasSubstr(expected_text));
-    }
+    insitu::testing::expect_error_naming<ComputeError>(function, expected_text);
 }
 
 TEST(ComputeDevice, SharedDeviceExistsAndDescribesItself) {

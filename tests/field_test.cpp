@@ -14,6 +14,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "expect_error.hpp"
 #include "insitu/error.hpp"
 
 namespace insitu {
@@ -29,15 +30,7 @@ double code(std::int64_t i, std::int64_t j, std::int64_t k) {
     return static_cast<double>(i + 10 * j + 100 * k);
 }
 
-template <typename ErrorType, typename Function>
-void expect_error_naming(Function&& function, const std::string& expected_text) {
-    try {
-        function();
-        ADD_FAILURE() << "no exception; expected one naming \"" << expected_text << "\"";
-    } catch (const ErrorType& error) {
-        EXPECT_THAT(error.what(), HasSubstr(expected_text));
-    }
-}
+using insitu::testing::expect_error_naming;
 
 TEST(Field, ScalarTypesHaveSizesAndNamesThatRoundTrip) {
     EXPECT_EQ(scalar_size_bytes(ScalarType::uint8), 1u);

@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "expect_error.hpp"
 #include "insitu/error.hpp"
 
 namespace insitu {
@@ -35,15 +36,7 @@ void expect_rgba_near(glm::vec4 actual, glm::vec4 expected, const std::string& w
     }
 }
 
-template <typename ErrorType, typename Function>
-void expect_error_naming(Function&& function, const std::string& expected_text) {
-    try {
-        function();
-        ADD_FAILURE() << "no exception; expected one naming \"" << expected_text << "\"";
-    } catch (const ErrorType& error) {
-        EXPECT_THAT(error.what(), HasSubstr(expected_text));
-    }
-}
+using insitu::testing::expect_error_naming;
 
 // Three points over [-1, 3] with unequal segment lengths.
 TransferFunction three_points() {

@@ -583,29 +583,31 @@ ArchiveWriter::ArchiveWriter(const InstrumentConfig& config)
     }
 
     nlohmann::json configuration = config_.to_json();
+    nlohmann::json manifest;
     if (fs::exists(archive / af::kManifestFile)) {
         // A restarted run appends. A corrupt manifest throws here and is never overwritten.
-        manifest_ = af::read_manifest(path_);
-        if (manifest_.at("configuration") != configuration) {
-            manifest_["previous_configurations"].push_back(manifest_.at("configuration"));
+        manifest = af::read_manifest(path_);
+        if (manifest.at("configuration") != configuration) {
+            manifest["previous_configurations"].push_back(manifest.at("configuration"));
         }
     } else {
-        manifest_ = {{"schema_version", kArchiveSchemaVersion}, {"steps", nlohmann::json::array()}};
+        manifest = {{"schema_version", kArchiveSchemaVersion}, {"steps", nlohmann::json::array()}};
     }
-    manifest_["producer"] = std::string("libinsitu ") + INSITU_VERSION;
-    manifest_["configuration"] = std::move(configuration);
+    manifest["producer"] = std::string("libinsitu ") + INSITU_VERSION;
+    manifest["configuration"] = std::move(configuration);
     remove_leftover_temp_files(archive);
     // Writing both indexes now makes a fresh archive open (with no steps), catches an unwritable
     // directory at start-up, and brings a data.csv a crash left one step behind up to date.
-    write_file_atomically(archive / af::kManifestFile, manifest_text(manifest_));
-    write_file_atomically(archive / af::kCsvFile, data_csv(manifest_));
+    write_file_atomically(archive / af::kManifestFile, manifest_text(manifest));
+    write_file_atomically(archive / af::kCsvFile, data_csv(manifest));
+    for (const nlohmann::json& entry : manifest.at("steps")) {
+        steps_.push_back(entry.at("step").get<std::int64_t>());
+    }
+    std::sort(steps_.begin(), steps_.end());
 }
 
 bool ArchiveWriter::contains(std::int64_t step) const {
-    for (const nlohmann::json& entry : manifest_.at("steps")) {
-        if (entry.at("step").get<std::int64_t>() == step) return true;
-    }
-    return false;
+    return std::binary_search(steps_.begin(), steps_.end(), step);
 }
 
 StepWriteResult ArchiveWriter::write(const StepRecord& record) {
@@ -638,7 +640,9 @@ StepWriteResult ArchiveWriter::write(const StepRecord& record) {
                    file_entry(result.files.back(), af::kPreviewKind)}}});
         }
 
-        nlohmann::json manifest = manifest_;
+        // Read back rather than kept: memory stays flat over a long run (the file is ours,
+        // written by this writer, and validated again on the way in).
+        nlohmann::json manifest = af::read_manifest(path_);
         nlohmann::json& steps = manifest["steps"];
         const auto position = std::find_if(steps.begin(), steps.end(), [&](const auto& entry) {
             return entry.at("step").template get<std::int64_t>() > record.step;
@@ -646,9 +650,9 @@ StepWriteResult ArchiveWriter::write(const StepRecord& record) {
         steps.insert(position, std::move(step_entry));
         write_file_atomically(archive / af::kManifestFile, manifest_text(manifest));
         // From here the step is in the archive, whatever happens to data.csv.
-        manifest_ = std::move(manifest);
+        steps_.insert(std::upper_bound(steps_.begin(), steps_.end(), record.step), record.step);
         indexed = true;
-        write_file_atomically(archive / af::kCsvFile, data_csv(manifest_));
+        write_file_atomically(archive / af::kCsvFile, data_csv(manifest));
     } catch (...) {
         if (!indexed) {
             // Nothing names these files; remove them so the archive is as it was (best effort,

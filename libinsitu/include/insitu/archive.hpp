@@ -90,7 +90,9 @@ public:
 private:
     std::string path_;
     InstrumentConfig config_;
-    nlohmann::json manifest_;
+    /// The manifest lives on disk and is read back for each write, so a long run's memory stays
+    /// flat; only the step numbers (sorted) are kept, for contains().
+    std::vector<std::int64_t> steps_;
 };
 
 /// What the reader can load of one view at one step.
