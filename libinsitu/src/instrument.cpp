@@ -205,7 +205,12 @@ StepRecord Instrument::Impl::compute(std::int64_t step, double time, const Field
     single.attenuation = config.proxies.attenuation;
     single.mean_depth = config.proxies.attenuation;
     single.optical_depth = config.proxies.optical_depth;
-    single.training_transfer_functions = config.training_transfer_functions;
+    // Training renderings are stored only on request ("keep_training_images"). Nothing in situ
+    // consumes them yet (the colour model that will arrives with the exploration work), so
+    // unkept ones are not rendered at all rather than rendered and thrown away.
+    if (config.keep_training_images) {
+        single.training_transfer_functions = config.training_transfer_functions;
+    }
     const bool wants_single = single.depth_layers || single.attenuation || single.optical_depth ||
                               !single.training_transfer_functions.empty();
 
@@ -231,7 +236,7 @@ StepRecord Instrument::Impl::compute(std::int64_t step, double time, const Field
         out.view_index = static_cast<int>(v);
         out.view = view;
         out.transfer_function = config.transfer_function;
-        out.training_transfer_functions = config.training_transfer_functions;
+        out.training_transfer_functions = single.training_transfer_functions;
         const Camera camera = Camera::orbit(view.orbit, volume.bounds);
         if (wants_single) out.single = renderer->render(camera, single);
         if (wants_multi) {
