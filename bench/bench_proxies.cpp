@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "gray_scott_simulation.hpp"
+#include "sample_count.hpp"
 #include "insitu/analytic_fields.hpp"
 #include "insitu/proxy_renderer.hpp"
 
@@ -84,33 +85,6 @@ void report(const char* label, double ms, double reference_ms) {
     std::printf("  %-46s %9.1f ms  %6.2fx the ground truth\n", label, ms, ms / reference_ms);
 }
 
-// Samples the marcher takes along a ray when it never stops early: t_near + (i + 0.5) step
-// while t < t_far (insitu/volume_renderer.hpp), counted on the host, not assumed.
-std::int64_t samples_along(const Ray& ray, const Bounds& box, double step) {
-    double t_near = 0.0;
-    double t_far = std::numeric_limits<double>::infinity();
-    for (int axis = 0; axis < 3; ++axis) {
-        const double inverse = 1.0 / ray.direction[axis];
-        double t0 = (box.lower[axis] - ray.origin[axis]) * inverse;
-        double t1 = (box.upper[axis] - ray.origin[axis]) * inverse;
-        if (t0 > t1) std::swap(t0, t1);
-        t_near = std::max(t_near, t0);
-        t_far = std::min(t_far, t1);
-    }
-    if (!(t_near <= t_far)) return 0;
-    return static_cast<std::int64_t>(std::ceil((t_far - t_near) / step - 0.5));
-}
-
-template <typename AnyCamera>
-std::int64_t samples_per_frame(const AnyCamera& camera, int width, int height, const Bounds& box,
-                               double step) {
-    std::int64_t total = 0;
-    for (int y = 0; y < height; ++y) {
-        for (int x = 0; x < width; ++x) total += samples_along(camera.ray(x + 0.5, y + 0.5), box, step);
-    }
-    return total;
-}
-
 void run_scene(const char* name, const SampledVolume& volume, const TransferFunction& tf,
                const Options& options) {
     ProxyRenderer proxies;
@@ -135,8 +109,8 @@ void run_scene(const char* name, const SampledVolume& volume, const TransferFunc
                 static_cast<long long>(volume.dims[2]), options.image, options.image);
     const Bounds& box = proxies.volume().bounds;
     const double step = proxies.volume().step_world(1.0);
-    const std::int64_t single_samples = samples_per_frame(camera, view.width, view.height, box, step);
-    const std::int64_t multi_samples = samples_per_frame(distortion, view.width, view.height, box, step);
+    const std::uint64_t single_samples = bench::samples_per_frame(camera, view.width, view.height, box, step);
+    const std::uint64_t multi_samples = bench::samples_per_frame(distortion, view.width, view.height, box, step);
     std::printf("  %-46s %9.1f ms  %7.1f Msamples/s\n", "ground truth, unshaded, no early termination",
                 truth_ms, single_samples / truth_ms / 1e3);
 
@@ -167,7 +141,7 @@ void run_scene(const char* name, const SampledVolume& volume, const TransferFunc
         const double plain = time_request(multi, false, 2.0);
         const double exact_stop = time_request(multi, false, 1.0);
         const double skipping = time_request(multi, true, 1.0);
-        const std::int64_t samples = multi ? multi_samples : single_samples;
+        const std::uint64_t samples = multi ? multi_samples : single_samples;
         std::printf("  %s: %.1f M samples per frame (%.2fx the ground truth's), %.1f Msamples/s\n",
                     which, samples / 1e6, static_cast<double>(samples) / single_samples,
                     samples / plain / 1e3);

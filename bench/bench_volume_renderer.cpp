@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "sample_count.hpp"
 #include "insitu/analytic_fields.hpp"
 #include "insitu/camera.hpp"
 #include "insitu/error.hpp"
@@ -111,33 +112,6 @@ BenchOptions parse_options(int argc, char** argv) {
     return options;
 }
 
-/// Samples per frame, counted ray by ray with the renderer's rule: the ray is clipped to the
-/// box (slab test, t_near >= 0) and sample i sits at t_near + (i + 0.5) * step while t < t_far.
-std::uint64_t count_samples(const insitu::Camera& camera, const insitu::Bounds& box,
-                            double step_world) {
-    std::uint64_t total = 0;
-    for (int y = 0; y < camera.height(); ++y) {
-        for (int x = 0; x < camera.width(); ++x) {
-            const insitu::Ray ray = camera.ray(x + 0.5, y + 0.5);
-            double t_near = 0.0;
-            double t_far = INFINITY;
-            for (int axis = 0; axis < 3; ++axis) {
-                // 1/0 = +-inf gives the right slab for axis-parallel rays, as in the kernel.
-                const double inverse = 1.0 / ray.direction[axis];
-                const double t0 = (box.lower[axis] - ray.origin[axis]) * inverse;
-                const double t1 = (box.upper[axis] - ray.origin[axis]) * inverse;
-                t_near = std::max(t_near, std::min(t0, t1));
-                t_far = std::min(t_far, std::max(t0, t1));
-            }
-            if (!(t_near <= t_far)) continue;
-            // i + 0.5 < (t_far - t_near) / step  <=>  i < span_steps - 0.5
-            const double span_steps = (t_far - t_near) / step_world;
-            total += static_cast<std::uint64_t>(std::max(0.0, std::ceil(span_steps - 0.5)));
-        }
-    }
-    return total;
-}
-
 struct Timing {
     double median_ms = 0.0;
     double min_ms = 0.0;
@@ -212,9 +186,11 @@ int run(const BenchOptions& options) {
     const insitu::Camera reference_camera = insitu::Camera::orbit(reference_view, field.bounds());
 
     const double step_world = renderer.volume().step_world(options.step_voxels);
-    const std::uint64_t samples = count_samples(camera, field.bounds(), step_world);
+    const std::uint64_t samples = insitu::bench::samples_per_frame(camera, camera.width(), camera.height(),
+                                          field.bounds(), step_world);
     const std::uint64_t reference_samples =
-        count_samples(reference_camera, field.bounds(), step_world);
+        insitu::bench::samples_per_frame(reference_camera, reference_camera.width(),
+                                         reference_camera.height(), field.bounds(), step_world);
 
     std::printf("device:    %s\n", renderer.device()->description().c_str());
     std::printf("volume:    Marschner-Lobb %lld^3 float32 (made in %.1f s, uploaded in %.1f ms)\n",
