@@ -298,13 +298,18 @@ Camera camera_from_json(const nlohmann::json& json, const PartContext& where) {
         // Orthographic: the smaller half side is the bounding radius and the camera plane
         // touches the sphere. Perspective: only the eye matters; any radius works, at the
         // distance where that sphere fits the smaller field of view (camera.cpp).
+        // Archives record the orbit's sphere (so a new view orbits the same centre); without
+        // it the perspective centre is unknown and any point on the view axis stands in.
         double radius = 1.0, distance = 1.0;
         if (view.projection == Projection::orthographic) {
             radius = distance = std::min(half_width, half_height);
         } else {
+            if (json.contains("orbit_radius")) radius = json.at("orbit_radius").get<double>();
             distance = radius / std::sin(std::atan(std::min(half_width, half_height)));
         }
-        const glm::dvec3 center = position + distance * forward;
+        const glm::dvec3 center = json.contains("orbit_center")
+                                      ? vec_from_json(json.at("orbit_center"))
+                                      : position + distance * forward;
         const glm::dvec3 half_extent(radius / std::sqrt(3.0));
         const Camera camera =
             Camera::orbit(view, Bounds{center - half_extent, center + half_extent});

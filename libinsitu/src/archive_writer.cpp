@@ -209,21 +209,19 @@ nlohmann::json vec_json(const glm::dvec3& v) {
 /// they describe exactly this camera, e.g. the orthographic base of a distortion camera) and its
 /// vectors. The reader rebuilds the Camera from both and checks they agree.
 nlohmann::json camera_json(const Camera& camera) {
-    const glm::dvec3 right = camera.right();
-    const glm::dvec3 towards_camera = -camera.forward();
-    // right = (cos az, 0, -sin az) and towards = (sin az cos el, sin el, cos az cos el)
-    // (DESIGN.md "Conventions"); right stays defined at the poles, where towards loses az.
     nlohmann::json json{
         {"projection", to_string(camera.projection())},
-        {"azimuth", glm::degrees(std::atan2(-right.z, right.x))},
-        {"elevation", glm::degrees(std::asin(std::clamp(towards_camera.y, -1.0, 1.0)))},
+        {"azimuth", camera.azimuth_deg()},
+        {"elevation", camera.elevation_deg()},
         {"size", {camera.width(), camera.height()}},
         {"position", vec_json(camera.position())},
         {"forward", vec_json(camera.forward())},
         {"right", vec_json(camera.right())},
         {"up", vec_json(camera.up())},
         {"half_width", camera.half_width()},
-        {"half_height", camera.half_height()}};
+        {"half_height", camera.half_height()},
+        {"orbit_center", vec_json(camera.orbit_center())},
+        {"orbit_radius", camera.orbit_radius()}};
     if (camera.projection() == Projection::perspective) {
         json["fov"] = glm::degrees(2.0 * std::atan(camera.half_height()));
     }

@@ -51,6 +51,9 @@ Camera Camera::orbit(const OrbitView& view, const Bounds& bounds) {
 
     // A degenerate (single-sample) field still gets a usable camera.
     const double radius = std::max(bounds.radius(), 1e-6);
+    camera.orbit_center_ = bounds.center();
+    camera.orbit_radius_ = radius;
+    camera.fov_y_deg_ = view.fov_y_deg;
     const double aspect = static_cast<double>(view.width) / view.height;
     if (view.projection == Projection::orthographic) {
         // The smaller image side spans the bounding sphere's diameter.
@@ -98,6 +101,28 @@ glm::dvec2 Camera::project(const glm::dvec3& point_world) const {
         v /= depth;
     }
     return {(u / half_width_ + 1.0) * 0.5 * width_, (1.0 - v / half_height_) * 0.5 * height_};
+}
+
+Camera Camera::reorbit(double azimuth_deg, double elevation_deg) const {
+    OrbitView view;
+    view.azimuth_deg = azimuth_deg;
+    view.elevation_deg = elevation_deg;
+    view.projection = projection_;
+    view.fov_y_deg = fov_y_deg_;
+    view.width = width_;
+    view.height = height_;
+    // A cube whose bounding sphere is the orbit's sphere reproduces centre and radius exactly.
+    const glm::dvec3 half_extent(orbit_radius_ / std::sqrt(3.0));
+    return orbit(view, Bounds{orbit_center_ - half_extent, orbit_center_ + half_extent});
+}
+
+double Camera::azimuth_deg() const {
+    // right = (cos az, 0, -sin az) stays defined at the poles, where forward loses az.
+    return glm::degrees(std::atan2(-right_.z, right_.x));
+}
+
+double Camera::elevation_deg() const {
+    return glm::degrees(std::asin(std::clamp(-forward_.y, -1.0, 1.0)));
 }
 
 std::ostream& operator<<(std::ostream& out, const Camera& camera) {

@@ -70,6 +70,16 @@ public:
     /// Image position (pixels) of a world point; perspective requires depth_of(point) > 0.
     glm::dvec2 project(const glm::dvec3& point_world) const;
 
+    /// Centre and radius (world units) of the bounding sphere the orbit camera frames.
+    glm::dvec3 orbit_center() const { return orbit_center_; }
+    double orbit_radius() const { return orbit_radius_; }
+    /// The same orbit (centre, radius, projection, field of view, image size) seen from other
+    /// angles in degrees: how exploration names a new view of a stored one.
+    Camera reorbit(double azimuth_deg, double elevation_deg) const;
+    /// Orbit angles (degrees) of this camera's view direction (DESIGN.md "Conventions").
+    double azimuth_deg() const;
+    double elevation_deg() const;
+
 private:
     Projection projection_ = Projection::orthographic;
     int width_ = 1;
@@ -80,6 +90,9 @@ private:
     glm::dvec3 up_{0.0, 1.0, 0.0};
     double half_height_ = 1.0;
     double half_width_ = 1.0;
+    glm::dvec3 orbit_center_{0.0};
+    double orbit_radius_ = 1.0;
+    double fov_y_deg_ = 30.0;
 };
 
 std::ostream& operator<<(std::ostream& out, const Camera& camera);

@@ -1,0 +1,1 @@
+// colour_model kernels (placeholder)

@@ -1,0 +1,1 @@
+// enhancement kernels (placeholder)

@@ -1,0 +1,1 @@
+// relighting kernels (placeholder)

@@ -1,0 +1,1 @@
+// transfer_function_edit kernels (placeholder)

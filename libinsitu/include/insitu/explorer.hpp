@@ -1,0 +1,2 @@
+#pragma once
+// placeholder: the Explorer facade (written next)

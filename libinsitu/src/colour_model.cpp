@@ -1,0 +1,1 @@
+#include "insitu/colour_model.hpp"

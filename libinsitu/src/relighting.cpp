@@ -1,0 +1,1 @@
+#include "insitu/relighting.hpp"

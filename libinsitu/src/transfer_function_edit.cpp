@@ -1,0 +1,1 @@
+#include "insitu/transfer_function_edit.hpp"

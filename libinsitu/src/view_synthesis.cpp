@@ -1,0 +1,1 @@
+#include "insitu/view_synthesis.hpp"

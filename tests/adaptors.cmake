@@ -1,0 +1,1 @@
+# Tests of the VTK and OpenVDB adaptors and insitu-capture (placeholder)

@@ -1,0 +1,1 @@
+#include "insitu/explorer.hpp"
