@@ -7,6 +7,7 @@
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfIntAttribute.h>
 #include <OpenEXR/ImfMultiPartInputFile.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <gmock/gmock.h>
@@ -27,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "expect_error.hpp"
 #include "insitu/analytic_fields.hpp"
 #include "insitu/distortion_camera.hpp"
 #include "insitu/error.hpp"
@@ -427,6 +429,61 @@ TEST_F(Archive, ExrheaderReadsTheFileAndSeesSelfDescribingNames) {
                              "libinsitu.field"}) {
         EXPECT_THAT(output, HasSubstr(name));
     }
+}
+
+/// A model over the 5 intervals of single_frame() with distinct, exactly representable-in-float
+/// (not in half) values, so a HALF part would show.
+ColourModel test_model(int intervals, int clusters) {
+    std::vector<float> table(static_cast<std::size_t>(4 * intervals + 3) * clusters);
+    for (std::size_t i = 0; i < table.size(); ++i) table[i] = 0.001f * i + 1.0f / 3.0f;
+    return ColourModel::from_table(intervals, clusters, table);
+}
+
+TEST_F(Archive, ColourModelRoundTripsExactlyInAFloatModelPart) {
+    config_.precision = StoragePrecision::half;  // the model is FLOAT regardless
+    StepRecord step = record(12);
+    step.views[0].single->colour_model = test_model(5, 3);
+    ArchiveWriter(config_).write(step);
+    const ArchiveReader reader(archive().string());
+    const ProxyFrame frame = reader.load(12, 0);
+    ASSERT_TRUE(frame.colour_model.has_value());
+    EXPECT_EQ(frame.colour_model->intervals(), 5);
+    EXPECT_EQ(frame.colour_model->clusters(), 3);
+    EXPECT_EQ(frame.colour_model->table(), step.views[0].single->colour_model->table());
+    EXPECT_FALSE(reader.load(12, 1).colour_model.has_value());
+    EXPECT_FALSE(reader.load(12, 0, /*multi_perspective=*/true).colour_model.has_value());
+
+    Imf::MultiPartInputFile file(exr(12, 0).c_str());
+    int found = 0;
+    for (int p = 0; p < file.parts(); ++p) {
+        const Imf::Header& header = file.header(p);
+        if (header.name() != "model") continue;
+        ++found;
+        const Imf::Channel* channel = header.channels().findChannel("model.table");
+        ASSERT_NE(channel, nullptr);
+        EXPECT_EQ(channel->type, Imf::FLOAT);
+        const Imath::Box2i window = header.dataWindow();
+        EXPECT_EQ(window.max.x - window.min.x + 1, 4 * 5 + 3);
+        EXPECT_EQ(window.max.y - window.min.y + 1, 3);
+        EXPECT_EQ(header.typedAttribute<Imf::IntAttribute>("libinsitu.model_intervals").value(), 5);
+        EXPECT_EQ(header.typedAttribute<Imf::IntAttribute>("libinsitu.model_clusters").value(), 3);
+        const auto functions = nlohmann::json::parse(
+            header
+                .typedAttribute<Imf::StringAttribute>("libinsitu.model_training_transfer_functions")
+                .value());
+        ASSERT_EQ(functions.size(), 2u);
+        EXPECT_EQ(functions[1], ramp(0.9f).to_json());
+        EXPECT_THAT(header.typedAttribute<Imf::StringAttribute>("libinsitu.model_layout").value(),
+                    HasSubstr("one row per cluster"));
+    }
+    EXPECT_EQ(found, 1);
+}
+
+TEST_F(Archive, ColourModelOfOtherIntervalsThanTheAttenuationIsRejected) {
+    StepRecord step = record(13);
+    step.views[0].single->colour_model = test_model(4, 2);
+    testing::expect_error_naming<InvalidArgument>([&] { ArchiveWriter(config_).write(step); },
+                                                  "colour model has 4 intervals");
 }
 
 TEST_F(Archive, DataCsvIsCinemaSpecDWithFileLast) {

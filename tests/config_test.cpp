@@ -240,6 +240,34 @@ TEST(InstrumentConfig, ToJsonEmitsEveryKeyAndRoundTrips) {
     EXPECT_EQ(again.when_full, WhenFull::drop);
 }
 
+TEST(InstrumentConfig, ColourModelKeyIsParsedValidatedAndRoundTrips) {
+    const InstrumentConfig defaults;
+    EXPECT_EQ(defaults.colour_model.clusters, 24);
+    EXPECT_TRUE(defaults.colour_model.enabled);
+    EXPECT_EQ(defaults.to_json()["colour_model"],
+              nlohmann::json({{"clusters", 24}, {"enabled", true}}));
+
+    std::vector<std::string> unknown;
+    const InstrumentConfig config = InstrumentConfig::from_json_text(
+        R"({"colour_model": {"clusters": 8, "enabled": false, "metric": "l1"}})", &unknown);
+    EXPECT_EQ(config.colour_model.clusters, 8);
+    EXPECT_FALSE(config.colour_model.enabled);
+    EXPECT_THAT(unknown, ElementsAre("colour_model.metric"));
+    const InstrumentConfig again = InstrumentConfig::from_json(config.to_json());
+    EXPECT_EQ(again.colour_model.clusters, 8);
+    EXPECT_FALSE(again.colour_model.enabled);
+
+    expect_error<InvalidArgument>(R"({"colour_model": {"clusters": 0}})",
+                                  {"colour_model.clusters", "0"});
+    expect_error<InvalidArgument>(R"({"colour_model": {"clusters": 5000}})",
+                                  {"colour_model.clusters", "5000"});
+    expect_error<ParseError>(R"({"colour_model": {"clusters": 2.5}})",
+                             {"colour_model.clusters", "2.5"});
+    expect_error<ParseError>(R"({"colour_model": {"enabled": "yes"}})",
+                             {"colour_model.enabled", "yes"});
+    expect_error<ParseError>(R"({"colour_model": 24})", {"colour_model", "24"});
+}
+
 TEST(InstrumentConfig, SelectsEveryNthStepOrTheListedSteps) {
     InstrumentConfig config;
     config.every = 5;

@@ -188,6 +188,38 @@ TEST_F(ImageFiles, PngRejectsOtherChannelCounts) {
     }
 }
 
+// encode_png (the web viewer's in-memory PNG) holds exactly write_png's pixels, whatever its
+// compression: decoded bytes are compared for equality, no tolerance.
+TEST_F(ImageFiles, EncodedPngHoldsTheSamePixelsAsTheWrittenFile) {
+    for (const int channels : {1, 3, 4}) {
+        Image image(37, 23, channels);
+        for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+            image.pixels[i] = static_cast<float>((i * 7919) % 1000) / 999.0f;  // all of [0, 1]
+        }
+        const png_uint_32 format = channels == 4   ? PNG_FORMAT_RGBA
+                                   : channels == 3 ? PNG_FORMAT_RGB
+                                                   : PNG_FORMAT_GRAY;
+        const std::string file = path("written.png");
+        write_png(file, image);
+        const PngPixels written = read_png(file, format);
+
+        const std::vector<std::uint8_t> encoded = encode_png(image);
+        png_image png{};
+        png.version = PNG_IMAGE_VERSION;
+        ASSERT_TRUE(png_image_begin_read_from_memory(&png, encoded.data(), encoded.size()))
+            << png.message;
+        EXPECT_EQ(png.width, 37u);
+        EXPECT_EQ(png.height, 23u);
+        EXPECT_EQ(png.format, written.file_format);
+        png.format = format;
+        std::vector<png_byte> decoded(PNG_IMAGE_SIZE(png));
+        ASSERT_TRUE(png_image_finish_read(&png, nullptr, decoded.data(), 0, nullptr))
+            << png.message;
+        EXPECT_EQ(decoded, written.bytes) << channels << " channels";
+    }
+    EXPECT_THROW(encode_png(Image(2, 2, 2)), InvalidArgument);
+}
+
 // Bit-exact equality, with NaN equal to NaN.
 void expect_same_floats(const std::vector<float>& actual, const std::vector<float>& expected) {
     ASSERT_EQ(actual.size(), expected.size());

@@ -151,6 +151,54 @@ TEST_F(InstrumentTest, TrainingImagesAreRenderedAndStoredOnlyOnRequest) {
     }
 }
 
+TEST_F(InstrumentTest, ColourModelIsFittedAndStoredWhenTrainingFunctionsAreConfigured) {
+    const std::vector<TransferFunction> training = {
+        TransferFunction({{0.0, {1, 1, 1, 0}}, {1.0, {1, 1, 0, 0.8}}}),
+        TransferFunction({{0.0, {1, 1, 1, 0.1}}, {1.0, {1, 1, 0, 0.2}}})};
+    struct Case {
+        const char* name;
+        bool training;
+        bool enabled;
+        bool expect_model;
+    };
+    for (const Case& c :
+         {Case{"with_training", true, true, true}, Case{"without_training", false, true, false},
+          Case{"disabled", true, false, false}}) {
+        SCOPED_TRACE(c.name);
+        InstrumentConfig config = small_config(directory_ / (std::string(c.name) + ".cdb"));
+        if (c.training) config.training_transfer_functions = training;
+        config.colour_model.enabled = c.enabled;
+        config.colour_model.clusters = 6;
+        {
+            Instrument instrument(config, quiet());
+            ASSERT_EQ(instrument.execute(0, 0.0, {volume_.field()}), Status::ok)
+                << instrument.last_error();
+            ASSERT_EQ(instrument.finalize(), Status::ok) << instrument.last_error();
+        }
+        const ArchiveReader reader(config.archive);
+        const ProxyFrame frame = reader.load(0, 0);
+        ASSERT_EQ(frame.colour_model.has_value(), c.expect_model);
+        // The training renderings the model learnt from are not kept by default.
+        EXPECT_TRUE(frame.training.empty());
+        const nlohmann::json& parts = reader.manifest()["steps"][0]["views"][0]["parts"];
+        EXPECT_EQ(std::count(parts.begin(), parts.end(), "model"), c.expect_model ? 1 : 0);
+        if (!c.expect_model) continue;
+        EXPECT_EQ(frame.colour_model->intervals(), config.interval_count);
+        EXPECT_GE(frame.colour_model->clusters(), 1);
+        EXPECT_LE(frame.colour_model->clusters(), 6);
+        // The model predicts the first training function's rendering from attenuation under
+        // it; the archive keeps no such pair, so check what is stored: alpha is exact and
+        // colours are finite within [0, alpha].
+        const Image predicted = frame.colour_model->predict(frame.attenuation);
+        for (std::size_t p = 0; p < predicted.pixel_count(); ++p) {
+            for (int ch = 0; ch < 3; ++ch) {
+                EXPECT_GE(predicted.pixels[4 * p + ch], 0.0f);
+                EXPECT_LE(predicted.pixels[4 * p + ch], predicted.pixels[4 * p + 3] + 1e-6f);
+            }
+        }
+    }
+}
+
 TEST_F(InstrumentTest, AutoLayersAndIntervalsAreChosenFromTheData) {
     InstrumentConfig config = small_config(archive());
     config.layers.reset();

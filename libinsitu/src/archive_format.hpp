@@ -7,11 +7,17 @@
 //   part "depth"              depth.layer0 .. depth.layer<K-1>                        FLOAT
 //   part "attenuation"        attenuation.a00 .., attenuation.zmean00 .., attenuation.tau00 ..
 //   part "train<k>"           train<k>.R, .G, .B, .A  (a training rendering, premultiplied)
+//   part "model"              model.table: the colour model of seed 000 §6.2 as an image of
+//                             (4 L + 3) x K pixels, one row per cluster: a0 (L), c0 (RGB),
+//                             J (3 x L, row-major by colour component)                  FLOAT
 //   part "multi.depth"        multi.depth.layer0 ..       distortion camera (seed 000 §4.1) FLOAT
 //   part "multi.distortion"   multi.distortion.layer0 ..  ds of Eq. 2, world units          FLOAT
 //   part "multi.attenuation"  multi.attenuation.a00 .., .zmean00 .., .tau00 ..
 // Attenuation, mean depth, optical depth and training channels are HALF or FLOAT as the
-// configuration's "precision" says. Only parts with images are written.
+// configuration's "precision" says. Only parts with images are written. The model part carries
+// libinsitu.model_intervals (L), libinsitu.model_clusters (K), libinsitu.model_layout (the row
+// layout in words) and libinsitu.model_training_transfer_functions (the functions it was
+// fitted on, JSON); it is written whenever the frame has a model, kept training images or not.
 #include <cstddef>
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -38,6 +44,7 @@ inline constexpr const char* kDepthPart = "depth";
 inline constexpr const char* kDistortionPart = "distortion";  // only ever as "multi.distortion"
 inline constexpr const char* kAttenuationPart = "attenuation";
 inline constexpr const char* kTrainingPartPrefix = "train";
+inline constexpr const char* kModelPart = "model";
 
 // Channel suffixes.
 inline constexpr const char* kLayerChannel = ".layer";
@@ -45,6 +52,7 @@ inline constexpr const char* kAttenuationChannel = ".a";
 inline constexpr const char* kMeanDepthChannel = ".zmean";
 inline constexpr const char* kOpticalDepthChannel = ".tau";
 inline constexpr const char* kTrainingChannels[4] = {".R", ".G", ".B", ".A"};
+inline constexpr const char* kModelChannel = ".table";
 
 // Header attributes of every part (StringAttribute holding JSON unless noted).
 inline constexpr const char* kSchemaAttribute = "libinsitu.schema_version";  // int
@@ -62,6 +70,14 @@ inline constexpr const char* kTransferFunctionAttribute = "libinsitu.transfer_fu
 inline constexpr const char* kTrainingFunctionsAttribute = "libinsitu.training_transfer_functions";
 /// On "train<k>" parts: the transfer function that rendering used.
 inline constexpr const char* kTrainingFunctionAttribute = "libinsitu.training_transfer_function";
+/// On "model" parts: L and K (int), the row layout (plain string) and the training functions.
+inline constexpr const char* kModelIntervalsAttribute = "libinsitu.model_intervals";
+inline constexpr const char* kModelClustersAttribute = "libinsitu.model_clusters";
+inline constexpr const char* kModelLayoutAttribute = "libinsitu.model_layout";
+inline constexpr const char* kModelFunctionsAttribute =
+    "libinsitu.model_training_transfer_functions";
+inline constexpr const char* kModelLayout =
+    "one row per cluster: a0[0..L-1], c0 R G B, J row-major 3 x L (R row, G row, B row)";
 
 /// "depth" -> "multi.depth" for the distortion camera's proxies.
 inline std::string part_name(const char* base, bool multi_perspective) {

@@ -476,6 +476,33 @@ Image read_training(Imf::InputPart& part, const PartContext& where) {
     return read_channels(part, names, where);
 }
 
+/// The colour model of a "model" part: its table image, checked against L and K.
+ColourModel read_model(Imf::InputPart& part, const PartContext& where) {
+    const Imf::Header& header = part.header();
+    const auto* intervals =
+        header.findTypedAttribute<Imf::IntAttribute>(af::kModelIntervalsAttribute);
+    const auto* clusters =
+        header.findTypedAttribute<Imf::IntAttribute>(af::kModelClustersAttribute);
+    if (!intervals || !clusters) {
+        where.error(std::string("no int attributes \"") + af::kModelIntervalsAttribute +
+                    "\" and \"" + af::kModelClustersAttribute + "\"");
+    }
+    const std::string channel = where.part + af::kModelChannel;
+    if (!header.channels().findChannel(channel)) where.error("no channel \"" + channel + "\"");
+    const Image table = read_channels(part, {channel}, where);
+    const long long row = 4ll * intervals->value() + 3;
+    if (table.width != row || table.height != clusters->value()) {
+        where.error("table is " + std::to_string(table.width) + "x" + std::to_string(table.height) +
+                    ", expected (4 L + 3) x K = " + std::to_string(row) + "x" +
+                    std::to_string(clusters->value()));
+    }
+    try {
+        return ColourModel::from_table(intervals->value(), clusters->value(), table.pixels);
+    } catch (const InvalidArgument& error) {
+        where.error(error.what());
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // PNG previews
 
@@ -626,6 +653,8 @@ ProxyFrame ArchiveReader::load(std::int64_t step, int view, bool multi_perspecti
             } else if (base.rfind(af::kTrainingPartPrefix, 0) == 0 &&
                        base == af::kTrainingPartPrefix + std::to_string(frame.training.size())) {
                 frame.training.push_back(read_training(part, where));
+            } else if (base == af::kModelPart && !frame.colour_model) {
+                frame.colour_model = read_model(part, where);
             } else {
                 where.error("unknown or out-of-order part");
             }

@@ -27,6 +27,7 @@
 #include <cstring>
 #include <filesystem>
 #include <glm/trigonometric.hpp>
+#include <memory>
 #include <set>
 #include <sstream>
 
@@ -249,6 +250,10 @@ struct PartSource {
     std::string name;
     std::vector<ChannelSource> channels;
     nlohmann::json training_function;  ///< train<k> parts only
+    const ColourModel* model = nullptr;  ///< model parts only
+    /// Pixels made for the part (the model's table as an image); shared so that channel
+    /// pointers stay valid when the part is moved.
+    std::shared_ptr<const Image> storage{};
 };
 
 void add_channels(PartSource& part, const Image& image, const char* suffix, Imf::PixelType type) {
@@ -332,6 +337,18 @@ std::vector<PartSource> frame_parts(const ProxyFrame& frame, const ViewRecord& v
         if (t < view.training_transfer_functions.size()) {
             part.training_function = view.training_transfer_functions[t].to_json();
         }
+        parts.push_back(std::move(part));
+    }
+    if (frame.colour_model) {
+        const ColourModel& model = *frame.colour_model;
+        if (interval_count >= 0 && model.intervals() != interval_count) {
+            fail<InvalidArgument>(where, ": colour model has ", model.intervals(),
+                                  " intervals, the attenuation proxies ", interval_count);
+        }
+        auto table = std::make_shared<Image>(model.row_floats(), model.clusters(), 1);
+        table->pixels = model.table();
+        PartSource part{af::part_name(af::kModelPart, multi), {}, {}, &model, table};
+        part.channels.push_back({part.name + af::kModelChannel, table.get(), 0, Imf::FLOAT});
         parts.push_back(std::move(part));
     }
     for (const PartSource& part : parts) check_same_size(part, where);
@@ -419,6 +436,18 @@ std::string encode_view(const StepRecord& record, const ViewRecord& view,
         if (!part.source.training_function.is_null()) {
             header.insert(af::kTrainingFunctionAttribute,
                           Imf::StringAttribute(part.source.training_function.dump()));
+        }
+        if (part.source.model) {
+            header.insert(af::kModelIntervalsAttribute,
+                          Imf::IntAttribute(part.source.model->intervals()));
+            header.insert(af::kModelClustersAttribute,
+                          Imf::IntAttribute(part.source.model->clusters()));
+            header.insert(af::kModelLayoutAttribute, Imf::StringAttribute(af::kModelLayout));
+            nlohmann::json functions = nlohmann::json::array();
+            for (const TransferFunction& tf : view.training_transfer_functions) {
+                functions.push_back(tf.to_json());
+            }
+            header.insert(af::kModelFunctionsAttribute, Imf::StringAttribute(functions.dump()));
         }
         headers.push_back(std::move(header));
         part_names.push_back(part.source.name);

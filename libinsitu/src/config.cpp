@@ -223,6 +223,20 @@ void parse_writer(const json& value, InstrumentConfig& config, std::vector<std::
     }
 }
 
+void parse_colour_model(const json& value, InstrumentConfig& config,
+                        std::vector<std::string>& unknown) {
+    require_object(value, "colour_model");
+    collect_unknown(value, "colour_model", {"clusters", "enabled"}, unknown);
+    if (value.contains("clusters")) {
+        config.colour_model.clusters = small_integer(value["clusters"], "colour_model.clusters");
+    }
+    if (value.contains("enabled")) {
+        const json& enabled = value["enabled"];
+        if (!enabled.is_boolean()) wrong_type("colour_model.enabled", enabled, "true or false");
+        config.colour_model.enabled = enabled.get<bool>();
+    }
+}
+
 std::string join(const std::vector<std::string>& names) {
     std::string joined;
     for (const std::string& name : names) joined += (joined.empty() ? "" : ", ") + name;
@@ -237,11 +251,12 @@ InstrumentConfig InstrumentConfig::from_json(const nlohmann::json& document,
         fail<ParseError>("configuration: expected a JSON object, got ", document.dump());
     }
     std::vector<std::string> unknown;
-    collect_unknown(document, "",
-                    {"fields", "views", "transfer_function", "training_transfer_functions",
-                     "layers", "max_layers", "intervals", "proxies", "step", "every", "steps",
-                     "archive", "precision", "compression", "writer", "keep_training_images"},
-                    unknown);
+    collect_unknown(
+        document, "",
+        {"fields", "views", "transfer_function", "training_transfer_functions", "layers",
+         "max_layers", "intervals", "proxies", "step", "every", "steps", "archive", "precision",
+         "compression", "writer", "keep_training_images", "colour_model"},
+        unknown);
 
     InstrumentConfig config;
     if (document.contains("fields")) {
@@ -324,6 +339,9 @@ InstrumentConfig InstrumentConfig::from_json(const nlohmann::json& document,
         const json& keep = document["keep_training_images"];
         if (!keep.is_boolean()) wrong_type("keep_training_images", keep, "true or false");
         config.keep_training_images = keep.get<bool>();
+    }
+    if (document.contains("colour_model")) {
+        parse_colour_model(document["colour_model"], config, unknown);
     }
 
     config.validate();
@@ -425,6 +443,10 @@ void InstrumentConfig::validate() const {
                      "expected none, rle, zips, zip, piz, pxr24 or b44");
     }
     if (writer_queue < 1) out_of_range("writer.queue", text_of(writer_queue), "must be >= 1");
+    if (colour_model.clusters < 1 || colour_model.clusters > kMaxColourModelClusters) {
+        out_of_range("colour_model.clusters", text_of(colour_model.clusters), "must be in [1, ",
+                     kMaxColourModelClusters, "]");
+    }
 }
 
 nlohmann::json InstrumentConfig::to_json() const {
@@ -467,6 +489,8 @@ nlohmann::json InstrumentConfig::to_json() const {
     result["writer"] = {{"queue", writer_queue},
                         {"when_full", when_full == WhenFull::block ? "block" : "drop"}};
     result["keep_training_images"] = keep_training_images;
+    result["colour_model"] = {{"clusters", colour_model.clusters},
+                              {"enabled", colour_model.enabled}};
     return result;
 }
 

@@ -45,19 +45,26 @@ std::string extension_of(const std::string& path) {
 }
 }  // namespace
 
-void write_png(const std::string& path, const Image& image) {
+namespace {
+/// 8-bit sRGB samples of `image` as PNG stores them, and the libpng description of them;
+/// `where` names the caller in errors.
+struct PngPixels {
+    png_image description{};
+    std::vector<std::uint8_t> bytes;
+};
+
+PngPixels png_pixels(const Image& image, const std::string& where) {
     if (image.channels != 1 && image.channels != 3 && image.channels != 4) {
-        fail<InvalidArgument>("write_png(\"", path, "\"): ", image.channels,
-                              " channels (expected 1, 3 or 4)");
+        fail<InvalidArgument>(where, ": ", image.channels, " channels (expected 1, 3 or 4)");
     }
     if (image.width < 1 || image.height < 1) {
-        fail<InvalidArgument>("write_png(\"", path, "\"): empty image ", image.width, "x",
-                              image.height);
+        fail<InvalidArgument>(where, ": empty image ", image.width, "x", image.height);
     }
-    std::vector<std::uint8_t> bytes(image.pixels.size());
+    PngPixels png;
+    png.bytes.resize(image.pixels.size());
     for (std::size_t p = 0; p < image.pixel_count(); ++p) {
         const float* in = &image.pixels[p * image.channels];
-        std::uint8_t* out = &bytes[p * image.channels];
+        std::uint8_t* out = &png.bytes[p * image.channels];
         if (image.channels == 4) {
             // Premultiplied linear -> straight-alpha sRGB, as PNG defines alpha.
             const float alpha = std::clamp(in[3], 0.0f, 1.0f);
@@ -69,20 +76,44 @@ void write_png(const std::string& path, const Image& image) {
             for (int c = 0; c < image.channels; ++c) out[c] = to_byte(linear_to_srgb(in[c]));
         }
     }
+    png.description.version = PNG_IMAGE_VERSION;
+    png.description.width = static_cast<png_uint_32>(image.width);
+    png.description.height = static_cast<png_uint_32>(image.height);
+    png.description.format = image.channels == 4   ? PNG_FORMAT_RGBA
+                             : image.channels == 3 ? PNG_FORMAT_RGB
+                                                   : PNG_FORMAT_GRAY;
+    return png;
+}
+}  // namespace
 
-    png_image png{};
-    png.version = PNG_IMAGE_VERSION;
-    png.width = static_cast<png_uint_32>(image.width);
-    png.height = static_cast<png_uint_32>(image.height);
-    png.format = image.channels == 4   ? PNG_FORMAT_RGBA
-                 : image.channels == 3 ? PNG_FORMAT_RGB
-                                       : PNG_FORMAT_GRAY;
+void write_png(const std::string& path, const Image& image) {
+    PngPixels png = png_pixels(image, "write_png(\"" + path + "\")");
     // The simplified API tags 8-bit data as sRGB, which is what we wrote.
-    if (!png_image_write_to_file(&png, path.c_str(), 0, bytes.data(), 0, nullptr)) {
-        const std::string message = png.message;
-        png_image_free(&png);
+    if (!png_image_write_to_file(&png.description, path.c_str(), 0, png.bytes.data(), 0, nullptr)) {
+        const std::string message = png.description.message;
+        png_image_free(&png.description);
         fail<IoError>("cannot write PNG \"", path, "\": ", message);
     }
+}
+
+std::vector<std::uint8_t> encode_png(const Image& image) {
+    PngPixels png = png_pixels(image, "encode_png");
+    // Interactive callers wait for the encoder: a faster zlib setting, larger output, same pixels.
+    png.description.flags |= PNG_IMAGE_FLAG_FAST;
+    png_alloc_size_t size = 0;
+    // First call sizes the buffer, second fills it (libpng's in-memory protocol).
+    if (png_image_write_get_memory_size(png.description, size, 0, png.bytes.data(), 0, nullptr)) {
+        std::vector<std::uint8_t> encoded(size);
+        if (png_image_write_to_memory(&png.description, encoded.data(), &size, 0, png.bytes.data(),
+                                      0, nullptr)) {
+            encoded.resize(size);
+            return encoded;
+        }
+    }
+    const std::string message = png.description.message;
+    png_image_free(&png.description);
+    fail<IoError>("cannot encode PNG of ", image.width, "x", image.height, "x", image.channels,
+                  ": ", message);
 }
 
 void write_exr(const std::string& path, const Image& image,

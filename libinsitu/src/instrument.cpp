@@ -15,6 +15,7 @@
 
 #include "insitu/archive.hpp"
 #include "insitu/camera.hpp"
+#include "insitu/colour_model.hpp"
 #include "insitu/distortion_camera.hpp"
 #include "insitu/error.hpp"
 #include "insitu/proxy_renderer.hpp"
@@ -205,14 +206,24 @@ StepRecord Instrument::Impl::compute(std::int64_t step, double time, const Field
     single.attenuation = config.proxies.attenuation;
     single.mean_depth = config.proxies.attenuation;
     single.optical_depth = config.proxies.optical_depth;
-    // Training renderings are stored only on request ("keep_training_images"). Nothing in situ
-    // consumes them yet (the colour model that will arrives with the exploration work), so
-    // unkept ones are not rendered at all rather than rendered and thrown away.
-    if (config.keep_training_images) {
+    // The colour model maps the stored attenuation to colour, so it is fitted only where that
+    // attenuation is stored. Training renderings are rendered when the model or the archive
+    // needs them, and stored only on request ("keep_training_images").
+    const bool fits_model = config.colour_model.enabled &&
+                            !config.training_transfer_functions.empty() &&
+                            config.proxies.attenuation;
+    if (config.keep_training_images || fits_model) {
         single.training_transfer_functions = config.training_transfer_functions;
     }
     const bool wants_single = single.depth_layers || single.attenuation || single.optical_depth ||
                               !single.training_transfer_functions.empty();
+    // Attenuation under each training function, from the same intervals, step and camera as
+    // its training rendering: the pairs seed 000 §6.2 learns from.
+    ProxyRequest training_attenuation = base;
+    training_attenuation.depth_layers = false;
+    training_attenuation.mean_depth = false;
+    ColourModelSettings model_settings;
+    model_settings.clusters = config.colour_model.clusters;
 
     ProxyRequest multi = base;
     multi.depth_layers = config.proxies.distortion;
@@ -239,6 +250,16 @@ StepRecord Instrument::Impl::compute(std::int64_t step, double time, const Field
         out.training_transfer_functions = single.training_transfer_functions;
         const Camera camera = Camera::orbit(view.orbit, volume.bounds);
         if (wants_single) out.single = renderer->render(camera, single);
+        if (fits_model) {
+            std::vector<Image> attenuations;
+            for (const TransferFunction& tf : config.training_transfer_functions) {
+                training_attenuation.transfer_function = tf;
+                attenuations.push_back(renderer->render(camera, training_attenuation).attenuation);
+            }
+            out.single->colour_model =
+                ColourModel::fit(attenuations, out.single->training, model_settings);
+            if (!config.keep_training_images) out.single->training.clear();
+        }
         if (wants_multi) {
             out.multi = renderer->render(
                 DistortionCamera::orbit(view.orbit, volume.bounds, view.distortion_tilt_deg),

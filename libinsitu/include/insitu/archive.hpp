@@ -12,9 +12,13 @@
 //
 // EXR parts (channel names start with the part name; libinsitu/src/archive_format.hpp):
 //   depth (depth.layer0..), attenuation (attenuation.a00.., .zmean00.., .tau00..),
-//   train0.. (train0.R/G/B/A), multi.depth (multi.depth.layer0..), multi.distortion
+//   train0.. (train0.R/G/B/A), model (model.table: the colour model of seed 000 §6.2, one row
+//   of (4 L + 3) floats per cluster, with libinsitu.model_{intervals, clusters, layout,
+//   training_transfer_functions}), multi.depth (multi.depth.layer0..), multi.distortion
 //   (multi.distortion.layer0..), multi.attenuation (multi.attenuation.a00.., ...).
-// Depth and distortion are always FLOAT; the rest HALF or FLOAT by "precision". Every part
+// Depth, distortion and the model are always FLOAT; the rest HALF or FLOAT by "precision". The
+// model is stored whenever the Instrument fitted one (training transfer functions configured);
+// the training renderings it was fitted on only with keep_training_images. Every part
 // carries the header attributes libinsitu.{schema_version, step, time, field, view, view_config,
 // perspective, camera, isovalues, intervals, transfer_function, training_transfer_functions}
 // (+ distortion_tilt on multi.* parts, training_transfer_function on train<k>); JSON text in
@@ -116,9 +120,10 @@ public:
     ArchivedView entry(std::int64_t step, int view) const;
 
     /// Loads the single- or multi-perspective proxies of (step, view) from its EXR, lazily (only
-    /// this file is read). Corrupt, truncated or foreign files raise IoError naming file and part.
-    /// The file's size and CRC-32 are checked against the manifest before it is parsed. A step,
-    /// view or perspective the manifest does not list raises InvalidArgument.
+    /// this file is read), the colour model (ProxyFrame::colour_model) included when stored.
+    /// Corrupt, truncated or foreign files raise IoError naming file and part. The file's size and
+    /// CRC-32 are checked against the manifest before it is parsed. A step, view or perspective the
+    /// manifest does not list raises InvalidArgument.
     ProxyFrame load(std::int64_t step, int view, bool multi_perspective = false) const;
     /// The preview as linear, premultiplied floats (the inverse of write_png, to 8-bit sRGB
     /// precision), with the PNG's channel count (1, 3 or 4).

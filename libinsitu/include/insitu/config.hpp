@@ -10,7 +10,8 @@
 //  "layers": "auto", "intervals": {"count": 16, "mode": "uniform"},
 //  "proxies": ["depth", "distortion", "attenuation"], "step": 1.0, "every": 10,
 //  "archive": "run.cdb", "precision": "half", "compression": "zip",
-//  "writer": {"queue": 4, "when_full": "block"}}
+//  "writer": {"queue": 4, "when_full": "block"},
+//  "colour_model": {"clusters": 24, "enabled": true}}
 //
 // Every key is optional; defaults are listed on the members below. Unknown keys (at any level)
 // are collected by name, not silently ignored; invalid values raise InvalidArgument/ParseError
@@ -18,6 +19,10 @@
 // A view's keys: "azimuth", "elevation" (degrees), "camera" ("ortho" | "orthographic" |
 // "perspective"), "fov" (degrees, perspective only), "size" ([width, height] pixels),
 // "distortion_tilt" (degrees).
+// The colour model (seed 000 §6.2) is fitted in situ, per step and view, when it is enabled,
+// training transfer functions are given and "attenuation" is among the proxies: each training
+// function gets a ground-truth rendering and attenuation proxies of its own, the model is fitted
+// on those pairs and stored in the archive (the renderings only with "keep_training_images").
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -50,6 +55,15 @@ struct ProxySelection {
     bool optical_depth = false;      ///< "optical_depth": tau_j as well
 };
 
+/// "colour_model": the in-situ fit of seed 000 §6.2 (insitu/colour_model.hpp).
+struct ColourModelConfig {
+    int clusters = 24;    ///< "clusters": K, in [1, kMaxColourModelClusters]
+    bool enabled = true;  ///< "enabled": fit when training transfer functions are given
+};
+
+/// Largest K a configuration may ask for (the fit's cost grows with K, and K rows are stored).
+constexpr int kMaxColourModelClusters = 1024;
+
 struct InstrumentConfig {
     std::vector<std::string> fields{"v"};  ///< "fields": names of the fields to visualise
     std::vector<ViewConfig> views{ViewConfig{}};
@@ -74,6 +88,7 @@ struct InstrumentConfig {
     int writer_queue = 4;             ///< "writer": {"queue": N}, steps held in memory at most
     WhenFull when_full = WhenFull::block;  ///< "writer": {"when_full": "block" | "drop"}
     bool keep_training_images = false;     ///< "keep_training_images"
+    ColourModelConfig colour_model;        ///< "colour_model"
 
     /// Parses `json`; unknown keys are appended to `unknown_keys` as dotted paths
     /// ("views[0].zoom"). Throws ParseError (wrong JSON type) or InvalidArgument (value out of

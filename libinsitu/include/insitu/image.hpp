@@ -1,6 +1,7 @@
 #pragma once
 // Images: row-major, pixel (0, 0) at the top-left, linear float, premultiplied alpha (DESIGN.md).
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,11 @@ float linear_to_srgb(float linear);
 /// an 8-bit sRGB PNG via libpng. RGBA is un-premultiplied into PNG's straight alpha.
 /// Throws IoError naming the path on failure, InvalidArgument for other channel counts.
 void write_png(const std::string& path, const Image& image);
+
+/// `image` as PNG in memory with exactly the pixels write_png writes (the same conversion), for
+/// callers that send PNG elsewhere, e.g. the web viewer. Compressed for speed rather than size,
+/// so the bytes may differ from write_png's file. Errors as write_png.
+std::vector<std::uint8_t> encode_png(const Image& image);
 
 /// Writes float channels to an OpenEXR file (ZIP compression). `channel_names` must have
 /// image.channels entries, e.g. {"R","G","B","A"} or {"Z"}.

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "insitu/camera.hpp"
+#include "insitu/colour_model.hpp"
 #include "insitu/distortion_camera.hpp"
 #include "insitu/image.hpp"
 #include "insitu/intervals.hpp"
@@ -70,6 +71,8 @@ struct ProxyFrame {
     Image mean_depth;                              ///< L channels
     Image optical_depth;                           ///< L channels
     std::vector<Image> training;                   ///< RGBA each
+    /// Colour model fitted on the training renderings (seed 000 §6.2), single perspective only.
+    std::optional<ColourModel> colour_model;
 };
 
 class ProxyRenderer {

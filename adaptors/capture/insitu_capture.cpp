@@ -1,0 +1,503 @@
+// insitu-capture: the offline path. Reads a time series of files already on disk (.vti, .pvd,
+// .vdb or raw) and writes the same timestep proxy archive an Instrument writes in situ, from the
+// same JSON configuration.
+//
+// Steps are numbered first-step + position in the input list (a .pvd contributes its data sets in
+// timestep order); a step's time is the .pvd timestep, or its step number.
+//
+// Exit status: 0 success (inputs skipped with --on-error skip are named on stderr); 2 bad
+// arguments or bad input (unknown flag, malformed value, unreadable configuration, an input that
+// cannot be read when --on-error is stop, or no input readable at all); 1 anything else (no
+// OpenCL device, an archive that cannot be written). Every failure is one line on stderr naming
+// the flag, value or file; the archive keeps every step written before it.
+#include <unistd.h>
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <exception>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "insitu/capture_input.hpp"
+#include "insitu/config.hpp"
+#include "insitu/error.hpp"
+#include "insitu/instrument.hpp"
+#include "insitu/raw_reader.hpp"
+
+namespace {
+
+constexpr const char* kProgram = "insitu-capture";
+constexpr int kExitRuntimeError = 1;
+constexpr int kExitBadInput = 2;
+
+/// A command line or input that cannot be acted on (exit 2).
+class UsageError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+/// A failure that is not the user's input (exit 1).
+class RuntimeFailure : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+enum class OnError { stop, skip };
+
+struct Arguments {
+    std::string config_path;
+    std::string out_path;
+    std::optional<insitu::Index3> raw_dims;
+    std::optional<insitu::capture::RawType> raw_type;
+    glm::dvec3 raw_spacing{1.0};
+    bool raw_big_endian = false;
+    std::string field;
+    OnError on_error = OnError::stop;
+    std::int64_t first_step = 0;
+    std::vector<std::string> inputs;
+    bool help = false;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Value parsers: each takes the whole token or fails.
+
+double parse_number(const std::string& flag, const std::string& text) {
+    double value = 0.0;
+    const char* end = text.data() + text.size();
+    const auto [stop, error] = std::from_chars(text.data(), end, value);
+    if (text.empty() || error != std::errc() || stop != end || !std::isfinite(value)) {
+        throw UsageError(flag + ": expected a finite number, got \"" + text + "\"");
+    }
+    return value;
+}
+
+std::int64_t parse_integer(const std::string& flag, const std::string& text, std::int64_t minimum) {
+    std::int64_t value = 0;
+    const char* end = text.data() + text.size();
+    const auto [stop, error] = std::from_chars(text.data(), end, value);
+    if (text.empty() || error != std::errc() || stop != end || value < minimum) {
+        throw UsageError(flag + ": expected an integer >= " + std::to_string(minimum) + ", got \"" +
+                         text + "\"");
+    }
+    return value;
+}
+
+std::vector<std::string> split_exactly(const std::string& flag, const std::string& text,
+                                       const char* shape) {
+    std::vector<std::string> parts;
+    std::string::size_type begin = 0;
+    for (;;) {
+        const auto end = text.find(',', begin);
+        parts.push_back(text.substr(begin, end - begin));
+        if (end == std::string::npos) break;
+        begin = end + 1;
+    }
+    if (parts.size() != 3)
+        throw UsageError(flag + ": expected " + shape + ", got \"" + text + "\"");
+    return parts;
+}
+
+insitu::Index3 parse_dims(const std::string& flag, const std::string& text) {
+    const auto parts = split_exactly(flag, text, "NX,NY,NZ");
+    return {parse_integer(flag, parts[0], 1), parse_integer(flag, parts[1], 1),
+            parse_integer(flag, parts[2], 1)};
+}
+
+glm::dvec3 parse_spacing(const std::string& flag, const std::string& text) {
+    const auto parts = split_exactly(flag, text, "SX,SY,SZ");
+    glm::dvec3 spacing{parse_number(flag, parts[0]), parse_number(flag, parts[1]),
+                       parse_number(flag, parts[2])};
+    for (int axis = 0; axis < 3; ++axis) {
+        if (!(spacing[axis] > 0.0))
+            throw UsageError(flag + ": spacing must be positive, got \"" + text + "\"");
+    }
+    return spacing;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The option table: one row per flag; help and parsing both come from it.
+
+struct Option {
+    const char* name;
+    const char* value_name;  ///< nullptr for switches
+    bool required;
+    const char* help;
+    std::function<void(Arguments&, const std::string& flag, const std::string& value)> apply;
+};
+
+const std::vector<Option>& options() {
+    using V = const std::string&;
+    static const std::vector<Option> table = {
+        {"--config", "CONFIG.json", true,
+         "libinsitu JSON configuration (views, fields, transfer function, proxies)",
+         [](Arguments& a, V, V v) { a.config_path = v; }},
+        {"--out", "ARCHIVE", true,
+         "archive directory (overrides the configuration's \"archive\"; an existing archive is "
+         "continued)",
+         [](Arguments& a, V, V v) { a.out_path = v; }},
+        {"--field", "NAME", false,
+         "array (.vti) or grid (.vdb) to read (default: the configuration's first field)",
+         [](Arguments& a, V, V v) { a.field = v; }},
+        {"--raw-dims", "NX,NY,NZ", false, "samples per axis of raw inputs",
+         [](Arguments& a, V f, V v) { a.raw_dims = parse_dims(f, v); }},
+        {"--raw-type", "TYPE", false,
+         "raw sample type: uint8 int8 uint16 int16 uint32 int32 uint64 int64 float32 float64",
+         [](Arguments& a, V f, V v) {
+             try {
+                 a.raw_type = insitu::capture::parse_raw_type(v);
+             } catch (const insitu::Error& error) {
+                 throw UsageError(f + ": " + error.what());
+             }
+         }},
+        {"--raw-spacing", "SX,SY,SZ", false, "raw sample spacing in world units (default 1,1,1)",
+         [](Arguments& a, V f, V v) { a.raw_spacing = parse_spacing(f, v); }},
+        {"--raw-big-endian", nullptr, false, "raw inputs are big-endian (default little-endian)",
+         [](Arguments& a, V, V) { a.raw_big_endian = true; }},
+        {"--on-error", "stop|skip", false,
+         "an input that cannot be read stops the capture (default) or is skipped",
+         [](Arguments& a, V f, V v) {
+             if (v != "stop" && v != "skip") {
+                 throw UsageError(f + ": expected stop or skip, got \"" + v + "\"");
+             }
+             a.on_error = v == "stop" ? OnError::stop : OnError::skip;
+         }},
+        {"--first-step", "N", false, "step number of the first input (default 0)",
+         [](Arguments& a, V f, V v) { a.first_step = parse_integer(f, v, 0); }},
+        {"--help", nullptr, false, "print this help and exit",
+         [](Arguments& a, V, V) { a.help = true; }},
+    };
+    return table;
+}
+
+void print_help(std::ostream& out) {
+    out << "usage: " << kProgram << " --config CONFIG.json --out ARCHIVE [options] INPUT...\n\n"
+        << "Writes a timestep proxy archive from files on disk, one timestep per input, with the\n"
+           "configuration an Instrument uses in situ. The input type follows from the name:\n"
+           "  .vti  VTK image data (point or cell array; cell values sit at cell centres)\n"
+           "  .pvd  VTK collection of .vti files (time from each data set's timestep)\n"
+           "  .vdb  OpenVDB float/double grid (active bounding box densified; level sets get a\n"
+           "        layer at the zero crossing unless the configuration names its layers)\n"
+           "  other raw samples, x fastest, described by --raw-dims and --raw-type\n\n";
+    for (const Option& option : options()) {
+        std::string left = std::string("  ") + option.name;
+        if (option.value_name) left += std::string(" ") + option.value_name;
+        constexpr std::size_t kHelpColumn = 28;
+        out << left
+            << (left.size() < kHelpColumn ? std::string(kHelpColumn - left.size(), ' ')
+                                          : std::string("\n") + std::string(kHelpColumn, ' '))
+            << option.help << (option.required ? " [required]" : "") << "\n";
+    }
+    out << "\nA progress bar (steps, rate, ETA) is drawn on stderr when it is a terminal.\n"
+        << "Exit status: 0 success, 2 bad arguments or input, 1 other failures.\n";
+}
+
+Arguments parse_arguments(int argc, char** argv) {
+    Arguments arguments;
+    std::map<std::string, bool> seen;
+    bool options_ended = false;
+    for (int i = 1; i < argc; ++i) {
+        std::string token = argv[i];
+        if (options_ended || token.rfind("-", 0) != 0 || token == "-") {
+            arguments.inputs.push_back(token);
+            continue;
+        }
+        if (token == "--") {
+            options_ended = true;
+            continue;
+        }
+        std::string value;
+        bool has_inline_value = false;
+        if (const auto equals = token.find('='); equals != token.npos) {
+            value = token.substr(equals + 1);
+            token.resize(equals);
+            has_inline_value = true;
+        }
+        const auto& table = options();
+        const auto option = std::find_if(table.begin(), table.end(),
+                                         [&](const Option& o) { return token == o.name; });
+        if (option == table.end()) throw UsageError("unknown option \"" + token + "\"");
+        if (seen[token]) throw UsageError(token + ": given more than once");
+        seen[token] = true;
+        if (!option->value_name) {
+            if (has_inline_value) throw UsageError(token + ": takes no value");
+        } else if (!has_inline_value) {
+            if (i + 1 >= argc || std::string(argv[i + 1]).rfind("--", 0) == 0) {
+                throw UsageError(token + ": missing value " + option->value_name);
+            }
+            value = argv[++i];
+        }
+        option->apply(arguments, token, value);
+    }
+    if (arguments.help) return arguments;
+    for (const Option& option : options()) {
+        if (option.required && !seen[option.name]) {
+            throw UsageError(std::string("missing required option ") + option.name + " " +
+                             option.value_name + " (see --help)");
+        }
+    }
+    if (arguments.inputs.empty()) throw UsageError("no INPUT files given (see --help)");
+    if (arguments.raw_dims.has_value() != arguments.raw_type.has_value()) {
+        throw UsageError(arguments.raw_dims ? "--raw-dims needs --raw-type"
+                                            : "--raw-type needs --raw-dims");
+    }
+    return arguments;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+/// Messages must stay one line (nested errors and build logs may span several).
+std::string one_line(const std::string& message) {
+    std::string line;
+    for (char c : message) {
+        const bool is_break = c == '\n' || c == '\r';
+        if (is_break && (line.empty() || line.back() == ' ')) continue;
+        line += is_break ? ' ' : c;
+    }
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    return line;
+}
+
+std::string format_duration(double seconds) {
+    const auto total = static_cast<std::int64_t>(std::llround(std::max(0.0, seconds)));
+    std::ostringstream text;
+    text << total / 60 << ":" << std::setw(2) << std::setfill('0') << total % 60;
+    return text.str();
+}
+
+/// Steps done, rate and ETA on one redrawn line of stderr, only when stderr is a terminal.
+class ProgressBar {
+public:
+    explicit ProgressBar(std::size_t total)
+        : total_(total), enabled_(isatty(STDERR_FILENO) == 1), start_(Clock::now()) {}
+
+    void update(std::size_t done) {
+        if (!enabled_) return;
+        const double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
+        const double rate = elapsed > 0.0 ? static_cast<double>(done) / elapsed : 0.0;
+        constexpr std::size_t kWidth = 30;
+        const std::size_t filled = total_ == 0 ? kWidth : done * kWidth / total_;
+        std::ostringstream line;
+        line << "\r[" << std::string(filled, '#') << std::string(kWidth - filled, ' ') << "] "
+             << done << "/" << total_ << " steps  " << std::fixed << std::setprecision(2) << rate
+             << " steps/s  ETA "
+             << (done > 0 && rate > 0.0 ? format_duration(static_cast<double>(total_ - done) / rate)
+                                        : std::string("--:--"))
+             << "\x1b[K";
+        std::cerr << line.str() << std::flush;
+        drawn_ = true;
+    }
+    /// Prints a line of its own (a warning) without tearing the bar.
+    void message(const std::string& text) {
+        if (drawn_) std::cerr << "\r\x1b[K";
+        std::cerr << text << "\n";
+    }
+    void finish() {
+        if (drawn_) std::cerr << "\n";
+        drawn_ = false;
+    }
+
+private:
+    using Clock = std::chrono::steady_clock;
+    std::size_t total_;
+    bool enabled_;
+    bool drawn_ = false;
+    Clock::time_point start_;
+};
+
+std::string joined(const std::vector<std::string>& names) {
+    std::string text;
+    for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
+    return text;
+}
+
+int run(const Arguments& arguments) {
+    namespace capture = insitu::capture;
+    // Everything cheap is checked before any input is read and OpenCL is started.
+    std::vector<std::string> unknown_keys;
+    insitu::InstrumentConfig config =
+        insitu::InstrumentConfig::from_json_file(arguments.config_path, &unknown_keys);
+    config.archive = arguments.out_path;
+    if (!unknown_keys.empty()) {
+        std::cerr << kProgram
+                  << ": warning: unknown configuration keys ignored: " << joined(unknown_keys)
+                  << "\n";
+    }
+
+    capture::InputOptions input_options;
+    input_options.field_name = config.fields.front();
+    input_options.array_name = arguments.field.empty() ? config.fields.front() : arguments.field;
+    if (arguments.raw_dims) {
+        capture::RawOptions raw;
+        raw.dims = *arguments.raw_dims;
+        raw.type = *arguments.raw_type;
+        raw.spacing_world = arguments.raw_spacing;
+        raw.big_endian = arguments.raw_big_endian;
+        input_options.raw = raw;
+    }
+
+    std::vector<capture::InputStep> steps;
+    for (const std::string& path : arguments.inputs) {
+        const capture::InputKind kind = capture::input_kind(path);
+        if (!capture::supported(kind)) {
+            throw UsageError("\"" + path + "\": " + capture::to_string(kind) +
+                             " input is not supported by this build (built without " +
+                             (kind == capture::InputKind::vdb ? "OpenVDB" : "VTK") + ")");
+        }
+        if (kind == capture::InputKind::raw && !input_options.raw) {
+            throw UsageError("\"" + path +
+                             "\" is not .vti, .pvd or .vdb, so it is read as raw, which needs "
+                             "--raw-dims and --raw-type");
+        }
+        if (kind == capture::InputKind::pvd) {
+            const std::vector<capture::InputStep> expanded = capture::expand_pvd(path);
+            steps.insert(steps.end(), expanded.begin(), expanded.end());
+        } else {
+            steps.push_back({path, kind, std::nullopt});
+        }
+    }
+
+    const auto start = std::chrono::steady_clock::now();
+    ProgressBar progress(steps.size());
+    std::unique_ptr<insitu::Instrument> instrument;
+    std::size_t captured = 0;
+    std::size_t not_selected = 0;
+    std::size_t dropped = 0;
+    std::size_t skipped = 0;
+    std::string layers_note;
+    // An input that cannot be used: skipped, or the end of the run (the archive keeps what the
+    // Instrument already wrote: finalize drains its queue).
+    const auto input_failed = [&](const std::string& why) {
+        if (arguments.on_error == OnError::skip) {
+            ++skipped;
+            // Every reader's message names the file already.
+            progress.message(std::string(kProgram) + ": skipped: " + one_line(why));
+            return;
+        }
+        progress.finish();
+        if (instrument) instrument->finalize();
+        throw UsageError(one_line(why) + " (stopped; the archive keeps the " +
+                         std::to_string(captured) +
+                         " step(s) captured before; --on-error skip goes on)");
+    };
+
+    progress.update(0);
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+        const capture::InputStep& input = steps[i];
+        const std::int64_t step = arguments.first_step + static_cast<std::int64_t>(i);
+        std::unique_ptr<capture::LoadedStep> loaded;
+        try {
+            loaded = capture::load_step(input, input_options);
+        } catch (const insitu::Error& error) {
+            input_failed(error.what());
+            progress.update(i + 1);
+            continue;
+        }
+        if (!instrument) {
+            // Level sets: the zero crossing is a layer unless the configuration names layers.
+            if (!config.layers && !loaded->default_isovalues().empty()) {
+                config.layers = loaded->default_isovalues();
+                layers_note = ", layers at the level set's zero crossing";
+            }
+            insitu::InstrumentOptions instrument_options;
+            instrument_options.log = false;  // this tool reports, one line per problem
+            try {
+                instrument = std::make_unique<insitu::Instrument>(config, instrument_options);
+            } catch (const insitu::Error& error) {
+                progress.finish();
+                throw RuntimeFailure(std::string("cannot start capturing into \"") +
+                                     config.archive + "\": " + error.what());
+            }
+        }
+        const double time = input.time.value_or(static_cast<double>(step));
+        const insitu::Status status = instrument->execute(step, time, {loaded->field()});
+        if (status == insitu::Status::error) {
+            const std::string why = "\"" + input.path + "\" (step " + std::to_string(step) +
+                                    "): " + instrument->last_error();
+            if (instrument->last_error_kind() == insitu::ErrorKind::invalid_argument) {
+                input_failed(why);
+            } else {
+                progress.finish();
+                instrument->finalize();
+                throw RuntimeFailure(one_line(why) + " (the archive keeps the " +
+                                     std::to_string(captured) + " steps before it)");
+            }
+        } else if (status == insitu::Status::ok) {
+            ++captured;
+        } else if (status == insitu::Status::not_selected) {
+            ++not_selected;
+        } else {
+            ++dropped;
+        }
+        progress.update(i + 1);
+    }
+    progress.finish();
+
+    if (!instrument) {
+        throw UsageError("none of the " + std::to_string(steps.size()) +
+                         " inputs could be read; nothing was captured");
+    }
+    if (instrument->finalize() == insitu::Status::error) {
+        throw RuntimeFailure("writing the archive \"" + config.archive +
+                             "\" failed: " + instrument->last_error());
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const insitu::InstrumentStatistics statistics = instrument->statistics();
+    std::ostringstream summary;
+    summary << std::fixed << std::setprecision(2) << kProgram << ": " << statistics.steps_written
+            << " of " << steps.size() << " steps archived (" << skipped << " skipped, "
+            << not_selected << " not selected by the cadence, " << dropped << " dropped) in "
+            << seconds << " s, " << (seconds > 0.0 ? captured / seconds : 0.0) << " steps/s"
+            << layers_note << " -> " << config.archive;
+    std::cout << summary.str() << "\n";
+    return 0;
+}
+
+int report(const std::string& message, int status) {
+    std::cerr << kProgram << ": " << one_line(message) << "\n";
+    return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    Arguments arguments;
+    try {
+        arguments = parse_arguments(argc, argv);
+    } catch (const UsageError& error) {
+        return report(error.what(), kExitBadInput);
+    }
+    if (arguments.help) {
+        print_help(std::cout);
+        return 0;
+    }
+    try {
+        return run(arguments);
+    } catch (const UsageError& error) {
+        return report(error.what(), kExitBadInput);
+    } catch (const RuntimeFailure& error) {
+        return report(error.what(), kExitRuntimeError);
+    } catch (const insitu::InvalidArgument& error) {
+        return report(error.what(), kExitBadInput);
+    } catch (const insitu::ParseError& error) {
+        return report(error.what(), kExitBadInput);
+    } catch (const insitu::IoError& error) {
+        return report(error.what(), kExitBadInput);
+    } catch (const std::exception& error) {
+        // ComputeError, other insitu::Error, std::bad_alloc: not the user's input.
+        return report(error.what(), kExitRuntimeError);
+    }
+}

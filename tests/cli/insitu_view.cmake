@@ -1,0 +1,102 @@
+# Tests of insitu-view (viewer/insitu_view.cpp), included from tests/cli/CMakeLists.txt: a small
+# Gray-Scott archive (single + multi-perspective proxies, multi-perspective attenuation, training
+# transfer functions so a colour model is fitted), then info, render (stored view, new view,
+# edits, lighting, enhancement, mask) and verify, and the command-line contract for bad input.
+if(NOT TARGET gray-scott OR NOT TARGET insitu-view)
+  return()
+endif()
+
+set(view_cli_dir ${CMAKE_CURRENT_LIST_DIR})
+set(view_archive ${CMAKE_CURRENT_BINARY_DIR}/insitu_view.cdb)
+set(view_output ${CMAKE_CURRENT_BINARY_DIR}/insitu_view_output)
+set(view_config ${CMAKE_CURRENT_BINARY_DIR}/insitu_view_config.json)
+file(WRITE ${view_config} [=[
+{"fields": ["v"],
+ "views": [{"azimuth": 30, "elevation": 20, "size": [48, 48], "distortion_tilt": 30}],
+ "transfer_function": {"points": [[0.0, 0, 0, 1, 0], [0.1, 0, 0.5, 1, 0.2], [0.4, 1, 0.3, 0, 1]],
+                       "unit_length": 1.0},
+ "training_transfer_functions": [
+   {"points": [[0.0, 0, 0, 1, 0], [0.1, 0, 0.5, 1, 0.05], [0.4, 1, 0.3, 0, 1]], "unit_length": 1.0},
+   {"points": [[0.0, 0, 0, 1, 0], [0.1, 0, 0.5, 1, 0.6], [0.4, 1, 0.3, 0, 1]], "unit_length": 1.0}],
+ "colour_model": {"clusters": 8},
+ "layers": [0.2], "intervals": {"count": 8},
+ "proxies": ["depth", "distortion", "attenuation", "multi_attenuation"],
+ "precision": "float", "steps": [4, 8]}
+]=])
+set(edited_tf ${CMAKE_CURRENT_BINARY_DIR}/insitu_view_edited_tf.json)
+file(WRITE ${edited_tf} [=[
+{"points": [[0.0, 0, 0, 1, 0], [0.1, 0, 0.5, 1, 0.05], [0.4, 1, 0.3, 0, 1]], "unit_length": 1.0}
+]=])
+
+add_test(NAME insitu_view.setup_clean
+         COMMAND ${CMAKE_COMMAND} -E rm -rf ${view_archive} ${view_output})
+add_test(NAME insitu_view.setup_output COMMAND ${CMAKE_COMMAND} -E make_directory ${view_output})
+add_test(NAME insitu_view.setup_archive
+         COMMAND gray-scott --size 24 --steps 8 --config ${view_config} --out ${view_archive})
+set_tests_properties(insitu_view.setup_clean PROPERTIES FIXTURES_SETUP insitu_view_clean)
+set_tests_properties(insitu_view.setup_output PROPERTIES
+                     FIXTURES_REQUIRED insitu_view_clean FIXTURES_SETUP insitu_view_output)
+set_tests_properties(insitu_view.setup_archive PROPERTIES
+                     FIXTURES_REQUIRED insitu_view_output FIXTURES_SETUP insitu_view_archive
+                     TIMEOUT 120)
+
+# view_case(NAME EXIT STDERR|STDOUT TEXT ARGS...): runs insitu-view ARGS on the archive fixture.
+function(view_case name exit_status stream text)
+  string(JOIN "|" command $<TARGET_FILE:insitu-view> ${ARGN})
+  add_test(NAME insitu_view.${name}
+           COMMAND ${CMAKE_COMMAND} -DEXPECTED_EXIT=${exit_status}
+                   "-DEXPECTED_${stream}_SUBSTRING=${text}" "-DCOMMAND=${command}"
+                   -P ${view_cli_dir}/expect_exit.cmake)
+  set_tests_properties(insitu_view.${name} PROPERTIES
+                       FIXTURES_REQUIRED insitu_view_archive TIMEOUT 60)
+endfunction()
+
+view_case(help 0 STDOUT "usage:" --help)
+view_case(info 0 STDOUT "steps         2 (4 .. 8)" info ${view_archive})
+view_case(info_model 0 STDOUT "colour model L=8 K=8" info ${view_archive})
+view_case(info_json 0 STDOUT "\"view_count\": 1" info ${view_archive} --json)
+view_case(verify 0 STDOUT "0 problems" verify ${view_archive})
+view_case(render_stored 0 STDERR "stored view" render ${view_archive} --step 4
+          --out ${view_output}/stored.png)
+view_case(render_rotated 0 STDERR "new view" render ${view_archive} --step 8 --azimuth 45
+          --elevation 10 --mask ${view_output}/rotated_mask.png --out ${view_output}/rotated.exr)
+view_case(render_opacity_edit 0 STDERR "colour by model" render ${view_archive} --step 8
+          --opacity-scale 1=0.25,2=0.5 --out ${view_output}/opacity.png)
+view_case(render_tf_edit 0 STDERR "colour by model" render ${view_archive} --step 8
+          --tf ${edited_tf} --out ${view_output}/tf.png)
+view_case(render_recompose 0 STDERR "colour by recompose" render ${view_archive} --step 8
+          --opacity-scale 1=0.25 --colour recompose --out ${view_output}/recompose.png)
+view_case(render_lit 0 STDERR "stored view" render ${view_archive} --step 8 --light camera
+          --light 90,30,0.5,0.2 --ao --ao-radius 4 --enhance 0.5,0.5
+          --out ${view_output}/lit.png)
+add_test(NAME insitu_view.outputs
+         COMMAND ${CMAKE_COMMAND} -DDIRECTORY=${view_output}
+                 "-DFILES=stored.png|rotated.exr|rotated_mask.png|opacity.png|tf.png|recompose.png|lit.png"
+                 -DEXPECTED_COUNT=6 -DPATTERN=*.png -P ${view_cli_dir}/check_files.cmake)
+set_tests_properties(insitu_view.outputs PROPERTIES
+                     DEPENDS "insitu_view.render_stored;insitu_view.render_rotated;insitu_view.render_opacity_edit;insitu_view.render_tf_edit;insitu_view.render_recompose;insitu_view.render_lit"
+                     FIXTURES_REQUIRED insitu_view_archive)
+
+# Bad input: exit 2 and one line naming the offending value.
+view_case(no_command 2 STDERR "missing command")
+view_case(unknown_command 2 STDERR "unknown command \"show\"" show ${view_archive})
+view_case(missing_archive 2 STDERR "no_such.cdb" info ${CMAKE_CURRENT_BINARY_DIR}/no_such.cdb)
+view_case(missing_step 2 STDERR "has no step 999" render ${view_archive} --step 999
+          --out ${view_output}/never.png)
+view_case(missing_view 2 STDERR "has no view 3" render ${view_archive} --step 4 --view 3
+          --out ${view_output}/never.png)
+view_case(missing_out 2 STDERR "missing --out" render ${view_archive} --step 4)
+view_case(unknown_flag 2 STDERR "unknown flag --zoom" render ${view_archive} --step 4 --zoom 2
+          --out ${view_output}/never.png)
+view_case(bad_scale 2 STDERR "opacity-scale" render ${view_archive} --step 4
+          --opacity-scale 1=abc --out ${view_output}/never.png)
+view_case(scale_interval_out_of_range 2 STDERR "opacity-scale interval 12" render
+          ${view_archive} --step 4 --opacity-scale 12=0.5 --out ${view_output}/never.png)
+view_case(bad_elevation 2 STDERR "elevation = 95" render ${view_archive} --step 4
+          --elevation 95 --out ${view_output}/never.png)
+view_case(bad_enhance 2 STDERR "enhance = \"0.5\"" render ${view_archive} --step 4
+          --enhance 0.5 --out ${view_output}/never.png)
+view_case(missing_tf_file 2 STDERR "--tf: cannot read" render ${view_archive} --step 4
+          --tf ${CMAKE_CURRENT_BINARY_DIR}/no_such_tf.json --out ${view_output}/never.png)
+view_case(bad_extension 2 STDERR "never.bmp" render ${view_archive} --step 4
+          --out ${view_output}/never.bmp)
