@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
         config.views[0].orbit =
             OrbitView{30.0, 20.0, Projection::orthographic, 30.0, options.image, options.image};
         config.transfer_function = ramp(0.5);
-        config.training_transfer_functions = {ramp(0.15), ramp(1.5)};
+        config.training_transfer_functions = {ramp(0.15), ramp(1.0)};
         config.colour_model.clusters = options.clusters;
         config.interval_count = options.intervals;
         config.layers = std::vector<double>{0.25, 0.5, 0.75, 0.9};

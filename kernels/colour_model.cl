@@ -17,6 +17,14 @@ __kernel void predict_colour(__global const float* attenuation, int intervals, u
         alpha += a[j];
     }
 
+    // Nothing on this ray: the clamp below would give transparent black anyway, so skip the
+    // K x L search (background is often most of the image).
+    __global float* out = rgba_out + pixel * 4u;
+    if (!(alpha > 0.0f)) {
+        vstore4((float4)(0.0f), 0, out);
+        return;
+    }
+
     // seed 000 Eq. 10: the nearest centroid, the lowest index on ties.
     const int row = 4 * intervals + 3;
     int best = 0;
@@ -39,8 +47,7 @@ __kernel void predict_colour(__global const float* attenuation, int intervals, u
     __global const float* a0 = table + best * row;
     __global const float* c0 = a0 + intervals;
     __global const float* jacobian = c0 + 3;
-    const float upper = fmax(alpha, 0.0f);
-    __global float* out = rgba_out + pixel * 4u;
+    const float upper = alpha;
     for (int ch = 0; ch < 3; ++ch) {
         float colour = c0[ch];
         for (int j = 0; j < intervals; ++j) colour += jacobian[ch * intervals + j] * (a[j] - a0[j]);

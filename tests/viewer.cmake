@@ -1,0 +1,86 @@
+# Tests of the web viewer, `insitu-view serve` (viewer/server.cpp, viewer/web/), included from
+# tests/CMakeLists.txt. A small Gray-Scott archive is the fixture; node runs the tests in
+# tests/viewer/: browser.test.mjs drives headless Debian chromium through playwright-core
+# (installed by scripts/setup into tests/viewer/node_modules) and compares every displayed frame
+# with `insitu-view render`; api.test.mjs checks refusals, containment, coalescing and a growing
+# archive. Plus the command line of `serve` itself.
+if(NOT TARGET gray-scott OR NOT TARGET insitu-view)
+  return()  # examples not built (INSITU_BUILD_EXAMPLES=OFF)
+endif()
+find_program(NODE_EXECUTABLE node)
+if(NOT NODE_EXECUTABLE)
+  message(WARNING "node not found: the viewer's browser and API tests are not added "
+                  "(scripts/setup installs nodejs)")
+  return()
+endif()
+
+set(viewer_tests_dir ${CMAKE_CURRENT_LIST_DIR}/viewer)
+set(viewer_work ${CMAKE_CURRENT_BINARY_DIR}/viewer)
+set(viewer_archive ${viewer_work}/viewer.cdb)
+set(viewer_config ${CMAKE_CURRENT_BINARY_DIR}/viewer_config.json)
+# 32^3 for 20 steps, archived at 10 and 20 in 256x256: every kind of proxy (multi-perspective
+# attenuation for orbiting, depth layers for ambient occlusion) and training renderings so a
+# colour model is fitted. Well under a second once the kernels are built.
+file(WRITE ${viewer_config} [=[
+{"fields": ["v"],
+ "views": [{"azimuth": 30, "elevation": 20, "size": [256, 256]}],
+ "transfer_function": {"points": [[0.0, 0.1, 0.25, 0.75, 0.0], [0.12, 0.1, 0.25, 0.75, 0.0],
+                                  [0.2, 0.15, 0.55, 0.9, 0.04], [0.28, 0.35, 0.85, 0.7, 0.1],
+                                  [0.36, 0.95, 0.8, 0.3, 0.22], [0.45, 1.0, 0.4, 0.15, 0.4]],
+                       "unit_length": 1.0},
+ "training_transfer_functions": [
+   {"points": [[0.0, 0.9, 0.9, 0.2, 0.0], [0.2, 0.9, 0.3, 0.2, 0.1], [0.45, 0.2, 0.3, 0.9, 0.3]],
+    "unit_length": 1.0},
+   {"points": [[0.0, 0.2, 0.9, 0.3, 0.0], [0.25, 0.6, 0.6, 0.6, 0.2], [0.45, 0.9, 0.1, 0.1, 0.5]],
+    "unit_length": 1.0}],
+ "colour_model": {"clusters": 8},
+ "intervals": {"count": 8},
+ "proxies": ["depth", "distortion", "attenuation", "multi_attenuation"],
+ "every": 10}
+]=])
+
+add_test(NAME viewer.setup_clean COMMAND ${CMAKE_COMMAND} -E rm -rf ${viewer_work})
+add_test(NAME viewer.setup_work COMMAND ${CMAKE_COMMAND} -E make_directory ${viewer_work})
+add_test(NAME viewer.setup_archive
+         COMMAND gray-scott --size 32 --steps 20 --config ${viewer_config} --out ${viewer_archive})
+set_tests_properties(viewer.setup_clean PROPERTIES FIXTURES_SETUP viewer_clean)
+set_tests_properties(viewer.setup_work PROPERTIES
+                     FIXTURES_REQUIRED viewer_clean FIXTURES_SETUP viewer_work)
+set_tests_properties(viewer.setup_archive PROPERTIES
+                     FIXTURES_REQUIRED viewer_work FIXTURES_SETUP viewer_archive TIMEOUT 120)
+
+set(viewer_environment
+    INSITU_VIEW=$<TARGET_FILE:insitu-view> GRAY_SCOTT=$<TARGET_FILE:gray-scott>
+    ARCHIVE=${viewer_archive} WORK_DIR=${viewer_work})
+foreach(suite IN ITEMS browser api)
+  add_test(NAME viewer.${suite}
+           COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/${suite}.test.mjs
+           WORKING_DIRECTORY ${viewer_tests_dir})
+  # Each takes about 5-10 s on 2 cores; the limit leaves room for a loaded machine.
+  set_tests_properties(viewer.${suite} PROPERTIES
+                       FIXTURES_REQUIRED viewer_archive
+                       ENVIRONMENT "${viewer_environment}"
+                       TIMEOUT 120)
+endforeach()
+
+# serve's command line: exit 2 and one line on stderr for bad arguments or archives.
+function(viewer_serve_case name exit_status stream text)
+  string(JOIN "|" command $<TARGET_FILE:insitu-view> serve ${ARGN})
+  add_test(NAME viewer.serve_${name}
+           COMMAND ${CMAKE_COMMAND} -DEXPECTED_EXIT=${exit_status}
+                   "-DEXPECTED_${stream}_SUBSTRING=${text}" "-DCOMMAND=${command}"
+                   -P ${CMAKE_CURRENT_LIST_DIR}/cli/expect_exit.cmake)
+  set_tests_properties(viewer.serve_${name} PROPERTIES TIMEOUT 60)
+endfunction()
+viewer_serve_case(missing_archive 2 STDERR "serve: missing ARCHIVE")
+viewer_serve_case(no_such_archive 2 STDERR "no_such.cdb" ${viewer_work}/no_such.cdb)
+viewer_serve_case(port_not_a_number 2 STDERR "--port http" some.cdb --port http)
+viewer_serve_case(port_out_of_range 2 STDERR "--port 70000" some.cdb --port 70000)
+viewer_serve_case(port_missing_value 2 STDERR "--port: missing value" some.cdb --port)
+viewer_serve_case(unknown_flag 2 STDERR "unknown flag --open" some.cdb --open)
+viewer_serve_case(two_archives 2 STDERR "unexpected argument" a.cdb b.cdb)
+# Without a usable OpenCL device it cannot serve: exit 1, naming the device setting.
+viewer_serve_case(no_opencl_device 1 STDERR "INSITU_OPENCL_DEVICE" ${viewer_archive} --port 0)
+set_tests_properties(viewer.serve_no_opencl_device PROPERTIES
+                     ENVIRONMENT INSITU_OPENCL_DEVICE=no-such-opencl-device
+                     FIXTURES_REQUIRED viewer_archive)

@@ -1,0 +1,88 @@
+// Measures (does not test) how fast `insitu-view serve` delivers frames of ARCHIVE:
+//  1. over HTTP, one request in flight as the page does: per scenario the engine's time per
+//     frame (X-Insitu-Milliseconds), the round trip, and frames per second;
+//  2. in headless chromium: frames per second the page displays during a continuous orbit drag
+//     (round trip + PNG decode + display).
+//
+//   node tests/viewer/frame_rate.mjs INSITU_VIEW ARCHIVE [FRAMES]
+import { performance } from 'node:perf_hooks';
+
+import { CHROMIUM, CHROMIUM_ARGS, loadPlaywright, startServer, stopServer } from './lib.mjs';
+
+const [binary, archive, framesText] = process.argv.slice(2);
+if (!binary || !archive) {
+  console.error('usage: node frame_rate.mjs INSITU_VIEW ARCHIVE [FRAMES]');
+  process.exit(2);
+}
+const frames = Number(framesText || 40);
+const server = await startServer(binary, archive);
+try {
+  const description = await (await fetch(server.url + 'api/archive')).json();
+  const steps = description.timeline.map((entry) => entry.step);
+  const step = steps[steps.length - 1];
+  const info = await (await fetch(`${server.url}api/step?step=${step}`)).json();
+  const intervals = info.intervals.length - 1;
+  console.log(`archive ${description.name}: ${info.size[0]}x${info.size[1]}, ${steps.length} steps, ` +
+    `${intervals} intervals, ${info.depth_layers} depth layer(s); ${frames} frames per scenario`);
+
+  const orbit = (i) => ({ azimuth: (info.azimuth + 10 + (i % 40)).toFixed(2), elevation: (info.elevation + 5).toFixed(2) });
+  const half = Math.floor(intervals / 2);
+  const scenarios = [
+    ['stored view, scrubbing steps', (i) => ({ step: String(steps[i % steps.length]) })],
+    ['orbit (synthesised view)', (i) => ({ step: String(step), ...orbit(i) })],
+    ['orbit + opacity edit', (i) => ({ step: String(step), ...orbit(i), 'opacity-scale': `${half}=0.2,${half + 1}=3` })],
+    ['orbit + 2 lights', (i) => ({ step: String(step), ...orbit(i), light: 'camera;60,40', ambient: '0.2' })],
+    ['orbit + lights + AO (r 8)', (i) => ({ step: String(step), ...orbit(i), light: 'camera;60,40', ao: '8,1' })],
+    ['orbit + enhancement', (i) => ({ step: String(step), ...orbit(i), enhance: '1,0.5' })],
+  ];
+  console.log('scenario                         engine ms   PNG ms   round trip ms   frames/s');
+  for (const [name, options] of scenarios) {
+    // One warm-up frame builds kernels and loads proxies; it is not counted.
+    await (await fetch(server.url + 'api/frame?' + new URLSearchParams(options(frames)))).arrayBuffer();
+    let engine = 0;
+    let encode = 0;
+    const start = performance.now();
+    for (let i = 0; i < frames; ++i) {
+      const response = await fetch(server.url + 'api/frame?' + new URLSearchParams({ ...options(i), session: 'rate' }));
+      if (!response.ok) throw new Error(`${name}: ${response.status} ${await response.text()}`);
+      await response.arrayBuffer();
+      engine += Number(response.headers.get('X-Insitu-Milliseconds'));
+      encode += Number(response.headers.get('X-Insitu-Encode-Milliseconds'));
+    }
+    const wall = performance.now() - start;
+    console.log(`${name.padEnd(32)} ${(engine / frames).toFixed(1).padStart(9)} ` +
+      `${(encode / frames).toFixed(1).padStart(8)} ` +
+      `${(wall / frames).toFixed(1).padStart(15)} ${((frames * 1000) / wall).toFixed(1).padStart(10)}`);
+  }
+
+  // The page itself: a pointer dragging across the viewport for a few seconds.
+  const { chromium } = loadPlaywright();
+  const browser = await chromium.launch({ executablePath: CHROMIUM, args: CHROMIUM_ARGS });
+  try {
+    const page = await browser.newPage({ viewport: { width: 1280, height: 900 } });
+    await page.goto(server.url);
+    await page.waitForFunction(() => window.insituViewer.frameCount > 0);
+    const box = await page.locator('#viewport').boundingBox();
+    const y = box.y + box.height / 2;
+    await page.mouse.move(box.x + 100, y);
+    await page.mouse.down();
+    const first = await page.evaluate(() => window.insituViewer.frameCount);
+    const start = performance.now();
+    const dragMs = 4000;
+    for (let i = 0; performance.now() - start < dragMs; ++i) {
+      await page.mouse.move(box.x + 100 + (i % 300), y);
+      await new Promise((resolve) => setTimeout(resolve, 8));  // a 120 Hz pointer
+    }
+    const shown = (await page.evaluate(() => window.insituViewer.frameCount)) - first;
+    const elapsed = performance.now() - start;
+    await page.mouse.up();
+    console.log(`page, orbit drag: ${shown} frames displayed in ${(elapsed / 1000).toFixed(1)} s = ` +
+      `${((shown * 1000) / elapsed).toFixed(1)} frames/s`);
+  } finally {
+    await browser.close();
+  }
+  const status = await (await fetch(server.url + 'api/status')).json();
+  console.log(`server: ${status.frames_rendered} frames rendered, ${status.superseded} superseded`);
+} finally {
+  await stopServer(server);
+}

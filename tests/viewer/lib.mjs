@@ -1,0 +1,169 @@
+// Helpers of the viewer tests: start `insitu-view serve`, render the same options with
+// `insitu-view render`, and decode PNGs to compare pixels (no dependency beyond node's zlib).
+import { spawn, spawnSync } from 'node:child_process';
+import { existsSync, mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
+import { createRequire } from 'node:module';
+import { tmpdir } from 'node:os';
+import path from 'node:path';
+import { inflateSync } from 'node:zlib';
+
+/// A required environment variable (set by tests/viewer.cmake).
+export function env(name) {
+  const value = process.env[name];
+  if (!value) throw new Error(`environment variable ${name} is not set (tests/viewer.cmake sets it)`);
+  return value;
+}
+
+/// playwright-core from tests/viewer/node_modules, with a message that says how to get it.
+export function loadPlaywright() {
+  const require = createRequire(import.meta.url);
+  try {
+    return require('playwright-core');
+  } catch (error) {
+    throw new Error('playwright-core is not installed in tests/viewer/node_modules: run ' +
+      'scripts/setup (or `npm ci` in tests/viewer)');
+  }
+}
+
+/// Headless Debian chromium, never a downloaded browser.
+export const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
+export const CHROMIUM_ARGS = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'];
+
+/// Starts `insitu-view serve ARCHIVE --port 0` and resolves once it prints its URL.
+export function startServer(binary, archive, extraArgs = []) {
+  const child = spawn(binary, ['serve', archive, '--port', '0', ...extraArgs],
+    { stdio: ['ignore', 'pipe', 'pipe'] });
+  const server = { child, stderr: '', stdout: '', url: null };
+  child.stderr.on('data', (chunk) => { server.stderr += chunk; });
+  return new Promise((resolve, reject) => {
+    const timer = setTimeout(() => reject(new Error(`no URL from serve: ${server.stderr}`)), 20000);
+    child.stdout.on('data', (chunk) => {
+      server.stdout += chunk;
+      const match = server.stdout.match(/http:\/\/[^\s]+\//);
+      if (match && !server.url) {
+        server.url = match[0];
+        clearTimeout(timer);
+        resolve(server);
+      }
+    });
+    child.on('exit', (code) => {
+      clearTimeout(timer);
+      if (!server.url) reject(new Error(`serve exited with ${code}: ${server.stderr}`));
+    });
+  });
+}
+
+/// Stops a server with SIGTERM; resolves with its exit code.
+export function stopServer(server) {
+  if (server.child.exitCode !== null) return Promise.resolve(server.child.exitCode);
+  return new Promise((resolve) => {
+    server.child.on('exit', (code) => resolve(code));
+    server.child.kill('SIGTERM');
+  });
+}
+
+/// The `insitu-view render` arguments for explore options as the page sends them.
+export function renderArguments(options, workDir) {
+  const args = [];
+  for (const [key, value] of Object.entries(options)) {
+    if (key === 'tf') {
+      // The CLI reads an edited transfer function from a file; the page sends its text.
+      const file = path.join(mkdtempSync(path.join(workDir, 'tf-')), 'tf.json');
+      writeFileSync(file, value);
+      args.push('--tf', file);
+    } else if (key === 'ao') {
+      const [radius, strength] = value.split(',');
+      args.push('--ao-radius', radius);
+      if (strength !== undefined) args.push('--ao-strength', strength);
+    } else if (key === 'light') {
+      for (const light of value.split(';')) args.push('--light', light);
+    } else {
+      args.push(`--${key}`, value);
+    }
+  }
+  return args;
+}
+
+/// Renders `options` with the CLI: {colour, mask} PNG buffers.
+export function renderWithCli(binary, archive, options, workDir) {
+  const dir = mkdtempSync(path.join(workDir, 'render-'));
+  const out = path.join(dir, 'frame.png');
+  const mask = path.join(dir, 'mask.png');
+  const result = spawnSync(binary,
+    ['render', archive, ...renderArguments(options, workDir), '--out', out, '--mask', mask],
+    { encoding: 'utf8' });
+  if (result.status !== 0) {
+    throw new Error(`insitu-view render failed (${result.status}): ${result.stderr}`);
+  }
+  return { colour: readFileSync(out), mask: readFileSync(mask) };
+}
+
+/// Decodes an 8-bit, non-interlaced PNG (grey, grey+alpha, RGB, RGBA): {width, height,
+/// channels, data}.
+export function decodePng(buffer) {
+  const signature = Buffer.from([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a]);
+  if (!buffer.subarray(0, 8).equals(signature)) throw new Error('not a PNG');
+  let offset = 8;
+  let width = 0;
+  let height = 0;
+  let channels = 0;
+  const idat = [];
+  while (offset < buffer.length) {
+    const length = buffer.readUInt32BE(offset);
+    const type = buffer.toString('latin1', offset + 4, offset + 8);
+    const data = buffer.subarray(offset + 8, offset + 8 + length);
+    if (type === 'IHDR') {
+      width = data.readUInt32BE(0);
+      height = data.readUInt32BE(4);
+      const [depth, colourType, , , interlace] = data.subarray(8, 13);
+      if (depth !== 8 || interlace !== 0) throw new Error('only 8-bit non-interlaced PNG');
+      channels = { 0: 1, 2: 3, 4: 2, 6: 4 }[colourType];
+      if (!channels) throw new Error(`PNG colour type ${colourType} not supported`);
+    } else if (type === 'IDAT') {
+      idat.push(data);
+    }
+    offset += 12 + length;
+  }
+  const raw = inflateSync(Buffer.concat(idat));
+  const stride = width * channels;
+  const out = new Uint8Array(height * stride);
+  for (let y = 0; y < height; ++y) {
+    const filter = raw[y * (stride + 1)];
+    const line = raw.subarray(y * (stride + 1) + 1, (y + 1) * (stride + 1));
+    for (let x = 0; x < stride; ++x) {
+      const a = x >= channels ? out[y * stride + x - channels] : 0;
+      const b = y > 0 ? out[(y - 1) * stride + x] : 0;
+      const c = x >= channels && y > 0 ? out[(y - 1) * stride + x - channels] : 0;
+      let predictor = 0;
+      if (filter === 1) predictor = a;
+      else if (filter === 2) predictor = b;
+      else if (filter === 3) predictor = (a + b) >> 1;
+      else if (filter === 4) {
+        const p = a + b - c;
+        const pa = Math.abs(p - a);
+        const pb = Math.abs(p - b);
+        const pc = Math.abs(p - c);
+        predictor = pa <= pb && pa <= pc ? a : pb <= pc ? b : c;
+      }
+      out[y * stride + x] = (line[x] + predictor) & 0xff;
+    }
+  }
+  return { width, height, channels, data: out };
+}
+
+/// Number of samples (pixel components) that differ between two decoded images of one shape.
+export function differingSamples(a, b) {
+  if (a.width !== b.width || a.height !== b.height || a.channels !== b.channels) {
+    throw new Error(`shapes differ: ${a.width}x${a.height}x${a.channels} vs ` +
+      `${b.width}x${b.height}x${b.channels}`);
+  }
+  let count = 0;
+  for (let i = 0; i < a.data.length; ++i) if (a.data[i] !== b.data[i]) ++count;
+  return count;
+}
+
+export function makeWorkDir(prefix) {
+  const base = process.env.WORK_DIR || tmpdir();
+  if (!existsSync(base)) throw new Error(`WORK_DIR ${base} does not exist`);
+  return mkdtempSync(path.join(base, prefix));
+}
