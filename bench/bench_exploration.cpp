@@ -5,6 +5,8 @@
 // Prints figures; never a test.
 //
 //   bench_exploration [--image P] [--intervals L] [--clusters K] [--repeats R] [--sizes 128,256]
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -15,16 +17,16 @@
 #include <string>
 #include <vector>
 
-#include <unistd.h>
-
 #include "insitu/analytic_fields.hpp"
 #include "insitu/explorer.hpp"
 #include "insitu/instrument.hpp"
 #include "insitu/proxy_renderer.hpp"
+#include "median_time.hpp"
 
 namespace {
 
 using namespace insitu;
+using bench::median_ms;
 namespace fs = std::filesystem;
 
 struct Options {
@@ -59,28 +61,18 @@ Options parse(int argc, char** argv) {
         }
         const int number = std::atoi(value.c_str());
         if (number < 1) usage_error(flag + " = " + value + " (must be a positive integer)");
-        if (flag == "--image") options.image = number;
-        else if (flag == "--intervals") options.intervals = number;
-        else if (flag == "--clusters") options.clusters = number;
-        else if (flag == "--repeats") options.repeats = number;
-        else usage_error("unknown flag " + flag);
+        if (flag == "--image")
+            options.image = number;
+        else if (flag == "--intervals")
+            options.intervals = number;
+        else if (flag == "--clusters")
+            options.clusters = number;
+        else if (flag == "--repeats")
+            options.repeats = number;
+        else
+            usage_error("unknown flag " + flag);
     }
     return options;
-}
-
-/// Median wall time (ms) of `repeats` runs after one warm-up run (kernel builds, buffers).
-double median_ms(int repeats, const std::function<void()>& run) {
-    run();
-    std::vector<double> times;
-    for (int r = 0; r < repeats; ++r) {
-        const auto start = std::chrono::steady_clock::now();
-        run();
-        times.push_back(
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                .count());
-    }
-    std::sort(times.begin(), times.end());
-    return times[times.size() / 2];
 }
 
 TransferFunction ramp(double peak_opacity) {
@@ -97,10 +89,10 @@ int main(int argc, char** argv) {
     const Options options = parse(argc, argv);
     const fs::path scratch =
         fs::temp_directory_path() / ("insitu_bench_exploration_" + std::to_string(::getpid()));
-    std::printf("exploration vs ground truth: %dx%d image, L = %d, K = %d, 1-voxel step, "
-                "median of %d\n",
-                options.image, options.image, options.intervals, options.clusters,
-                options.repeats);
+    std::printf(
+        "exploration vs ground truth: %dx%d image, L = %d, K = %d, 1-voxel step, "
+        "median of %d\n",
+        options.image, options.image, options.intervals, options.clusters, options.repeats);
     std::printf("%-6s %10s %10s %10s %10s %10s %10s %10s\n", "volume", "truth_ms", "stored_ms",
                 "tfedit_ms", "view_ms", "relight_ms", "emit_s", "slowest_x");
     for (const std::int64_t n : options.sizes) {
@@ -135,9 +127,8 @@ int main(int argc, char** argv) {
         ProxyRenderer renderer;
         renderer.upload(volume.field());
         const Camera camera = Camera::orbit(config.views[0].orbit, volume.field().bounds());
-        const double truth_ms = median_ms(std::max(1, options.repeats / 2), [&] {
-            renderer.render_ground_truth(camera, ramp(0.3));
-        });
+        const double truth_ms = median_ms(std::max(1, options.repeats / 2),
+                                          [&] { renderer.render_ground_truth(camera, ramp(0.3)); });
 
         Explorer explorer(config.archive);
         ExploreRequest stored;

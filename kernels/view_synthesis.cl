@@ -86,14 +86,18 @@ inline bool continuous(float3 p, float3 q, float nominal_pixel) {
 
 // Splats one target-space sample. Mode 0: atomic_min of its depth key. Mode 1: where the key
 // equals the one left by mode 0 (this sample won), writes (value_a, value_b) to values.
+// Equal keys from two samples are equally near and either is a valid winner, but only one may
+// write: two unsynchronised float2 stores can tear into a pair from different samples (a_j of
+// one with T_j of the other, a ratio above 1). The first to claim `owners` (EMPTY_KEY until
+// then) writes.
 inline void emit(int tx, int ty, float depth, int2 size, __global uint* keys, int key_stride,
-                 int key_offset, int mode, __global float2* values, float2 value) {
+                 int key_offset, int mode, __global float2* values, __global uint* owners,
+                 float2 value) {
     const int index = (ty * size.x + tx) * key_stride + key_offset;
     const uint key = depth_key(depth);
     if (mode == 0) {
         atomic_min(keys + index, key);
-    } else if (keys[index] == key) {
-        // Equal keys from two samples are equally near; either winner is valid.
+    } else if (keys[index] == key && atomic_cmpxchg(owners + index, EMPTY_KEY, 0u) == EMPTY_KEY) {
         values[index] = value;
     }
 }
@@ -107,7 +111,7 @@ inline void emit(int tx, int ty, float depth, int2 size, __global uint* keys, in
 // without neighbours on its surface it takes the sample's own depth.
 inline void splat_footprint(float3 centre, float3 dx, float3 dy, bool has_footprint, int2 size,
                             __global uint* keys, int key_stride, int key_offset, int mode,
-                            __global float2* values, float2 value) {
+                            __global float2* values, __global uint* owners, float2 value) {
     const float half_x = 0.5f * (fabs(dx.x) + fabs(dy.x));
     const float half_y = 0.5f * (fabs(dx.y) + fabs(dy.y));
     const float determinant = dx.x * dy.y - dx.y * dy.x;
@@ -134,7 +138,8 @@ inline void splat_footprint(float3 centre, float3 dx, float3 dy, bool has_footpr
         for (int tx = x0; tx <= x1; ++tx) {
             const float2 offset = (float2)((float)tx + 0.5f, (float)ty + 0.5f) - centre.xy;
             if (!tangent) {
-                emit(tx, ty, centre.z, size, keys, key_stride, key_offset, mode, values, value);
+                emit(tx, ty, centre.z, size, keys, key_stride, key_offset, mode, values, owners,
+                     value);
                 continue;
             }
             float s = (offset.x * dy.y - offset.y * dy.x) / determinant;
@@ -144,7 +149,7 @@ inline void splat_footprint(float3 centre, float3 dx, float3 dy, bool has_footpr
             s = clamp(s, -0.5f, 0.5f);
             t = clamp(t, -0.5f, 0.5f);
             emit(tx, ty, centre.z + s * dx.z + t * dy.z, size, keys, key_stride, key_offset, mode,
-                 values, value);
+                 values, owners, value);
         }
     }
 }
@@ -195,7 +200,7 @@ inline void splat_sample(__global const float* depth, __global const float* dist
                          int stride, int offset, float4 row0, float4 row1, float4 row2,
                          int2 target_size, float4 target_extent, __global uint* keys,
                          int key_stride, int key_offset, int mode, __global float2* values,
-                         float2 value) {
+                         __global uint* owners, float2 value) {
     float3 own;
     if (!source_point(depth, distortion, has_distortion, x, y, source_size, source_extent, stride,
                       offset, &own)) {
@@ -221,12 +226,20 @@ inline void splat_sample(__global const float* depth, __global const float* dist
                                row1, row2, target_size, target_extent, &dy) &&
                 footprint;
     splat_footprint(centre, dx, dy, footprint, target_size, keys, key_stride, key_offset, mode,
-                    values, value);
+                    values, owners, value);
 }
 
 __kernel void fill_keys(__global uint* keys, int count) {
     const int i = get_global_id(0);
     if (i < count) keys[i] = EMPTY_KEY;
+}
+
+// Values start as "no contribution" (a = 0, T = 1): a pixel whose depth key pass 2 does not
+// reproduce bit for bit (the two passes are separate kernels, compiled separately) then adds
+// nothing, instead of whatever the buffer held before.
+__kernel void fill_values(__global float2* values, int count) {
+    const int i = get_global_id(0);
+    if (i < count) values[i] = (float2)(0.0f, 1.0f);
 }
 
 // Pass 1 for depth layers: every stored sample of every layer into its layer's z-buffer.
@@ -242,7 +255,7 @@ __kernel void splat_layers(__global const float* depth, __global const float* di
     for (int l = 0; l < layer_count; ++l) {
         splat_sample(depth, distortion, has_distortion, x, y, source_size, source_extent, 1,
                      l * source_count, row0, row1, row2, target_size, target_extent, keys, 1,
-                     l * target_count, 0, 0, (float2)(0.0f));
+                     l * target_count, 0, 0, 0, (float2)(0.0f));
     }
 }
 
@@ -489,7 +502,7 @@ __kernel void splat_attenuation_depth(__global const float* mean_depth, int inte
         total += attenuation[pixel * interval_count + j];
         splat_sample(mean_depth, 0, has_distortion, x, y, source_size, source_extent,
                      interval_count, j, row0, row1, row2, target_size, target_extent, keys,
-                     interval_count, j, 0, 0, (float2)(0.0f));
+                     interval_count, j, 0, 0, 0, (float2)(0.0f));
     }
     source_total[pixel] = total;
 }
@@ -502,7 +515,8 @@ __kernel void splat_attenuation_values(__global const float* mean_depth, int int
                                        int has_distortion, int2 source_size, float4 source_extent,
                                        float4 row0, float4 row1, float4 row2, int2 target_size,
                                        float4 target_extent, __global uint* keys,
-                                       __global const float* attenuation, __global float2* values) {
+                                       __global const float* attenuation, __global float2* values,
+                                       __global uint* owners) {
     const int x = get_global_id(0);
     const int y = get_global_id(1);
     if (x >= source_size.x || y >= source_size.y) return;
@@ -527,7 +541,7 @@ __kernel void splat_attenuation_values(__global const float* mean_depth, int int
         const float a = attenuation[base + next];
         splat_sample(mean_depth, 0, has_distortion, x, y, source_size, source_extent,
                      interval_count, next, row0, row1, row2, target_size, target_extent, keys,
-                     interval_count, next, 1, values, (float2)(a, transmittance));
+                     interval_count, next, 1, values, owners, (float2)(a, transmittance));
         transmittance -= a;
         previous = next;
         previous_depth = next_depth;
@@ -647,7 +661,9 @@ __kernel void resolve_attenuation(__global const uint* keys, __global const floa
         if (next < 0) break;
         const float2 value = values[in + next];
         const float ratio = value.y > 0.0f ? transmittance / value.y : 0.0f;
-        const float a = fmin(value.x * ratio, transmittance);
+        // Clamped into [0, T]: archives written with lossy compression (pxr24, b44) can hold
+        // attenuation slightly outside [0, 1] or non-finite, which must not compound here.
+        const float a = fmin(fmax(value.x * ratio, 0.0f), transmittance);
         attenuation_out[out + next] = a;
         if (a > 0.0f) mean_depth_out[out + next] = key_depth(next_key);
         transmittance -= a;

@@ -137,8 +137,8 @@ TEST_F(ExplorerTest, StoredViewReproducesTheGroundTruthForColoursConstantPerInte
     RenderSettings settings;
     settings.early_termination_opacity = 1.0;  // the proxies' exact termination
     const Camera camera = Camera::orbit(config_.views[0].orbit, volume_.field().bounds());
-    const Rendering truth = renderer.render_ground_truth(camera, config_.transfer_function,
-                                                         settings);
+    const Rendering truth =
+        renderer.render_ground_truth(camera, config_.transfer_function, settings);
     EXPECT_LT(rms_difference(frame.colour, truth.rgba), 1e-4);
 }
 
@@ -218,6 +218,25 @@ TEST_F(ExplorerTest, ANewViewIsSynthesisedWithAConfidenceMask) {
     EXPECT_GT(covered, 0.0);
 }
 
+TEST_F(ExplorerTest, ANewViewComesFromTheSingleOrTheMultiPerspectiveProxiesAsAsked) {
+    write_steps({1});
+    Explorer explorer(config_.archive);
+    ExploreRequest request;
+    request.step = 1;
+    request.azimuth_deg = 40.0;
+    ExploreRequest single = request;
+    single.source = ProxySource::single;
+    ExploreRequest multi = request;
+    multi.source = ProxySource::multi;
+    const Image automatic_colour = explorer.render(request).colour;
+    const Image single_colour = explorer.render(single).colour;
+    const Image multi_colour = explorer.render(multi).colour;
+    expect_finite_premultiplied(multi_colour);
+    // "auto" prefers the single-perspective proxies (the archive has both).
+    EXPECT_EQ(automatic_colour.pixels, single_colour.pixels);
+    EXPECT_NE(multi_colour.pixels, single_colour.pixels);
+}
+
 TEST_F(ExplorerTest, LightingOcclusionAndEnhancementChangeTheFrameAndStayFinite) {
     write_steps({1});
     Explorer explorer(config_.archive);
@@ -250,16 +269,18 @@ TEST_F(ExplorerTest, BadRequestsNameWhatIsWrong) {
     Explorer explorer(config_.archive);
     ExploreRequest missing_step;
     missing_step.step = 7;
-    testing::expect_error_naming<InvalidArgument>([&] { explorer.render(missing_step); }, "has no step 7");
+    testing::expect_error_naming<InvalidArgument>([&] { explorer.render(missing_step); },
+                                                  "has no step 7");
     ExploreRequest missing_view;
     missing_view.step = 1;
     missing_view.view = 2;
-    testing::expect_error_naming<InvalidArgument>([&] { explorer.render(missing_view); }, "has no view 2");
+    testing::expect_error_naming<InvalidArgument>([&] { explorer.render(missing_view); },
+                                                  "has no view 2");
     ExploreRequest bad_interval;
     bad_interval.step = 1;
     bad_interval.opacity_scales = {{kIntervals, 0.5}};
     testing::expect_error_naming<InvalidArgument>([&] { explorer.render(bad_interval); },
-                                  "opacity-scale interval 6");
+                                                  "opacity-scale interval 6");
     ExploreRequest negative;
     negative.step = 1;
     negative.opacity_scales = {{1, -2.0}};
@@ -267,7 +288,8 @@ TEST_F(ExplorerTest, BadRequestsNameWhatIsWrong) {
     ExploreRequest no_model;
     no_model.step = 1;
     no_model.colour = ColourSource::model;
-    testing::expect_error_naming<InvalidArgument>([&] { explorer.render(no_model); }, "has no colour model");
+    testing::expect_error_naming<InvalidArgument>([&] { explorer.render(no_model); },
+                                                  "has no colour model");
 }
 
 TEST_F(ExplorerTest, StepsWrittenLaterAppearAfterRefresh) {
@@ -297,18 +319,18 @@ TEST_F(ExplorerTest, DescribeArchiveListsStepsViewsAndProxies) {
 }
 
 TEST(ExploreOptions, ParseEveryKey) {
-    const ExploreRequest request = viewer::request_from_options(
-        {{"step", "12"},
-         {"view", "1"},
-         {"azimuth", "-30.5"},
-         {"elevation", "45"},
-         {"opacity-scale", "0=0.5,3=2"},
-         {"colour", "recompose"},
-         {"light", "camera;90,0,0.4,0.1"},
-         {"ambient", "0.3"},
-         {"ao", "4,2"},
-         {"enhance", "0.7,0.4"},
-         {"fill", "2"}});
+    const ExploreRequest request = viewer::request_from_options({{"step", "12"},
+                                                                 {"view", "1"},
+                                                                 {"azimuth", "-30.5"},
+                                                                 {"elevation", "45"},
+                                                                 {"opacity-scale", "0=0.5,3=2"},
+                                                                 {"colour", "recompose"},
+                                                                 {"source", "multi"},
+                                                                 {"light", "camera;90,0,0.4,0.1"},
+                                                                 {"ambient", "0.3"},
+                                                                 {"ao", "4,2"},
+                                                                 {"enhance", "0.7,0.4"},
+                                                                 {"fill", "2"}});
     EXPECT_EQ(request.step, 12);
     EXPECT_EQ(request.view, 1);
     EXPECT_EQ(*request.azimuth_deg, -30.5);
@@ -316,6 +338,7 @@ TEST(ExploreOptions, ParseEveryKey) {
     ASSERT_EQ(request.opacity_scales.size(), 2u);
     EXPECT_EQ(request.opacity_scales[1], (std::pair<int, double>{3, 2.0}));
     EXPECT_EQ(request.colour, ColourSource::recompose);
+    EXPECT_EQ(request.source, ProxySource::multi);
     ASSERT_TRUE(request.lighting);
     ASSERT_EQ(request.lighting->lights.size(), 2u);
     EXPECT_EQ(request.lighting->lights[0].direction_world, glm::dvec3(0.0));
@@ -330,22 +353,66 @@ TEST(ExploreOptions, ParseEveryKey) {
 
 TEST(ExploreOptions, MalformedValuesNameKeyAndValue) {
     using viewer::request_from_options;
-    testing::expect_error_naming<InvalidArgument>([] { request_from_options({{"zoom", "2"}}); }, "zoom");
-    testing::expect_error_naming<InvalidArgument>([] { request_from_options({{"step", "1.5"}}); }, "step");
-    testing::expect_error_naming<InvalidArgument>([] { request_from_options({{"azimuth", "nan"}}); },
-                                  "azimuth");
-    testing::expect_error_naming<InvalidArgument>([] { request_from_options({{"elevation", "91"}}); },
-                                  "elevation = 91");
-    testing::expect_error_naming<InvalidArgument>([] { request_from_options({{"opacity-scale", "2"}}); },
-                                  "INTERVAL=SCALE");
-    testing::expect_error_naming<InvalidArgument>([] { request_from_options({{"opacity-scale", "1=-1"}}); },
-                                  "negative");
-    testing::expect_error_naming<InvalidArgument>([] { request_from_options({{"light", "10"}}); }, "light");
-    testing::expect_error_naming<InvalidArgument>([] { request_from_options({{"ao", "0"}}); }, "ao radius");
-    testing::expect_error_naming<InvalidArgument>([] { request_from_options({{"enhance", "1,0"}}); },
-                                  "GAMMA > 0");
-    testing::expect_error_naming<InvalidArgument>([] { request_from_options({{"colour", "pink"}}); }, "pink");
-    testing::expect_error_naming<ParseError>([] { request_from_options({{"tf", "{not json"}}); }, "");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"zoom", "2"}});
+        },
+        "zoom");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"step", "1.5"}});
+        },
+        "step");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"azimuth", "nan"}});
+        },
+        "azimuth");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"elevation", "91"}});
+        },
+        "elevation = 91");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"opacity-scale", "2"}});
+        },
+        "INTERVAL=SCALE");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"opacity-scale", "1=-1"}});
+        },
+        "negative");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"light", "10"}});
+        },
+        "light");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"ao", "0"}});
+        },
+        "ao radius");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"enhance", "1,0"}});
+        },
+        "GAMMA > 0");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"source", "both"}});
+        },
+        "both");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"colour", "pink"}});
+        },
+        "pink");
+    testing::expect_error_naming<ParseError>(
+        [] {
+            request_from_options({{"tf", "{not json"}});
+        },
+        "");
 }
 
 }  // namespace

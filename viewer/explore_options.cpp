@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <sstream>
-
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
+#include <sstream>
 
 #include "insitu/error.hpp"
 
@@ -50,8 +49,7 @@ std::vector<std::pair<int, double>> parse_scales(const std::string& key, const s
     for (const std::string& item : split(text, ',')) {
         const auto equals = item.find('=');
         if (equals == std::string::npos) {
-            fail<InvalidArgument>(key, " = \"", text, "\": \"", item,
-                                  "\" is not INTERVAL=SCALE");
+            fail<InvalidArgument>(key, " = \"", text, "\": \"", item, "\" is not INTERVAL=SCALE");
         }
         const std::int64_t index = integer(key, item.substr(0, equals));
         const double factor = number(key, item.substr(equals + 1), text);
@@ -81,8 +79,7 @@ Light parse_light(const std::string& key, const std::string& text) {
     }
     const double azimuth = glm::radians(number(key, parts[0], text));
     const double elevation = glm::radians(number(key, parts[1], text));
-    light.direction_world = glm::dvec3(std::sin(azimuth) * std::cos(elevation),
-                                       std::sin(elevation),
+    light.direction_world = glm::dvec3(std::sin(azimuth) * std::cos(elevation), std::sin(elevation),
                                        std::cos(azimuth) * std::cos(elevation));
     if (parts.size() > 2) light.diffuse = number(key, parts[2], text);
     if (parts.size() > 3) light.specular = number(key, parts[3], text);
@@ -96,8 +93,8 @@ Light parse_light(const std::string& key, const std::string& text) {
 
 const std::vector<std::string>& explore_option_keys() {
     static const std::vector<std::string> keys{
-        "step",  "view",    "azimuth", "elevation", "tf", "opacity-scale", "colour",
-        "light", "ambient", "ao",      "enhance",   "fill"};
+        "step",   "view",  "azimuth", "elevation", "tf",      "opacity-scale", "colour",
+        "source", "light", "ambient", "ao",        "enhance", "fill"};
     return keys;
 }
 
@@ -134,6 +131,7 @@ ExploreRequest request_from_options(const Options& options) {
         request.opacity_scales = parse_scales("opacity-scale", *text);
     }
     if (const auto* text = get("colour")) request.colour = parse_colour_source(*text);
+    if (const auto* text = get("source")) request.source = parse_proxy_source(*text);
     if (const auto* text = get("light")) {
         LightingSettings lighting;
         lighting.lights.clear();
@@ -176,8 +174,7 @@ ExploreRequest request_from_options(const Options& options) {
         enhancement.lambda = number("enhance", parts[0], *text);
         enhancement.gamma = number("enhance", parts[1], *text);
         if (enhancement.lambda < 0.0 || enhancement.gamma <= 0.0) {
-            fail<InvalidArgument>("enhance = \"", *text,
-                                  "\" (LAMBDA must be >= 0 and GAMMA > 0)");
+            fail<InvalidArgument>("enhance = \"", *text, "\" (LAMBDA must be >= 0 and GAMMA > 0)");
         }
         request.enhancement = enhancement;
     }

@@ -7,6 +7,7 @@
 //   tf=JSON-TEXT                     an edited transfer function (DESIGN.md TF JSON)
 //   opacity-scale=J=S[,J=S...]       interval J's opacity scaled by S (>= 0)
 //   colour=auto|model|recompose
+//   source=auto|single|multi         which stored proxies a new view is synthesised from
 //   light=AZ,EL[,DIFFUSE[,SPECULAR]][;AZ,EL...]   directional lights, orbit angles in degrees of
 //                                    the direction toward the light, in world space; "camera" =
 //                                    a headlight

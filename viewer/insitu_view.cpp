@@ -166,8 +166,8 @@ int run_render(const std::vector<std::string>& args) {
     if (options.find("step") == options.end()) throw UsageError("render: missing --step N");
     if (out_path.empty()) throw UsageError("render: missing --out OUT.png|exr");
     if (ao || !ao_radius.empty() || !ao_strength.empty()) {
-        options["ao"] = (ao_radius.empty() ? "8" : ao_radius) +
-                        (ao_strength.empty() ? "" : "," + ao_strength);
+        options["ao"] =
+            (ao_radius.empty() ? "8" : ao_radius) + (ao_strength.empty() ? "" : "," + ao_strength);
     }
     const insitu::ExploreRequest request = insitu::viewer::request_from_options(options);
     insitu::Explorer explorer(archive);
@@ -192,8 +192,8 @@ int run_verify(const std::vector<std::string>& args) {
     for (const auto& step : reader.manifest().at("steps")) {
         for (const auto& view : step.at("views")) files += view.at("files").size();
     }
-    std::cout << args[0] << ": " << files << " files checked, " << problems.size()
-              << " problem" << (problems.size() == 1 ? "" : "s") << "\n";
+    std::cout << args[0] << ": " << files << " files checked, " << problems.size() << " problem"
+              << (problems.size() == 1 ? "" : "s") << "\n";
     return problems.empty() ? 0 : kExitProblems;
 }
 
@@ -216,7 +216,8 @@ int main(int argc, char** argv) {
         if (command == "render") return run_render(args);
         if (command == "verify") return run_verify(args);
         if (command == "serve") return insitu::viewer::serve_main(args);
-        throw UsageError("unknown command \"" + command + "\" (expected info, render, verify "
+        throw UsageError("unknown command \"" + command +
+                         "\" (expected info, render, verify "
                          "or serve)");
     } catch (const UsageError& error) {
         return report(error.what(), kExitBadInput);

@@ -238,6 +238,13 @@ SynthesisedAttenuation synthesise_attenuation(const ProxyFrame& frame, const Cam
     const cl::Buffer mean_depth = upload_buffer(device, frame.mean_depth.pixels, "mean depth");
     const cl::Buffer keys = empty_keys(device, target_pixels * intervals);
     const cl::Buffer values = device_buffer(device, target_pixels * intervals * sizeof(cl_float2));
+    const cl::Buffer owners = empty_keys(device, target_pixels * intervals);
+    {
+        const std::size_t count = target_pixels * intervals;
+        cl::Kernel fill = device.kernel("view_synthesis", "fill_values");
+        device.launch(fill, cl::NDRange((count + 63) / 64 * 64), cl::NDRange(64), values,
+                      static_cast<cl_int>(count));
+    }
     const cl::Buffer source_total = device_buffer(device, source_pixels * sizeof(float));
     const cl_float4 source_extent =
         synthesis_extent(source, frame.multi_perspective ? frame.distortion_tilt_deg : 0.0);
@@ -257,7 +264,7 @@ SynthesisedAttenuation synthesise_attenuation(const ProxyFrame& frame, const Cam
     device.launch(splat_values, source_range, detail::image_local_range(), mean_depth,
                   static_cast<cl_int>(intervals), has_distortion, size_of(source), source_extent,
                   forward.rows[0], forward.rows[1], forward.rows[2], size_of(target), target_extent,
-                  keys, attenuation, values);
+                  keys, attenuation, values, owners);
 
     SynthesisedAttenuation result;
     result.attenuation = Image(target.width(), target.height(), intervals);

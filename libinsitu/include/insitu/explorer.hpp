@@ -8,8 +8,8 @@
 //  1. proxies of (step, view) from the archive (cached: the last few frames stay in memory);
 //  2. the target camera: the stored one, or Camera::reorbit(azimuth, elevation) of it;
 //  3. attenuation a (+ mean depth) in the target camera: as stored when the camera is the
-//     stored one, else synthesised (multi-perspective attenuation when the archive has it, the
-//     single-perspective proxies otherwise) with a confidence mask;
+//     stored one, else synthesised (from the single-perspective proxies unless the request or
+//     the archive says multi-perspective) with a confidence mask;
 //  4. opacity edits: per-interval scales (from an edited transfer function and/or explicit
 //     scales) turn a into a' (estimate_attenuation);
 //  5. colour: the fitted colour model (Eq. 8, 10) when the archive has one and the colours are
@@ -45,6 +45,14 @@ std::string to_string(ColourSource source);
 /// "auto" | "model" | "recompose"; InvalidArgument names other text.
 ColourSource parse_colour_source(const std::string& text);
 
+/// Which stored proxies a frame is made from: "auto" takes the single-perspective ones when the
+/// archive has them (measured ahead for every rotation; bench/RESULTS.md), else the
+/// multi-perspective ones.
+enum class ProxySource { automatic, single, multi };
+std::string to_string(ProxySource source);
+/// "auto" | "single" | "multi"; InvalidArgument names other text.
+ProxySource parse_proxy_source(const std::string& text);
+
 /// What to show. Everything optional: an empty request shows the stored view as stored.
 struct ExploreRequest {
     std::int64_t step = 0;
@@ -57,6 +65,7 @@ struct ExploreRequest {
     /// Extra opacity scales per interval (index, factor >= 0), applied on top of the edit.
     std::vector<std::pair<int, double>> opacity_scales;
     ColourSource colour = ColourSource::automatic;
+    ProxySource source = ProxySource::automatic;
     /// Lights in world space; a light whose direction is (0, 0, 0) is a headlight (toward the
     /// target camera).
     std::optional<LightingSettings> lighting;
@@ -70,7 +79,7 @@ struct ExploreFrame {
     Image colour;      ///< RGBA, linear, premultiplied
     Image confidence;  ///< 1 channel in [0, 1] (view_synthesis.hpp); all 1 for the stored view
     Camera camera;     ///< the camera the frame was made for
-    bool synthesised_view = false;  ///< the view differs from the stored one
+    bool synthesised_view = false;                         ///< the view differs from the stored one
     ColourSource colour_source = ColourSource::recompose;  ///< model or recompose, as used
     std::vector<double> opacity_scales;  ///< per interval, as applied (empty: none)
     double milliseconds = 0.0;           ///< wall time of render(), archive reads included

@@ -1,0 +1,516 @@
+#!/usr/bin/env python3
+"""Charts and RESULTS.md of the evaluation harness (bench/evaluate).
+
+Reads the CSV files insitu_evaluate and insitu_evaluate_vtk wrote into RESULTS_DIR, draws one
+PNG per chart there (matplotlib, Agg) and writes the markdown report. With --check it also
+verifies that every chart exists and every number in every CSV is finite, and exits 1 naming
+what is not (the CI smoke test).
+
+    charts.py RESULTS_DIR --markdown FILE [--image-prefix PREFIX] [--elapsed SECONDS] [--check]
+"""
+import argparse
+import csv
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+CHARTS = ["pareto", "rotation", "radiality", "clusters", "opacity_edits", "storage", "failures"]
+DPI = 80
+SOURCES = {"multi45": "multi-perspective, tilt 45°", "multi20": "multi-perspective, tilt 20°",
+           "single": "single perspective"}
+
+
+def read(directory, name):
+    path = os.path.join(directory, name + ".csv")
+    if not os.path.exists(path):
+        return []
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def num(row, key):
+    return float(row[key])
+
+
+def pareto_front(points):
+    """Points (cost, quality) not dominated by a cheaper-or-equal, better-or-equal point."""
+    front = []
+    for cost, quality in sorted(points, key=lambda p: (p[0], -p[1])):
+        if not front or quality > front[-1][1]:
+            front.append((cost, quality))
+    return front
+
+
+def chart_pareto(d, rows, primary):
+    rows = [r for r in rows if r["scene"] == primary]
+    fig, axes = plt.subplots(2, 2, figsize=(11, 8))
+    for i, (metric, title) in enumerate(
+            [("edit_psnr", "held-out opacity edit (colour model)"),
+             ("rotate15_psnr", "view rotated 15° (volumetric synthesis)")]):
+        for j, (cost, label) in enumerate(
+                [("archive_bytes", "archive MB per step"), ("emission_ms", "emission ms per camera")]):
+            ax = axes[i][j]
+            scale = 1e-6 if cost == "archive_bytes" else 1.0
+            pts = [(num(r, cost) * scale, num(r, metric)) for r in rows]
+            # Garbage (e.g. PSNR far below 0 dB) would squash the chart: such points sit on the
+            # lower edge as red triangles, labelled with their value.
+            floor = max(0.0, min([y for _, y in pts if y >= 0.0] or [0.0]) - 3.0)
+            for r, (x, y) in zip(rows, pts):
+                value = {"default": "default", "image": r["image"] + "²", "intervals": "L=" + r["intervals"],
+                         "clusters": "K=" + r["clusters"], "layers": r["layers"] + " layers",
+                         "tilt": "tilt " + r["tilt_deg"], "training": r["training"] + " train",
+                         "precision": r["precision"], "compression": r["compression"]}[r["varied"]]
+                if y < floor:
+                    ax.scatter([x], [floor], s=30, marker="v", color="red")
+                    ax.annotate("%s: %.0f dB" % (value, y), (x, floor), fontsize=7, color="red",
+                                xytext=(3, 4), textcoords="offset points")
+                    continue
+                ax.scatter([x], [y], s=18, color="C0" if r["varied"] != "default" else "C3")
+                ax.annotate(value, (x, y), fontsize=7, xytext=(3, 2), textcoords="offset points")
+            front = pareto_front([p for p in pts if p[1] >= floor])
+            ax.set_ylim(bottom=floor - 1.0)
+            ax.step([p[0] for p in front], [p[1] for p in front], where="post", color="C2",
+                    label="Pareto front")
+            ax.set_xscale("log")
+            ax.set_xlabel(label)
+            ax.set_ylabel("PSNR dB")
+            ax.set_title(title, fontsize=10)
+            ax.legend(fontsize=8, loc="lower right")
+    fig.suptitle("Speed and size against accuracy (%s; one parameter varied at a time)" % primary)
+    fig.tight_layout()
+    fig.savefig(os.path.join(d, "pareto.png"), dpi=DPI)
+    plt.close(fig)
+
+
+def chart_rotation(d, rows):
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
+    scenes = sorted({r["scene"] for r in rows})
+    for k, scene in enumerate(scenes):
+        for source, style in [("multi45", "-"), ("multi20", "-."), ("single", "--")]:
+            sel = [r for r in rows if r["scene"] == scene and r["source"] == source]
+            a = [num(r, "angle_deg") for r in sel]
+            label = "%s, %s" % (scene, SOURCES[source])
+            axes[0].plot(a, [num(r, "depth_corr") for r in sel], style, color="C%d" % k, label=label)
+            axes[1].plot(a, [num(r, "psnr") for r in sel], style, color="C%d" % k, label=label)
+            axes[2].plot(a, [num(r, "depth_flagged_fraction") for r in sel], style, color="C%d" % k,
+                         label=label + " (depth)")
+            if source != "multi20":
+                axes[2].plot(a, [num(r, "colour_flagged_fraction") for r in sel], ":", color="C%d" % k,
+                             label=label + " (colour)")
+    axes[0].plot([15, 30], [0.99, 0.95], "k*", markersize=10, label="goals (15°: 0.99, 30°: 0.95)")
+    for ax in axes:
+        ax.axvspan(60, 90, color="0.9")
+        ax.set_xlabel("rotation from the stored view, degrees (grey: beyond the paper's 60°)")
+    axes[0].set_ylabel("depth correlation (layer 0)")
+    axes[0].set_title("seed 000 Fig. 6a: depth correlation vs rotation", fontsize=10)
+    axes[1].set_ylabel("PSNR dB")
+    axes[1].set_title("volumetric view synthesis, colour", fontsize=10)
+    axes[2].set_ylabel("fraction of high-error pixels flagged")
+    axes[2].set_ylim(-0.05, 1.05)
+    axes[2].set_title("confidence-mask coverage of what went wrong", fontsize=10)
+    for ax in axes:
+        ax.legend(fontsize=6)
+    fig.tight_layout()
+    fig.savefig(os.path.join(d, "rotation.png"), dpi=DPI)
+    plt.close(fig)
+
+
+def chart_radiality(d, rows, curvature):
+    scenes = []
+    for r in rows:
+        if r["scene"] not in scenes:
+            scenes.append(r["scene"])
+    summary = {r["scene"]: r for r in curvature}
+    fig, axes = plt.subplots(1, len(scenes) + 1, figsize=(3.4 * (len(scenes) + 1), 3.4))
+    for ax, scene in zip(axes, scenes):
+        sel = [r for r in rows if r["scene"] == scene]
+        lo = [num(r, "bin_low_deg") for r in sel]
+        width = [num(r, "bin_high_deg") - num(r, "bin_low_deg") for r in sel]
+        ax.bar(lo, [num(r, "fraction") for r in sel], width=width, align="edge", color="C0")
+        s = summary.get(scene)
+        title = scene if not s else "%s\nmean %.0f°, corr@30° %.3f" % (
+            scene, num(s, "mean_radiality_deg"), num(s, "corr_30"))
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel("ray-normal angle, degrees")
+    axes[0].set_ylabel("fraction of hit pixels")
+    ax = axes[-1]
+    for k, s in enumerate(curvature):
+        for angle, marker in [("corr_15", "o"), ("corr_30", "s"), ("corr_60", "^")]:
+            ax.scatter([num(s, "mean_radiality_deg")], [num(s, angle)], marker=marker, color="C%d" % k,
+                       label="%s %s°" % (s["scene"], angle[5:]))
+    ax.set_xlabel("mean radiality, degrees")
+    ax.set_ylabel("depth correlation")
+    ax.set_title("curvature predicts rotation error", fontsize=9)
+    ax.legend(fontsize=5)
+    fig.suptitle("seed 000 Fig. 6b-d: radiality histograms (multi-perspective, tilt 45°)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(os.path.join(d, "radiality.png"), dpi=DPI)
+    plt.close(fig)
+
+
+def chart_clusters(d, rows):
+    fig, ax = plt.subplots(figsize=(6, 4))
+    k = [num(r, "clusters") for r in rows]
+    ax.plot(k, [num(r, "psnr_mean") for r in rows], "o-", label="mean over held-out edits")
+    ax.plot(k, [num(r, "psnr_min") for r in rows], "s--", label="worst held-out edit")
+    ax.axhline(35, color="k", lw=0.8, ls=":", label="goal 35 dB")
+    ax.set_xscale("log", base=2)
+    ax.set_xlabel("clusters K")
+    ax.set_ylabel("PSNR dB")
+    ax.set_title("seed 000 Fig. 12: prediction error vs K (3 training images)", fontsize=10)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(d, "clusters.png"), dpi=DPI)
+    plt.close(fig)
+
+
+def chart_opacity_edits(d, rows):
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    series = [("model", n, "%d training image%s" % (n, "s" if n > 1 else "")) for n in (1, 2, 3)]
+    series.append(("recompose", 0, "recomposition (no model)"))
+    for method, n, label in series:
+        sel = [r for r in rows if r["method"] == method and int(r["training_images"]) == n]
+        e = [int(r["edit"]) + 1 for r in sel]
+        axes[0].plot(e, [num(r, "ssd") for r in sel], "o-", label=label)
+        axes[1].plot(e, [num(r, "psnr") for r in sel], "o-", label=label)
+    axes[0].set_yscale("log")
+    axes[0].set_ylabel("SSD (sum of squared RGB differences)")
+    axes[1].set_ylabel("PSNR dB")
+    axes[1].axhline(35, color="k", lw=0.8, ls=":", label="goal 35 dB")
+    for ax in axes:
+        ax.set_xlabel("opacity edit (progressively fading the outer structures)")
+        ax.legend(fontsize=8)
+    fig.suptitle("seed 000 Fig. 13: error over a sequence of held-out opacity edits", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(os.path.join(d, "opacity_edits.png"), dpi=DPI)
+    plt.close(fig)
+
+
+def chart_storage(d, rows):
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    raw = [r for r in rows if r["kind"] == "raw_float32"]
+    ax.plot([num(r, "volume_n") for r in raw], [num(r, "bytes") for r in raw], "k-o", label="volume, float32")
+    combos = sorted({(int(r["image"]), int(r["layers"])) for r in rows if r["kind"] == "computed_uncompressed"})
+    for i, (image, layers) in enumerate(combos):
+        sel = [r for r in rows if r["kind"] == "computed_uncompressed" and int(r["image"]) == image
+               and int(r["layers"]) == layers]
+        ax.plot([num(r, "volume_n") for r in sel], [num(r, "bytes") for r in sel], "--",
+                color="C%d" % (i // 3), alpha=0.4 + 0.2 * (i % 3),
+                label="proxies %d², k=%d, L=16 (computed, uncompressed)" % (image, layers))
+    meas = [r for r in rows if r["kind"] == "measured_half_zip"]
+    ax.plot([num(r, "volume_n") for r in meas], [num(r, "bytes") for r in meas], "r*", markersize=12,
+            label="measured archive step (%s², k=4, half+zip)" % (meas[0]["image"] if meas else "?"))
+    ax.set_xscale("log", base=2)
+    ax.set_yscale("log")
+    ax.set_xlabel("volume side N (N³ samples)")
+    ax.set_ylabel("bytes")
+    ax.set_title("seed 000 Fig. 15a: storage of proxies vs volume", fontsize=10)
+    ax.legend(fontsize=6)
+    fig.tight_layout()
+    fig.savefig(os.path.join(d, "storage.png"), dpi=DPI)
+    plt.close(fig)
+
+
+def chart_failures(d, scale_rows, interval_rows, occlusion_rows, cluster_rows):
+    fig, axes = plt.subplots(1, 4, figsize=(18, 4))
+    ax = axes[0]
+    for method in ("model", "recompose"):
+        sel = [r for r in scale_rows if r["method"] == method]
+        ax.plot([num(r, "scale") for r in sel], [num(r, "psnr") for r in sel], "o-", label=method)
+    ax.axvspan(0.2, 1.0, color="C2", alpha=0.15, label="training range")
+    ax.set_xscale("log", base=2)
+    ax.set_xlabel("opacity scale on every interval")
+    ax.set_ylabel("PSNR dB")
+    ax.set_title("opacity far outside the training range", fontsize=10)
+    ax.legend(fontsize=8)
+    ax = axes[1]
+    L = [num(r, "intervals") for r in interval_rows]
+    for key, label in [("edit_model_psnr", "opacity edit, model"), ("edit_recompose_psnr", "opacity edit, recompose"),
+                       ("recolour_smooth_psnr", "recolour, smooth colours"),
+                       ("recolour_piecewise_psnr", "recolour, colours constant per interval")]:
+        ax.plot(L, [num(r, key) for r in interval_rows], "o-", label=label)
+    ax.axhline(50, color="k", lw=0.8, ls=":", label="recolour goal 50 dB")
+    ax.set_xscale("log", base=2)
+    ax.set_xlabel("intervals L")
+    ax.set_ylabel("PSNR dB")
+    ax.set_title("too few intervals", fontsize=10)
+    ax.legend(fontsize=7)
+    ax = axes[2]
+    labels = ["%s\n%s" % (r["training"].replace("_", " "), r["method"]) for r in occlusion_rows]
+    ax.bar(range(len(occlusion_rows)), [num(r, "psnr") for r in occlusion_rows],
+           color=["C3" if r["training"] == "inner_occluded" and r["method"] == "model" else "C0" for r in occlusion_rows])
+    ax.set_xticks(range(len(occlusion_rows)))
+    ax.set_xticklabels(labels, fontsize=7)
+    ax.set_ylabel("PSNR dB")
+    ax.set_title("feature occluded in every training image", fontsize=10)
+    ax = axes[3]
+    ax.plot([num(r, "clusters") for r in cluster_rows], [num(r, "psnr_min") for r in cluster_rows], "o-")
+    ax.set_xscale("log", base=2)
+    ax.set_xlabel("clusters K (K = 1: one linear fit)")
+    ax.set_ylabel("worst held-out edit, PSNR dB")
+    ax.set_title("K = 1", fontsize=10)
+    fig.suptitle("Where the methods fail", fontsize=11)
+    fig.tight_layout()
+    fig.savefig(os.path.join(d, "failures.png"), dpi=DPI)
+    plt.close(fig)
+
+
+def table(header, rows):
+    out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    out += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
+    return "\n".join(out)
+
+
+def lookup(rows, **match):
+    for r in rows:
+        if all(r.get(k) == v for k, v in match.items()):
+            return r
+    return None
+
+
+def write_markdown(d, path, prefix, elapsed):
+    machine = {r["key"]: r["value"] for r in read(d, "machine")}
+    configs = read(d, "configurations")
+    rotation = read(d, "rotation")
+    curvature = read(d, "curvature")
+    edits = read(d, "opacity_edits")
+    intervals = read(d, "intervals")
+    scale = read(d, "opacity_scale")
+    occlusion = read(d, "occlusion")
+    clusters = read(d, "clusters")
+    storage = read(d, "storage")
+    peer = read(d, "peer")
+    peer_acc = read(d, "peer_accuracy")
+    primary = edits[0]["scene"] if edits else "?"
+    rot_scene = rotation[0]["scene"] if rotation else "?"
+
+    def rot(angle, source="multi45", key="depth_corr"):
+        r = lookup(rotation, scene=rot_scene, source=source, angle_deg=str(angle))
+        return num(r, key) if r else float("nan")
+
+    def met(ok):
+        return "**met**" if ok else "**not met**"
+
+    # The goal rows report the source Explorer uses for a new view by default (single
+    # perspective when the archive has it: ahead of both tilts at every angle measured).
+    c15, c30 = rot(15, "single"), rot(30, "single")
+    three = [r for r in edits if r["method"] == "model" and r["training_images"] == "3"]
+    edit_min = min(num(r, "psnr") for r in three) if three else float("nan")
+    edit_mean = sum(num(r, "psnr") for r in three) / len(three) if three else float("nan")
+    default = lookup(configs, scene=primary, varied="default")
+    l16 = lookup(intervals, intervals="16")
+    recolour_float = num(l16, "recolour_piecewise_psnr") if l16 else float("nan")
+    recolour_half = num(default, "recolour_psnr") if default else float("nan")
+
+    lines = ["# Evaluation results", "",
+             "Generated by `bench/evaluate` (%s run, %.0f s); do not edit by hand. CSV files and charts: "
+             "`bench/results/`. Machine: %s, %s hardware threads; OpenCL device: %s." % (
+                 machine.get("mode", "?"), elapsed, machine.get("cpu", "?"),
+                 machine.get("hardware_threads", "?"), machine.get("opencl_device", "?")), "",
+             "Errors are against the ground-truth renderer on the same view and transfer function "
+             "(unshaded, 1-voxel step, no early termination); PSNR on premultiplied RGB over black, "
+             "SSIM on luminance (11x11 Gaussian window), depth correlation = Pearson r over pixels finite "
+             "in both (bench/evaluation/metrics.hpp). Stored view: orthographic, azimuth 30°, elevation 20°; "
+             "the primary field is the Gray-Scott v field (%s)." % primary, "",
+             "## Goals", "",
+             table(["goal", "target", "measured", ""], [
+                 ["view synthesis, depth correlation at 15° (%s, single perspective: Explorer's default)" % rot_scene, "≥ 0.99",
+                  "%.4f" % c15, met(c15 >= 0.99)],
+                 ["view synthesis, depth correlation at 30°", "≥ 0.95", "%.4f" % c30, met(c30 >= 0.95)],
+                 ["held-out opacity edits in the training range, 3 training images (worst / mean of %d)" % len(three),
+                  "≥ 35 dB", "%.1f / %.1f dB" % (edit_min, edit_mean), met(edit_min >= 35)],
+                 ["recolouring, colours constant per interval (float in memory / half from the archive)",
+                  "≥ 50 dB", "%.1f / %.1f dB" % (recolour_float, recolour_half),
+                  met(min(recolour_float, recolour_half) >= 50)],
+             ]), ""]
+    lines += ["Depth correlation by proxy source (%s; the goal rows above use the single-perspective "
+              "proxies, which Explorer prefers; tilt 45° is the configuration default and the paper's "
+              "Eq. 1):" % rot_scene, "",
+              table(["source", "0°", "15°", "30°", "60°", "90°"],
+                    [[SOURCES[src]] + ["%.4f" % rot(a, src) for a in (0, 15, 30, 60, 90)]
+                     for src in ("multi45", "multi20", "single")]), ""]
+
+    lines += ["## Speed and size against accuracy", "", "![pareto](%spareto.png)" % prefix, ""]
+    header = ["scene", "varied", "image", "L", "K", "layers", "tilt", "train", "precision", "compr.",
+              "emission ms", "archive MB", "synthesis ms", "edit PSNR", "edit SSIM", "recolour PSNR",
+              "rot15 PSNR", "corr 15°", "corr 30°"]
+    body = []
+    for r in configs:
+        body.append([r["scene"], r["varied"], r["image"], r["intervals"], r["clusters"], r["layers"],
+                     r["tilt_deg"], r["training"], r["precision"], r["compression"],
+                     "%.1f" % num(r, "emission_ms"), "%.2f" % (num(r, "archive_bytes") / 1e6),
+                     "%.1f" % num(r, "synthesis_ms"), "%.1f" % num(r, "edit_psnr"),
+                     "%.4f" % num(r, "edit_ssim"), "%.1f" % num(r, "recolour_psnr"),
+                     "%.1f" % num(r, "rotate15_psnr"), "%.4f" % num(r, "depth_corr_15"),
+                     "%.4f" % num(r, "depth_corr_30")])
+    lines += [table(header, body), ""]
+
+    lines += ["## View synthesis against rotation (Fig. 6)", "", "![rotation](%srotation.png)" % prefix, "",
+              "![radiality](%sradiality.png)" % prefix, ""]
+    body = [[r["scene"], "%.1f" % num(r, "mean_radiality_deg"), "%.4f" % num(r, "corr_15"),
+             "%.4f" % num(r, "corr_30"), "%.4f" % num(r, "corr_60"), "%.1f" % num(r, "psnr_30")]
+            for r in curvature]
+    lines += [table(["field", "mean radiality °", "corr 15°", "corr 30°", "corr 60°", "PSNR 30° dB"], body), ""]
+
+    lines += ["## Colour model and opacity edits (Figs. 12, 13)", "",
+              "![clusters](%sclusters.png)" % prefix, "", "![opacity edits](%sopacity_edits.png)" % prefix, ""]
+    lines += ["## Storage (Fig. 15a)", "", "![storage](%sstorage.png)" % prefix, ""]
+    meas = [r for r in storage if r["kind"] == "measured_half_zip"]
+    if meas:
+        lines += [table(["volume", "raw float32 MB", "archive step MB (measured)", "ratio"],
+                        [["%s³" % r["volume_n"], "%.1f" % (int(r["volume_n"]) ** 3 * 4 / 1e6),
+                          "%.2f" % (num(r, "bytes") / 1e6),
+                          "%.1f×" % (int(r["volume_n"]) ** 3 * 4 / num(r, "bytes"))] for r in meas]), ""]
+
+    lines += ["## Where the methods fail", "", "![failures](%sfailures.png)" % prefix, ""]
+    body = [[r["scale"], "yes" if r["in_training_range"] == "1" else "no", r["method"], "%.1f" % num(r, "psnr"),
+             "%.3f" % num(r, "high_error_fraction"), "%.2f" % num(r, "flagged_fraction")] for r in scale]
+    lines += ["Opacity scaled on every interval (pixels off by > 0.1 of full scale, and the fraction the "
+              "confidence mask flagged; at the stored view the explorer's mask is 1 everywhere):", "",
+              table(["scale", "in training range", "method", "PSNR dB", "high-error px", "flagged"], body), ""]
+    body = [[r["training"].replace("_", " "), r["method"], "%.1f" % num(r, "psnr"), "%.3f" % num(r, "high_error_fraction"),
+             "%.2f" % num(r, "flagged_fraction")] for r in occlusion]
+    lines += ["A feature occluded in every training image (nested shells, the outer one opaque in all "
+              "training functions, then faded by the edit):", "",
+              table(["training images", "method", "PSNR dB", "high-error px", "flagged"], body), ""]
+    rot_rows = [r for r in rotation if r["scene"] == rot_scene and r["source"] == "multi45"
+                and float(r["angle_deg"]) in (15.0, 30.0, 60.0, 90.0)]
+    body = [[r["angle_deg"], "%.4f" % num(r, "depth_corr"), "%.3f" % num(r, "depth_high_error_fraction"),
+             "%.2f" % num(r, "depth_flagged_fraction"), "%.1f" % num(r, "psnr"),
+             "%.3f" % num(r, "colour_high_error_fraction"), "%.2f" % num(r, "colour_flagged_fraction")]
+            for r in rot_rows]
+    lines += ["Rotation (%s, multi-perspective 45°): high-error pixels (depth off by > 2 voxels or a "
+              "surface missing/invented; colour off by > 0.1) and the fraction the mask flagged:" % rot_scene, "",
+              table(["angle °", "depth corr", "depth high-error px", "flagged", "PSNR dB",
+                     "colour high-error px", "flagged"], body), ""]
+    body = [[r["intervals"], "%.1f" % num(r, "edit_model_psnr"), "%.1f" % num(r, "edit_recompose_psnr"),
+             "%.1f" % num(r, "recolour_smooth_psnr"), "%.1f" % num(r, "recolour_piecewise_psnr")] for r in intervals]
+    lines += ["Intervals:", "", table(["L", "edit, model dB", "edit, recompose dB", "recolour smooth dB",
+                                       "recolour per-interval dB"], body), ""]
+
+    lines += ["## Peer: VTK's CPU ray caster", ""]
+    if peer:
+        vtk = lookup(peer, renderer="vtk_fixed_point")
+        body = [[r["renderer"], "%s³" % r["volume_n"], "%s²" % r["image"], "%.1f" % num(r, "ms_per_frame"),
+                 "%.2f×" % (num(r, "ms_per_frame") / num(vtk, "ms_per_frame"))] for r in peer]
+        lines += [table(["renderer", "volume", "image", "ms per frame", "vs VTK"], body), ""]
+        allp = lookup(peer, renderer="ours_proxies_all")
+        if peer_acc:
+            lines += ["PSNR between VTK's image and our ground truth: %.2f dB (SSIM %.4f)." % (
+                num(peer_acc[0], "psnr_ours_vs_vtk"), num(peer_acc[0], "ssim_ours_vs_vtk")), ""]
+        lines += ["Goal (all proxies of a camera ≤ one VTK CPU frame): %s (%.2f×)." % (
+            met(num(allp, "ms_per_frame") <= num(vtk, "ms_per_frame")),
+            num(allp, "ms_per_frame") / num(vtk, "ms_per_frame")), "", "![peer](%speer.png)" % prefix, ""]
+    else:
+        reason = open(os.path.join(d, "peer_error.txt")).read().strip() if os.path.exists(
+            os.path.join(d, "peer_error.txt")) else "not run"
+        lines += ["Not run: %s" % reason, ""]
+
+    lines += ["## What they mean", ""]
+    lines += [meaning(configs, primary, c15, c30, edit_min, rotation, rot_scene, occlusion, scale), ""]
+    with open(path, "w") as f:
+        f.write("\n".join(lines))
+
+
+def meaning(configs, primary, c15, c30, edit_min, rotation, rot_scene, occlusion, scale):
+    prim = [r for r in configs if r["scene"] == primary]
+    default = lookup(prim, varied="default")
+    s1 = ("Transfer-function edits are where proxies are strong: a held-out opacity edit predicted by the "
+          "colour model stays at %.1f dB or better with 3 training images, while an archive step costs %.2f MB "
+          "and its emission %.0f ms per camera, so cost is set by the image size and L, not by accuracy knobs "
+          "such as K, precision or compression." % (edit_min, num(default, "archive_bytes") / 1e6,
+                                                      num(default, "emission_ms"))) if default else ""
+    r90 = lookup(rotation, scene=rot_scene, source="multi45", angle_deg="90")
+    s2 = ("View synthesis is where they are weak: on %s the depth correlation of a multi-perspective proxy is "
+          "%.3f at 15° and %.3f at 30° and keeps falling toward 90°, and the confidence mask flags %.0f%% of the "
+          "pixels that went wrong at 90°." % (rot_scene, c15, c30,
+                                               100 * num(r90, "depth_flagged_fraction") if r90 else float("nan")))
+    occ = lookup(occlusion, training="inner_occluded", method="model")
+    far = [r for r in scale if r["method"] == "model" and r["in_training_range"] == "0"]
+    worst_far = min(num(r, "psnr") for r in far) if far else float("nan")
+    s3 = ("Colour-model failures are silent: a feature hidden in every training image drops the model to %.1f dB "
+          "and opacity scaled far outside the training range to %.1f dB, with no pixel flagged, because "
+          "nothing but the view-synthesis mask carries a confidence." % (
+              num(occ, "psnr") if occ else float("nan"), worst_far))
+    return " ".join([s1, s2, s3])
+
+
+def chart_peer(d):
+    a, b = os.path.join(d, "peer_vtk.png"), os.path.join(d, "peer_ours.png")
+    if not (os.path.exists(a) and os.path.exists(b)):
+        return False
+    import numpy as np
+    ia, ib = plt.imread(a)[..., :3], plt.imread(b)[..., :3]
+    fig, axes = plt.subplots(1, 3, figsize=(10, 3.6))
+    for ax, img, title in [(axes[0], ia, "VTK fixed point"), (axes[1], ib, "ours (ground truth)"),
+                           (axes[2], np.abs(ia - ib).max(axis=2) * 10, "|difference| × 10")]:
+        ax.imshow(np.clip(img, 0, 1), cmap="gray" if img.ndim == 2 else None)
+        ax.set_title(title, fontsize=9)
+        ax.axis("off")
+    fig.tight_layout()
+    fig.savefig(os.path.join(d, "peer.png"), dpi=60)
+    plt.close(fig)
+    os.remove(a)
+    os.remove(b)
+    return True
+
+
+def check(d):
+    problems = []
+    for name in CHARTS + ["peer"]:
+        if not os.path.exists(os.path.join(d, name + ".png")):
+            problems.append("missing chart %s.png" % name)
+    for file in sorted(os.listdir(d)):
+        if not file.endswith(".csv") or file == "machine.csv":
+            continue
+        rows = read(d, file[:-4])
+        if not rows:
+            problems.append("%s: no rows" % file)
+        for i, r in enumerate(rows):
+            for k, v in r.items():
+                try:
+                    x = float(v)
+                except ValueError:
+                    continue
+                if not math.isfinite(x):
+                    problems.append("%s row %d: %s = %s" % (file, i + 1, k, v))
+    return problems
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("results")
+    parser.add_argument("--markdown", required=True)
+    parser.add_argument("--image-prefix", default="results/")
+    parser.add_argument("--elapsed", type=float, default=0.0)
+    parser.add_argument("--check", action="store_true")
+    args = parser.parse_args()
+    d = args.results
+    configs = read(d, "configurations")
+    primary = read(d, "opacity_edits")[0]["scene"]
+    chart_pareto(d, configs, primary)
+    chart_rotation(d, read(d, "rotation"))
+    chart_radiality(d, read(d, "radiality"), read(d, "curvature"))
+    chart_clusters(d, read(d, "clusters"))
+    chart_opacity_edits(d, read(d, "opacity_edits"))
+    chart_storage(d, read(d, "storage"))
+    chart_failures(d, read(d, "opacity_scale"), read(d, "intervals"), read(d, "occlusion"), read(d, "clusters"))
+    chart_peer(d)
+    write_markdown(d, args.markdown, args.image_prefix, args.elapsed)
+    if args.check:
+        problems = check(d)
+        for p in problems:
+            print("charts.py: " + p, file=sys.stderr)
+        if problems:
+            return 1
+        print("charts.py: %d charts, every figure finite" % (len(CHARTS) + 1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

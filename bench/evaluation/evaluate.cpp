@@ -1,0 +1,873 @@
+// insitu_evaluate: accuracy against cost of the proxies (the harness bench/evaluate runs).
+// For fields (analytic, Gray-Scott timesteps, raw files) and configurations it measures cost
+// (emission ms per camera, archive bytes per step, synthesis ms per frame) and error against the
+// ground-truth renderer on the same view and transfer function (PSNR, SSIM, max abs error, depth
+// correlation; bench/evaluation/metrics.hpp), and sweeps each method into where it fails. Writes
+// CSV files; bench/evaluation/charts.py draws them. Measures and prints; asserts nothing.
+//
+//   insitu_evaluate --out DIR [--smoke] [--sections a,b,...] [--raw PATH:NXxNYxNZ:TYPE ...]
+// Sections: rotation, curvature, colour, configurations, storage (default: all).
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "insitu/analytic_fields.hpp"
+#include "insitu/archive.hpp"
+#include "insitu/colour_model.hpp"
+#include "insitu/explorer.hpp"
+#include "insitu/instrument.hpp"
+#include "insitu/proxy_renderer.hpp"
+#include "insitu/transfer_function_edit.hpp"
+#include "insitu/view_synthesis.hpp"
+#include "median_time.hpp"
+#include "metrics.hpp"
+#include "scenes.hpp"
+
+namespace {
+
+using namespace insitu;
+using namespace insitu::evaluation;
+using bench::median_ms;
+using bench::ms_since;
+namespace fs = std::filesystem;
+
+struct RawInput {
+    std::string path;
+    Index3 dims{0, 0, 0};
+    ScalarType type = ScalarType::float32;
+};
+
+struct Options {
+    std::string out;
+    bool smoke = false;
+    std::set<std::string> sections{"rotation", "curvature", "colour", "configurations", "storage"};
+    std::vector<RawInput> raw;
+};
+
+[[noreturn]] void usage_error(const std::string& message) {
+    std::fprintf(stderr,
+                 "insitu_evaluate: %s\nusage: insitu_evaluate --out DIR [--smoke] "
+                 "[--sections rotation,curvature,colour,configurations,storage] "
+                 "[--raw PATH:NXxNYxNZ:TYPE ...]\n",
+                 message.c_str());
+    std::exit(2);
+}
+
+RawInput parse_raw(const std::string& text) {
+    // PATH:NXxNYxNZ:TYPE, split from the right so a path may hold ':'.
+    const std::size_t type_colon = text.rfind(':');
+    const std::size_t dims_colon =
+        type_colon == std::string::npos ? std::string::npos : text.rfind(':', type_colon - 1);
+    if (dims_colon == std::string::npos || dims_colon == 0) {
+        usage_error("--raw " + text + " (expected PATH:NXxNYxNZ:TYPE)");
+    }
+    RawInput raw;
+    raw.path = text.substr(0, dims_colon);
+    const std::string dims = text.substr(dims_colon + 1, type_colon - dims_colon - 1);
+    long long nx = 0, ny = 0, nz = 0;
+    if (std::sscanf(dims.c_str(), "%lldx%lldx%lld", &nx, &ny, &nz) != 3 || nx < 2 || ny < 2 ||
+        nz < 2) {
+        usage_error("--raw " + text + ": dims \"" + dims + "\" (expected NXxNYxNZ, each >= 2)");
+    }
+    raw.dims = {nx, ny, nz};
+    try {
+        raw.type = parse_scalar_type(text.substr(type_colon + 1));
+    } catch (const Error& error) {
+        usage_error("--raw " + text + ": " + error.what());
+    }
+    return raw;
+}
+
+Options parse(int argc, char** argv) {
+    Options options;
+    for (int i = 1; i < argc; ++i) {
+        const std::string flag = argv[i];
+        if (flag == "--smoke") {
+            options.smoke = true;
+            continue;
+        }
+        if (i + 1 >= argc) usage_error(flag + " needs a value");
+        const std::string value = argv[++i];
+        if (flag == "--out") {
+            options.out = value;
+        } else if (flag == "--raw") {
+            options.raw.push_back(parse_raw(value));
+        } else if (flag == "--sections") {
+            std::set<std::string> known = options.sections;
+            options.sections.clear();
+            std::stringstream list(value);
+            std::string item;
+            while (std::getline(list, item, ',')) {
+                if (!known.count(item)) usage_error("unknown section " + item);
+                options.sections.insert(item);
+            }
+        } else {
+            usage_error("unknown flag " + flag);
+        }
+    }
+    if (options.out.empty()) usage_error("--out DIR is required");
+    return options;
+}
+
+/// One CSV file: a header, then rows of numbers and words.
+class Csv {
+public:
+    Csv(const fs::path& path, const std::string& header) : out_(path) {
+        if (!out_) fail<IoError>("cannot write \"", path.string(), "\"");
+        out_ << header << '\n';
+    }
+    template <typename... Values>
+    void row(const Values&... values) {
+        bool first = true;
+        ((out_ << (first ? "" : ",") << format(values), first = false), ...);
+        out_ << '\n';
+        out_.flush();
+    }
+
+private:
+    static std::string format(double value) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.6g", value);
+        return text;
+    }
+    static std::string format(int value) { return std::to_string(value); }
+    static std::string format(long value) { return std::to_string(value); }
+    static std::string format(long long value) { return std::to_string(value); }
+    static std::string format(unsigned long value) { return std::to_string(value); }
+    static std::string format(unsigned long long value) { return std::to_string(value); }
+    static std::string format(const std::string& value) { return value; }
+    static std::string format(const char* value) { return value; }
+    std::ofstream out_;
+};
+
+/// The ground truth every figure is measured against: exact (no early termination: the proxies
+/// stop only where T = 0 too), unshaded like the proxies' emission-absorption model, 1-voxel
+/// step, a fine table so colour steps at interval edges stay sharp.
+RenderSettings truth_settings() {
+    RenderSettings settings;
+    settings.early_termination_opacity = 1.0;
+    settings.tf_value_bins = 4096;
+    return settings;
+}
+
+/// The stored view of every experiment: orbit azimuth 30, elevation 20, orthographic.
+OrbitView stored_view(int image) {
+    OrbitView view;
+    view.azimuth_deg = 30.0;
+    view.elevation_deg = 20.0;
+    view.width = image;
+    view.height = image;
+    return view;
+}
+
+constexpr double kStoredAzimuth = 30.0, kStoredElevation = 20.0;
+/// A pixel "went wrong" when its premultiplied colour is off by more than this (of full scale 1)
+/// or its depth by more than kDepthErrorVoxels voxels (or a surface is missing or invented).
+constexpr double kColourErrorThreshold = 0.1;
+constexpr double kDepthErrorVoxels = 2.0;
+
+ProxyRequest proxy_request(const Scene& scene, const TransferFunction& tf, int intervals,
+                           int layers) {
+    ProxyRequest request;
+    request.isovalues = scene_layers(scene, layers);
+    request.intervals = scene_intervals(scene, intervals);
+    request.transfer_function = tf;
+    request.march.tf_value_bins = truth_settings().tf_value_bins;
+    return request;
+}
+
+/// Ground-truth first crossing of layer 0 (x = 0.3) seen from `camera`: the depth image
+/// "generated from 3D data" of seed 000 §4.4.
+Image truth_depth(ProxyRenderer& renderer, const Scene& scene, const Camera& camera) {
+    ProxyRequest request;
+    request.attenuation = false;
+    request.mean_depth = false;
+    request.isovalues = scene_layers(scene, 1);
+    return renderer.render(camera, request).depth_layers.front();
+}
+
+// ---------------------------------------------------------------------------------------------
+// View synthesis against rotation, 0..90 degrees (seed 000 Fig. 6a, and beyond into failure).
+
+void section_rotation(const std::vector<const Scene*>& scenes, const Options& options, int image) {
+    Csv csv(fs::path(options.out) / "rotation.csv",
+            "scene,source,angle_deg,depth_corr,depth_pixels,depth_high_error_fraction,"
+            "depth_flagged_fraction,psnr,ssim,max_abs,colour_high_error_fraction,"
+            "colour_flagged_fraction,layers_ms,attenuation_ms");
+    std::vector<double> angles;
+    for (int a = 0; a <= 90; a += options.smoke ? 30 : 5) angles.push_back(a);
+    for (const Scene* scene : scenes) {
+        const auto start = std::chrono::steady_clock::now();
+        ProxyRenderer renderer;
+        renderer.upload(scene->volume.field());
+        const Bounds& bounds = renderer.volume().bounds;
+        const double voxel = renderer.volume().step_world(1.0);
+        const TransferFunction tf = make_tf(*scene);
+        const ProxyRequest request = proxy_request(*scene, tf, 16, 4);
+        const Camera camera = Camera::orbit(stored_view(image), bounds);
+        const ProxyFrame single = renderer.render(camera, request);
+        // Tilt 45 is the paper's Eq. 1 and the configuration default; 20 keeps more of the front
+        // of a centred object in view (tests/view_synthesis_test.cpp).
+        const ProxyFrame multi45 =
+            renderer.render(DistortionCamera::orbit(stored_view(image), bounds, 45.0), request);
+        const ProxyFrame multi20 =
+            renderer.render(DistortionCamera::orbit(stored_view(image), bounds, 20.0), request);
+        const std::vector<float> colours = interval_colours(tf, *request.intervals);
+        for (const double angle : angles) {
+            const Camera target = camera.reorbit(kStoredAzimuth + angle, kStoredElevation);
+            const Image depth = truth_depth(renderer, *scene, target);
+            const Image colour = renderer.render_ground_truth(target, tf, truth_settings()).rgba;
+            for (const ProxyFrame* frame : {&multi45, &multi20, &single}) {
+                SynthesisedLayers layers;
+                const double layers_ms =
+                    median_ms(1, [&] { layers = synthesise_layers(*frame, target); });
+                SynthesisedAttenuation attenuation;
+                const double attenuation_ms =
+                    median_ms(1, [&] { attenuation = synthesise_attenuation(*frame, target); });
+                const Image predicted = recolour(attenuation.attenuation, colours);
+                const DepthCorrelation corr = depth_correlation(depth, layers.depth.front());
+                const MaskCoverage depth_mask =
+                    mask_coverage(pixel_errors_depth(depth, layers.depth.front()),
+                                  layers.layer_confidence.front(), kDepthErrorVoxels * voxel);
+                const MaskCoverage colour_mask =
+                    mask_coverage(pixel_errors_rgb(colour, predicted), attenuation.confidence,
+                                  kColourErrorThreshold);
+                const std::string source =
+                    frame->multi_perspective
+                        ? "multi" + std::to_string(static_cast<int>(frame->distortion_tilt_deg))
+                        : "single";
+                csv.row(scene->name, source, angle, corr.coefficient,
+                        static_cast<long long>(corr.pixels), depth_mask.high_error_fraction(),
+                        depth_mask.flagged_fraction(), psnr_db(colour, predicted),
+                        ssim_luminance(colour, predicted), max_abs_error(colour, predicted),
+                        colour_mask.high_error_fraction(), colour_mask.flagged_fraction(),
+                        layers_ms, attenuation_ms);
+            }
+        }
+        std::printf("rotation: %s, %zu angles, %.1f s\n", scene->name.c_str(), angles.size(),
+                    ms_since(start) / 1e3);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Radiality histograms (seed 000 Fig. 6b-d) and the rotation error they predict, from smooth to
+// high-curvature fields.
+
+void section_curvature(const std::vector<const Scene*>& scenes, const Options& options, int image) {
+    Csv histograms(fs::path(options.out) / "radiality.csv",
+                   "scene,bin_low_deg,bin_high_deg,count,fraction");
+    Csv summary(fs::path(options.out) / "curvature.csv",
+                "scene,mean_radiality_deg,corr_15,corr_30,corr_60,psnr_30");
+    for (const Scene* scene : scenes) {
+        ProxyRenderer renderer;
+        renderer.upload(scene->volume.field());
+        const Bounds& bounds = renderer.volume().bounds;
+        const TransferFunction tf = make_tf(*scene);
+        const ProxyRequest request = proxy_request(*scene, tf, 16, 1);
+        const ProxyFrame multi =
+            renderer.render(DistortionCamera::orbit(stored_view(image), bounds, 45.0), request);
+        const RadialityHistogram histogram = radiality_histogram(multi, 18);
+        std::int64_t total = 0;
+        for (const std::int64_t count : histogram.counts) total += count;
+        for (std::size_t b = 0; b < histogram.counts.size(); ++b) {
+            histograms.row(scene->name, histogram.bin_edges_deg[b], histogram.bin_edges_deg[b + 1],
+                           static_cast<long long>(histogram.counts[b]),
+                           total ? static_cast<double>(histogram.counts[b]) / total : 0.0);
+        }
+        const Camera camera = Camera::orbit(stored_view(image), bounds);
+        double corr[3] = {0, 0, 0};
+        const double angles[3] = {15.0, 30.0, 60.0};
+        for (int a = 0; a < 3; ++a) {
+            const Camera target = camera.reorbit(kStoredAzimuth + angles[a], kStoredElevation);
+            corr[a] = depth_correlation(truth_depth(renderer, *scene, target),
+                                        synthesise_layers(multi, target).depth.front())
+                          .coefficient;
+        }
+        const Camera target = camera.reorbit(kStoredAzimuth + 30.0, kStoredElevation);
+        const Image predicted = recolour(synthesise_attenuation(multi, target).attenuation,
+                                         interval_colours(tf, *request.intervals));
+        const double psnr_30 =
+            psnr_db(renderer.render_ground_truth(target, tf, truth_settings()).rgba, predicted);
+        summary.row(scene->name, histogram.mean_deg, corr[0], corr[1], corr[2], psnr_30);
+        std::printf(
+            "curvature: %s mean radiality %.1f deg, depth corr 15/30/60 deg %.4f %.4f "
+            "%.4f\n",
+            scene->name.c_str(), histogram.mean_deg, corr[0], corr[1], corr[2]);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Colour: the colour model against K (Fig. 12), opacity edits for 1-3 training images (Fig. 13),
+// recolouring, and the failure regimes (scales outside the training range, few intervals, a
+// feature occluded in every training image).
+
+struct ImageErrors {
+    double psnr, ssim, max_abs, ssd;
+};
+
+ImageErrors errors_of(const Image& truth, const Image& predicted) {
+    return {psnr_db(truth, predicted), ssim_luminance(truth, predicted),
+            max_abs_error(truth, predicted), ssd_rgb(truth, predicted)};
+}
+
+/// One stored view of a scene with L intervals: its proxies and, per training function, the
+/// (attenuation, ground-truth rendering) pair the colour model learns from (what the Instrument
+/// computes in situ).
+struct ColourSetup {
+    const Scene* scene = nullptr;
+    Camera camera;
+    IntervalSet intervals{{0.0, 1.0}};
+    TransferFunction stored_tf{std::vector<ControlPoint>{{0.0, {0, 0, 0, 0}}}};
+    ProxyFrame frame;
+    std::vector<Image> training_attenuation;
+    std::vector<Image> training_colour;
+};
+
+ColourSetup colour_setup(ProxyRenderer& renderer, const Scene& scene, int image, int intervals,
+                         const std::vector<TfSpec>& training, const TfSpec& stored = {}) {
+    ColourSetup setup;
+    setup.scene = &scene;
+    setup.camera = Camera::orbit(stored_view(image), renderer.volume().bounds);
+    setup.stored_tf = make_tf(scene, stored);
+    ProxyRequest request = proxy_request(scene, setup.stored_tf, intervals, 1);
+    request.depth_layers = false;
+    setup.intervals = *request.intervals;
+    setup.frame = renderer.render(setup.camera, request);
+    for (const TfSpec& spec : training) {
+        const TransferFunction tf = make_tf(scene, spec);
+        request.transfer_function = tf;
+        request.mean_depth = false;
+        setup.training_attenuation.push_back(renderer.render(setup.camera, request).attenuation);
+        setup.training_colour.push_back(
+            renderer.render_ground_truth(setup.camera, tf, truth_settings()).rgba);
+    }
+    return setup;
+}
+
+ColourModel fit_model(const ColourSetup& setup, int training, int clusters) {
+    ColourModelSettings settings;
+    settings.clusters = clusters;
+    const std::vector<Image> a(setup.training_attenuation.begin(),
+                               setup.training_attenuation.begin() + training);
+    const std::vector<Image> c(setup.training_colour.begin(),
+                               setup.training_colour.begin() + training);
+    return ColourModel::fit(a, c, settings);
+}
+
+/// The stored attenuation after the opacity edit from the stored function to `edited`
+/// (seed 000 §6.3 step 1).
+Image edited_attenuation(const ColourSetup& setup, const TransferFunction& edited) {
+    const std::vector<double> scales = opacity_scales(setup.stored_tf, edited, setup.intervals);
+    return estimate_attenuation(setup.frame.attenuation, setup.frame.mean_depth, nullptr, scales);
+}
+
+void section_colour(const Scene& scene, const Options& options, int image) {
+    const auto start = std::chrono::steady_clock::now();
+    ProxyRenderer renderer;
+    renderer.upload(scene.volume.field());
+    const int edit_count = options.smoke ? 3 : 8;
+    const std::vector<TfSpec> edits = held_out_edits(edit_count);
+    const ColourSetup setup = colour_setup(renderer, scene, image, 16, training_specs(3));
+    std::vector<Image> edit_truth;
+    for (const TfSpec& edit : edits) {
+        edit_truth.push_back(
+            renderer.render_ground_truth(setup.camera, make_tf(scene, edit), truth_settings())
+                .rgba);
+    }
+
+    // Fig. 13: every edit, 1, 2 and 3 training images; recomposition as the model-free baseline.
+    {
+        Csv csv(fs::path(options.out) / "opacity_edits.csv",
+                "scene,method,training_images,edit,low_scale,high_scale,psnr,ssim,max_abs,ssd");
+        for (int training = 1; training <= 3; ++training) {
+            const ColourModel model = fit_model(setup, training, 24);
+            for (std::size_t e = 0; e < edits.size(); ++e) {
+                const Image predicted =
+                    model.predict(edited_attenuation(setup, make_tf(scene, edits[e])));
+                const ImageErrors err = errors_of(edit_truth[e], predicted);
+                csv.row(scene.name, "model", training, static_cast<int>(e), edits[e].low_scale,
+                        edits[e].high_scale, err.psnr, err.ssim, err.max_abs, err.ssd);
+            }
+        }
+        for (std::size_t e = 0; e < edits.size(); ++e) {
+            const TransferFunction edited = make_tf(scene, edits[e]);
+            const Image predicted = recolour(edited_attenuation(setup, edited),
+                                             interval_colours(edited, setup.intervals));
+            const ImageErrors err = errors_of(edit_truth[e], predicted);
+            csv.row(scene.name, "recompose", 0, static_cast<int>(e), edits[e].low_scale,
+                    edits[e].high_scale, err.psnr, err.ssim, err.max_abs, err.ssd);
+        }
+    }
+
+    // Fig. 12: error against the number of clusters K (3 training images, every edit).
+    {
+        Csv csv(fs::path(options.out) / "clusters.csv",
+                "scene,clusters,clusters_used,psnr_mean,psnr_min,ssim_mean,max_abs,ssd_mean,"
+                "fit_ms,predict_ms");
+        const std::vector<int> ks = options.smoke ? std::vector<int>{1, 4, 24}
+                                                  : std::vector<int>{1, 2, 4, 8, 16, 24, 48, 96};
+        std::vector<Image> edited;
+        for (const TfSpec& edit : edits) {
+            edited.push_back(edited_attenuation(setup, make_tf(scene, edit)));
+        }
+        for (const int k : ks) {
+            const auto fit_start = std::chrono::steady_clock::now();
+            const ColourModel model = fit_model(setup, 3, k);
+            const double fit_ms = ms_since(fit_start);
+            double psnr_sum = 0, psnr_min = kPsnrCapDb, ssim_sum = 0, max_abs = 0, ssd_sum = 0;
+            double predict_ms = 0.0;
+            for (std::size_t e = 0; e < edits.size(); ++e) {
+                Image predicted;
+                predict_ms += median_ms(1, [&] { predicted = model.predict(edited[e]); });
+                const ImageErrors err = errors_of(edit_truth[e], predicted);
+                psnr_sum += err.psnr;
+                psnr_min = std::min(psnr_min, err.psnr);
+                ssim_sum += err.ssim;
+                max_abs = std::max(max_abs, err.max_abs);
+                ssd_sum += err.ssd;
+            }
+            const double n = static_cast<double>(edits.size());
+            csv.row(scene.name, k, model.clusters(), psnr_sum / n, psnr_min, ssim_sum / n, max_abs,
+                    ssd_sum / n, fit_ms, predict_ms / n);
+        }
+    }
+
+    // Failure: one opacity scale on every interval, from far below to far above the training
+    // range (the training functions span scales 0.2..1 per band).
+    {
+        Csv csv(fs::path(options.out) / "opacity_scale.csv",
+                "scene,scale,in_training_range,method,psnr,ssim,max_abs,high_error_fraction,"
+                "flagged_fraction");
+        const ColourModel model = fit_model(setup, 3, 24);
+        const std::vector<double> scales =
+            options.smoke
+                ? std::vector<double>{1.0 / 16, 1.0, 16.0}
+                : std::vector<double>{1.0 / 64, 1.0 / 16, 1.0 / 4, 0.5, 1.0, 2.0, 4.0, 16.0, 64.0};
+        // The stored view has no synthesis mask: the explorer's confidence is 1 everywhere.
+        const Image confidence(image, image, 1, 1.0f);
+        for (const double s : scales) {
+            TfSpec spec;
+            spec.scale = s;
+            const TransferFunction edited = make_tf(scene, spec);
+            const Image truth =
+                renderer.render_ground_truth(setup.camera, edited, truth_settings()).rgba;
+            const Image a = edited_attenuation(setup, edited);
+            const Image by_model = model.predict(a);
+            const Image by_recompose = recolour(a, interval_colours(edited, setup.intervals));
+            for (const auto& [method, predicted] :
+                 {std::pair<const char*, const Image*>{"model", &by_model},
+                  {"recompose", &by_recompose}}) {
+                const ImageErrors err = errors_of(truth, *predicted);
+                const MaskCoverage mask = mask_coverage(pixel_errors_rgb(truth, *predicted),
+                                                        confidence, kColourErrorThreshold);
+                csv.row(scene.name, s, (s >= 0.2 && s <= 1.0) ? 1 : 0, method, err.psnr, err.ssim,
+                        err.max_abs, mask.high_error_fraction(), mask.flagged_fraction());
+            }
+        }
+    }
+
+    // Failure (too few intervals) and recolouring: L from 1 to 64.
+    {
+        Csv csv(fs::path(options.out) / "intervals.csv",
+                "scene,intervals,edit_model_psnr,edit_recompose_psnr,recolour_piecewise_psnr,"
+                "recolour_piecewise_ssim,recolour_piecewise_max_abs,recolour_smooth_psnr,"
+                "recolour_ms");
+        const std::vector<int> ls =
+            options.smoke ? std::vector<int>{1, 16} : std::vector<int>{1, 2, 4, 8, 16, 32, 64};
+        const TfSpec& mid_edit = edits[edits.size() / 2];
+        const TransferFunction mid_tf = make_tf(scene, mid_edit);
+        const Image& mid_truth = edit_truth[edits.size() / 2];
+        TfSpec smooth;
+        smooth.colours = TfSpec::Colours::other;
+        const TransferFunction smooth_tf = make_tf(scene, smooth);
+        const Image smooth_truth =
+            renderer.render_ground_truth(setup.camera, smooth_tf, truth_settings()).rgba;
+        for (const int l : ls) {
+            const ColourSetup by_l = colour_setup(renderer, scene, image, l, training_specs(3));
+            const Image a = edited_attenuation(by_l, mid_tf);
+            const double model_psnr = psnr_db(mid_truth, fit_model(by_l, 3, 24).predict(a));
+            const double recompose_psnr =
+                psnr_db(mid_truth, recolour(a, interval_colours(mid_tf, by_l.intervals)));
+            TfSpec piecewise;
+            piecewise.colours = TfSpec::Colours::piecewise;
+            piecewise.intervals = l;
+            const TransferFunction piecewise_tf = make_tf(scene, piecewise);
+            const Image piecewise_truth =
+                renderer.render_ground_truth(setup.camera, piecewise_tf, truth_settings()).rgba;
+            Image recoloured;
+            const double recolour_ms = median_ms(3, [&] {
+                recoloured = recolour(by_l.frame.attenuation,
+                                      interval_colours(piecewise_tf, by_l.intervals));
+            });
+            const ImageErrors err = errors_of(piecewise_truth, recoloured);
+            const double smooth_psnr = psnr_db(
+                smooth_truth,
+                recolour(by_l.frame.attenuation, interval_colours(smooth_tf, by_l.intervals)));
+            csv.row(scene.name, l, model_psnr, recompose_psnr, err.psnr, err.ssim, err.max_abs,
+                    smooth_psnr, recolour_ms);
+        }
+    }
+    std::printf("colour: %s, %.1f s\n", scene.name.c_str(), ms_since(start) / 1e3);
+}
+
+/// Failure: a feature occluded in every training image. Two nested shells: the stored function
+/// shows the inner one through the semi-transparent outer one (so the stored attenuation holds
+/// it), every training function makes the outer one opaque, and the edit fades the outer one.
+/// A control fits on training images that see the inner shell.
+void section_occlusion(const Options& options, int size, int image) {
+    const Scene scene = make_scene(
+        "nested_shells",
+        make_nested_shells({size, size, size}, {0.2 * size, 0.38 * size}, {1.0, 0.4}, 0.05 * size));
+    ProxyRenderer renderer;
+    renderer.upload(scene.volume.field());
+    // Outer shell x ~ 0.4 (low band), inner shell x ~ 1 (high band).
+    const std::vector<TfSpec> occluding{TfSpec{20.0, 1.0}, TfSpec{20.0, 0.5}, TfSpec{40.0, 2.0}};
+    TfSpec edit;
+    edit.low_scale = 0.3;
+    const TransferFunction edited = make_tf(scene, edit);
+    Csv csv(fs::path(options.out) / "occlusion.csv",
+            "training,method,psnr,ssim,max_abs,high_error_fraction,flagged_fraction");
+    for (const bool occluded : {true, false}) {
+        const ColourSetup setup =
+            colour_setup(renderer, scene, image, 16, occluded ? occluding : training_specs(3));
+        const Image truth =
+            renderer.render_ground_truth(setup.camera, edited, truth_settings()).rgba;
+        const Image a = edited_attenuation(setup, edited);
+        const Image by_model = fit_model(setup, 3, 24).predict(a);
+        const Image by_recompose = recolour(a, interval_colours(edited, setup.intervals));
+        // The stored view has no synthesis mask: the explorer's confidence is 1 everywhere.
+        const Image confidence(image, image, 1, 1.0f);
+        for (const auto& [method, predicted] :
+             {std::pair<const char*, const Image*>{"model", &by_model},
+              {"recompose", &by_recompose}}) {
+            const ImageErrors err = errors_of(truth, *predicted);
+            const MaskCoverage mask = mask_coverage(pixel_errors_rgb(truth, *predicted), confidence,
+                                                    kColourErrorThreshold);
+            csv.row(occluded ? "inner_occluded" : "inner_visible", method, err.psnr, err.ssim,
+                    err.max_abs, mask.high_error_fraction(), mask.flagged_fraction());
+        }
+    }
+    std::printf("occlusion: done\n");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The configuration grid: the in-situ path end to end (Instrument -> archive -> Explorer), one
+// parameter varied at a time around the default, on every field for the default.
+
+struct Configuration {
+    std::string varied = "default";  ///< which parameter differs from the default
+    int image = 256;
+    int intervals = 16;
+    int clusters = 24;
+    int layers = 4;
+    double tilt_deg = 45.0;
+    int training = 3;
+    StoragePrecision precision = StoragePrecision::half;
+    std::string compression = "zip";
+};
+
+std::vector<Configuration> configuration_grid(bool smoke) {
+    std::vector<Configuration> grid{Configuration{}};
+    auto vary = [&](const std::string& name, auto&& set) {
+        Configuration c;
+        c.varied = name;
+        set(c);
+        grid.push_back(c);
+    };
+    if (smoke) {
+        grid.front().image = 64;
+        vary("precision",
+             [](Configuration& c) { c.image = 64, c.precision = StoragePrecision::single; });
+        vary("clusters", [](Configuration& c) { c.image = 64, c.clusters = 4; });
+        return grid;
+    }
+    for (int image : {128, 512}) vary("image", [&](Configuration& c) { c.image = image; });
+    for (int l : {4, 8, 32}) vary("intervals", [&](Configuration& c) { c.intervals = l; });
+    for (int k : {4, 8, 48}) vary("clusters", [&](Configuration& c) { c.clusters = k; });
+    for (int n : {1, 2, 8}) vary("layers", [&](Configuration& c) { c.layers = n; });
+    for (double t : {15.0, 30.0, 60.0}) vary("tilt", [&](Configuration& c) { c.tilt_deg = t; });
+    for (int n : {1, 2}) vary("training", [&](Configuration& c) { c.training = n; });
+    vary("precision", [](Configuration& c) { c.precision = StoragePrecision::single; });
+    for (const char* z : {"none", "piz", "pxr24", "b44"}) {
+        vary("compression", [&](Configuration& c) { c.compression = z; });
+    }
+    return grid;
+}
+
+/// Ground truths of one scene at one image size, shared by every configuration of that size.
+struct Truths {
+    Image edit, rotated_15;
+    Image depth_15, depth_30;
+};
+
+void section_configurations(const std::vector<const Scene*>& scenes, const Scene& primary,
+                            const Options& options, const fs::path& scratch) {
+    Csv csv(fs::path(options.out) / "configurations.csv",
+            "scene,varied,image,intervals,clusters,layers,tilt_deg,training,precision,"
+            "compression,emission_single_ms,emission_multi_ms,emission_ms,instrument_ms,"
+            "archive_bytes,synthesis_ms,edit_ms,edit_psnr,edit_ssim,edit_max_abs,"
+            "recolour_psnr,recolour_ssim,recolour_max_abs,rotate15_psnr,rotate15_ssim,"
+            "rotate15_max_abs,depth_corr_15,depth_corr_30");
+    const std::vector<Configuration> grid = configuration_grid(options.smoke);
+    const int repeats = options.smoke ? 1 : 3;
+    int archive_index = 0;
+    for (const Scene* scene : scenes) {
+        const auto start = std::chrono::steady_clock::now();
+        ProxyRenderer renderer;
+        renderer.upload(scene->volume.field());
+        const Bounds& bounds = renderer.volume().bounds;
+        const TransferFunction stored_tf = make_tf(*scene);
+        const std::vector<TfSpec> edits = held_out_edits(8);
+        const TransferFunction edit_tf = make_tf(*scene, edits[edits.size() / 2]);
+        std::vector<std::pair<int, Truths>> truths;
+        auto truths_for = [&](int image) -> const Truths& {
+            for (const auto& [size, t] : truths) {
+                if (size == image) return t;
+            }
+            const Camera camera = Camera::orbit(stored_view(image), bounds);
+            Truths t;
+            t.edit = renderer.render_ground_truth(camera, edit_tf, truth_settings()).rgba;
+            const Camera at_15 = camera.reorbit(kStoredAzimuth + 15.0, kStoredElevation);
+            const Camera at_30 = camera.reorbit(kStoredAzimuth + 30.0, kStoredElevation);
+            t.rotated_15 = renderer.render_ground_truth(at_15, stored_tf, truth_settings()).rgba;
+            t.depth_15 = truth_depth(renderer, *scene, at_15);
+            t.depth_30 = truth_depth(renderer, *scene, at_30);
+            truths.emplace_back(image, std::move(t));
+            return truths.back().second;
+        };
+        for (const Configuration& c : grid) {
+            if (scene != &primary && c.varied != "default") continue;
+            const Truths& truth = truths_for(c.image);
+            const OrbitView view = stored_view(c.image);
+            const Camera camera = Camera::orbit(view, bounds);
+
+            // Emission: all proxies of the camera, single and multi-perspective passes.
+            ProxyRequest request = proxy_request(*scene, stored_tf, c.intervals, c.layers);
+            request.march.tf_value_bins = RenderSettings{}.tf_value_bins;  // as in situ
+            const DistortionCamera distortion = DistortionCamera::orbit(view, bounds, c.tilt_deg);
+            const double single_ms = median_ms(repeats, [&] { renderer.render(camera, request); });
+            const double multi_ms =
+                median_ms(repeats, [&] { renderer.render(distortion, request); });
+
+            // The in-situ path: one Instrument step into a fresh archive.
+            InstrumentConfig config;
+            config.fields = {scene->volume.name};
+            config.views[0].orbit = view;
+            config.views[0].distortion_tilt_deg = c.tilt_deg;
+            config.transfer_function = stored_tf;
+            for (const TfSpec& spec : training_specs(c.training)) {
+                config.training_transfer_functions.push_back(make_tf(*scene, spec));
+            }
+            config.layers = scene_layers(*scene, c.layers);
+            config.interval_count = c.intervals;
+            config.proxies.multi_attenuation = true;
+            config.precision = c.precision;
+            config.compression = c.compression;
+            config.colour_model.clusters = c.clusters;
+            config.archive = (scratch / ("archive" + std::to_string(archive_index++))).string();
+            InstrumentStatistics statistics;
+            {
+                InstrumentOptions instrument_options;
+                instrument_options.rethrow_errors = true;
+                instrument_options.log = false;
+                Instrument instrument(config, instrument_options);
+                instrument.execute(0, 0.0, {scene->volume.field()});
+                instrument.finalize();
+                statistics = instrument.statistics();
+            }
+
+            Explorer explorer(config.archive);
+            auto explore = [&](ExploreRequest request, double* ms) {
+                ExploreFrame frame;
+                *ms = median_ms(repeats, [&] { frame = explorer.render(request); });
+                return frame.colour;
+            };
+            double edit_ms = 0, recolour_ms = 0, synthesis_ms = 0;
+            ExploreRequest edit;
+            edit.transfer_function = edit_tf;
+            const ImageErrors edit_err = errors_of(truth.edit, explore(edit, &edit_ms));
+            TfSpec piecewise;
+            piecewise.colours = TfSpec::Colours::piecewise;
+            piecewise.intervals = c.intervals;
+            ExploreRequest recoloured;
+            recoloured.transfer_function = make_tf(*scene, piecewise);
+            const Image recolour_truth =
+                renderer
+                    .render_ground_truth(camera, *recoloured.transfer_function, truth_settings())
+                    .rgba;
+            const ImageErrors recolour_err =
+                errors_of(recolour_truth, explore(recoloured, &recolour_ms));
+            ExploreRequest rotated;
+            rotated.azimuth_deg = kStoredAzimuth + 15.0;
+            const ImageErrors rotate_err =
+                errors_of(truth.rotated_15, explore(rotated, &synthesis_ms));
+            const ProxyFrame multi = ArchiveReader(config.archive).load(0, 0, true);
+            const double corr_15 =
+                depth_correlation(truth.depth_15,
+                                  synthesise_layers(multi, camera.reorbit(kStoredAzimuth + 15.0,
+                                                                          kStoredElevation))
+                                      .depth.front())
+                    .coefficient;
+            const double corr_30 =
+                depth_correlation(truth.depth_30,
+                                  synthesise_layers(multi, camera.reorbit(kStoredAzimuth + 30.0,
+                                                                          kStoredElevation))
+                                      .depth.front())
+                    .coefficient;
+            csv.row(scene->name, c.varied, c.image, c.intervals, c.clusters, c.layers, c.tilt_deg,
+                    c.training, c.precision == StoragePrecision::half ? "half" : "float",
+                    c.compression, single_ms, multi_ms, single_ms + multi_ms,
+                    1e3 * statistics.compute_seconds,
+                    static_cast<unsigned long long>(statistics.bytes_written), synthesis_ms,
+                    edit_ms, edit_err.psnr, edit_err.ssim, edit_err.max_abs, recolour_err.psnr,
+                    recolour_err.ssim, recolour_err.max_abs, rotate_err.psnr, rotate_err.ssim,
+                    rotate_err.max_abs, corr_15, corr_30);
+            fs::remove_all(config.archive);
+        }
+        std::printf("configurations: %s, %.1f s\n", scene->name.c_str(), ms_since(start) / 1e3);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Storage of proxies against volume size (seed 000 Fig. 15a): measured archives where the volume
+// fits this machine, computed uncompressed sizes for every size.
+
+void section_storage(const Options& options, const fs::path& scratch) {
+    Csv csv(fs::path(options.out) / "storage.csv", "kind,volume_n,image,layers,intervals,bytes");
+    const std::vector<long long> computed_sizes{128, 256, 512, 1024};
+    for (const long long n : computed_sizes) {
+        csv.row("raw_float32", n, 0, 0, 0, static_cast<unsigned long long>(n * n * n * 4));
+        // Default layout, uncompressed: per layer single depth + multi depth + distortion
+        // (float), per interval attenuation + mean depth (half), single perspective.
+        for (const int image : {512, 1024, 2048}) {
+            for (const int layers : {4, 16, 44}) {
+                const unsigned long long per_pixel = 12ull * layers + 4ull * 16;
+                csv.row("computed_uncompressed", n, image, layers, 16,
+                        per_pixel * static_cast<unsigned long long>(image) * image);
+            }
+        }
+    }
+    const std::vector<long long> measured =
+        options.smoke ? std::vector<long long>{32, 64} : std::vector<long long>{128, 256};
+    const int image = options.smoke ? 128 : 512;
+    for (const long long n : measured) {
+        const Scene scene = make_scene("blobs", make_gaussian_blobs({n, n, n}, 12, 3));
+        InstrumentConfig config;
+        config.fields = {scene.volume.name};
+        config.views[0].orbit = stored_view(image);
+        config.transfer_function = make_tf(scene);
+        config.layers = scene_layers(scene, 4);
+        config.archive = (scratch / ("storage" + std::to_string(n))).string();
+        InstrumentOptions instrument_options;
+        instrument_options.rethrow_errors = true;
+        instrument_options.log = false;
+        std::uint64_t bytes = 0;
+        {
+            Instrument instrument(config, instrument_options);
+            instrument.execute(0, 0.0, {scene.volume.field()});
+            instrument.finalize();
+            bytes = instrument.statistics().bytes_written;
+        }
+        csv.row("measured_half_zip", n, image, 4, 16, static_cast<unsigned long long>(bytes));
+        fs::remove_all(config.archive);
+        std::printf("storage: %lld^3 -> %.2f MB per step at %d^2\n", n, bytes / 1e6, image);
+    }
+}
+
+std::string cpu_model() {
+    std::ifstream in("/proc/cpuinfo");
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+    }
+    return "unknown";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const Options options = parse(argc, argv);
+    std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress lines show up as they happen
+    try {
+        fs::create_directories(options.out);
+        const fs::path scratch =
+            fs::temp_directory_path() / ("insitu_evaluate_" + std::to_string(::getpid()));
+        fs::create_directories(scratch);
+        const auto start = std::chrono::steady_clock::now();
+        {
+            Csv machine(fs::path(options.out) / "machine.csv", "key,value");
+            machine.row("cpu", "\"" + cpu_model() + "\"");
+            machine.row("hardware_threads", static_cast<int>(std::thread::hardware_concurrency()));
+            machine.row("opencl_device", "\"" + ComputeDevice::shared()->description() + "\"");
+            machine.row("mode", options.smoke ? "smoke" : "full");
+        }
+        std::printf("device: %s\n", ComputeDevice::shared()->description().c_str());
+
+        // Most sweeps: 128^3 fields, 256^2 images (smoke: 40^3, 64^2).
+        const int size = options.smoke ? 40 : 128;
+        const int image = options.smoke ? 64 : 256;
+        const std::vector<int> snapshots =
+            options.smoke ? std::vector<int>{150} : std::vector<int>{300, 600};
+        const auto gs_start = std::chrono::steady_clock::now();
+        std::vector<Scene> gray_scott = gray_scott_scenes(size, snapshots);
+        std::printf("Gray-Scott %d^3 to step %d: %.1f s\n", size, snapshots.back(),
+                    ms_since(gs_start) / 1e3);
+        const Scene& primary = gray_scott.back();
+        const Index3 dims{size, size, size};
+        std::vector<Scene> analytic;
+        // Negated distance: high inside, so the transfer function fills the ball, not the corners.
+        SampledVolume sphere =
+            make_sphere_distance(dims, glm::dvec3(0.5 * (size - 1)), 0.35 * size);
+        for (float& value : sphere.values) value = -value;
+        analytic.push_back(make_scene("sphere", std::move(sphere)));
+        analytic.push_back(make_scene("blobs", make_gaussian_blobs(dims, 12, 3)));
+        analytic.push_back(make_scene("marschner_lobb", make_marschner_lobb(size)));
+        std::vector<Scene> raw;
+        for (const RawInput& input : options.raw) {
+            raw.push_back(load_raw(input.path, input.dims, input.type));
+        }
+
+        std::vector<const Scene*> all;
+        for (const Scene& s : gray_scott) all.push_back(&s);
+        for (const Scene& s : analytic) all.push_back(&s);
+        for (const Scene& s : raw) all.push_back(&s);
+
+        if (options.sections.count("rotation")) {
+            std::vector<const Scene*> rotated{&primary};
+            if (!options.smoke) rotated.push_back(&analytic[1]);
+            for (const Scene& s : raw) rotated.push_back(&s);
+            section_rotation(rotated, options, image);
+        }
+        if (options.sections.count("curvature")) {
+            std::vector<const Scene*> curved{&analytic[0], &analytic[1], &primary, &analytic[2]};
+            for (const Scene& s : raw) curved.push_back(&s);
+            section_curvature(curved, options, image);
+        }
+        if (options.sections.count("colour")) {
+            section_colour(primary, options, image);
+            section_occlusion(options, size, image);
+        }
+        if (options.sections.count("configurations")) {
+            section_configurations(all, primary, options, scratch);
+        }
+        if (options.sections.count("storage")) section_storage(options, scratch);
+        fs::remove_all(scratch);
+        std::printf("insitu_evaluate: done in %.1f s\n", ms_since(start) / 1e3);
+    } catch (const std::exception& error) {
+        std::fprintf(stderr, "insitu_evaluate: %s\n", error.what());
+        return 1;
+    }
+    return 0;
+}

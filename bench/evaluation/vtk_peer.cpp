@@ -1,0 +1,221 @@
+// insitu_evaluate_vtk: the peer comparison of bench/evaluate. The same field, view and transfer
+// function rendered in one run by VTK's CPU ray caster (vtkFixedPointVolumeRayCastMapper,
+// off-screen), by our ground-truth renderer, and as all proxies of the camera (single- and
+// multi-perspective passes): ms per frame for each, and the PSNR between VTK's image and ours
+// (a sanity check of our ground truth). Writes peer.csv; measures and prints, asserts nothing.
+//
+//   insitu_evaluate_vtk --out DIR [--size N] [--image P] [--repeats R]
+//
+// Both renderers: orthographic view at azimuth 30, elevation 20 framing the bounding sphere,
+// trilinear samples 1 voxel apart, unshaded emission-absorption, opacity per unit length
+// (vtkVolumeProperty::SetScalarOpacityUnitDistance), composited over black.
+#include <vtkCamera.h>
+#include <vtkColorTransferFunction.h>
+#include <vtkFixedPointVolumeRayCastMapper.h>
+#include <vtkFloatArray.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPiecewiseFunction.h>
+#include <vtkPointData.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkUnsignedCharArray.h>
+#include <vtkVolume.h>
+#include <vtkVolumeProperty.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "insitu/analytic_fields.hpp"
+#include "insitu/proxy_renderer.hpp"
+#include "median_time.hpp"
+#include "metrics.hpp"
+
+namespace {
+
+using namespace insitu;
+using bench::median_ms;
+namespace fs = std::filesystem;
+
+struct Options {
+    std::string out;
+    std::int64_t size = 256;
+    int image = 512;
+    int repeats = 3;
+};
+
+[[noreturn]] void usage_error(const std::string& message) {
+    std::fprintf(stderr,
+                 "insitu_evaluate_vtk: %s\nusage: insitu_evaluate_vtk --out DIR [--size N] "
+                 "[--image P] [--repeats R]\n",
+                 message.c_str());
+    std::exit(2);
+}
+
+Options parse(int argc, char** argv) {
+    Options options;
+    for (int i = 1; i < argc; ++i) {
+        const std::string flag = argv[i];
+        if (i + 1 >= argc) usage_error(flag + " needs a value");
+        const std::string value = argv[++i];
+        if (flag == "--out") {
+            options.out = value;
+            continue;
+        }
+        const int number = std::atoi(value.c_str());
+        if (number < 1) usage_error(flag + " = " + value + " (must be a positive integer)");
+        if (flag == "--size")
+            options.size = number;
+        else if (flag == "--image")
+            options.image = number;
+        else if (flag == "--repeats")
+            options.repeats = number;
+        else
+            usage_error("unknown flag " + flag);
+    }
+    if (options.out.empty()) usage_error("--out DIR is required");
+    return options;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const Options options = parse(argc, argv);
+    try {
+        fs::create_directories(options.out);
+        const std::int64_t n = options.size;
+        const SampledVolume volume = make_gaussian_blobs({n, n, n}, 12, 3);
+        // Semi-transparent throughout, opacity per unit length in voxels (spacing 1).
+        const TransferFunction tf({{0.0, {0.1f, 0.2f, 0.9f, 0.0f}},
+                                   {0.3, {0.1f, 0.8f, 0.9f, 0.01f}},
+                                   {0.6, {0.9f, 0.9f, 0.2f, 0.04f}},
+                                   {1.0, {0.9f, 0.2f, 0.1f, 0.1f}}},
+                                  1.0);
+        OrbitView view;
+        view.azimuth_deg = 30.0;
+        view.elevation_deg = 20.0;
+        view.width = options.image;
+        view.height = options.image;
+
+        // Ours: ground truth (early termination at 0.99, as VTK's caster stops near opaque) and
+        // every proxy of the camera.
+        ProxyRenderer proxies;
+        proxies.upload(volume.field());
+        const Bounds& bounds = proxies.volume().bounds;
+        const Camera camera = Camera::orbit(view, bounds);
+        RenderSettings settings;
+        Rendering ours;
+        const double ours_ms = median_ms(
+            options.repeats, [&] { ours = proxies.render_ground_truth(camera, tf, settings); });
+        ProxyRequest request;
+        request.isovalues = {0.3, 0.45, 0.6, 0.75};
+        request.intervals = proxies.choose_intervals(16, IntervalMode::uniform);
+        request.transfer_function = tf;
+        const double single_ms =
+            median_ms(options.repeats, [&] { proxies.render(camera, request); });
+        const DistortionCamera distortion = DistortionCamera::orbit(view, bounds, 45.0);
+        const double multi_ms =
+            median_ms(options.repeats, [&] { proxies.render(distortion, request); });
+
+        // VTK: the same samples, transfer function and camera.
+        vtkNew<vtkImageData> image;
+        image->SetDimensions(static_cast<int>(n), static_cast<int>(n), static_cast<int>(n));
+        image->SetOrigin(0.0, 0.0, 0.0);
+        image->SetSpacing(1.0, 1.0, 1.0);
+        vtkNew<vtkFloatArray> scalars;
+        scalars->SetName("f");
+        scalars->SetArray(const_cast<float*>(volume.values.data()),
+                          static_cast<vtkIdType>(volume.values.size()), 1);
+        image->GetPointData()->SetScalars(scalars);
+        vtkNew<vtkColorTransferFunction> colour;
+        vtkNew<vtkPiecewiseFunction> opacity;
+        for (const ControlPoint& point : tf.rows().front().points) {
+            colour->AddRGBPoint(point.value, point.rgba.r, point.rgba.g, point.rgba.b);
+            opacity->AddPoint(point.value, point.rgba.a);
+        }
+        vtkNew<vtkVolumeProperty> property;
+        property->SetColor(colour);
+        property->SetScalarOpacity(opacity);
+        property->SetScalarOpacityUnitDistance(tf.unit_length());
+        property->SetInterpolationTypeToLinear();
+        property->ShadeOff();
+        vtkNew<vtkFixedPointVolumeRayCastMapper> mapper;
+        mapper->SetInputData(image);
+        mapper->SetSampleDistance(1.0f);
+        mapper->SetInteractiveSampleDistance(1.0f);
+        mapper->SetImageSampleDistance(1.0f);
+        mapper->SetMinimumImageSampleDistance(1.0f);
+        mapper->SetMaximumImageSampleDistance(1.0f);
+        mapper->AutoAdjustSampleDistancesOff();
+        vtkNew<vtkVolume> actor;
+        actor->SetMapper(mapper);
+        actor->SetProperty(property);
+        vtkNew<vtkRenderer> renderer;
+        renderer->AddVolume(actor);
+        renderer->SetBackground(0.0, 0.0, 0.0);
+        vtkNew<vtkRenderWindow> window;
+        window->SetOffScreenRendering(1);
+        window->SetSize(options.image, options.image);
+        window->SetMultiSamples(0);
+        window->AddRenderer(renderer);
+        vtkCamera* vtk_camera = renderer->GetActiveCamera();
+        vtk_camera->ParallelProjectionOn();
+        const glm::dvec3 centre = camera.orbit_center();
+        const glm::dvec3 eye = centre - 2.0 * camera.orbit_radius() * camera.forward();
+        vtk_camera->SetFocalPoint(centre.x, centre.y, centre.z);
+        vtk_camera->SetPosition(eye.x, eye.y, eye.z);
+        vtk_camera->SetViewUp(camera.up().x, camera.up().y, camera.up().z);
+        vtk_camera->SetParallelScale(camera.half_height());
+        vtk_camera->SetClippingRange(0.01 * camera.orbit_radius(), 4.0 * camera.orbit_radius());
+        const double vtk_ms = median_ms(options.repeats, [&] { window->Render(); });
+
+        // VTK's pixels: RGB over black, bottom row first; ours: premultiplied RGBA, top first.
+        unsigned char* rgb = window->GetPixelData(0, 0, options.image - 1, options.image - 1, 0);
+        Image theirs(options.image, options.image, 4, 0.0f);
+        for (int y = 0; y < options.image; ++y) {
+            for (int x = 0; x < options.image; ++x) {
+                const unsigned char* p =
+                    rgb + 3 * (static_cast<std::size_t>(options.image - 1 - y) * options.image + x);
+                for (int c = 0; c < 3; ++c) theirs.at(x, y, c) = p[c] / 255.0f;
+                theirs.at(x, y, 3) = 1.0f;
+            }
+        }
+        delete[] rgb;
+        const double psnr = evaluation::psnr_db(ours.rgba, theirs);
+        const double ssim = evaluation::ssim_luminance(ours.rgba, theirs);
+        write_png((fs::path(options.out) / "peer_vtk.png").string(), theirs);
+        Image ours_opaque = ours.rgba;
+        for (std::size_t p = 0; p < ours_opaque.pixel_count(); ++p)
+            ours_opaque.pixels[p * 4 + 3] = 1;
+        write_png((fs::path(options.out) / "peer_ours.png").string(), ours_opaque);
+
+        std::ofstream csv(fs::path(options.out) / "peer.csv");
+        csv << "renderer,volume_n,image,ms_per_frame\n";
+        const std::pair<const char*, double> rows[] = {{"vtk_fixed_point", vtk_ms},
+                                                       {"ours_ground_truth", ours_ms},
+                                                       {"ours_proxies_single", single_ms},
+                                                       {"ours_proxies_multi", multi_ms},
+                                                       {"ours_proxies_all", single_ms + multi_ms}};
+        for (const auto& [name, ms] : rows) {
+            csv << name << ',' << n << ',' << options.image << ',' << ms << '\n';
+        }
+        std::ofstream accuracy(fs::path(options.out) / "peer_accuracy.csv");
+        accuracy << "psnr_ours_vs_vtk,ssim_ours_vs_vtk\n" << psnr << ',' << ssim << '\n';
+        std::printf(
+            "peer: %lld^3, %d^2: VTK fixed point %.1f ms, ours %.1f ms (PSNR %.2f dB vs "
+            "VTK), proxies single %.1f + multi %.1f = %.1f ms (%.2fx VTK)\n",
+            static_cast<long long>(n), options.image, vtk_ms, ours_ms, psnr, single_ms, multi_ms,
+            single_ms + multi_ms, (single_ms + multi_ms) / vtk_ms);
+    } catch (const std::exception& error) {
+        std::fprintf(stderr, "insitu_evaluate_vtk: %s\n", error.what());
+        return 1;
+    }
+    return 0;
+}
