@@ -264,6 +264,37 @@ TEST_F(ExplorerTest, LightingOcclusionAndEnhancementChangeTheFrameAndStayFinite)
     EXPECT_NE(explorer.render(enhanced).colour.pixels, reference.pixels);
 }
 
+TEST_F(ExplorerTest, WithoutAttenuationTheFrontLayerIsDrawnAsASurface) {
+    config_.proxies.attenuation = false;
+    config_.proxies.multi_attenuation = false;
+    config_.proxies.distortion = false;
+    write_steps({1});
+    Explorer explorer(config_.archive);
+    ExploreRequest request;
+    request.step = 1;
+    const ExploreFrame frame = explorer.render(request);
+    const ProxyFrame stored = ArchiveReader(config_.archive).load(1, 0);
+    ASSERT_EQ(stored.depth_layers.size(), 1u);
+    const glm::vec4 expected = config_.transfer_function.evaluate(stored.isovalues[0]);
+    int hits = 0;
+    for (std::size_t p = 0; p < frame.colour.pixel_count(); ++p) {
+        const bool hit = std::isfinite(stored.depth_layers[0].pixels[p]);
+        hits += hit;
+        const float* rgba = &frame.colour.pixels[4 * p];
+        ASSERT_EQ(rgba[3], hit ? 1.0f : 0.0f) << "pixel " << p;
+        ASSERT_EQ(rgba[0], hit ? expected.r : 0.0f) << "pixel " << p;
+        ASSERT_EQ(rgba[2], hit ? expected.b : 0.0f) << "pixel " << p;
+    }
+    EXPECT_GT(hits, 0);
+    ExploreRequest occluded = request;
+    occluded.ambient_occlusion = AmbientOcclusionSettings{};
+    expect_finite_premultiplied(explorer.render(occluded).colour);
+    ExploreRequest enhanced = request;
+    enhanced.enhancement = EnhancementSettings{};
+    testing::expect_error_naming<InvalidArgument>([&] { explorer.render(enhanced); },
+                                                  "needs attenuation proxies");
+}
+
 TEST_F(ExplorerTest, BadRequestsNameWhatIsWrong) {
     write_steps({1});
     Explorer explorer(config_.archive);

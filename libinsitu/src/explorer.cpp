@@ -137,44 +137,50 @@ private:
     std::size_t pixels_ = 0;
 };
 
-/// Front-most depth over the layers (+inf where none hits), and the layers as opaque surfaces in
-/// the transfer function's colour at each layer's isovalue.
-struct Surfaces {
-    Image front_depth;
-    Image colour;
+/// The front-most surface over the depth layers (+inf where none hits), kept on the device:
+/// ambient occlusion needs only its depth; without attenuation proxies the layers are also
+/// painted as opaque surfaces in the transfer function's colour at each layer's isovalue.
+class FrontSurface {
+public:
+    FrontSurface(ComputeDevice& device, const std::vector<Image>& layers)
+        : device_(device), layers_(layers) {
+        const Image& first = layers.front();
+        pixels_ = first.pixel_count();
+        front_.upload(device,
+                      Image(first.width, first.height, 1, std::numeric_limits<float>::infinity()),
+                      "front depth");
+        cl::Kernel front_kernel = device.kernel("explorer", "front_depth");
+        for (const Image& depth : layers) {
+            layer_.upload(device, depth, "depth layer");
+            device.launch(front_kernel, pixel_range(pixels_), cl::NullRange, front_.buffer(),
+                          layer_.buffer(), static_cast<cl_uint>(pixels_));
+        }
+    }
+
+    Image depth() const { return front_.download(device_, "front depth"); }
+
+    Image paint(const std::vector<double>& isovalues, const TransferFunction& tf) {
+        const Image& first = layers_.front();
+        detail::DeviceImage colour;
+        colour.upload(device_, Image(first.width, first.height, 4, 0.0f), "surface colour");
+        cl::Kernel paint = device_.kernel("explorer", "paint_surface");
+        for (std::size_t l = 0; l < layers_.size(); ++l) {
+            const glm::vec4 rgba =
+                tf.evaluate(l < isovalues.size() ? isovalues[l] : tf.value_min());
+            const cl_float4 rgb{{rgba.r, rgba.g, rgba.b, 1.0f}};
+            layer_.upload(device_, layers_[l], "depth layer");
+            device_.launch(paint, pixel_range(pixels_), cl::NullRange, colour.buffer(),
+                           layer_.buffer(), front_.buffer(), rgb, static_cast<cl_uint>(pixels_));
+        }
+        return colour.download(device_, "surface colour");
+    }
+
+private:
+    ComputeDevice& device_;
+    const std::vector<Image>& layers_;
+    std::size_t pixels_ = 0;
+    detail::DeviceImage front_, layer_;
 };
-
-Surfaces draw_surfaces(ComputeDevice& device, const std::vector<Image>& layers,
-                       const std::vector<double>& isovalues, const TransferFunction& tf) {
-    const Image& first = layers.front();
-    const std::size_t pixels = first.pixel_count();
-    const cl_uint count = static_cast<cl_uint>(pixels);
-    detail::DeviceImage front, layer, colour;
-    front.upload(device,
-                 Image(first.width, first.height, 1, std::numeric_limits<float>::infinity()),
-                 "front depth");
-    colour.upload(device, Image(first.width, first.height, 4, 0.0f), "surface colour");
-    cl::Kernel front_kernel = device.kernel("explorer", "front_depth");
-    for (const Image& depth : layers) {
-        layer.upload(device, depth, "depth layer");
-        device.launch(front_kernel, pixel_range(pixels), cl::NullRange, front.buffer(),
-                      layer.buffer(), count);
-    }
-    cl::Kernel paint = device.kernel("explorer", "paint_surface");
-    for (std::size_t l = 0; l < layers.size(); ++l) {
-        const glm::vec4 rgba = tf.evaluate(l < isovalues.size() ? isovalues[l] : tf.value_min());
-        const cl_float4 rgb{{rgba.r, rgba.g, rgba.b, 1.0f}};
-        layer.upload(device, layers[l], "depth layer");
-        device.launch(paint, pixel_range(pixels), cl::NullRange, colour.buffer(), layer.buffer(),
-                      front.buffer(), rgb, count);
-    }
-    return {front.download(device, "front depth"), colour.download(device, "surface colour")};
-}
-
-Image front_depth_of(ComputeDevice& device, const std::vector<Image>& layers,
-                     const std::vector<double>& isovalues, const TransferFunction& tf) {
-    return draw_surfaces(device, layers, isovalues, tf).front_depth;
-}
 
 }  // namespace
 
@@ -370,21 +376,24 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
 
     if (!attenuation_source) {
         // Surfaces only: the front-most layer in its isovalue's colour, lit from its normals.
-        Surfaces surfaces = draw_surfaces(device, layers, layer_source->isovalues, shown_tf);
-        frame.colour = std::move(surfaces.colour);
-        if (lighting) {
-            const Image normals = normals_from_depth(surfaces.front_depth, target, device);
-            frame.colour = shade(frame.colour, normals, target, *lighting, device);
-        }
-        if (request.ambient_occlusion) {
-            Compositor compositor(device, frame.colour);
-            compositor.apply_occlusion(ambient_occlusion(surfaces.front_depth, target,
-                                                         *request.ambient_occlusion, device));
-            frame.colour = compositor.result();
-        }
         if (request.enhancement) {
             fail<InvalidArgument>("depth-aware enhancement needs attenuation proxies, and step ",
                                   request.step, " view ", request.view, " has none");
+        }
+        FrontSurface surface(device, layers);
+        frame.colour = surface.paint(layer_source->isovalues, shown_tf);
+        if (lighting || request.ambient_occlusion) {
+            const Image front = surface.depth();
+            if (lighting) {
+                const Image normals = normals_from_depth(front, target, device);
+                frame.colour = shade(frame.colour, normals, target, *lighting, device);
+            }
+            if (request.ambient_occlusion) {
+                Compositor compositor(device, frame.colour);
+                compositor.apply_occlusion(
+                    ambient_occlusion(front, target, *request.ambient_occlusion, device));
+                frame.colour = compositor.result();
+            }
         }
     } else {
         const IntervalSet& intervals = *attenuation_source->intervals;
@@ -447,8 +456,7 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
                     light_volume(attenuation, mean_depth, white, target, *lighting, device));
             }
             if (request.ambient_occlusion) {
-                const Image front =
-                    front_depth_of(device, layers, layer_source->isovalues, shown_tf);
+                const Image front = FrontSurface(device, layers).depth();
                 compositor.apply_occlusion(
                     ambient_occlusion(front, target, *request.ambient_occlusion, device));
             }
