@@ -426,7 +426,7 @@ def meaning(configs, primary, c15, c30, edit_min, rotation, rot_scene, occlusion
           "such as K, precision or compression." % (edit_min, num(default, "archive_bytes") / 1e6,
                                                       num(default, "emission_ms"))) if default else ""
     r90 = lookup(rotation, scene=rot_scene, source="multi45", angle_deg="90")
-    s2 = ("View synthesis is where they are weak: on %s the depth correlation of a multi-perspective proxy is "
+    s2 = ("View synthesis is where they are weak: on %s the depth correlation of the single-perspective proxies Explorer synthesises from is "
           "%.3f at 15° and %.3f at 30° and keeps falling toward 90°, and the confidence mask flags %.0f%% of the "
           "pixels that went wrong at 90°." % (rot_scene, c15, c30,
                                                100 * num(r90, "depth_flagged_fraction") if r90 else float("nan")))
