@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "cli.hpp"
 #include "explore_options.hpp"
 #include "insitu/error.hpp"
 #include "insitu/explorer.hpp"
@@ -32,18 +33,9 @@
 namespace {
 
 constexpr const char* kProgram = "insitu-view";
-constexpr int kExitProblems = 1;
-constexpr int kExitBadInput = 2;
-
-class UsageError : public std::runtime_error {
-public:
-    using std::runtime_error::runtime_error;
-};
-
-int report(const std::string& message, int status) {
-    std::cerr << kProgram << ": " << message << "\n";
-    return status;
-}
+/// verify's status when it finds problems (as for runtime failures).
+constexpr int kExitProblems = insitu::cli::kExitRuntimeError;
+using insitu::cli::UsageError;
 
 void print_help(std::ostream& out) {
     out << "usage:\n"
@@ -202,8 +194,9 @@ int run_verify(const std::vector<std::string>& args) {
 int main(int argc, char** argv) {
     const std::vector<std::string> all(argv + 1, argv + argc);
     if (all.empty()) {
-        return report("missing command (info, render, verify or serve; --help for usage)",
-                      kExitBadInput);
+        return insitu::cli::report(
+            kProgram, "missing command (info, render, verify or serve; --help for usage)",
+            insitu::cli::kExitBadInput);
     }
     if (all[0] == "--help" || all[0] == "-h" || all[0] == "help") {
         print_help(std::cout);
@@ -211,23 +204,12 @@ int main(int argc, char** argv) {
     }
     const std::string command = all[0];
     const std::vector<std::string> args(all.begin() + 1, all.end());
-    try {
+    return insitu::cli::run_reporting(kProgram, [&] {
         if (command == "info") return run_info(args);
         if (command == "render") return run_render(args);
         if (command == "verify") return run_verify(args);
         if (command == "serve") return insitu::viewer::serve_main(args);
         throw UsageError("unknown command \"" + command +
-                         "\" (expected info, render, verify "
-                         "or serve)");
-    } catch (const UsageError& error) {
-        return report(error.what(), kExitBadInput);
-    } catch (const insitu::InvalidArgument& error) {
-        return report(error.what(), kExitBadInput);
-    } catch (const insitu::ParseError& error) {
-        return report(error.what(), kExitBadInput);
-    } catch (const insitu::IoError& error) {
-        return report(error.what(), kExitBadInput);
-    } catch (const std::exception& error) {
-        return report(error.what(), kExitProblems);
-    }
+                         "\" (expected info, render, verify or serve)");
+    });
 }

@@ -25,6 +25,7 @@
 #include <utility>
 #include <vector>
 
+#include "cli.hpp"
 #include "explore_options.hpp"
 #include "insitu/error.hpp"
 #include "insitu/explorer.hpp"
@@ -43,8 +44,7 @@ using json = nlohmann::json;
 
 constexpr const char* kProgram = "insitu-view serve";
 constexpr int kDefaultPort = 8765;
-constexpr int kExitCannotServe = 1;
-constexpr int kExitBadInput = 2;
+constexpr int kExitCannotServe = cli::kExitRuntimeError;
 
 /// Refusals that are the request's fault, with their status; everything else is a 500.
 class HttpError : public std::runtime_error {
@@ -75,11 +75,7 @@ constexpr const char* kErrorHeader = "X-Insitu-Error";
 constexpr double kTrustedMeanConfidence = 0.9;
 constexpr double kTrustOffsetsDeg[] = {5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 90.0};
 
-/// A bad command line: one line on stderr, exit status 2.
-class UsageError : public std::runtime_error {
-public:
-    using std::runtime_error::runtime_error;
-};
+using cli::UsageError;
 
 struct ServeArguments {
     std::string archive;
@@ -666,13 +662,9 @@ bool is_loopback(const std::string& address) {
 }  // namespace
 
 int serve_main(const std::vector<std::string>& args) {
-    ServeArguments arguments;
-    try {
-        arguments = parse_serve_arguments(args);
-    } catch (const UsageError& error) {
-        std::cerr << "insitu-view: " << error.what() << "\n";
-        return kExitBadInput;
-    }
+    // Bad arguments and the library's typed errors propagate to insitu-view's main, which reports
+    // them on one line with the tools' exit statuses (cli.hpp).
+    const ServeArguments arguments = parse_serve_arguments(args);
     // SIGINT/SIGTERM stop the server from a thread of their own (stop() is not
     // async-signal-safe). They are blocked before any thread starts (the OpenCL runtime's
     // workers, httplib's), so that every thread inherits the mask and only sigwait sees them.
@@ -682,26 +674,13 @@ int serve_main(const std::vector<std::string>& args) {
     sigaddset(&signals, SIGTERM);
     pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
-    // A missing, corrupt or escaping archive is bad input (2); anything else, such as no OpenCL
-    // device, is a failure to serve (1), as for the other subcommands.
+    // A missing or corrupt archive is bad input (2) and so is one whose files escape its
+    // directory; anything else, such as no OpenCL device, is a failure to serve (1).
     std::unique_ptr<ViewerService> service;
     try {
         service = std::make_unique<ViewerService>(arguments.archive);
     } catch (const HttpError& error) {
-        std::cerr << "insitu-view: " << error.what() << "\n";
-        return kExitBadInput;
-    } catch (const IoError& error) {
-        std::cerr << "insitu-view: " << error.what() << "\n";
-        return kExitBadInput;
-    } catch (const ParseError& error) {
-        std::cerr << "insitu-view: " << error.what() << "\n";
-        return kExitBadInput;
-    } catch (const InvalidArgument& error) {
-        std::cerr << "insitu-view: " << error.what() << "\n";
-        return kExitBadInput;
-    } catch (const std::exception& error) {
-        std::cerr << "insitu-view: " << error.what() << "\n";
-        return kExitCannotServe;
+        throw UsageError(error.what());
     }
 
     httplib::Server server;

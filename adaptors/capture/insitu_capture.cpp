@@ -31,6 +31,7 @@
 #include <system_error>
 #include <vector>
 
+#include "cli.hpp"
 #include "insitu/capture_input.hpp"
 #include "insitu/config.hpp"
 #include "insitu/error.hpp"
@@ -40,14 +41,8 @@
 namespace {
 
 constexpr const char* kProgram = "insitu-capture";
-constexpr int kExitRuntimeError = 1;
-constexpr int kExitBadInput = 2;
-
-/// A command line or input that cannot be acted on (exit 2).
-class UsageError : public std::runtime_error {
-public:
-    using std::runtime_error::runtime_error;
-};
+using insitu::cli::one_line;
+using insitu::cli::UsageError;
 
 /// A failure that is not the user's input (exit 1).
 class RuntimeFailure : public std::runtime_error {
@@ -258,18 +253,6 @@ Arguments parse_arguments(int argc, char** argv) {
 
 // ---------------------------------------------------------------------------------------------
 
-/// Messages must stay one line (nested errors and build logs may span several).
-std::string one_line(const std::string& message) {
-    std::string line;
-    for (char c : message) {
-        const bool is_break = c == '\n' || c == '\r';
-        if (is_break && (line.empty() || line.back() == ' ')) continue;
-        line += is_break ? ' ' : c;
-    }
-    while (!line.empty() && line.back() == ' ') line.pop_back();
-    return line;
-}
-
 std::string format_duration(double seconds) {
     const auto total = static_cast<std::int64_t>(std::llround(std::max(0.0, seconds)));
     std::ostringstream text;
@@ -466,38 +449,16 @@ int run(const Arguments& arguments) {
     return 0;
 }
 
-int report(const std::string& message, int status) {
-    std::cerr << kProgram << ": " << one_line(message) << "\n";
-    return status;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-    Arguments arguments;
-    try {
-        arguments = parse_arguments(argc, argv);
-    } catch (const UsageError& error) {
-        return report(error.what(), kExitBadInput);
-    }
-    if (arguments.help) {
-        print_help(std::cout);
-        return 0;
-    }
-    try {
+    // A RuntimeFailure is not the user's input: exit 1, like every non-input error.
+    return insitu::cli::run_reporting(kProgram, [&] {
+        const Arguments arguments = parse_arguments(argc, argv);
+        if (arguments.help) {
+            print_help(std::cout);
+            return 0;
+        }
         return run(arguments);
-    } catch (const UsageError& error) {
-        return report(error.what(), kExitBadInput);
-    } catch (const RuntimeFailure& error) {
-        return report(error.what(), kExitRuntimeError);
-    } catch (const insitu::InvalidArgument& error) {
-        return report(error.what(), kExitBadInput);
-    } catch (const insitu::ParseError& error) {
-        return report(error.what(), kExitBadInput);
-    } catch (const insitu::IoError& error) {
-        return report(error.what(), kExitBadInput);
-    } catch (const std::exception& error) {
-        // ComputeError, other insitu::Error, std::bad_alloc: not the user's input.
-        return report(error.what(), kExitRuntimeError);
-    }
+    });
 }

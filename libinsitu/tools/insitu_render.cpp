@@ -26,6 +26,7 @@
 #include <system_error>
 #include <vector>
 
+#include "cli.hpp"
 #include "insitu/camera.hpp"
 #include "insitu/error.hpp"
 #include "insitu/field.hpp"
@@ -36,14 +37,7 @@
 namespace {
 
 constexpr const char* kProgram = "insitu-render";
-constexpr int kExitRuntimeError = 1;
-constexpr int kExitBadInput = 2;
-
-/// A command line that cannot be acted on; the message names the flag and the value.
-class UsageError : public std::runtime_error {
-public:
-    using std::runtime_error::runtime_error;
-};
+using insitu::cli::UsageError;
 
 struct Arguments {
     std::string raw_path;
@@ -379,46 +373,15 @@ int run(const Arguments& arguments) {
     return 0;
 }
 
-/// Messages must stay one line (build logs and nested errors may span several).
-std::string one_line(const std::string& message) {
-    std::string line;
-    for (char c : message) {
-        const bool is_break = c == '\n' || c == '\r';
-        if (is_break && (line.empty() || line.back() == ' ')) continue;
-        line += is_break ? ' ' : c;
-    }
-    while (!line.empty() && line.back() == ' ') line.pop_back();
-    return line;
-}
-
-int report(const std::string& message, int status) {
-    std::cerr << kProgram << ": " << one_line(message) << "\n";
-    return status;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-    Arguments arguments;
-    try {
-        arguments = parse_arguments(argc, argv);
-    } catch (const UsageError& error) {
-        return report(error.what(), kExitBadInput);
-    }
-    if (arguments.help) {
-        print_help(std::cout);
-        return 0;
-    }
-    try {
+    return insitu::cli::run_reporting(kProgram, [&] {
+        const Arguments arguments = parse_arguments(argc, argv);
+        if (arguments.help) {
+            print_help(std::cout);
+            return 0;
+        }
         return run(arguments);
-    } catch (const insitu::InvalidArgument& error) {
-        return report(error.what(), kExitBadInput);
-    } catch (const insitu::ParseError& error) {
-        return report(error.what(), kExitBadInput);
-    } catch (const insitu::IoError& error) {
-        return report(error.what(), kExitBadInput);
-    } catch (const std::exception& error) {
-        // ComputeError, other insitu::Error, std::bad_alloc: not the user's input.
-        return report(error.what(), kExitRuntimeError);
-    }
+    });
 }
