@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "gray_scott_simulation.hpp"
+#include "gray_scott_volume.hpp"
 #include "sample_count.hpp"
 #include "insitu/analytic_fields.hpp"
 #include "insitu/proxy_renderer.hpp"
@@ -159,17 +160,7 @@ SampledVolume gray_scott_field(int size, int steps) {
     parameters.size = size;
     gray_scott::Simulation simulation(parameters);
     for (int s = 0; s < steps; ++s) simulation.step();
-    SampledVolume volume;
-    volume.name = "v";
-    volume.dims = {size, size, size};
-    volume.values.resize(static_cast<std::size_t>(size) * size * size);
-    std::size_t index = 0;
-    for (int k = 0; k < size; ++k) {
-        for (int j = 0; j < size; ++j) {
-            for (int i = 0; i < size; ++i) volume.values[index++] = static_cast<float>(simulation.v(i, j, k));
-        }
-    }
-    return volume;
+    return bench::gray_scott_volume(simulation);
 }
 
 }  // namespace

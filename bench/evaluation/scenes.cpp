@@ -7,6 +7,7 @@
 #include <iterator>
 
 #include "gray_scott_simulation.hpp"
+#include "gray_scott_volume.hpp"
 #include "insitu/error.hpp"
 
 namespace insitu::evaluation {
@@ -35,18 +36,7 @@ std::vector<Scene> gray_scott_scenes(int size, const std::vector<int>& snapshot_
     std::vector<Scene> scenes;
     for (const int snapshot : snapshot_steps) {
         while (simulation.steps_done() < snapshot) simulation.step();
-        SampledVolume volume;
-        volume.name = "v";
-        volume.dims = {size, size, size};
-        volume.values.resize(static_cast<std::size_t>(size) * size * size);
-        std::size_t index = 0;
-        for (int k = 0; k < size; ++k) {
-            for (int j = 0; j < size; ++j) {
-                for (int i = 0; i < size; ++i) {
-                    volume.values[index++] = static_cast<float>(simulation.v(i, j, k));
-                }
-            }
-        }
+        SampledVolume volume = bench::gray_scott_volume(simulation);
         scenes.push_back(make_scene("gray_scott_t" + std::to_string(snapshot), std::move(volume)));
     }
     return scenes;
