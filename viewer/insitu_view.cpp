@@ -3,6 +3,7 @@
 //   insitu-view info ARCHIVE [--json]
 //   insitu-view render ARCHIVE --step N [--view V] [--azimuth DEG --elevation DEG]
 //               [--tf TF.json | --opacity-scale J=S,...] [--colour auto|model|recompose]
+//               [--source auto|single|multi]
 //               [--light AZ,EL[,DIFFUSE[,SPECULAR]] | --light camera]... [--ambient A]
 //               [--ao] [--ao-radius PIXELS] [--ao-strength S] [--enhance LAMBDA,GAMMA]
 //               [--fill PIXELS] [--mask OUT.png] --out OUT.png|exr
@@ -42,6 +43,7 @@ void print_help(std::ostream& out) {
            "  insitu-view info ARCHIVE [--json]\n"
            "  insitu-view render ARCHIVE --step N [--view V] [--azimuth DEG --elevation DEG]\n"
            "      [--tf TF.json | --opacity-scale J=S,...] [--colour auto|model|recompose]\n"
+           "      [--source auto|single|multi]\n"
            "      [--light AZ,EL[,DIFFUSE[,SPECULAR]] | --light camera]... [--ambient A]\n"
            "      [--ao] [--ao-radius PIXELS] [--ao-strength S] [--enhance LAMBDA,GAMMA]\n"
            "      [--fill PIXELS] [--mask OUT.png] --out OUT.png|exr\n"
