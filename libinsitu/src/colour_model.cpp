@@ -373,11 +373,7 @@ Image ColourModel::predict(const Image& attenuation, ComputeDevice& device) cons
     detail::DeviceImage input, output;
     input.upload(device, attenuation, "colour model: attenuation");
     output.allocate(device, attenuation.width, attenuation.height, 4);
-    cl::Buffer table;
-    std::size_t capacity = 0;
-    const std::size_t table_bytes = table_.size() * sizeof(float);
-    device.ensure_buffer(table, capacity, table_bytes, CL_MEM_READ_ONLY);
-    device.upload(table, table_.data(), table_bytes, "colour model: table");
+    const cl::Buffer table = detail::upload_read_only(device, table_, "colour model: table");
     cl::Kernel kernel = device.kernel("colour_model", "predict_colour");
     device.launch(kernel, cl::NDRange(pixels), cl::NullRange, input.buffer(),
                   static_cast<cl_int>(intervals_), static_cast<cl_uint>(pixels), table,

@@ -3,6 +3,7 @@
 // synthesis, relighting, enhancement): one buffer per image, reused while it does not grow, so
 // an interactive session allocates once.
 #include <string>
+#include <vector>
 
 #include "insitu/compute_device.hpp"
 #include "insitu/error.hpp"
@@ -42,5 +43,21 @@ private:
     std::size_t capacity_ = 0;
     int width_ = 0, height_ = 0, channels_ = 0;
 };
+
+/// A read-only device buffer holding a copy of `bytes` bytes at `host` (small per-call inputs:
+/// tables, colours, scales, lights).
+inline cl::Buffer upload_read_only(ComputeDevice& device, const void* host, std::size_t bytes,
+                                   const char* what) {
+    cl::Buffer buffer;
+    std::size_t capacity = 0;
+    device.ensure_buffer(buffer, capacity, bytes, CL_MEM_READ_ONLY);
+    device.upload(buffer, host, bytes, what);
+    return buffer;
+}
+
+inline cl::Buffer upload_read_only(ComputeDevice& device, const std::vector<float>& values,
+                                   const char* what) {
+    return upload_read_only(device, values.data(), values.size() * sizeof(float), what);
+}
 
 }  // namespace insitu::detail

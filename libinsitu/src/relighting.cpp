@@ -55,16 +55,6 @@ CameraArgs camera_args(const Camera& camera) {
             detail::camera_extent(camera), cl_int2{{camera.width(), camera.height()}}};
 }
 
-/// A read-only device buffer holding a copy of `bytes` bytes at `host`.
-cl::Buffer upload_buffer(ComputeDevice& device, const void* host, std::size_t bytes,
-                         const char* what) {
-    cl::Buffer buffer;
-    std::size_t capacity = 0;
-    device.ensure_buffer(buffer, capacity, bytes, CL_MEM_READ_ONLY);
-    device.upload(buffer, host, bytes, what);
-    return buffer;
-}
-
 /// Three float4 per light (kernels/relighting.cl illuminate()); one zero light when there are
 /// none, because OpenCL buffers cannot be empty.
 cl::Buffer upload_lights(ComputeDevice& device, const LightingSettings& lighting) {
@@ -76,7 +66,8 @@ cl::Buffer upload_lights(ComputeDevice& device, const LightingSettings& lighting
         packed.push_back(to_float4(light.specular * light.colour));
     }
     if (packed.empty()) packed.resize(3, to_float4(0.0, 0.0, 0.0, 0.0));
-    return upload_buffer(device, packed.data(), packed.size() * sizeof(cl_float4), "lights");
+    return detail::upload_read_only(device, packed.data(), packed.size() * sizeof(cl_float4),
+                                    "lights");
 }
 
 double depth_scale_world(const AmbientOcclusionSettings& settings, const Camera& camera) {
@@ -203,8 +194,8 @@ Image unsharp_mask_occlusion(const Image& depth, const Camera& camera,
         const double sigma_pixels = 0.5 * radius;
         gaussian[d] = static_cast<float>(std::exp(-0.5 * d * d / (sigma_pixels * sigma_pixels)));
     }
-    cl::Buffer gaussian_device =
-        upload_buffer(device, gaussian.data(), gaussian.size() * sizeof(float), "Gaussian weights");
+    cl::Buffer gaussian_device = detail::upload_read_only(
+        device, gaussian.data(), gaussian.size() * sizeof(float), "Gaussian weights");
     const cl_float4 occlusion =
         to_float4(settings.strength, 1.0 / depth_scale_world(settings, camera), 0.0, 0.0);
     DeviceImage depth_device;
@@ -238,8 +229,9 @@ Image light_volume(const Image& attenuation, const Image& mean_depth,
     attenuation_device.upload(device, attenuation, "attenuation");
     mean_depth_device.upload(device, mean_depth, "mean depth");
     colour_device.allocate(device, attenuation.width, attenuation.height, 4);
-    cl::Buffer colours = upload_buffer(device, interval_colours.data(),
-                                       interval_colours.size() * sizeof(float), "interval colours");
+    cl::Buffer colours =
+        detail::upload_read_only(device, interval_colours.data(),
+                                 interval_colours.size() * sizeof(float), "interval colours");
     cl::Buffer lights = upload_lights(device, lighting);
     const CameraArgs cam = camera_args(camera);
     cl::Kernel kernel = device.kernel("relighting", "light_volume");

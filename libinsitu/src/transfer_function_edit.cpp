@@ -147,11 +147,8 @@ Image recolour(const Image& attenuation, const std::vector<float>& colours, Comp
     detail::DeviceImage input, output;
     input.upload(device, attenuation, "recolour: attenuation");
     output.allocate(device, attenuation.width, attenuation.height, 4);
-    cl::Buffer colour_buffer;
-    std::size_t capacity = 0;
-    const std::size_t bytes = colours.size() * sizeof(float);
-    device.ensure_buffer(colour_buffer, capacity, bytes, CL_MEM_READ_ONLY);
-    device.upload(colour_buffer, colours.data(), bytes, "recolour: interval colours");
+    const cl::Buffer colour_buffer =
+        detail::upload_read_only(device, colours, "recolour: interval colours");
     cl::Kernel kernel = device.kernel("transfer_function_edit", "recolour");
     device.launch(kernel, cl::NDRange(pixels), cl::NullRange, input.buffer(),
                   static_cast<cl_int>(intervals), static_cast<cl_uint>(pixels), colour_buffer,
@@ -186,11 +183,8 @@ Image estimate_attenuation(const Image& attenuation, const Image& mean_depth,
     depth.upload(device, mean_depth, "estimate_attenuation: mean depth");
     if (optical_depth) tau.upload(device, *optical_depth, "estimate_attenuation: optical depth");
     output.allocate(device, attenuation.width, attenuation.height, intervals);
-    cl::Buffer scale_buffer;
-    std::size_t capacity = 0;
-    const std::size_t bytes = scale_values.size() * sizeof(float);
-    device.ensure_buffer(scale_buffer, capacity, bytes, CL_MEM_READ_ONLY);
-    device.upload(scale_buffer, scale_values.data(), bytes, "estimate_attenuation: scales");
+    const cl::Buffer scale_buffer =
+        detail::upload_read_only(device, scale_values, "estimate_attenuation: scales");
     cl::Kernel kernel = device.kernel("transfer_function_edit", "estimate_attenuation");
     device.launch(kernel, cl::NDRange(pixels), cl::NullRange, a.buffer(), depth.buffer(),
                   optical_depth ? tau.buffer() : cl::Buffer(),

@@ -6,6 +6,7 @@
 #include <glm/trigonometric.hpp>
 #include <string>
 
+#include "device_image.hpp"
 #include "insitu/error.hpp"
 #include "kernel_args.hpp"
 
@@ -133,15 +134,6 @@ std::vector<Image> planes(const std::vector<float>& values, int width, int heigh
 }
 
 // A device buffer holding `values`.
-cl::Buffer upload_buffer(ComputeDevice& device, const std::vector<float>& values,
-                         const char* what) {
-    cl::Buffer buffer;
-    std::size_t capacity = 0;
-    device.ensure_buffer(buffer, capacity, values.size() * sizeof(float), CL_MEM_READ_ONLY);
-    device.upload(buffer, values.data(), values.size() * sizeof(float), what);
-    return buffer;
-}
-
 cl::Buffer device_buffer(ComputeDevice& device, std::size_t bytes) {
     cl::Buffer buffer;
     std::size_t capacity = 0;
@@ -172,10 +164,11 @@ SynthesisedLayers synthesise_layers(const ProxyFrame& frame, const Camera& targe
     const int layers = static_cast<int>(frame.depth_layers.size());
     const std::size_t target_pixels = static_cast<std::size_t>(target.width()) * target.height();
 
-    const cl::Buffer depth = upload_buffer(device, planar(frame.depth_layers), "depth layers");
+    const cl::Buffer depth =
+        detail::upload_read_only(device, planar(frame.depth_layers), "depth layers");
     const cl::Buffer distortion =
         frame.multi_perspective
-            ? upload_buffer(device, planar(frame.distortion_layers), "distortion layers")
+            ? detail::upload_read_only(device, planar(frame.distortion_layers), "distortion layers")
             : cl::Buffer();
     const cl::Buffer keys = empty_keys(device, target_pixels * layers);
     const cl_float4 source_extent =
@@ -234,8 +227,10 @@ SynthesisedAttenuation synthesise_attenuation(const ProxyFrame& frame, const Cam
     const std::size_t source_pixels = static_cast<std::size_t>(source.width()) * source.height();
     const std::size_t target_pixels = static_cast<std::size_t>(target.width()) * target.height();
 
-    const cl::Buffer attenuation = upload_buffer(device, frame.attenuation.pixels, "attenuation");
-    const cl::Buffer mean_depth = upload_buffer(device, frame.mean_depth.pixels, "mean depth");
+    const cl::Buffer attenuation =
+        detail::upload_read_only(device, frame.attenuation.pixels, "attenuation");
+    const cl::Buffer mean_depth =
+        detail::upload_read_only(device, frame.mean_depth.pixels, "mean depth");
     const cl::Buffer keys = empty_keys(device, target_pixels * intervals);
     const cl::Buffer values = device_buffer(device, target_pixels * intervals * sizeof(cl_float2));
     const cl::Buffer owners = empty_keys(device, target_pixels * intervals);
@@ -301,10 +296,11 @@ RadialityHistogram radiality_histogram(const ProxyFrame& multi_frame, int bins,
     const std::size_t pixels = static_cast<std::size_t>(camera.width()) * camera.height();
 
     const cl::Buffer depth =
-        upload_buffer(device, planar(multi_frame.depth_layers), "depth layers");
+        detail::upload_read_only(device, planar(multi_frame.depth_layers), "depth layers");
     const cl::Buffer distortion =
         multi_frame.multi_perspective
-            ? upload_buffer(device, planar(multi_frame.distortion_layers), "distortion layers")
+            ? detail::upload_read_only(device, planar(multi_frame.distortion_layers),
+                                       "distortion layers")
             : cl::Buffer();
     const cl::Buffer angles = device_buffer(device, pixels * layers * sizeof(float));
     cl::Kernel kernel = device.kernel("view_synthesis", "radiality_angles");
