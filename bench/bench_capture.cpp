@@ -36,11 +36,11 @@
 #include <string>
 #include <vector>
 
-#include "insitu/camera.hpp"
+#include "insitu/core/camera.hpp"
 #include "insitu/capture_input.hpp"
 #include "insitu/config.hpp"
 #include "insitu/instrument.hpp"
-#include "insitu/proxy_renderer.hpp"
+#include "insitu/render/proxy_renderer.hpp"
 
 namespace {
 

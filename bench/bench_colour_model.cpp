@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "insitu/analytic_fields.hpp"
-#include "insitu/colour_model.hpp"
-#include "insitu/proxy_renderer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "insitu/explore/colour_model.hpp"
+#include "insitu/render/proxy_renderer.hpp"
 
 namespace {
 

@@ -17,10 +17,10 @@
 #include <string>
 #include <vector>
 
-#include "insitu/analytic_fields.hpp"
-#include "insitu/explorer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "insitu/explore/explorer.hpp"
 #include "insitu/instrument.hpp"
-#include "insitu/proxy_renderer.hpp"
+#include "insitu/render/proxy_renderer.hpp"
 #include "median_time.hpp"
 
 namespace {

@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "insitu/analytic_fields.hpp"
-#include "insitu/archive.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "insitu/archive/archive.hpp"
 #include "insitu/instrument.hpp"
 
 namespace {

@@ -16,8 +16,8 @@
 #include "gray_scott_simulation.hpp"
 #include "gray_scott_volume.hpp"
 #include "sample_count.hpp"
-#include "insitu/analytic_fields.hpp"
-#include "insitu/proxy_renderer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "insitu/render/proxy_renderer.hpp"
 
 namespace {
 

@@ -25,12 +25,12 @@
 #include <vector>
 
 #include "sample_count.hpp"
-#include "insitu/analytic_fields.hpp"
-#include "insitu/camera.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "insitu/core/camera.hpp"
 #include "insitu/error.hpp"
-#include "insitu/transfer_function.hpp"
-#include "insitu/volume_renderer.hpp"
-#include "reference_renderer.hpp"
+#include "insitu/core/transfer_function.hpp"
+#include "insitu/render/volume_renderer.hpp"
+#include "insitu/testing/reference_renderer.hpp"
 
 namespace {
 

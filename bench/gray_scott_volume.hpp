@@ -5,7 +5,7 @@
 #include <cstddef>
 
 #include "gray_scott_simulation.hpp"
-#include "insitu/analytic_fields.hpp"
+#include "insitu/testing/analytic_fields.hpp"
 
 namespace insitu::bench {
 

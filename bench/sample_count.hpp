@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "insitu/camera.hpp"
+#include "insitu/core/camera.hpp"
 #include "insitu/field.hpp"
 
 namespace insitu::bench {

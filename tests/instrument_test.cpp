@@ -27,8 +27,8 @@
 #include <thread>
 #include <vector>
 
-#include "insitu/analytic_fields.hpp"
-#include "insitu/archive.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "insitu/archive/archive.hpp"
 #include "insitu/error.hpp"
 
 namespace insitu {

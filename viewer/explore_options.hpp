@@ -19,7 +19,7 @@
 #include <map>
 #include <string>
 
-#include "insitu/explorer.hpp"
+#include "insitu/explore/explorer.hpp"
 
 namespace insitu::viewer {
 

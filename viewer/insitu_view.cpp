@@ -27,8 +27,8 @@
 #include "cli.hpp"
 #include "explore_options.hpp"
 #include "insitu/error.hpp"
-#include "insitu/explorer.hpp"
-#include "insitu/image.hpp"
+#include "insitu/explore/explorer.hpp"
+#include "insitu/core/image.hpp"
 #include "server.hpp"
 
 namespace {

@@ -28,9 +28,9 @@
 #include "cli.hpp"
 #include "explore_options.hpp"
 #include "insitu/error.hpp"
-#include "insitu/explorer.hpp"
-#include "insitu/image.hpp"
-#include "insitu/transfer_function_edit.hpp"
+#include "insitu/explore/explorer.hpp"
+#include "insitu/core/image.hpp"
+#include "insitu/explore/transfer_function_edit.hpp"
 
 namespace insitu::viewer {
 

@@ -23,16 +23,16 @@
 #include <thread>
 #include <vector>
 
-#include "insitu/analytic_fields.hpp"
-#include "insitu/archive.hpp"
-#include "insitu/colour_model.hpp"
-#include "insitu/explorer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "insitu/archive/archive.hpp"
+#include "insitu/explore/colour_model.hpp"
+#include "insitu/explore/explorer.hpp"
 #include "insitu/instrument.hpp"
-#include "insitu/proxy_renderer.hpp"
-#include "insitu/transfer_function_edit.hpp"
-#include "insitu/view_synthesis.hpp"
+#include "insitu/render/proxy_renderer.hpp"
+#include "insitu/explore/transfer_function_edit.hpp"
+#include "insitu/explore/view_synthesis.hpp"
 #include "median_time.hpp"
-#include "metrics.hpp"
+#include "insitu/testing/metrics.hpp"
 #include "scenes.hpp"
 
 namespace {

@@ -33,10 +33,10 @@
 #include <string>
 #include <vector>
 
-#include "insitu/analytic_fields.hpp"
-#include "insitu/proxy_renderer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "insitu/render/proxy_renderer.hpp"
 #include "median_time.hpp"
-#include "metrics.hpp"
+#include "insitu/testing/metrics.hpp"
 
 namespace {
 

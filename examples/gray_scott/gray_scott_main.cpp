@@ -27,12 +27,12 @@
 #include <vector>
 
 #include "gray_scott_simulation.hpp"
-#include "insitu/compute_device.hpp"
+#include "insitu/device/compute_device.hpp"
 #include "insitu/config.hpp"
 #include "insitu/error.hpp"
 #include "insitu/field.hpp"
 #include "insitu/instrument.hpp"
-#include "insitu/transfer_function.hpp"
+#include "insitu/core/transfer_function.hpp"
 
 namespace {
 

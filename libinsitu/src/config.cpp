@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "insitu/error.hpp"
-#include "insitu/layers.hpp"
+#include "insitu/core/layers.hpp"
 
 namespace insitu {
 

@@ -13,12 +13,12 @@
 #include <sstream>
 #include <thread>
 
-#include "insitu/archive.hpp"
-#include "insitu/camera.hpp"
-#include "insitu/colour_model.hpp"
-#include "insitu/distortion_camera.hpp"
+#include "insitu/archive/archive.hpp"
+#include "insitu/core/camera.hpp"
+#include "insitu/explore/colour_model.hpp"
+#include "insitu/render/distortion_camera.hpp"
 #include "insitu/error.hpp"
-#include "insitu/proxy_renderer.hpp"
+#include "insitu/render/proxy_renderer.hpp"
 
 namespace insitu {
 

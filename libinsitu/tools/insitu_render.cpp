@@ -27,12 +27,12 @@
 #include <vector>
 
 #include "cli.hpp"
-#include "insitu/camera.hpp"
+#include "insitu/core/camera.hpp"
 #include "insitu/error.hpp"
 #include "insitu/field.hpp"
-#include "insitu/image.hpp"
-#include "insitu/transfer_function.hpp"
-#include "insitu/volume_renderer.hpp"
+#include "insitu/core/image.hpp"
+#include "insitu/core/transfer_function.hpp"
+#include "insitu/render/volume_renderer.hpp"
 
 namespace {
 

@@ -11,7 +11,7 @@ set(capture_out ${CMAKE_CURRENT_BINARY_DIR}/insitu_capture)
 set(capture_in ${capture_out}/inputs)
 
 add_executable(make_capture_inputs make_capture_inputs.cpp)
-target_compile_options(make_capture_inputs PRIVATE -Wall -Wextra -Wpedantic)
+target_link_libraries(make_capture_inputs PRIVATE insitu_warnings)
 if(TARGET insitu_vtk)
   target_link_libraries(make_capture_inputs PRIVATE VTK::CommonDataModel VTK::IOXML)
   target_compile_definitions(make_capture_inputs PRIVATE INSITU_CAPTURE_INPUTS_WITH_VTK)

@@ -8,7 +8,7 @@ set(insitu_render_out ${CMAKE_CURRENT_BINARY_DIR}/insitu_render)
 
 add_executable(make_raw_volume make_raw_volume.cpp)
 target_link_libraries(make_raw_volume PRIVATE insitu)
-target_compile_options(make_raw_volume PRIVATE -Wall -Wextra -Wpedantic)
+target_link_libraries(make_raw_volume PRIVATE insitu_warnings)
 
 # Fixtures: clean (stale images from an earlier run cannot pass) -> volumes -> each render -> its
 # file check. Volumes are tiny, so every render takes well under a second on PoCL.

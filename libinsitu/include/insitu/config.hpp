@@ -30,9 +30,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "insitu/camera.hpp"
-#include "insitu/intervals.hpp"
-#include "insitu/transfer_function.hpp"
+#include "insitu/core/camera.hpp"
+#include "insitu/core/intervals.hpp"
+#include "insitu/core/transfer_function.hpp"
 
 namespace insitu {
 

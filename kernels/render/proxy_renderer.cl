@@ -1,0 +1,180 @@
+// Proxy images in one ray-marching pass per camera (seed 000 §3-§6); the definition is written
+// out in libinsitu/include/insitu/proxy_renderer.hpp. One work-item per pixel.
+// Layer outputs are planar (layer l of pixel p at l * pixel_count + p: one image per layer);
+// per-interval outputs are interleaved (interval j of pixel p at p * interval_count + j), and
+// the kernel accumulates into them in place: a pixel's intervals share one or two cache lines,
+// whereas private arrays indexed by a data-dependent interval cost PoCL about 3x the whole pass.
+
+// MAX_LAYERS and the WANT_* bits of `wanted` come from the host as -D options
+// (libinsitu/src/device/kernel_constants.hpp).
+
+// Interval of a value: [edges[j], edges[j+1]), last closed, outside values to the end intervals.
+inline int interval_of(__global const float* edges, int count, float value) {
+    int low = 0;
+    int high = count - 1;
+    while (low < high) {
+        const int mid = (low + high + 1) / 2;
+        if (value >= edges[mid]) low = mid; else high = mid - 1;
+    }
+    return low;
+}
+
+__kernel void render_proxies(__global const float* volume, int4 dims, float4 origin_world,
+                             float4 inv_spacing, float4 box_lower, float4 box_upper,
+                             __global const float4* tf_table, int2 tf_bins, float4 tf_domain,
+                             float4 cam_position, float4 cam_forward, float4 cam_right,
+                             float4 cam_up, float4 cam_half_extent, int2 size,
+                             float4 march, int wanted, int layer_count,
+                             __global const float* isovalues, int interval_count,
+                             float uniform_interval_scale,
+                             __global const float* interval_edges, __global float* depth_out,
+                             __global float* distortion_out,
+                             __global float* attenuation_out,  // always given when accumulating
+                             __global float* mean_depth_out, __global float* optical_depth_out,
+                             __global const uchar* skippable_blocks, int4 block_counts,
+                             int block_size) {
+    const int x = get_global_id(0);
+    const int y = get_global_id(1);
+    if (x >= size.x || y >= size.y) return;
+    const int pixel = y * size.x + x;
+    const int pixel_count = size.x * size.y;
+
+    // march = (step in world units, early-termination opacity, sin(tilt), cos(tilt));
+    // tilt = 0 for single-perspective cameras.
+    const float step = march.x;
+    const float stop_opacity = march.y;
+    const float sin_tilt = march.z;
+    const float cos_tilt = march.w;
+
+    float3 ray_origin;
+    float3 ray_direction;
+    camera_ray(x, y, size, cam_position, cam_forward, cam_right, cam_up, cam_half_extent,
+               &ray_origin, &ray_direction);
+    if (sin_tilt != 0.0f) {
+        // Volume distortion camera (seed 000 Eq. 1): tilt towards the pole line through the
+        // image centre.
+        const float3 offset = ray_origin - cam_position.xyz;
+        const float offset_length = length(offset);
+        const float3 radial = offset_length > 0.0f ? offset / offset_length : (float3)(0.0f);
+        ray_direction = normalize(cam_forward.xyz * cos_tilt - radial * sin_tilt);
+    }
+
+    const bool want_layers = (wanted & WANT_DEPTH) != 0 && layer_count > 0;
+    const bool want_attenuation = (wanted & WANT_ATTENUATION) != 0;
+    const bool want_mean_depth = (wanted & WANT_MEAN_DEPTH) != 0;
+    const bool want_optical_depth = (wanted & WANT_OPTICAL_DEPTH) != 0;
+
+    float layer_t[MAX_LAYERS];
+    for (int l = 0; l < layer_count; ++l) layer_t[l] = INFINITY;
+    int layers_found = 0;
+    // Mean and optical depth need the same accumulation, even when a_j is not stored.
+    const bool accumulate = want_attenuation || want_mean_depth || want_optical_depth;
+    __global float* attenuation = attenuation_out + pixel * interval_count;
+    __global float* weighted_depth = mean_depth_out + pixel * interval_count;
+    __global float* optical_depth = optical_depth_out + pixel * interval_count;
+    if (accumulate) {
+        for (int j = 0; j < interval_count; ++j) {
+            attenuation[j] = 0.0f;
+            if (want_mean_depth) weighted_depth[j] = 0.0f;
+            if (want_optical_depth) optical_depth[j] = 0.0f;
+        }
+    }
+
+    const float2 span = intersect_box(ray_origin, ray_direction, box_lower.xyz, box_upper.xyz);
+    const float depth_origin = dot(ray_origin - cam_position.xyz, cam_forward.xyz);
+    const float depth_per_t = dot(ray_direction, cam_forward.xyz);
+    if (span.x <= span.y) {
+        const float3 start_voxels = (ray_origin - origin_world.xyz) * inv_spacing.xyz;
+        const float3 direction_voxels = ray_direction * inv_spacing.xyz;
+        float transmittance = 1.0f;
+        bool accumulating = accumulate;
+        float previous_value = NAN;
+        float previous_t = 0.0f;
+        float next_block_t = -INFINITY;  // t where the ray leaves the block looked up last
+        for (int i = 0;; ++i) {
+            const float t = span.x + ((float)i + 0.5f) * step;
+            if (t >= span.y) break;
+            const float value = sample_trilinear(volume, dims, start_voxels + t * direction_voxels);
+            if (isnan(value)) {
+                previous_value = NAN;
+                continue;
+            }
+            if (want_layers && !isnan(previous_value)) {
+                for (int l = 0; l < layer_count; ++l) {
+                    const float iso = isovalues[l];
+                    if (isinf(layer_t[l]) && ((previous_value >= iso) != (value >= iso))) {
+                        // Linear refinement between the two bracketing samples.
+                        layer_t[l] = previous_t + (iso - previous_value) /
+                                                      (value - previous_value) * step;
+                        ++layers_found;
+                    }
+                }
+            }
+            previous_value = value;
+            previous_t = t;
+
+            if (accumulating) {
+                const float alpha = lookup_transfer(tf_table, tf_bins, tf_domain, value, 0.0f).w;
+                if (alpha > 0.0f) {
+                    // Uniform intervals (the default) need no search: L / (max - min) > 0.
+                    const int j =
+                        uniform_interval_scale > 0.0f
+                            ? clamp((int)((value - interval_edges[0]) * uniform_interval_scale), 0,
+                                    interval_count - 1)
+                            : interval_of(interval_edges, interval_count, value);
+                    const float weight = transmittance * alpha;  // seed 000 Eq. 7
+                    attenuation[j] += weight;
+                    if (want_mean_depth) {
+                        weighted_depth[j] += weight * (depth_origin + t * depth_per_t);
+                    }
+                    if (want_optical_depth) {
+                        // alpha = 1 would be infinite optical depth; clamp to float's largest.
+                        optical_depth[j] += alpha < 1.0f ? -log(1.0f - alpha) : FLT_MAX;
+                    }
+                    transmittance *= 1.0f - alpha;
+                    if (1.0f - transmittance >= stop_opacity) accumulating = false;
+                }
+            }
+            if (!accumulating && (!want_layers || layers_found == layer_count)) break;
+
+            // Empty-space skipping, exact: in a skippable block every sample has zero opacity and
+            // lies on one side of every isovalue. Having evaluated this (first) sample of the
+            // block, jump to its last sample, so crossings are still found between consecutive
+            // samples and nothing between them could have contributed. Blocks are looked up once
+            // per block the ray enters, not per sample.
+            if (block_size > 0 && t >= next_block_t) {
+                const float3 p = start_voxels + t * direction_voxels;
+                const int3 block = clamp(convert_int3(floor(p / (float)block_size)), (int3)(0),
+                                         block_counts.xyz - 1);
+                const float3 lower = convert_float3(block * block_size);
+                const float3 upper = lower + (float3)(block_size);
+                const float3 exit_plane = select(lower, upper, direction_voxels > 0.0f);
+                const float3 t_axis = select((exit_plane - start_voxels) / direction_voxels,
+                                             (float3)(INFINITY), direction_voxels == 0.0f);
+                next_block_t = fmin(fmin(t_axis.x, t_axis.y), t_axis.z);
+                const int block_index =
+                    (block.z * block_counts.y + block.y) * block_counts.x + block.x;
+                if (skippable_blocks[block_index]) {
+                    const int last = (int)ceil((next_block_t - span.x) / step - 0.5f) - 1;
+                    if (last > i + 1) i = last - 1;
+                }
+            }
+        }
+    }
+
+    if (want_layers) {
+        for (int l = 0; l < layer_count; ++l) {
+            const float t = layer_t[l];
+            depth_out[l * pixel_count + pixel] = depth_origin + t * depth_per_t;
+            if ((wanted & WANT_DISTORTION) != 0) {
+                distortion_out[l * pixel_count + pixel] = isinf(t) ? INFINITY : t * sin_tilt;
+            }
+        }
+    }
+    if (want_mean_depth) {
+        for (int j = 0; j < interval_count; ++j) {
+            weighted_depth[j] = attenuation[j] > 0.0f ? weighted_depth[j] / attenuation[j]
+                                                      : INFINITY;
+        }
+    }
+}

@@ -1,0 +1,122 @@
+#pragma once
+// Exploration by proxy (seed 000 §4.3, §5, §6; DESIGN.md data flow "archive -> Explorer"): one
+// object that turns an archive into images for another view, transfer function, lighting and
+// enhancement, without the volume. The CLI (insitu-view render), the web viewer (insitu-view
+// serve) and the benchmarks all go through Explorer::render, so they show the same pixels.
+//
+// One frame, in order:
+//  1. proxies of (step, view) from the archive (cached: the last few frames stay in memory);
+//  2. the target camera: the stored one, or Camera::reorbit(azimuth, elevation) of it;
+//  3. attenuation a (+ mean depth) in the target camera: as stored when the camera is the
+//     stored one, else synthesised (from the single-perspective proxies unless the request or
+//     the archive says multi-perspective) with a confidence mask;
+//  4. opacity edits: per-interval scales (from an edited transfer function and/or explicit
+//     scales) turn a into a' (estimate_attenuation);
+//  5. colour: the fitted colour model (Eq. 8, 10) when the archive has one and the colours are
+//     unchanged, else exact recomposition sum_j c_j a'_j (recolour);
+//  6. lighting: per-pixel factor from the per-interval mean depths (light_volume, §6.5), and
+//     ambient occlusion (Eq. 5) from the front-most depth layer;
+//  7. depth-aware enhancement (Eq. 11).
+// Without attenuation proxies the front-most depth layer is drawn as a surface in the transfer
+// function's colour at its isovalue.
+#include <cstdint>
+#include <list>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "insitu/archive/archive.hpp"
+#include "insitu/core/camera.hpp"
+#include "insitu/explore/colour_model.hpp"
+#include "insitu/device/compute_device.hpp"
+#include "insitu/explore/enhancement.hpp"
+#include "insitu/core/image.hpp"
+#include "insitu/explore/relighting.hpp"
+#include "insitu/core/transfer_function.hpp"
+#include "insitu/explore/view_synthesis.hpp"
+
+namespace insitu {
+
+enum class ColourSource { automatic, model, recompose };
+std::string to_string(ColourSource source);
+/// "auto" | "model" | "recompose"; InvalidArgument names other text.
+ColourSource parse_colour_source(const std::string& text);
+
+/// Which stored proxies a frame is made from: "auto" takes the single-perspective ones when the
+/// archive has them (measured ahead for every rotation; bench/RESULTS.md), else the
+/// multi-perspective ones.
+enum class ProxySource { automatic, single, multi };
+std::string to_string(ProxySource source);
+/// "auto" | "single" | "multi"; InvalidArgument names other text.
+ProxySource parse_proxy_source(const std::string& text);
+
+/// What to show. Everything optional: an empty request shows the stored view as stored.
+struct ExploreRequest {
+    std::int64_t step = 0;
+    int view = 0;
+    /// Orbit angles in degrees of the new view; unset = the stored view's angle.
+    std::optional<double> azimuth_deg;
+    std::optional<double> elevation_deg;
+    /// An edited transfer function (colour and opacity) over the same value range.
+    std::optional<TransferFunction> transfer_function;
+    /// Extra opacity scales per interval (index, factor >= 0), applied on top of the edit.
+    std::vector<std::pair<int, double>> opacity_scales;
+    ColourSource colour = ColourSource::automatic;
+    ProxySource source = ProxySource::automatic;
+    /// Lights in world space; a light whose direction is (0, 0, 0) is a headlight (toward the
+    /// target camera).
+    std::optional<LightingSettings> lighting;
+    std::optional<AmbientOcclusionSettings> ambient_occlusion;
+    std::optional<EnhancementSettings> enhancement;
+    SynthesisSettings synthesis;
+};
+
+/// One explored frame.
+struct ExploreFrame {
+    Image colour;      ///< RGBA, linear, premultiplied
+    Image confidence;  ///< 1 channel in [0, 1] (view_synthesis.hpp); all 1 for the stored view
+    Camera camera;     ///< the camera the frame was made for
+    bool synthesised_view = false;                         ///< the view differs from the stored one
+    ColourSource colour_source = ColourSource::recompose;  ///< model or recompose, as used
+    std::vector<double> opacity_scales;  ///< per interval, as applied (empty: none)
+    double milliseconds = 0.0;           ///< wall time of render(), archive reads included
+};
+
+/// A summary of an archive for `insitu-view info` and the viewer's API.
+nlohmann::json describe_archive(const ArchiveReader& archive);
+
+class Explorer {
+public:
+    /// Opens the archive (IoError/ParseError name the file).
+    explicit Explorer(const std::string& archive_path,
+                      std::shared_ptr<ComputeDevice> device = ComputeDevice::shared());
+
+    /// Re-reads the manifest so steps a running simulation wrote since appear.
+    void refresh();
+    const ArchiveReader& archive() const { return *archive_; }
+
+    /// Renders one frame. InvalidArgument names a step or view the archive lacks, an interval
+    /// index out of range, a negative or non-finite scale, or a model requested that the
+    /// archive does not hold. Thread-safe (one frame at a time).
+    ExploreFrame render(const ExploreRequest& request);
+
+private:
+    struct CachedStep {
+        std::int64_t step = 0;
+        int view = 0;
+        std::optional<ProxyFrame> single;  ///< at least one of the two is present
+        std::optional<ProxyFrame> multi;
+    };
+    const CachedStep& load(std::int64_t step, int view);
+
+    std::string path_;
+    std::shared_ptr<ComputeDevice> device_;
+    std::unique_ptr<ArchiveReader> archive_;
+    std::list<CachedStep> cache_;  ///< most recently used first
+    std::mutex mutex_;
+};
+
+}  // namespace insitu

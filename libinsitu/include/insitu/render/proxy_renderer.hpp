@@ -1,0 +1,138 @@
+#pragma once
+// Proxy images (seed 000 §3-§6, DESIGN.md "Proxies"): one ray-marching pass per camera yields
+// every requested proxy of that camera.
+//  * depth layers: per isovalue, the depth (world units from the camera plane) of the first
+//    crossing between two consecutive samples, refined by linear interpolation between them;
+//    +inf where the ray never crosses. A NaN sample breaks the pair (no crossing through it).
+//  * distortion (multi-perspective only): per layer, ds = t sin(theta) of that crossing (Eq. 2).
+//  * accumulated attenuation (Eq. 7): a_j = sum over samples i with value in I_j of
+//    alpha_i prod_{k<i}(1 - alpha_k), alpha from the transfer function exactly as the
+//    ground-truth renderer classifies it (same samples, same step correction, no shading).
+//  * mean depth: the attenuation-weighted mean depth of interval j, sum(w depth) / a_j; +inf
+//    where a_j = 0.
+//  * optical depth: tau_j = -sum ln(1 - alpha_i) over the samples in I_j.
+// Attenuation stops, like the ground truth, once 1 - T reaches the early-termination opacity;
+// the proxies' default (1.0) stops only where T is exactly 0, so nothing is lost. Depth layers
+// keep marching until every layer is found or the ray leaves the volume.
+// Training renderings are ground-truth renderings (VolumeRenderer) of the single-perspective
+// camera, one per training transfer function.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "insitu/core/camera.hpp"
+#include "insitu/explore/colour_model.hpp"
+#include "insitu/render/distortion_camera.hpp"
+#include "insitu/core/image.hpp"
+#include "insitu/core/intervals.hpp"
+#include "insitu/core/transfer_function.hpp"
+#include "insitu/render/volume_renderer.hpp"
+
+namespace insitu {
+
+/// Which proxies one camera's pass produces; nothing unrequested is computed or allocated.
+struct ProxyRequest {
+    bool depth_layers = true;
+    bool attenuation = true;
+    bool mean_depth = true;
+    bool optical_depth = false;
+    /// Isovalues of the depth layers (at most kMaxLayers), in field units.
+    std::vector<double> isovalues;
+    /// Intervals of the attenuation proxies; required when attenuation is requested.
+    std::optional<IntervalSet> intervals;
+    /// Transfer function whose opacity the attenuation accumulates.
+    std::optional<TransferFunction> transfer_function;
+    /// Ground-truth renderings from the single-perspective camera.
+    std::vector<TransferFunction> training_transfer_functions;
+    /// Skip blocks of 8^3 voxels where the transfer function is transparent and no isovalue
+    /// lies within the values: exact (the same proxies), only faster.
+    bool skip_empty_space = true;
+    /// Step, table resolution and shading of training renderings. The proxies' early
+    /// termination defaults to exact (stop only where the ray is fully opaque).
+    RenderSettings march = [] {
+        RenderSettings settings;
+        settings.early_termination_opacity = 1.0;
+        return settings;
+    }();
+};
+
+/// Every proxy of one camera. Images are planar: one Image per layer, L-channel images for the
+/// per-interval proxies (channel j = interval j). Empty images for what was not requested.
+struct ProxyFrame {
+    bool multi_perspective = false;
+    Camera camera;                                 ///< the single-perspective camera, or the base
+    double distortion_tilt_deg = 0.0;              ///< multi-perspective only
+    std::vector<double> isovalues;
+    std::optional<IntervalSet> intervals;
+    std::vector<Image> depth_layers;               ///< 1 channel each
+    std::vector<Image> distortion_layers;          ///< 1 channel each, multi-perspective only
+    Image attenuation;                             ///< L channels
+    Image mean_depth;                              ///< L channels
+    Image optical_depth;                           ///< L channels
+    std::vector<Image> training;                   ///< RGBA each
+    /// Colour model fitted on the training renderings (seed 000 §6.2), single perspective only.
+    std::optional<ColourModel> colour_model;
+};
+
+class ProxyRenderer {
+public:
+    explicit ProxyRenderer(std::shared_ptr<ComputeDevice> device = ComputeDevice::shared());
+    ~ProxyRenderer();
+    ProxyRenderer(ProxyRenderer&&) noexcept;
+    ProxyRenderer& operator=(ProxyRenderer&&) noexcept;
+
+    /// Uploads a field (device memory reused across timesteps); see VolumeRenderer::upload.
+    void upload(const Field& field);
+    const DeviceVolume& volume() const { return renderer_.volume(); }
+
+    /// Intervals over the values actually present in the uploaded field: uniform, or
+    /// histogram-equalised over its samples.
+    IntervalSet choose_intervals(int count, IntervalMode mode) const;
+    /// Layers chosen from the data: the peaks of `tf`'s opacity inside the uploaded field's value
+    /// range (see opacity_peaks in insitu/layers.hpp).
+    std::vector<double> choose_layers(const TransferFunction& tf, int max_layers) const;
+
+    /// Single-perspective proxies (orthographic or perspective camera) plus training renderings.
+    ProxyFrame render(const Camera& camera, const ProxyRequest& request);
+    /// Multi-perspective proxies from the volume distortion camera (no training renderings: they
+    /// belong to the single-perspective view).
+    ProxyFrame render(const DistortionCamera& camera, const ProxyRequest& request);
+
+    /// Ground-truth rendering (VolumeRenderer) of the uploaded field, sharing its device copy:
+    /// an Instrument's preview needs no second upload.
+    Rendering render_ground_truth(const Camera& camera, const TransferFunction& tf,
+                                  const RenderSettings& settings = {}) {
+        return renderer_.render(camera, tf, settings);
+    }
+
+    /// Fraction of blocks the last pass was allowed to skip (0 when skipping was off).
+    double last_skippable_fraction() const { return last_skippable_fraction_; }
+
+private:
+    ProxyFrame march(const Camera& camera, double tilt_deg, bool multi_perspective,
+                     const ProxyRequest& request);
+
+    /// Flags, per block, whether the pass may skip it for this request.
+    std::vector<std::uint8_t> skippable_blocks(const TransferTable& table,
+                                               const std::vector<double>& isovalues,
+                                               bool accumulates);
+
+    std::shared_ptr<ComputeDevice> device_;
+    VolumeRenderer renderer_;
+    /// Kernel and reused device buffers (libinsitu/src/render/proxy_renderer.cpp).
+    struct DeviceState;
+    std::unique_ptr<DeviceState> state_;
+    /// Value range of every block of the uploaded volume (min > max: the block holds NaN).
+    struct BlockRanges {
+        std::uint64_t generation = 0;
+        Index3 counts{0, 0, 0};
+        std::vector<float> min, max;
+    } blocks_;
+    double last_skippable_fraction_ = 0.0;
+};
+
+/// Throws InvalidArgument naming what is missing or out of range in `request`.
+void validate(const ProxyRequest& request);
+
+}  // namespace insitu

@@ -1,0 +1,131 @@
+#pragma once
+// The ground-truth volume renderer (seed 002): emission-absorption ray casting.
+//
+// The definition every accuracy figure depends on, and which tests/reference_renderer.cpp
+// implements independently:
+//  * Rays come from Camera::ray at pixel centres. They are clipped to the field's world bounds;
+//    sample i (i = 0, 1, ...) lies at t = t_near + (i + 0.5) * step while t < t_far, where
+//    step = step_voxels * min(spacing) in world units.
+//  * Samples are trilinear in voxel coordinates (p - origin) / spacing, clamped to the grid.
+//    NaN (non-finite input) samples are empty: they add nothing and stop nothing.
+//  * Gradients (for shading and 2D transfer functions): central differences of trilinear samples
+//    one voxel apart along each axis, divided by 2 * spacing (field units per world unit).
+//    A gradient that touches an empty (NaN) sample counts as |gradient| = 0: classified there
+//    and left unshaded.
+//  * Classification: rgba = tf(value[, |gradient|]); opacity corrected for the step:
+//    alpha = 1 - (1 - a)^(step / unit_length).
+//  * Shading (Phong, optional): light along -ray direction (a headlight); n = gradient / |gradient|
+//    turned to face the light; colour = rgb * (ambient + diffuse * max(n.l, 0))
+//    + specular * max(n.h, 0)^shininess, h = l (headlight, so the half vector is l). Samples whose
+//    |gradient| is below 1e-12 field units per world unit stay unshaded.
+//  * Compositing front to back, premultiplied: C += T * alpha * colour; T *= 1 - alpha.
+//    Output RGBA = (C, 1 - T). The march stops once 1 - T >= early_termination_opacity
+//    (set it above 1 to disable).
+//  * Depth: depth (Camera::depth_of) of the first sample with alpha > 0; +inf where none.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "insitu/core/camera.hpp"
+#include "insitu/device/compute_device.hpp"
+#include "insitu/field.hpp"
+#include "insitu/core/image.hpp"
+#include "insitu/core/transfer_function.hpp"
+
+namespace insitu {
+
+namespace detail {
+struct DeviceMemory;
+}
+
+struct PhongParameters {
+    float ambient = 0.3f;
+    float diffuse = 0.7f;
+    float specular = 0.3f;
+    float shininess = 32.0f;
+};
+
+struct RenderSettings {
+    /// Distance between samples along a ray, in units of the smallest grid spacing (> 0).
+    double step_voxels = 1.0;
+    /// Stop a ray once its accumulated opacity reaches this (in (0, 1]; > 1 disables).
+    double early_termination_opacity = 0.99;
+    bool shading = false;
+    PhongParameters phong;
+    /// Resolution of the transfer-function table on the device.
+    int tf_value_bins = 1024;
+    int tf_gradient_bins = 64;
+};
+
+/// What one render produces: premultiplied RGBA and first-hit depth (+inf where nothing).
+struct Rendering {
+    Image rgba;   ///< 4 channels
+    Image depth;  ///< 1 channel, world units from the camera plane
+};
+
+/// A field's interior resident on the device as float32, x fastest. Re-uploading a field that
+/// fits reuses the buffer, so successive timesteps allocate nothing.
+struct DeviceVolume {
+    /// The device copy (opaque here: defined in libinsitu/src/device/opencl_device.hpp).
+    std::shared_ptr<detail::DeviceMemory> memory;
+    Index3 dims{0, 0, 0};
+    glm::dvec3 origin{0.0};
+    glm::dvec3 spacing{1.0};
+    Bounds bounds;
+    ValueRange range;
+    /// The host copy that was uploaded (kept: histograms and interval choices read it).
+    std::vector<float> host_values;
+    /// Incremented by every upload, so derived data (block ranges) knows when it is stale.
+    std::uint64_t generation = 0;
+
+    bool empty() const { return dims[0] == 0; }
+    /// Bytes of device memory held for the values.
+    std::size_t capacity_bytes() const;
+    /// Distance between ray samples in world units for a step given in voxels.
+    double step_world(double step_voxels) const;
+    /// Uploads `field`; throws InvalidArgument when an axis has fewer than 2 samples.
+    void upload(ComputeDevice& device, const Field& field);
+};
+
+class VolumeRenderer {
+public:
+    explicit VolumeRenderer(std::shared_ptr<ComputeDevice> device = ComputeDevice::shared());
+    ~VolumeRenderer();
+    VolumeRenderer(VolumeRenderer&&) noexcept;
+    VolumeRenderer& operator=(VolumeRenderer&&) noexcept;
+
+    /// Copies the field's interior to the device (as float). Reuses the device buffer when the
+    /// new field fits, so successive timesteps allocate nothing. Throws InvalidArgument when an
+    /// axis has fewer than 2 samples.
+    void upload(const Field& field);
+
+    /// Renders the uploaded field. Throws InvalidArgument for bad settings, Error if nothing has
+    /// been uploaded.
+    Rendering render(const Camera& camera, const TransferFunction& tf,
+                     const RenderSettings& settings = {});
+
+    /// Value range of the uploaded field (from the upload scan).
+    const ValueRange& value_range() const { return volume_.range; }
+    const Bounds& bounds() const { return volume_.bounds; }
+    /// Bytes of device memory currently held for the volume.
+    std::size_t volume_capacity_bytes() const { return volume_.capacity_bytes(); }
+    const DeviceVolume& volume() const { return volume_; }
+    const std::shared_ptr<ComputeDevice>& device() const { return device_; }
+
+private:
+    std::shared_ptr<ComputeDevice> device_;
+    DeviceVolume volume_;
+    /// Kernel and reused device buffers (libinsitu/src/render/volume_renderer.cpp).
+    struct DeviceState;
+    std::unique_ptr<DeviceState> state_;
+};
+
+void validate(const RenderSettings& settings);
+
+/// The transfer function as the device reads it: a table whose opacity is already corrected for
+/// a step of `step_world` world units, so kernels need no pow per sample.
+TransferTable step_corrected_table(const TransferFunction& tf, double step_world,
+                                   const RenderSettings& settings);
+
+}  // namespace insitu

@@ -1,0 +1,119 @@
+#include "insitu/core/intervals.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <ostream>
+
+#include <nlohmann/json.hpp>
+
+#include "insitu/error.hpp"
+
+namespace insitu {
+
+std::string to_string(IntervalMode mode) {
+    return mode == IntervalMode::uniform ? "uniform" : "histogram";
+}
+
+IntervalMode parse_interval_mode(const std::string& text) {
+    if (text == "uniform") return IntervalMode::uniform;
+    if (text == "histogram" || text == "histogram_equalized") {
+        return IntervalMode::histogram_equalized;
+    }
+    fail<InvalidArgument>("interval mode \"", text, "\" (expected uniform or histogram)");
+}
+
+namespace {
+void check_count(int count) {
+    if (count < 1 || count > kMaxIntervals) {
+        fail<InvalidArgument>("interval count = ", count, " (must be in [1, ", kMaxIntervals,
+                              "])");
+    }
+}
+}  // namespace
+
+IntervalSet::IntervalSet(std::vector<double> edges) : edges_(std::move(edges)) {
+    if (edges_.size() < 2 || edges_.size() > kMaxIntervals + 1) {
+        fail<InvalidArgument>("interval edges: ", edges_.size(), " values (need 2 to ",
+                              kMaxIntervals + 1, ")");
+    }
+    for (std::size_t i = 0; i < edges_.size(); ++i) {
+        if (!std::isfinite(edges_[i]) || (i > 0 && edges_[i] < edges_[i - 1])) {
+            fail<InvalidArgument>("interval edges[", i, "] = ", edges_[i],
+                                  " (edges must be finite and non-decreasing)");
+        }
+    }
+}
+
+IntervalSet IntervalSet::uniform(double min, double max, int count) {
+    check_count(count);
+    if (!std::isfinite(min) || !std::isfinite(max) || max < min) {
+        fail<InvalidArgument>("interval range [", min, ", ", max, "] (must be finite, min <= max)");
+    }
+    if (max == min) {
+        min -= 0.5;
+        max += 0.5;
+    }
+    std::vector<double> edges(static_cast<std::size_t>(count) + 1);
+    for (int j = 0; j <= count; ++j) edges[j] = min + (max - min) * j / count;
+    edges.back() = max;  // exact, whatever the rounding
+    return IntervalSet(std::move(edges));
+}
+
+IntervalSet IntervalSet::histogram_equalized(const std::vector<float>& values, double min,
+                                             double max, int count) {
+    IntervalSet fallback = uniform(min, max, count);
+    const double lo = fallback.edges_.front();
+    const double hi = fallback.edges_.back();
+    // A fine histogram (64 bins per interval) is enough to place quantiles well and costs one
+    // pass over the data.
+    const int bins = 64 * count;
+    std::vector<double> histogram(static_cast<std::size_t>(bins), 0.0);
+    double total = 0.0;
+    for (float value : values) {
+        if (std::isnan(value)) continue;
+        const int bin = std::clamp(static_cast<int>((value - lo) / (hi - lo) * bins), 0, bins - 1);
+        histogram[bin] += 1.0;
+        total += 1.0;
+    }
+    if (total == 0.0) return fallback;
+    std::vector<double> edges{lo};
+    double cumulative = 0.0;
+    int next = 1;
+    for (int bin = 0; bin < bins && next < count; ++bin) {
+        const double before = cumulative;
+        cumulative += histogram[bin];
+        while (next < count && cumulative >= total * next / count) {
+            // Interpolate the cumulative count inside the bin: dense data puts many quantiles
+            // into few bins, and bin edges alone would be too coarse there.
+            const double fraction = (total * next / count - before) / histogram[bin];
+            edges.push_back(lo + (hi - lo) * (bin + fraction) / bins);
+            ++next;
+        }
+    }
+    while (static_cast<int>(edges.size()) < count) edges.push_back(hi);
+    edges.push_back(hi);
+    return IntervalSet(std::move(edges));
+}
+
+bool IntervalSet::is_uniform() const {
+    const double range = edges_.back() - edges_.front();
+    if (!(range > 0.0)) return false;
+    const double width = range / count();
+    for (int j = 0; j < count(); ++j) {
+        if (std::abs(edges_[j + 1] - edges_[j] - width) > 1e-6 * range) return false;
+    }
+    return true;
+}
+
+int IntervalSet::index_of(double value) const {
+    const auto upper = std::upper_bound(edges_.begin() + 1, edges_.end() - 1, value);
+    return static_cast<int>(upper - (edges_.begin() + 1));
+}
+
+nlohmann::json IntervalSet::to_json() const { return nlohmann::json{{"edges", edges_}}; }
+
+std::ostream& operator<<(std::ostream& out, const IntervalSet& intervals) {
+    return out << "IntervalSet" << intervals.to_json().dump();
+}
+
+}  // namespace insitu

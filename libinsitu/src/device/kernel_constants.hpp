@@ -1,0 +1,48 @@
+#pragma once
+// Constants that host code and kernels must agree on, each spelled once as a C++ constant and
+// handed to every OpenCL build as a -D option (OpenClDevice::build_options), so a kernel never
+// carries a hand-copied limit. Kernels refer to them by the names in kKernelConstants.
+#include <array>
+
+#include "insitu/core/intervals.hpp"
+#include "insitu/core/layers.hpp"
+#include "insitu/explore/relighting.hpp"
+
+namespace insitu::detail {
+
+/// Bits of render_proxies' `wanted` argument (kernels/render/proxy_renderer.cl): which outputs
+/// a pass computes; unrequested outputs get no device memory.
+constexpr int kWantDepth = 1;
+constexpr int kWantDistortion = 2;
+constexpr int kWantAttenuation = 4;
+constexpr int kWantMeanDepth = 8;
+constexpr int kWantOpticalDepth = 16;
+
+struct KernelConstant {
+    const char* name;  ///< the macro the kernels use
+    int value;
+};
+
+/// Every constant passed to the kernels. Private arrays are sized by the MAX_* limits, so they
+/// bound each work-item's private memory.
+inline constexpr std::array<KernelConstant, 8> kKernelConstants{{
+    {"MAX_LAYERS", kMaxLayers},        // depth layers per pass (layer_t[] in the proxy kernel)
+    {"MAX_INTERVALS", kMaxIntervals},  // intensity intervals (a[] in colour model, edits)
+    {"MAX_LIGHTS", kMaxLights},        // lights per relighting call (half_vectors[])
+    {"WANT_DEPTH", kWantDepth},
+    {"WANT_DISTORTION", kWantDistortion},
+    {"WANT_ATTENUATION", kWantAttenuation},
+    {"WANT_MEAN_DEPTH", kWantMeanDepth},
+    {"WANT_OPTICAL_DEPTH", kWantOpticalDepth},
+}};
+
+// Archive channel names number intervals with two digits ("attenuation.a07").
+static_assert(kMaxIntervals >= 1 && kMaxIntervals <= 99, "interval channels have two digits");
+static_assert(kMaxLayers >= 1 && kMaxLayers <= 64, "layer_t[] is a private array per work-item");
+static_assert(kMaxLights >= 1 && kMaxLights <= 64, "half_vectors[] is a private array per pixel");
+// The wanted bits must be distinct powers of two.
+static_assert((kWantDepth | kWantDistortion | kWantAttenuation | kWantMeanDepth |
+               kWantOpticalDepth) == 31,
+              "wanted bits are the five distinct low bits");
+
+}  // namespace insitu::detail

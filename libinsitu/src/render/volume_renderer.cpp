@@ -1,0 +1,146 @@
+#include "insitu/render/volume_renderer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "insitu/error.hpp"
+#include "device/kernel_args.hpp"
+#include "device/opencl_device.hpp"
+
+namespace insitu {
+
+using detail::to_float4;
+
+void validate(const RenderSettings& settings) {
+    if (!(settings.step_voxels > 0.0) || !std::isfinite(settings.step_voxels)) {
+        fail<InvalidArgument>("step = ", settings.step_voxels, " voxels (must be finite and > 0)");
+    }
+    if (!(settings.early_termination_opacity > 0.0)) {
+        fail<InvalidArgument>("early_termination_opacity = ", settings.early_termination_opacity,
+                              " (must be > 0; use a value > 1 to disable)");
+    }
+    const PhongParameters& p = settings.phong;
+    for (float value : {p.ambient, p.diffuse, p.specular, p.shininess}) {
+        if (!(value >= 0.0f) || !std::isfinite(value)) {
+            fail<InvalidArgument>("Phong parameter ", value, " (ambient, diffuse, specular and "
+                                  "shininess must be finite and >= 0)");
+        }
+    }
+    if (settings.tf_value_bins < 2 || settings.tf_gradient_bins < 2) {
+        fail<InvalidArgument>("transfer table bins ", settings.tf_value_bins, "x",
+                              settings.tf_gradient_bins, " (both must be >= 2)");
+    }
+}
+
+TransferTable step_corrected_table(const TransferFunction& tf, double step_world,
+                                   const RenderSettings& settings) {
+    TransferTable table = tf.sample(settings.tf_value_bins, settings.tf_gradient_bins);
+    // alpha_step = 1 - (1 - a)^(step / unit_length); correcting the table rather than every
+    // sample differs from the exact order by O(bin width^2), far below float precision here.
+    const double exponent = step_world / tf.unit_length();
+    for (std::size_t i = 3; i < table.rgba.size(); i += 4) {
+        table.rgba[i] = static_cast<float>(1.0 - std::pow(1.0 - table.rgba[i], exponent));
+    }
+    return table;
+}
+
+std::size_t DeviceVolume::capacity_bytes() const { return memory ? memory->capacity : 0; }
+
+double DeviceVolume::step_world(double step_voxels) const {
+    return step_voxels * std::min({spacing.x, spacing.y, spacing.z});
+}
+
+void DeviceVolume::upload(ComputeDevice& device, const Field& field) {
+    const Index3 field_dims = field.dims();
+    for (int axis = 0; axis < 3; ++axis) {
+        if (field_dims[axis] < 2) {
+            fail<InvalidArgument>("field \"", field.name(), "\": ", "xyz"[axis], " has ",
+                                  field_dims[axis],
+                                  " interior samples (volume rendering needs >= 2)");
+        }
+    }
+    if (field.sample_count() > std::numeric_limits<std::uint32_t>::max()) {
+        fail<InvalidArgument>("field \"", field.name(), "\": ", field.sample_count(),
+                              " samples exceed the 2^32 a device buffer index can address");
+    }
+    range = field.copy_interior_as_float(host_values);
+    const std::size_t bytes = host_values.size() * sizeof(float);
+    if (!memory) memory = std::make_shared<detail::DeviceMemory>();
+    device.opencl().ensure_buffer(memory->buffer, memory->capacity, bytes, CL_MEM_READ_ONLY);
+    device.opencl().upload(memory->buffer, host_values.data(), bytes, "volume");
+    dims = field_dims;
+    origin = field.origin();
+    spacing = field.spacing();
+    bounds = field.bounds();
+    ++generation;
+}
+
+struct VolumeRenderer::DeviceState {
+    cl::Kernel kernel;
+    detail::DeviceMemory table, rgba_out, depth_out;
+};
+
+VolumeRenderer::VolumeRenderer(std::shared_ptr<ComputeDevice> device)
+    : device_(std::move(device)), state_(std::make_unique<DeviceState>()) {
+    if (!device_) fail<InvalidArgument>("VolumeRenderer: compute device is null");
+    state_->kernel = device_->opencl().kernel("volume_renderer", "render_volume");
+}
+
+VolumeRenderer::~VolumeRenderer() = default;
+VolumeRenderer::VolumeRenderer(VolumeRenderer&&) noexcept = default;
+VolumeRenderer& VolumeRenderer::operator=(VolumeRenderer&&) noexcept = default;
+
+void VolumeRenderer::upload(const Field& field) { volume_.upload(*device_, field); }
+
+Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& tf,
+                                 const RenderSettings& settings) {
+    validate(settings);
+    if (volume_.empty()) fail<Error>("VolumeRenderer::render called before upload()");
+
+    const double step_world = volume_.step_world(settings.step_voxels);
+    const TransferTable table = step_corrected_table(tf, step_world, settings);
+    const std::size_t table_bytes = table.rgba.size() * sizeof(float);
+    device_->opencl().ensure_buffer(state_->table.buffer, state_->table.capacity, table_bytes, CL_MEM_READ_ONLY);
+    device_->opencl().upload(state_->table.buffer, table.rgba.data(), table_bytes, "transfer-function table");
+
+    const int width = camera.width();
+    const int height = camera.height();
+    const std::size_t pixels = static_cast<std::size_t>(width) * height;
+    device_->opencl().ensure_buffer(state_->rgba_out.buffer, state_->rgba_out.capacity, pixels * 4 * sizeof(float),
+                           CL_MEM_WRITE_ONLY);
+    device_->opencl().ensure_buffer(state_->depth_out.buffer, state_->depth_out.capacity, pixels * sizeof(float), CL_MEM_WRITE_ONLY);
+
+    const bool needs_gradient = settings.shading || tf.is_2d();
+    const Index3& d = volume_.dims;
+    const cl_int4 dims = {{static_cast<cl_int>(d[0]), static_cast<cl_int>(d[1]),
+                           static_cast<cl_int>(d[2]), 0}};
+    const cl_int2 tf_bins = {{table.value_bins, table.gradient_bins}};
+    const cl_int2 size = {{width, height}};
+    const cl_float4 march = to_float4(step_world, settings.early_termination_opacity,
+                                      settings.shading ? 1.0 : 0.0, needs_gradient ? 1.0 : 0.0);
+    const PhongParameters& phong = settings.phong;
+    const cl_float4 phong_parameters =
+        to_float4(phong.ambient, phong.diffuse, phong.specular, phong.shininess);
+
+    device_->opencl().launch(state_->kernel, detail::image_global_range(width, height),
+                    detail::image_local_range(), volume_.memory->buffer, dims,
+                    to_float4(volume_.origin), to_float4(1.0 / volume_.spacing),
+                    to_float4(0.5 / volume_.spacing), to_float4(volume_.bounds.lower),
+                    to_float4(volume_.bounds.upper), state_->table.buffer, tf_bins,
+                    detail::transfer_domain(table), to_float4(camera.position()),
+                    to_float4(camera.forward()), to_float4(camera.right()),
+                    to_float4(camera.up()), detail::camera_extent(camera), size, march,
+                    phong_parameters, state_->rgba_out.buffer, state_->depth_out.buffer);
+
+    Rendering result;
+    result.rgba = Image(width, height, 4);
+    result.depth = Image(width, height, 1);
+    device_->opencl().download(state_->rgba_out.buffer, result.rgba.pixels.data(), pixels * 4 * sizeof(float),
+                      "rendered RGBA");
+    device_->opencl().download(state_->depth_out.buffer, result.depth.pixels.data(), pixels * sizeof(float),
+                      "rendered depth");
+    return result;
+}
+
+}  // namespace insitu

@@ -1,0 +1,144 @@
+#include "insitu/core/intervals.hpp"
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "insitu/error.hpp"
+#include "insitu/core/layers.hpp"
+
+namespace insitu {
+namespace {
+
+TEST(IntervalSet, UniformEdgesSpanTheRangeEvenly) {
+    const IntervalSet intervals = IntervalSet::uniform(-1.0, 3.0, 4);
+    ASSERT_EQ(intervals.count(), 4);
+    const std::vector<double> expected{-1.0, 0.0, 1.0, 2.0, 3.0};
+    for (int j = 0; j <= 4; ++j) EXPECT_DOUBLE_EQ(intervals.edges()[j], expected[j]) << j;
+}
+
+TEST(IntervalSet, IndexOfIsHalfOpenLastClosedAndClampsOutside) {
+    const IntervalSet intervals = IntervalSet::uniform(0.0, 4.0, 4);
+    EXPECT_EQ(intervals.index_of(0.0), 0);
+    EXPECT_EQ(intervals.index_of(0.999), 0);
+    EXPECT_EQ(intervals.index_of(1.0), 1);
+    EXPECT_EQ(intervals.index_of(3.5), 3);
+    EXPECT_EQ(intervals.index_of(4.0), 3);   // the last interval is closed
+    EXPECT_EQ(intervals.index_of(-7.0), 0);  // outside values go to the end intervals
+    EXPECT_EQ(intervals.index_of(9.0), 3);
+}
+
+TEST(IntervalSet, KnowsWhetherItsIntervalsAreEqualWidth) {
+    EXPECT_TRUE(IntervalSet::uniform(-2.0, 7.0, 9).is_uniform());
+    EXPECT_FALSE(IntervalSet({0.0, 1.0, 3.0}).is_uniform());
+    EXPECT_FALSE(IntervalSet({1.0, 1.0}).is_uniform());  // zero width: no scale to compute
+}
+
+TEST(IntervalSet, DegenerateRangeIsWidenedSoWidthsStayPositive) {
+    const IntervalSet intervals = IntervalSet::uniform(2.0, 2.0, 3);
+    EXPECT_DOUBLE_EQ(intervals.edges().front(), 1.5);
+    EXPECT_DOUBLE_EQ(intervals.edges().back(), 2.5);
+    EXPECT_EQ(intervals.index_of(2.0), 1);
+}
+
+TEST(IntervalSet, HistogramEqualizedIntervalsHoldAboutEqualCounts) {
+    // Values concentrated near 0 (exponential): uniform intervals would be nearly all empty.
+    std::mt19937 random(7);
+    std::exponential_distribution<float> exponential(8.0f);
+    std::vector<float> values(200000);
+    for (float& v : values) v = std::min(exponential(random), 1.0f);
+    values[0] = std::numeric_limits<float>::quiet_NaN();  // ignored
+    const int count = 8;
+    const IntervalSet intervals = IntervalSet::histogram_equalized(values, 0.0, 1.0, count);
+    ASSERT_EQ(intervals.count(), count);
+    std::vector<int> histogram(count, 0);
+    for (std::size_t i = 1; i < values.size(); ++i) ++histogram[intervals.index_of(values[i])];
+    const double expected = static_cast<double>(values.size() - 1) / count;
+    // Quantiles are placed on a 64-bins-per-interval histogram: a few percent of slack.
+    constexpr double kRelativeTolerance = 0.05;
+    for (int j = 0; j < count; ++j) {
+        EXPECT_NEAR(histogram[j], expected, kRelativeTolerance * expected) << "interval " << j;
+    }
+}
+
+TEST(IntervalSet, RejectsBadCountsAndEdgesNamingTheValue) {
+    for (int count : {0, 65, -3}) {
+        try {
+            IntervalSet::uniform(0.0, 1.0, count);
+            FAIL() << "count " << count << " accepted";
+        } catch (const InvalidArgument& error) {
+            EXPECT_NE(std::string(error.what()).find(std::to_string(count)), std::string::npos)
+                << error.what();
+        }
+    }
+    EXPECT_THROW(IntervalSet({0.0, 2.0, 1.0}), InvalidArgument);
+    EXPECT_THROW(IntervalSet({0.0}), InvalidArgument);
+    EXPECT_THROW(IntervalSet::uniform(0.0, std::nan(""), 4), InvalidArgument);
+    EXPECT_THROW(parse_interval_mode("quantile"), InvalidArgument);
+    EXPECT_EQ(parse_interval_mode("histogram"), IntervalMode::histogram_equalized);
+}
+
+TransferFunction tent(double centre, double half_width, float peak) {
+    return TransferFunction({{centre - half_width, {1, 1, 1, 0}},
+                             {centre, {1, 1, 1, peak}},
+                             {centre + half_width, {1, 1, 1, 0}}});
+}
+
+ValueRange range(double min, double max) {
+    ValueRange r;
+    r.min = min;
+    r.max = max;
+    r.finite_count = 1;
+    return r;
+}
+
+TEST(OpacityPeaks, FindsTentsAndPlateausMostOpaqueFirst) {
+    const TransferFunction tf({{0.0, {0, 0, 0, 0}},
+                               {0.2, {1, 0, 0, 0.8}},
+                               {0.3, {1, 0, 0, 0}},
+                               {0.5, {0, 1, 0, 0.4}},
+                               {0.7, {0, 1, 0, 0.4}},  // plateau 0.5..0.7, centre 0.6
+                               {0.8, {0, 0, 0, 0}},
+                               {0.9, {0, 0, 1, 0.1}},
+                               {1.0, {0, 0, 0, 0}}});
+    const std::vector<double> all = opacity_peaks(tf, range(0.0, 1.0), 8);
+    ASSERT_EQ(all.size(), 3u);
+    EXPECT_DOUBLE_EQ(all[0], 0.2);
+    EXPECT_DOUBLE_EQ(all[1], 0.6);
+    EXPECT_DOUBLE_EQ(all[2], 0.9);
+    // Limited to two layers, the faintest peak (0.9) goes.
+    const std::vector<double> two = opacity_peaks(tf, range(0.0, 1.0), 2);
+    ASSERT_EQ(two.size(), 2u);
+    EXPECT_DOUBLE_EQ(two[0], 0.2);
+    EXPECT_DOUBLE_EQ(two[1], 0.6);
+    // Peaks outside the data's range are dropped.
+    const std::vector<double> inside = opacity_peaks(tf, range(0.5, 1.0), 8);
+    ASSERT_EQ(inside.size(), 2u);
+    EXPECT_DOUBLE_EQ(inside[0], 0.6);
+}
+
+TEST(OpacityPeaks, RampWithTopBeyondTheDataUsesTheHalfOpacityOnset) {
+    const TransferFunction ramp({{0.0, {0, 0, 1, 0}}, {1.0, {1, 0, 0, 0.5}}});
+    const std::vector<double> layers = opacity_peaks(ramp, range(0.0, 0.4), 4);
+    ASSERT_EQ(layers.size(), 1u);
+    // Opacity over [0, 0.4] peaks at 0.2 (value 0.4); half of it is reached at value 0.2.
+    EXPECT_NEAR(layers[0], 0.2, 0.4 / 1024 + 1e-12);
+    // Over the whole ramp, the clamped top at value 1.0 is the peak.
+    const std::vector<double> full = opacity_peaks(ramp, range(0.0, 1.0), 4);
+    ASSERT_EQ(full.size(), 1u);
+    EXPECT_DOUBLE_EQ(full[0], 1.0);
+}
+
+TEST(OpacityPeaks, TransparentFunctionOrEmptyDataGivesNoLayers) {
+    const TransferFunction clear({{0.0, {1, 1, 1, 0}}, {1.0, {1, 1, 1, 0}}});
+    EXPECT_TRUE(opacity_peaks(clear, range(0.0, 1.0), 4).empty());
+    EXPECT_TRUE(opacity_peaks(tent(0.5, 0.1, 1.0f), ValueRange{}, 4).empty());
+    EXPECT_THROW(opacity_peaks(clear, range(0.0, 1.0), 17), InvalidArgument);
+    EXPECT_THROW(validate_isovalues({0.0, std::nan("")}), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace insitu

@@ -1,0 +1,450 @@
+// insitu::Explorer (exploration by proxy, seed 000 §4-§6) end to end on a small archive written by
+// an Instrument: the stored view is reproduced exactly and matches the ground truth; identity
+// edits change nothing; opacity edits, new views, lighting, occlusion and enhancement give
+// finite, bounded frames; every bad request names what is wrong; steps written after the
+// Explorer opened appear after refresh(). Also the text options shared by the CLI and the viewer.
+#include "insitu/explore/explorer.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "support/expect_error.hpp"
+#include "explore_options.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "insitu/instrument.hpp"
+#include "insitu/render/proxy_renderer.hpp"
+
+namespace insitu {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+constexpr int kImage = 40;
+constexpr int kIntervals = 6;
+
+// Colour constant per interval (the default intervals: kIntervals uniform ones over the values
+// present, [lowest, highest]), so recomposition from attenuation is exact (Eq. 7). The renderers
+// interpolate their 1024-bin table between bins, so a colour step is exact only where the
+// opacity is zero on both sides of it: each interval's opacity ramps up over its first and down
+// over its last `gap` (4 table bins), and the colour changes inside that transparent margin.
+TransferFunction piecewise_constant_tf(double lowest, double highest) {
+    const float colours[kIntervals][3] = {{0, 0, 0}, {0, 0, 1}, {0, 1, 1},
+                                          {0, 1, 0}, {1, 1, 0}, {1, 0, 0}};
+    const float opacities[kIntervals] = {0.0f, 0.05f, 0.15f, 0.3f, 0.6f, 0.9f};
+    const double width = (highest - lowest) / kIntervals;
+    const double gap = 4.0 * (highest - lowest) / 1024.0;
+    std::vector<ControlPoint> points;
+    for (int j = 0; j < kIntervals; ++j) {
+        const double lower = lowest + j * width;
+        const double upper = lowest + (j + 1) * width;
+        const glm::vec3 rgb(colours[j][0], colours[j][1], colours[j][2]);
+        points.push_back({lower + gap, glm::vec4(rgb, 0.0f)});
+        points.push_back({lower + 2 * gap, glm::vec4(rgb, opacities[j])});
+        points.push_back({upper - 2 * gap, glm::vec4(rgb, opacities[j])});
+        points.push_back({upper - gap, glm::vec4(rgb, 0.0f)});
+    }
+    return TransferFunction(points, 1.0);
+}
+
+InstrumentConfig explorer_config(const fs::path& archive, const SampledVolume& volume) {
+    const auto [lowest, highest] = std::minmax_element(volume.values.begin(), volume.values.end());
+    InstrumentConfig config;
+    config.fields = {"f"};
+    config.views[0].orbit = OrbitView{20.0, 15.0, Projection::orthographic, 30.0, kImage, kImage};
+    config.views[0].distortion_tilt_deg = 30.0;
+    config.transfer_function = piecewise_constant_tf(*lowest, *highest);
+    config.layers = std::vector<double>{0.45};
+    config.interval_count = kIntervals;
+    config.proxies.multi_attenuation = true;
+    config.precision = StoragePrecision::single;
+    config.archive = archive.string();
+    return config;
+}
+
+class ExplorerTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        directory_ = fs::temp_directory_path() /
+                     ("insitu_explorer_test_" + std::to_string(::getpid()) + "_" +
+                      ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::remove_all(directory_);
+        fs::create_directories(directory_);
+        config_ = explorer_config(directory_ / "run.cdb", volume_);
+    }
+    void TearDown() override { fs::remove_all(directory_); }
+
+    void write_steps(const std::vector<std::int64_t>& steps) {
+        InstrumentOptions options;
+        options.log = false;
+        options.rethrow_errors = true;
+        Instrument instrument(config_, options);
+        for (const std::int64_t step : steps) {
+            ASSERT_EQ(instrument.execute(step, 0.1 * step, {volume_.field()}), Status::ok);
+        }
+        ASSERT_EQ(instrument.finalize(), Status::ok);
+    }
+
+    fs::path directory_;
+    InstrumentConfig config_;
+    // Values in [0, ~1]: the transfer function's domain.
+    SampledVolume volume_ = make_gaussian_blobs({32, 32, 32}, 4, /*seed=*/11);
+};
+
+double rms_difference(const Image& a, const Image& b) {
+    EXPECT_EQ(a.pixels.size(), b.pixels.size());
+    double sum = 0.0;
+    for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+        const double d = static_cast<double>(a.pixels[i]) - b.pixels[i];
+        sum += d * d;
+    }
+    return std::sqrt(sum / std::max<std::size_t>(1, a.pixels.size()));
+}
+
+void expect_finite_premultiplied(const Image& colour) {
+    ASSERT_EQ(colour.channels, 4);
+    for (std::size_t p = 0; p < colour.pixel_count(); ++p) {
+        const float* rgba = &colour.pixels[4 * p];
+        for (int c = 0; c < 4; ++c) ASSERT_TRUE(std::isfinite(rgba[c])) << "pixel " << p;
+        // Alpha is 1 - T of the estimated attenuation: in [0, 1] up to float rounding.
+        ASSERT_GE(rgba[3], -1e-6f) << "pixel " << p;
+        ASSERT_LE(rgba[3], 1.0f + 1e-5f) << "pixel " << p;
+    }
+}
+
+TEST_F(ExplorerTest, StoredViewReproducesTheGroundTruthForColoursConstantPerInterval) {
+    write_steps({1});
+    Explorer explorer(config_.archive);
+    ExploreRequest request;
+    request.step = 1;
+    const ExploreFrame frame = explorer.render(request);
+    EXPECT_FALSE(frame.synthesised_view);
+    EXPECT_EQ(frame.colour_source, ColourSource::recompose);
+    ASSERT_EQ(frame.colour.width, kImage);
+    for (const float c : frame.confidence.pixels) ASSERT_EQ(c, 1.0f);
+
+    // The ground truth of the same camera and transfer function, rendered from the volume the
+    // archive never saw. Exact recomposition (Eq. 7) up to float rounding of both renderers.
+    ProxyRenderer renderer;
+    renderer.upload(volume_.field());
+    RenderSettings settings;
+    settings.early_termination_opacity = 1.0;  // the proxies' exact termination
+    const Camera camera = Camera::orbit(config_.views[0].orbit, volume_.field().bounds());
+    const Rendering truth =
+        renderer.render_ground_truth(camera, config_.transfer_function, settings);
+    EXPECT_LT(rms_difference(frame.colour, truth.rgba), 1e-4);
+}
+
+TEST_F(ExplorerTest, IdentityEditsChangeNothing) {
+    write_steps({1});
+    Explorer explorer(config_.archive);
+    ExploreRequest plain;
+    plain.step = 1;
+    const Image reference = explorer.render(plain).colour;
+
+    ExploreRequest same_tf = plain;
+    same_tf.transfer_function = config_.transfer_function;
+    EXPECT_EQ(explorer.render(same_tf).colour.pixels, reference.pixels);
+
+    ExploreRequest unit_scales = plain;
+    unit_scales.opacity_scales = {{2, 1.0}, {4, 1.0}};
+    const ExploreFrame frame = explorer.render(unit_scales);
+    EXPECT_TRUE(frame.opacity_scales.empty());
+    EXPECT_EQ(frame.colour.pixels, reference.pixels);
+
+    ExploreRequest same_angles = plain;
+    same_angles.azimuth_deg = 20.0 + 360.0;
+    same_angles.elevation_deg = 15.0;
+    const ExploreFrame turned = explorer.render(same_angles);
+    EXPECT_FALSE(turned.synthesised_view);
+    EXPECT_EQ(turned.colour.pixels, reference.pixels);
+}
+
+TEST_F(ExplorerTest, OpacityEditsAreBoundedAndZeroOpacityIsTransparent) {
+    write_steps({1});
+    Explorer explorer(config_.archive);
+    ExploreRequest request;
+    request.step = 1;
+    const Image reference = explorer.render(request).colour;
+
+    for (const double scale : {0.0, 0.3, 3.0, 1000.0}) {
+        SCOPED_TRACE("scale " + std::to_string(scale));
+        ExploreRequest edited = request;
+        for (int j = 0; j < kIntervals; ++j) edited.opacity_scales.emplace_back(j, scale);
+        const ExploreFrame frame = explorer.render(edited);
+        expect_finite_premultiplied(frame.colour);
+        ASSERT_EQ(frame.opacity_scales.size(), static_cast<std::size_t>(kIntervals));
+        if (scale == 0.0) {
+            for (const float v : frame.colour.pixels) ASSERT_EQ(v, 0.0f);
+        }
+    }
+    // Halving the opacity of every interval cannot make any pixel more opaque.
+    ExploreRequest thinner = request;
+    for (int j = 0; j < kIntervals; ++j) thinner.opacity_scales.emplace_back(j, 0.5);
+    const Image thin = explorer.render(thinner).colour;
+    for (std::size_t p = 0; p < thin.pixel_count(); ++p) {
+        ASSERT_LE(thin.pixels[4 * p + 3], reference.pixels[4 * p + 3] + 1e-6f) << "pixel " << p;
+    }
+}
+
+TEST_F(ExplorerTest, ANewViewIsSynthesisedWithAConfidenceMask) {
+    write_steps({1});
+    Explorer explorer(config_.archive);
+    ExploreRequest request;
+    request.step = 1;
+    request.azimuth_deg = 35.0;
+    request.elevation_deg = 25.0;
+    const ExploreFrame frame = explorer.render(request);
+    EXPECT_TRUE(frame.synthesised_view);
+    EXPECT_NEAR(frame.camera.azimuth_deg(), 35.0, 1e-9);
+    EXPECT_NEAR(frame.camera.elevation_deg(), 25.0, 1e-9);
+    expect_finite_premultiplied(frame.colour);
+    ASSERT_EQ(frame.confidence.channels, 1);
+    ASSERT_EQ(frame.confidence.pixel_count(), frame.colour.pixel_count());
+    double covered = 0.0;
+    for (const float c : frame.confidence.pixels) {
+        ASSERT_GE(c, 0.0f);
+        ASSERT_LE(c, 1.0f);
+        covered += c;
+    }
+    // Something of the stored view lands in the new one.
+    EXPECT_GT(covered, 0.0);
+}
+
+TEST_F(ExplorerTest, ANewViewComesFromTheSingleOrTheMultiPerspectiveProxiesAsAsked) {
+    write_steps({1});
+    Explorer explorer(config_.archive);
+    ExploreRequest request;
+    request.step = 1;
+    request.azimuth_deg = 40.0;
+    ExploreRequest single = request;
+    single.source = ProxySource::single;
+    ExploreRequest multi = request;
+    multi.source = ProxySource::multi;
+    const Image automatic_colour = explorer.render(request).colour;
+    const Image single_colour = explorer.render(single).colour;
+    const Image multi_colour = explorer.render(multi).colour;
+    expect_finite_premultiplied(multi_colour);
+    // "auto" prefers the single-perspective proxies (the archive has both).
+    EXPECT_EQ(automatic_colour.pixels, single_colour.pixels);
+    EXPECT_NE(multi_colour.pixels, single_colour.pixels);
+}
+
+TEST_F(ExplorerTest, LightingOcclusionAndEnhancementChangeTheFrameAndStayFinite) {
+    write_steps({1});
+    Explorer explorer(config_.archive);
+    ExploreRequest plain;
+    plain.step = 1;
+    const Image reference = explorer.render(plain).colour;
+
+    ExploreRequest lit = plain;
+    lit.lighting = LightingSettings{};
+    lit.lighting->lights = {Light{}};
+    lit.lighting->lights[0].direction_world = glm::dvec3(0.0);  // headlight
+    ExploreRequest occluded = plain;
+    occluded.ambient_occlusion = AmbientOcclusionSettings{};
+    ExploreRequest enhanced = plain;
+    enhanced.enhancement = EnhancementSettings{1.0, 0.5};
+    for (const ExploreRequest* request : {&lit, &occluded, &enhanced}) {
+        const Image colour = explorer.render(*request).colour;
+        expect_finite_premultiplied(colour);
+        // Alpha is the attenuation's: none of these steps changes coverage.
+        for (std::size_t p = 0; p < colour.pixel_count(); ++p) {
+            ASSERT_NEAR(colour.pixels[4 * p + 3], reference.pixels[4 * p + 3], 1e-6f);
+        }
+    }
+    EXPECT_NE(explorer.render(lit).colour.pixels, reference.pixels);
+    EXPECT_NE(explorer.render(enhanced).colour.pixels, reference.pixels);
+}
+
+TEST_F(ExplorerTest, WithoutAttenuationTheFrontLayerIsDrawnAsASurface) {
+    config_.proxies.attenuation = false;
+    config_.proxies.multi_attenuation = false;
+    config_.proxies.distortion = false;
+    write_steps({1});
+    Explorer explorer(config_.archive);
+    ExploreRequest request;
+    request.step = 1;
+    const ExploreFrame frame = explorer.render(request);
+    const ProxyFrame stored = ArchiveReader(config_.archive).load(1, 0);
+    ASSERT_EQ(stored.depth_layers.size(), 1u);
+    const glm::vec4 expected = config_.transfer_function.evaluate(stored.isovalues[0]);
+    int hits = 0;
+    for (std::size_t p = 0; p < frame.colour.pixel_count(); ++p) {
+        const bool hit = std::isfinite(stored.depth_layers[0].pixels[p]);
+        hits += hit;
+        const float* rgba = &frame.colour.pixels[4 * p];
+        ASSERT_EQ(rgba[3], hit ? 1.0f : 0.0f) << "pixel " << p;
+        ASSERT_EQ(rgba[0], hit ? expected.r : 0.0f) << "pixel " << p;
+        ASSERT_EQ(rgba[2], hit ? expected.b : 0.0f) << "pixel " << p;
+    }
+    EXPECT_GT(hits, 0);
+    ExploreRequest occluded = request;
+    occluded.ambient_occlusion = AmbientOcclusionSettings{};
+    expect_finite_premultiplied(explorer.render(occluded).colour);
+    ExploreRequest enhanced = request;
+    enhanced.enhancement = EnhancementSettings{};
+    testing::expect_error_naming<InvalidArgument>([&] { explorer.render(enhanced); },
+                                                  "needs attenuation proxies");
+}
+
+TEST_F(ExplorerTest, BadRequestsNameWhatIsWrong) {
+    write_steps({1});
+    Explorer explorer(config_.archive);
+    ExploreRequest missing_step;
+    missing_step.step = 7;
+    testing::expect_error_naming<InvalidArgument>([&] { explorer.render(missing_step); },
+                                                  "has no step 7");
+    ExploreRequest missing_view;
+    missing_view.step = 1;
+    missing_view.view = 2;
+    testing::expect_error_naming<InvalidArgument>([&] { explorer.render(missing_view); },
+                                                  "has no view 2");
+    ExploreRequest bad_interval;
+    bad_interval.step = 1;
+    bad_interval.opacity_scales = {{kIntervals, 0.5}};
+    testing::expect_error_naming<InvalidArgument>([&] { explorer.render(bad_interval); },
+                                                  "opacity-scale interval 6");
+    ExploreRequest negative;
+    negative.step = 1;
+    negative.opacity_scales = {{1, -2.0}};
+    testing::expect_error_naming<InvalidArgument>([&] { explorer.render(negative); }, "= -2");
+    ExploreRequest no_model;
+    no_model.step = 1;
+    no_model.colour = ColourSource::model;
+    testing::expect_error_naming<InvalidArgument>([&] { explorer.render(no_model); },
+                                                  "has no colour model");
+}
+
+TEST_F(ExplorerTest, StepsWrittenLaterAppearAfterRefresh) {
+    write_steps({1});
+    Explorer explorer(config_.archive);
+    EXPECT_EQ(explorer.archive().steps(), std::vector<std::int64_t>{1});
+    write_steps({2});  // the simulation continues the archive
+    explorer.refresh();
+    EXPECT_EQ(explorer.archive().steps(), (std::vector<std::int64_t>{1, 2}));
+    ExploreRequest request;
+    request.step = 2;
+    expect_finite_premultiplied(explorer.render(request).colour);
+}
+
+TEST_F(ExplorerTest, DescribeArchiveListsStepsViewsAndProxies) {
+    write_steps({1, 2});
+    const ArchiveReader reader(config_.archive);
+    const nlohmann::json description = describe_archive(reader);
+    EXPECT_EQ(description.at("steps"), nlohmann::json({1, 2}));
+    EXPECT_EQ(description.at("view_count"), 1);
+    const auto& single = description.at("views").at(0).at("single");
+    EXPECT_EQ(single.at("size"), nlohmann::json({kImage, kImage}));
+    EXPECT_EQ(single.at("depth_layers"), 1);
+    EXPECT_TRUE(single.at("attenuation").get<bool>());
+    EXPECT_TRUE(description.at("views").at(0).contains("multi"));
+    EXPECT_GT(description.at("bytes").get<std::uint64_t>(), 0u);
+}
+
+TEST(ExploreOptions, ParseEveryKey) {
+    const ExploreRequest request = viewer::request_from_options({{"step", "12"},
+                                                                 {"view", "1"},
+                                                                 {"azimuth", "-30.5"},
+                                                                 {"elevation", "45"},
+                                                                 {"opacity-scale", "0=0.5,3=2"},
+                                                                 {"colour", "recompose"},
+                                                                 {"source", "multi"},
+                                                                 {"light", "camera;90,0,0.4,0.1"},
+                                                                 {"ambient", "0.3"},
+                                                                 {"ao", "4,2"},
+                                                                 {"enhance", "0.7,0.4"},
+                                                                 {"fill", "2"}});
+    EXPECT_EQ(request.step, 12);
+    EXPECT_EQ(request.view, 1);
+    EXPECT_EQ(*request.azimuth_deg, -30.5);
+    EXPECT_EQ(*request.elevation_deg, 45.0);
+    ASSERT_EQ(request.opacity_scales.size(), 2u);
+    EXPECT_EQ(request.opacity_scales[1], (std::pair<int, double>{3, 2.0}));
+    EXPECT_EQ(request.colour, ColourSource::recompose);
+    EXPECT_EQ(request.source, ProxySource::multi);
+    ASSERT_TRUE(request.lighting);
+    ASSERT_EQ(request.lighting->lights.size(), 2u);
+    EXPECT_EQ(request.lighting->lights[0].direction_world, glm::dvec3(0.0));
+    EXPECT_NEAR(request.lighting->lights[1].direction_world.x, 1.0, 1e-12);
+    EXPECT_EQ(request.lighting->lights[1].diffuse, 0.4);
+    EXPECT_EQ(request.lighting->ambient, 0.3);
+    EXPECT_EQ(request.ambient_occlusion->radius_pixels, 4);
+    EXPECT_EQ(request.ambient_occlusion->strength, 2.0);
+    EXPECT_EQ(request.enhancement->lambda, 0.7);
+    EXPECT_EQ(request.synthesis.hole_fill_radius_pixels, 2);
+}
+
+TEST(ExploreOptions, MalformedValuesNameKeyAndValue) {
+    using viewer::request_from_options;
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"zoom", "2"}});
+        },
+        "zoom");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"step", "1.5"}});
+        },
+        "step");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"azimuth", "nan"}});
+        },
+        "azimuth");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"elevation", "91"}});
+        },
+        "elevation = 91");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"opacity-scale", "2"}});
+        },
+        "INTERVAL=SCALE");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"opacity-scale", "1=-1"}});
+        },
+        "negative");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"light", "10"}});
+        },
+        "light");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"ao", "0"}});
+        },
+        "ao radius");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"enhance", "1,0"}});
+        },
+        "GAMMA > 0");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"source", "both"}});
+        },
+        "both");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"colour", "pink"}});
+        },
+        "pink");
+    testing::expect_error_naming<ParseError>(
+        [] {
+            request_from_options({{"tf", "{not json"}});
+        },
+        "");
+}
+
+}  // namespace
+}  // namespace insitu
