@@ -36,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "arguments.hpp"
 #include "insitu/core/camera.hpp"
 #include "insitu/capture_input.hpp"
 #include "insitu/config.hpp"
@@ -46,6 +47,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
+using insitu::cli::parse_integer;
 
 double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
@@ -261,8 +263,8 @@ int main(int argc, char** argv) {
             if (argc != 6) throw std::runtime_error("--child MODE DIR N W");
             const std::string mode = argv[2];
             const fs::path dir = argv[3];
-            const int n = std::stoi(argv[4]);
-            const int image = std::stoi(argv[5]);
+            const int n = parse_integer<int>("--child N", argv[4], 1);
+            const int image = parse_integer<int>("--child W", argv[5], 1);
             if (mode == "generate") return child_generate(dir, n);
             if (mode == "sparse" || mode == "dense") {
                 return child_capture(dir, mode == "sparse", n, image);
@@ -272,16 +274,17 @@ int main(int argc, char** argv) {
         int n = 512;
         int image = 256;
         std::string keep;
-        for (int i = 1; i + 1 < argc; i += 2) {
+        for (int i = 1; i < argc; ++i) {
             const std::string flag = argv[i];
+            const std::string value = insitu::cli::next_value(argc, argv, i);
             if (flag == "--size") {
-                n = std::stoi(argv[i + 1]);
+                n = parse_integer<int>(flag, value, 1);
             } else if (flag == "--image") {
-                image = std::stoi(argv[i + 1]);
+                image = parse_integer<int>(flag, value, 1);
             } else if (flag == "--keep") {
-                keep = argv[i + 1];
+                keep = value;
             } else {
-                throw std::runtime_error("unknown option " + flag);
+                throw insitu::cli::UsageError("unknown option " + flag);
             }
         }
         const fs::path dir =
@@ -319,6 +322,8 @@ int main(int argc, char** argv) {
                   << std::stod(sparse["peak_mib"]) / std::stod(dense["peak_mib"]) << "\n";
         if (keep.empty()) fs::remove_all(dir);
         return 0;
+    } catch (const insitu::cli::UsageError& error) {
+        return insitu::cli::report("bench_capture", error.what(), insitu::cli::kExitBadInput);
     } catch (const std::exception& error) {
         std::cerr << "bench_capture: " << error.what() << "\n";
         return 1;

@@ -9,10 +9,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <vector>
 
+#include "arguments.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/explore/colour_model.hpp"
 #include "insitu/render/proxy_renderer.hpp"
@@ -32,14 +32,9 @@ struct Options {
 
 Options parse(int argc, char** argv) {
     Options options;
-    for (int i = 1; i + 1 < argc; i += 2) {
+    for (int i = 1; i < argc; ++i) {
         const std::string flag = argv[i];
-        const int value = std::atoi(argv[i + 1]);
-        if (value < 1) {
-            std::fprintf(stderr, "bench_colour_model: %s = %s (must be >= 1)\n", flag.c_str(),
-                         argv[i + 1]);
-            std::exit(2);
-        }
+        const int value = cli::parse_integer<int>(flag, cli::next_value(argc, argv, i), 1);
         if (flag == "--image")
             options.image = value;
         else if (flag == "--volume")
@@ -50,10 +45,8 @@ Options parse(int argc, char** argv) {
             options.clusters = value;
         else if (flag == "--repeats")
             options.repeats = value;
-        else {
-            std::fprintf(stderr, "bench_colour_model: unknown flag %s\n", flag.c_str());
-            std::exit(2);
-        }
+        else
+            throw cli::UsageError("unknown flag " + flag);
     }
     return options;
 }
@@ -90,7 +83,8 @@ double median(std::vector<double> values) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    const Options options = parse(argc, argv);
+    const Options options =
+        cli::parse_or_exit("bench_colour_model", [&] { return parse(argc, argv); });
     const std::int64_t n = options.volume;
     const SampledVolume volume = make_gaussian_blobs({n, n, n}, 12, /*seed=*/3);
     ProxyRenderer renderer;

@@ -9,14 +9,16 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "arguments.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/explore/explorer.hpp"
 #include "insitu/instrument.hpp"
@@ -37,30 +39,23 @@ struct Options {
     std::vector<std::int64_t> sizes{128, 256, 512};
 };
 
-[[noreturn]] void usage_error(const std::string& message) {
-    std::fprintf(stderr, "bench_exploration: %s\n", message.c_str());
-    std::exit(2);
-}
-
 Options parse(int argc, char** argv) {
     Options options;
     for (int i = 1; i < argc; ++i) {
         const std::string flag = argv[i];
-        if (i + 1 >= argc) usage_error(flag + " needs a value");
+        if (i + 1 >= argc) throw cli::UsageError(flag + " needs a value");
         const std::string value = argv[++i];
         if (flag == "--sizes") {
             options.sizes.clear();
             std::stringstream list(value);
             std::string item;
             while (std::getline(list, item, ',')) {
-                const long size = std::atol(item.c_str());
-                if (size < 8) usage_error("--sizes " + value + " (each must be >= 8)");
-                options.sizes.push_back(size);
+                options.sizes.push_back(cli::parse_integer<std::int64_t>(
+                    flag, item, 8, std::numeric_limits<std::int64_t>::max(), value));
             }
             continue;
         }
-        const int number = std::atoi(value.c_str());
-        if (number < 1) usage_error(flag + " = " + value + " (must be a positive integer)");
+        const int number = cli::parse_integer<int>(flag, value, 1);
         if (flag == "--image")
             options.image = number;
         else if (flag == "--intervals")
@@ -70,7 +65,7 @@ Options parse(int argc, char** argv) {
         else if (flag == "--repeats")
             options.repeats = number;
         else
-            usage_error("unknown flag " + flag);
+            throw cli::UsageError("unknown flag " + flag);
     }
     return options;
 }
@@ -86,7 +81,8 @@ TransferFunction ramp(double peak_opacity) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    const Options options = parse(argc, argv);
+    const Options options =
+        cli::parse_or_exit("bench_exploration", [&] { return parse(argc, argv); });
     const fs::path scratch =
         fs::temp_directory_path() / ("insitu_bench_exploration_" + std::to_string(::getpid()));
     std::printf(

@@ -7,13 +7,15 @@
 //   bench_instrument [--sizes 128,256,512] [--image P] [--steps S] [--disk DIR] [--fast DIR]
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "arguments.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/archive/archive.hpp"
 #include "insitu/instrument.hpp"
@@ -31,36 +33,29 @@ struct Options {
     std::string fast = "/dev/shm/bench-instrument-archives";
 };
 
-[[noreturn]] void usage_error(const std::string& message) {
-    std::fprintf(stderr, "bench_instrument: %s\n", message.c_str());
-    std::exit(2);
-}
-
 Options parse(int argc, char** argv) {
     Options options;
     for (int i = 1; i < argc; ++i) {
         const std::string flag = argv[i];
-        if (i + 1 >= argc) usage_error(flag + " needs a value");
+        if (i + 1 >= argc) throw cli::UsageError(flag + " needs a value");
         const std::string value = argv[++i];
         if (flag == "--sizes") {
             options.sizes.clear();
             std::stringstream list(value);
             std::string item;
             while (std::getline(list, item, ',')) {
-                const long long n = std::atoll(item.c_str());
-                if (n < 8) usage_error("--sizes entry " + item + " (must be >= 8)");
-                options.sizes.push_back(n);
+                options.sizes.push_back(cli::parse_integer<std::int64_t>(
+                    flag, item, 8, std::numeric_limits<std::int64_t>::max(), value));
             }
         } else if (flag == "--image" || flag == "--steps") {
-            const int n = std::atoi(value.c_str());
-            if (n < 1) usage_error(flag + " = " + value + " (must be a positive integer)");
-            (flag == "--image" ? options.image : options.steps) = n;
+            (flag == "--image" ? options.image : options.steps) =
+                cli::parse_integer<int>(flag, value, 1);
         } else if (flag == "--disk") {
             options.disk = value;
         } else if (flag == "--fast") {
             options.fast = value;
         } else {
-            usage_error("unknown flag " + flag);
+            throw cli::UsageError("unknown flag " + flag);
         }
     }
     return options;
@@ -164,7 +159,8 @@ void sizes(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    const Options options = parse(argc, argv);
+    const Options options =
+        cli::parse_or_exit("bench_instrument", [&] { return parse(argc, argv); });
     try {
         std::error_code ignored;
         fs::create_directories(options.disk, ignored);

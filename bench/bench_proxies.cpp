@@ -8,11 +8,10 @@
 #include <cmath>
 #include <limits>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <string>
 #include <vector>
 
+#include "arguments.hpp"
 #include "gray_scott_simulation.hpp"
 #include "gray_scott_volume.hpp"
 #include "sample_count.hpp"
@@ -35,25 +34,15 @@ Options parse(int argc, char** argv) {
     Options options;
     for (int i = 1; i < argc; ++i) {
         const std::string flag = argv[i];
-        if (i + 1 >= argc) {
-            std::fprintf(stderr, "bench_proxies: %s needs a value\n", flag.c_str());
-            std::exit(2);
-        }
-        const int value = std::atoi(argv[++i]);
-        if (value < 1) {
-            std::fprintf(stderr, "bench_proxies: %s = %s (must be a positive integer)\n",
-                         flag.c_str(), argv[i]);
-            std::exit(2);
-        }
+        if (i + 1 >= argc) throw cli::UsageError(flag + " needs a value");
+        const int value = cli::parse_integer<int>(flag, argv[++i], 1);
         if (flag == "--size") options.size = value;
         else if (flag == "--image") options.image = value;
         else if (flag == "--repeats") options.repeats = value;
         else if (flag == "--gray-scott-size") options.gray_scott_size = value;
         else if (flag == "--gray-scott-steps") options.gray_scott_steps = value;
-        else {
-            std::fprintf(stderr, "bench_proxies: unknown flag %s\n", flag.c_str());
-            std::exit(2);
-        }
+        else
+            throw cli::UsageError("unknown flag " + flag);
     }
     return options;
 }
@@ -166,7 +155,7 @@ SampledVolume gray_scott_field(int size, int steps) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    const Options options = parse(argc, argv);
+    const Options options = cli::parse_or_exit("bench_proxies", [&] { return parse(argc, argv); });
     try {
         std::printf("device: %s\n", ComputeDevice::shared()->description().c_str());
         const SampledVolume blobs =

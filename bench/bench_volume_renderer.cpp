@@ -17,13 +17,14 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <functional>
 #include <iostream>
-#include <stdexcept>
+#include <limits>
 #include <string>
+#include <system_error>
 #include <vector>
 
+#include "arguments.hpp"
 #include "sample_count.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/core/camera.hpp"
@@ -58,23 +59,14 @@ void print_usage() {
                  "reference)\n";
 }
 
-long parse_integer(const std::string& flag, const std::string& text, long minimum) {
-    char* end = nullptr;
-    const long value = std::strtol(text.c_str(), &end, 10);
-    if (text.empty() || *end != '\0' || value < minimum) {
-        throw std::invalid_argument(flag + ": expected an integer >= " + std::to_string(minimum) +
-                                    ", got \"" + text + "\"");
-    }
-    return value;
-}
+using insitu::cli::parse_integer;
+using insitu::cli::UsageError;
 
 void parse_size(const std::string& flag, const std::string& text, int& width, int& height) {
-    const auto x = text.find('x');
-    if (x == std::string::npos) {
-        throw std::invalid_argument(flag + ": expected WxH, got \"" + text + "\"");
-    }
-    width = static_cast<int>(parse_integer(flag, text.substr(0, x), 1));
-    height = static_cast<int>(parse_integer(flag, text.substr(x + 1), 1));
+    const insitu::cli::PixelSize size =
+        insitu::cli::parse_pixel_size(flag, text, std::numeric_limits<int>::max());
+    width = size.width;
+    height = size.height;
 }
 
 BenchOptions parse_options(int argc, char** argv) {
@@ -85,28 +77,29 @@ BenchOptions parse_options(int argc, char** argv) {
             options.help = true;
             continue;
         }
-        if (i + 1 >= argc) throw std::invalid_argument(flag + ": missing value");
+        if (i + 1 >= argc) throw UsageError(flag + ": missing value");
         const std::string value = argv[++i];
         if (flag == "--volume") {
-            options.volume_side = parse_integer(flag, value, 2);
+            options.volume_side = parse_integer<std::int64_t>(flag, value, 2);
         } else if (flag == "--image") {
             parse_size(flag, value, options.image_width, options.image_height);
         } else if (flag == "--warmup") {
-            options.warmup = static_cast<int>(parse_integer(flag, value, 0));
+            options.warmup = parse_integer<int>(flag, value, 0);
         } else if (flag == "--repeats") {
-            options.repeats = static_cast<int>(parse_integer(flag, value, 1));
+            options.repeats = parse_integer<int>(flag, value, 1);
         } else if (flag == "--reference-image") {
             parse_size(flag, value, options.reference_width, options.reference_height);
         } else if (flag == "--reference-repeats") {
-            options.reference_repeats = static_cast<int>(parse_integer(flag, value, 0));
+            options.reference_repeats = parse_integer<int>(flag, value, 0);
         } else if (flag == "--step") {
-            char* end = nullptr;
-            options.step_voxels = std::strtod(value.c_str(), &end);
-            if (*end != '\0' || !(options.step_voxels > 0.0)) {
-                throw std::invalid_argument("--step: expected a number > 0, got \"" + value + "\"");
+            double step_voxels = 0.0;
+            if (insitu::cli::convert_finite(value, step_voxels) != std::errc() ||
+                !(step_voxels > 0.0)) {
+                throw UsageError("--step: expected a number > 0, got \"" + value + "\"");
             }
+            options.step_voxels = step_voxels;
         } else {
-            throw std::invalid_argument("unknown option \"" + flag + "\"");
+            throw UsageError("unknown option \"" + flag + "\"");
         }
     }
     return options;
@@ -253,13 +246,8 @@ int run(const BenchOptions& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    BenchOptions options;
-    try {
-        options = parse_options(argc, argv);
-    } catch (const std::invalid_argument& error) {
-        std::cerr << "bench_volume_renderer: " << error.what() << "\n";
-        return 2;
-    }
+    const BenchOptions options = insitu::cli::parse_or_exit(
+        "bench_volume_renderer", [&] { return parse_options(argc, argv); });
     if (options.help) {
         print_usage();
         return 0;

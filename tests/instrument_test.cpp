@@ -27,6 +27,8 @@
 #include <thread>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/archive/archive.hpp"
 #include "insitu/error.hpp"
@@ -78,6 +80,12 @@ protected:
     fs::path directory_;
     SampledVolume volume_ = small_volume();
 };
+
+TEST(InstrumentStatus, PrintsItsName) {
+    std::ostringstream text;
+    text << Status::not_selected << " " << Status::error << " " << InstrumentOptions{};
+    EXPECT_EQ(text.str(), "not_selected error InstrumentOptions{rethrow_errors false, log true}");
+}
 
 TEST_F(InstrumentTest, WritesEveryNthStepIntoAnArchiveTheReaderOpens) {
     InstrumentConfig config = small_config(archive());

@@ -1,12 +1,12 @@
 #include "explore_options.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 #include <sstream>
 
+#include "arguments.hpp"
 #include "insitu/error.hpp"
 
 namespace insitu::viewer {
@@ -23,11 +23,10 @@ std::vector<std::string> split(const std::string& text, char separator) {
     return pieces;
 }
 
+// The tools' strict rules (arguments.hpp), worded for a request: the server answers these 400.
 double number(const std::string& key, const std::string& text, const std::string& whole) {
     double value = 0.0;
-    const char* end = text.data() + text.size();
-    const auto [stop, error] = std::from_chars(text.data(), end, value);
-    if (text.empty() || error != std::errc() || stop != end || !std::isfinite(value)) {
+    if (cli::convert_finite(text, value) != std::errc()) {
         fail<InvalidArgument>(key, " = \"", whole, "\": \"", text, "\" is not a finite number");
     }
     return value;
@@ -35,9 +34,7 @@ double number(const std::string& key, const std::string& text, const std::string
 
 std::int64_t integer(const std::string& key, const std::string& text) {
     std::int64_t value = 0;
-    const char* end = text.data() + text.size();
-    const auto [stop, error] = std::from_chars(text.data(), end, value);
-    if (text.empty() || error != std::errc() || stop != end) {
+    if (cli::convert_integer(text, value) != std::errc()) {
         fail<InvalidArgument>(key, " = \"", text, "\" is not an integer");
     }
     return value;

@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -25,12 +24,14 @@
 #include <utility>
 #include <vector>
 
+#include "arguments.hpp"
 #include "cli.hpp"
 #include "explore_options.hpp"
 #include "insitu/error.hpp"
 #include "insitu/explore/explorer.hpp"
 #include "insitu/core/image.hpp"
 #include "insitu/explore/transfer_function_edit.hpp"
+#include "insitu/explore/trust.hpp"
 
 namespace insitu::viewer {
 
@@ -70,11 +71,6 @@ constexpr std::size_t kMaxCachedMasks = 16;
 constexpr std::size_t kLoggedLength = 240;
 constexpr const char* kErrorHeader = "X-Insitu-Error";
 
-/// Mean confidence (in [0, 1], see frame_confidence) that a synthesised view must keep to count
-/// as trustworthy; the orbit offsets probed for it, degrees, outward.
-constexpr double kTrustedMeanConfidence = 0.9;
-constexpr double kTrustOffsetsDeg[] = {5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 90.0};
-
 using cli::UsageError;
 
 struct ServeArguments {
@@ -96,10 +92,7 @@ ServeArguments parse_serve_arguments(const std::vector<std::string>& args) {
                 continue;
             }
             int port = -1;
-            const auto [end, error] =
-                std::from_chars(value.data(), value.data() + value.size(), port);
-            if (value.empty() || error != std::errc() || end != value.data() + value.size() ||
-                port < 0 || port > 65535) {
+            if (cli::convert_integer(value, port) != std::errc() || port < 0 || port > 65535) {
                 throw UsageError("--port " + value + ": not a port in 0..65535 (0 = any free)");
             }
             parsed.port = port;
@@ -122,8 +115,7 @@ bool is_session_character(char c) {
 
 std::int64_t parse_step_or_view(const std::string& key, const std::string& text) {
     std::int64_t value = 0;
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
+    if (cli::convert_integer(text, value) != std::errc()) {
         throw HttpError(400, key + " = \"" + text + "\" is not an integer");
     }
     return value;
@@ -245,6 +237,23 @@ public:
 private:
     using Handler = std::function<void(const httplib::Request&, httplib::Response&)>;
 
+    /// The status of a failure of this kind that is not an HttpError: the request's fault (400)
+    /// or the server's (500).
+    static int http_status(ErrorKind kind) {
+        switch (kind) {
+            case ErrorKind::invalid_argument:
+            case ErrorKind::parse:
+                return 400;
+            case ErrorKind::none:
+            case ErrorKind::compute:
+            case ErrorKind::io:
+            case ErrorKind::state:
+            case ErrorKind::unknown:
+                break;
+        }
+        return 500;
+    }
+
     /// Turns every exception into a status and a JSON error: nothing a client sends can stop the
     /// server.
     Handler guarded(Handler handler) {
@@ -258,13 +267,8 @@ private:
             } catch (const HttpError& error) {
                 status = error.status();
                 message = error.what();
-            } catch (const InvalidArgument& error) {
-                status = 400;
-                message = error.what();
-            } catch (const ParseError& error) {
-                status = 400;
-                message = error.what();
             } catch (const std::exception& error) {
+                status = http_status(classify(std::current_exception()));
                 message = error.what();
             } catch (...) {
                 message = "unknown error";
@@ -489,27 +493,6 @@ private:
         return text;
     }
 
-    /// Mean confidence over the pixels that matter: those the frame shows something in (alpha
-    /// above one 8-bit level) and those it cannot vouch for (confidence < 1, e.g. disoccluded
-    /// holes). Pixels known to be empty are left out, so an object's trust is not diluted by
-    /// the empty space around it. 1 when no pixel matters. A summary for the readout and the
-    /// trusted range, not synthesis.
-    static double frame_confidence(const ExploreFrame& frame) {
-        const Image& colour = frame.colour;
-        const Image& confidence = frame.confidence;
-        double sum = 0.0;
-        std::size_t counted = 0;
-        for (std::size_t p = 0; p < confidence.pixel_count(); ++p) {
-            const float c = confidence.pixels[p];
-            const bool shown = colour.channels == 4 && colour.pixels[p * 4 + 3] > 1.0f / 255.0f;
-            if (shown || c < 1.0f) {
-                sum += c;
-                ++counted;
-            }
-        }
-        return counted == 0 ? 1.0 : sum / static_cast<double>(counted);
-    }
-
     /// Renders, holding the engine lock, once the step is listed and its files lie inside.
     ExploreFrame render_checked(const ExploreRequest& request) {
         std::lock_guard<std::mutex> lock(engine_mutex_);
@@ -558,7 +541,7 @@ private:
         response.set_header("X-Insitu-Encode-Milliseconds", std::to_string(encode_ms));
         response.set_header("X-Insitu-Synthesised", rendered->synthesised_view ? "1" : "0");
         response.set_header("X-Insitu-Colour-Source", to_string(rendered->colour_source));
-        response.set_header("X-Insitu-Confidence", std::to_string(frame_confidence(*rendered)));
+        response.set_header("X-Insitu-Confidence", std::to_string(mean_confidence(*rendered)));
         send_png(response, png);
     }
 
@@ -567,8 +550,7 @@ private:
         response.set_content(reinterpret_cast<const char*>(png.data()), png.size(), "image/png");
     }
 
-    /// Mean confidence at growing orbit offsets from the stored view, outward in each of the
-    /// four directions until it drops below kTrustedMeanConfidence: the range the page marks.
+    /// The trusted orbit range of a stored view (probe_orbit_trust), the range the page marks.
     void trust(const httplib::Request& request, httplib::Response& response) {
         const StepKey key = step_key(request);
         {
@@ -583,42 +565,30 @@ private:
         // to come back (409) rather than rendering everything twice.
         const std::string session =
             "trust:" + std::to_string(key.step) + ":" + std::to_string(key.view);
-        ExploreRequest probe;
-        probe.step = key.step;
-        probe.view = key.view;
-        std::optional<Camera> stored;
-        const auto run = [&](const std::function<void()>& job) {
-            if (!scheduler_.run(session, job)) {
-                throw HttpError(409, "superseded by a newer request for " + session);
-            }
-        };
-        run([&] { stored = render_checked(probe).camera; });
-        const double azimuth = stored->azimuth_deg();
-        const double elevation = stored->elevation_deg();
-        json samples = json::array();
-        json range{{"azimuth", {0.0, 0.0}}, {"elevation", {0.0, 0.0}}};
-        for (const char* axis : {"azimuth", "elevation"}) {
-            for (const int sign : {-1, 1}) {
-                for (const double offset : kTrustOffsetsDeg) {
-                    const bool along_azimuth = std::string(axis) == "azimuth";
-                    const double probed_elevation = elevation + sign * offset;
-                    if (!along_azimuth && std::abs(probed_elevation) > 90.0) break;
-                    probe.azimuth_deg = azimuth + (along_azimuth ? sign * offset : 0.0);
-                    probe.elevation_deg = along_azimuth ? elevation : probed_elevation;
-                    double confidence = 0.0;
-                    run([&] { confidence = frame_confidence(render_checked(probe)); });
-                    samples.push_back({{"axis", axis},
-                                       {"offset", sign * offset},
-                                       {"mean_confidence", confidence}});
-                    if (confidence < kTrustedMeanConfidence) break;
-                    range[axis][sign < 0 ? 0 : 1] = sign * offset;
+        const OrbitTrust trust = probe_orbit_trust(
+            [&](const ExploreRequest& probe) {
+                std::optional<ExploreFrame> rendered;
+                if (!scheduler_.run(session, [&] { rendered = render_checked(probe); })) {
+                    throw HttpError(409, "superseded by a newer request for " + session);
                 }
-            }
+                return std::move(*rendered);
+            },
+            key.step, key.view);
+        json samples = json::array();
+        for (const TrustSample& sample : trust.samples) {
+            samples.push_back({{"axis", to_string(sample.axis)},
+                               {"offset", sample.offset_deg},
+                               {"mean_confidence", sample.mean_confidence}});
         }
-        const json result{
-            {"step", key.step},   {"view", key.view},       {"threshold", kTrustedMeanConfidence},
-            {"azimuth", azimuth}, {"elevation", elevation}, {"trusted_offsets", range},
-            {"samples", samples}};
+        const json range{{"azimuth", trust.azimuth_range_deg},
+                         {"elevation", trust.elevation_range_deg}};
+        const json result{{"step", key.step},
+                          {"view", key.view},
+                          {"threshold", trust.threshold},
+                          {"azimuth", trust.azimuth_deg},
+                          {"elevation", trust.elevation_deg},
+                          {"trusted_offsets", range},
+                          {"samples", samples}};
         std::lock_guard<std::mutex> lock(engine_mutex_);
         if (trust_.size() >= kMaxStepInfos) trust_.clear();
         trust_[key] = result.dump();

@@ -50,29 +50,6 @@ int fail_with(int code, const char* function, const std::string& message) noexce
     return fail_with(code, function, message.c_str());
 }
 
-// Runs `body` (which returns a status code) and turns any exception into a code and a message
-// prefixed with the C function's name. Most derived classes are caught first.
-template <typename Body>
-int guarded(const char* function, Body&& body) noexcept {
-    try {
-        return body();
-    } catch (const insitu::InvalidArgument& error) {
-        return fail_with(INSITU_ERROR_INVALID_ARGUMENT, function, error.what());
-    } catch (const insitu::ParseError& error) {
-        return fail_with(INSITU_ERROR_PARSE, function, error.what());
-    } catch (const insitu::ComputeError& error) {
-        return fail_with(INSITU_ERROR_COMPUTE, function, error.what());
-    } catch (const insitu::IoError& error) {
-        return fail_with(INSITU_ERROR_IO, function, error.what());
-    } catch (const StateError& error) {
-        return fail_with(INSITU_ERROR_STATE, function, error.what());
-    } catch (const std::exception& error) {  // other insitu::Error, std::bad_alloc, ...
-        return fail_with(INSITU_ERROR_UNKNOWN, function, error.what());
-    } catch (...) {
-        return fail_with(INSITU_ERROR_UNKNOWN, function, "unknown exception");
-    }
-}
-
 template <typename Pointer>
 void require_not_null(Pointer* pointer, const char* argument) {
     if (pointer == nullptr) insitu::fail<insitu::InvalidArgument>(argument, " is NULL");
@@ -98,8 +75,9 @@ insitu::ScalarType scalar_type_from_c(int scalar_type) {
     }
 }
 
-// Instrument::execute/finalize report failures as Status::error plus last_error() and
-// last_error_kind() (the Instrument is made with rethrow_errors = false: the simulation is sacred).
+// The C status of each kind of error, for what guarded() catches and for the failures that
+// Instrument::execute/finalize report as Status::error plus last_error() and last_error_kind()
+// (the Instrument is made with rethrow_errors = false: the simulation is sacred).
 int code_for_kind(insitu::ErrorKind kind) {
     switch (kind) {
         case insitu::ErrorKind::invalid_argument: return INSITU_ERROR_INVALID_ARGUMENT;
@@ -111,6 +89,21 @@ int code_for_kind(insitu::ErrorKind kind) {
         case insitu::ErrorKind::unknown: break;
     }
     return INSITU_ERROR_UNKNOWN;
+}
+
+// Runs `body` (which returns a status code) and turns any exception into the code of its kind
+// (insitu::classify; other insitu::Error, std::bad_alloc, ... are INSITU_ERROR_UNKNOWN) and a
+// message prefixed with the C function's name.
+template <typename Body>
+int guarded(const char* function, Body&& body) noexcept {
+    try {
+        return body();
+    } catch (const std::exception& error) {
+        const int code = code_for_kind(insitu::classify(std::current_exception()));
+        return fail_with(code, function, error.what());
+    } catch (...) {
+        return fail_with(INSITU_ERROR_UNKNOWN, function, "unknown exception");
+    }
 }
 
 enum class Call { execute, finalize };

@@ -13,9 +13,7 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <charconv>
 #include <chrono>
-#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <exception>
@@ -28,9 +26,9 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
-#include <system_error>
 #include <vector>
 
+#include "arguments.hpp"
 #include "cli.hpp"
 #include "insitu/capture_input.hpp"
 #include "insitu/config.hpp"
@@ -41,7 +39,10 @@
 namespace {
 
 constexpr const char* kProgram = "insitu-capture";
-using insitu::cli::one_line;
+using insitu::one_line;
+using insitu::cli::parse_finite;
+using insitu::cli::parse_integer;
+using insitu::cli::split_exactly;
 using insitu::cli::UsageError;
 
 /// A failure that is not the user's input (exit 1).
@@ -67,54 +68,19 @@ struct Arguments {
 };
 
 // ---------------------------------------------------------------------------------------------
-// Value parsers: each takes the whole token or fails.
-
-double parse_number(const std::string& flag, const std::string& text) {
-    double value = 0.0;
-    const char* end = text.data() + text.size();
-    const auto [stop, error] = std::from_chars(text.data(), end, value);
-    if (text.empty() || error != std::errc() || stop != end || !std::isfinite(value)) {
-        throw UsageError(flag + ": expected a finite number, got \"" + text + "\"");
-    }
-    return value;
-}
-
-std::int64_t parse_integer(const std::string& flag, const std::string& text, std::int64_t minimum) {
-    std::int64_t value = 0;
-    const char* end = text.data() + text.size();
-    const auto [stop, error] = std::from_chars(text.data(), end, value);
-    if (text.empty() || error != std::errc() || stop != end || value < minimum) {
-        throw UsageError(flag + ": expected an integer >= " + std::to_string(minimum) + ", got \"" +
-                         text + "\"");
-    }
-    return value;
-}
-
-std::vector<std::string> split_exactly(const std::string& flag, const std::string& text,
-                                       const char* shape) {
-    std::vector<std::string> parts;
-    std::string::size_type begin = 0;
-    for (;;) {
-        const auto end = text.find(',', begin);
-        parts.push_back(text.substr(begin, end - begin));
-        if (end == std::string::npos) break;
-        begin = end + 1;
-    }
-    if (parts.size() != 3)
-        throw UsageError(flag + ": expected " + shape + ", got \"" + text + "\"");
-    return parts;
-}
+// Value parsers (arguments.hpp: each takes the whole token or fails).
 
 insitu::Index3 parse_dims(const std::string& flag, const std::string& text) {
-    const auto parts = split_exactly(flag, text, "NX,NY,NZ");
-    return {parse_integer(flag, parts[0], 1), parse_integer(flag, parts[1], 1),
-            parse_integer(flag, parts[2], 1)};
+    const auto parts = split_exactly(flag, text, ',', 3, "NX,NY,NZ");
+    return {parse_integer<std::int64_t>(flag, parts[0], 1),
+            parse_integer<std::int64_t>(flag, parts[1], 1),
+            parse_integer<std::int64_t>(flag, parts[2], 1)};
 }
 
 glm::dvec3 parse_spacing(const std::string& flag, const std::string& text) {
-    const auto parts = split_exactly(flag, text, "SX,SY,SZ");
-    glm::dvec3 spacing{parse_number(flag, parts[0]), parse_number(flag, parts[1]),
-                       parse_number(flag, parts[2])};
+    const auto parts = split_exactly(flag, text, ',', 3, "SX,SY,SZ");
+    glm::dvec3 spacing{parse_finite(flag, parts[0]), parse_finite(flag, parts[1]),
+                       parse_finite(flag, parts[2])};
     for (int axis = 0; axis < 3; ++axis) {
         if (!(spacing[axis] > 0.0))
             throw UsageError(flag + ": spacing must be positive, got \"" + text + "\"");
@@ -170,7 +136,7 @@ const std::vector<Option>& options() {
              a.on_error = v == "stop" ? OnError::stop : OnError::skip;
          }},
         {"--first-step", "N", false, "step number of the first input (default 0)",
-         [](Arguments& a, V f, V v) { a.first_step = parse_integer(f, v, 0); }},
+         [](Arguments& a, V f, V v) { a.first_step = parse_integer<std::int64_t>(f, v, 0); }},
         {"--help", nullptr, false, "print this help and exit",
          [](Arguments& a, V, V) { a.help = true; }},
     };

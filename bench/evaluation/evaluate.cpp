@@ -20,9 +20,11 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
+#include "arguments.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/archive/archive.hpp"
 #include "insitu/explore/colour_model.hpp"
@@ -76,12 +78,21 @@ RawInput parse_raw(const std::string& text) {
     RawInput raw;
     raw.path = text.substr(0, dims_colon);
     const std::string dims = text.substr(dims_colon + 1, type_colon - dims_colon - 1);
-    long long nx = 0, ny = 0, nz = 0;
-    if (std::sscanf(dims.c_str(), "%lldx%lldx%lld", &nx, &ny, &nz) != 3 || nx < 2 || ny < 2 ||
-        nz < 2) {
+    const auto bad_dims = [&] {
         usage_error("--raw " + text + ": dims \"" + dims + "\" (expected NXxNYxNZ, each >= 2)");
+    };
+    std::vector<std::string> sides;
+    try {
+        sides = cli::split_exactly("--raw", dims, 'x', 3, "NXxNYxNZ");
+    } catch (const cli::UsageError&) {
+        bad_dims();
     }
-    raw.dims = {nx, ny, nz};
+    for (std::size_t axis = 0; axis < 3; ++axis) {
+        if (cli::convert_integer(sides[axis], raw.dims[axis]) != std::errc() ||
+            raw.dims[axis] < 2) {
+            bad_dims();
+        }
+    }
     try {
         raw.type = parse_scalar_type(text.substr(type_colon + 1));
     } catch (const Error& error) {

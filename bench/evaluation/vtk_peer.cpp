@@ -31,8 +31,10 @@
 #include <fstream>
 #include <functional>
 #include <string>
+#include <system_error>
 #include <vector>
 
+#include "arguments.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "median_time.hpp"
@@ -69,8 +71,9 @@ Options parse(int argc, char** argv) {
             options.out = value;
             continue;
         }
-        const int number = std::atoi(value.c_str());
-        if (number < 1) usage_error(flag + " = " + value + " (must be a positive integer)");
+        int number = 0;
+        if (insitu::cli::convert_integer(value, number) != std::errc() || number < 1)
+            usage_error(flag + " = " + value + " (must be a positive integer)");
         if (flag == "--size")
             options.size = number;
         else if (flag == "--image")

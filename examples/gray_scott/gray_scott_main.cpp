@@ -8,7 +8,6 @@
 // archived), 2 a bad command line or configuration. Every failure is reported as one line on
 // stderr.
 #include <algorithm>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -26,6 +25,8 @@
 #include <system_error>
 #include <vector>
 
+#include "arguments.hpp"
+#include "cli.hpp"
 #include "gray_scott_simulation.hpp"
 #include "insitu/device/compute_device.hpp"
 #include "insitu/config.hpp"
@@ -66,10 +67,7 @@ steps that could not be archived: one line, exit status 1.
 )";
 
 /// A command-line mistake; main reports it in one line and exits with status 2.
-class UsageError : public std::runtime_error {
-public:
-    using std::runtime_error::runtime_error;
-};
+using insitu::cli::UsageError;
 
 struct Options {
     gray_scott::Parameters simulation;
@@ -85,27 +83,23 @@ struct Options {
     bool help = false;
 };
 
+// The shared strict rules (arguments.hpp) in gray-scott's wording: "FLAG VALUE: problem".
 template <typename Integer>
 Integer parse_integer(const std::string& flag, const std::string& text, Integer low, Integer high) {
     Integer value{};
-    const char* end = text.data() + text.size();
-    const auto [stop, error] = std::from_chars(text.data(), end, value);
+    const std::errc error = insitu::cli::convert_integer(text, value);
     if (error == std::errc::result_out_of_range ||
-        (error == std::errc() && stop == end && (value < low || value > high))) {
+        (error == std::errc() && (value < low || value > high))) {
         throw UsageError(flag + " " + text + ": must be between " + std::to_string(low) + " and " +
                          std::to_string(high));
     }
-    if (error != std::errc() || stop != end || text.empty()) {
-        throw UsageError(flag + " " + text + ": not an integer");
-    }
+    if (error != std::errc()) throw UsageError(flag + " " + text + ": not an integer");
     return value;
 }
 
 double parse_real(const std::string& flag, const std::string& text) {
     double value = 0.0;
-    const char* end = text.data() + text.size();
-    const auto [stop, error] = std::from_chars(text.data(), end, value);
-    if (error != std::errc() || stop != end || text.empty() || !std::isfinite(value)) {
+    if (insitu::cli::convert_finite(text, value) != std::errc()) {
         throw UsageError(flag + " " + text + ": not a finite number");
     }
     return value;
@@ -143,15 +137,13 @@ Options parse_arguments(int argc, char** argv) {
          }},
         {"--image-size",
          [&](const auto& flag, const auto& value) {
-             const UsageError malformed(flag + " " + value +
-                                        ": expected WxH, 1 to 16384 pixels each");
-             const std::size_t x = value.find('x');
-             if (x == std::string::npos) throw malformed;
              try {
-                 options.image_width = parse_integer<int>(flag, value.substr(0, x), 1, 16384);
-                 options.image_height = parse_integer<int>(flag, value.substr(x + 1), 1, 16384);
+                 const insitu::cli::PixelSize size =
+                     insitu::cli::parse_pixel_size(flag, value, 16384);
+                 options.image_width = size.width;
+                 options.image_height = size.height;
              } catch (const UsageError&) {
-                 throw malformed;
+                 throw UsageError(flag + " " + value + ": expected WxH, 1 to 16384 pixels each");
              }
          }},
         {"--azimuth", [&](const auto& flag,
@@ -219,11 +211,7 @@ double milliseconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 /// Error texts may carry OpenCL build logs; the one-line promise holds for them too.
-std::string one_line(std::string text) {
-    std::replace(text.begin(), text.end(), '\n', ' ');
-    while (!text.empty() && text.back() == ' ') text.pop_back();
-    return text;
-}
+using insitu::one_line;
 
 /// The configuration without --config: field v seen from one orbit view, gray-scott's transfer
 /// function, layers and intervals chosen from the data (the library's defaults).

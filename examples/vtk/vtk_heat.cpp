@@ -21,7 +21,6 @@
 #include <vtkUnsignedCharArray.h>
 #include <vtkXMLImageDataWriter.h>
 
-#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -31,11 +30,11 @@
 #include <iostream>
 #include <memory>
 #include <sstream>
-#include <stdexcept>
 #include <string>
-#include <system_error>
 #include <vector>
 
+#include "arguments.hpp"
+#include "cli.hpp"
 #include "insitu/config.hpp"
 #include "insitu/error.hpp"
 #include "insitu/instrument.hpp"
@@ -47,10 +46,7 @@ constexpr const char* kUsage =
     "usage: vtk-heat ARCHIVE [--size N] [--steps S] [--every K] [--config CONFIG.json] "
     "[--write-vti DIR]";
 
-class UsageError : public std::runtime_error {
-public:
-    using std::runtime_error::runtime_error;
-};
+using insitu::cli::UsageError;
 
 struct Options {
     std::string archive;
@@ -60,16 +56,6 @@ struct Options {
     std::string config_path;
     std::string vti_folder;
 };
-
-int parse_int(const std::string& flag, const std::string& text, int minimum) {
-    int value = 0;
-    const char* end = text.data() + text.size();
-    const auto [stop, error] = std::from_chars(text.data(), end, value);
-    if (text.empty() || error != std::errc() || stop != end || value < minimum) {
-        throw UsageError(flag + " " + text + ": expected an integer >= " + std::to_string(minimum));
-    }
-    return value;
-}
 
 Options parse(int argc, char** argv) {
     Options options;
@@ -83,11 +69,11 @@ Options parse(int argc, char** argv) {
         if (i + 1 >= argc) throw UsageError(token + " needs a value");
         const std::string value = argv[++i];
         if (token == "--size") {
-            options.size = parse_int(token, value, 4);
+            options.size = insitu::cli::parse_integer<int>(token, value, 4);
         } else if (token == "--steps") {
-            options.steps = parse_int(token, value, 1);
+            options.steps = insitu::cli::parse_integer<int>(token, value, 1);
         } else if (token == "--every") {
-            options.every = parse_int(token, value, 1);
+            options.every = insitu::cli::parse_integer<int>(token, value, 1);
         } else if (token == "--config") {
             options.config_path = value;
         } else if (token == "--write-vti") {
@@ -247,14 +233,13 @@ int main(int argc, char** argv) {
     }
     try {
         return run(options);
-    } catch (const insitu::InvalidArgument& error) {
-        std::cerr << "vtk-heat: " << error.what() << "\n";
-        return 2;
-    } catch (const insitu::ParseError& error) {
-        std::cerr << "vtk-heat: " << error.what() << "\n";
-        return 2;
     } catch (const std::exception& error) {
-        std::cerr << "vtk-heat: " << error.what() << "\n";
-        return 1;
+        std::cerr << "vtk-heat: " << insitu::one_line(error.what()) << "\n";
+        // A bad configuration is the user's (2); files, devices and the rest are runtime
+        // failures (1).
+        const insitu::ErrorKind kind = insitu::classify(std::current_exception());
+        const bool bad_input =
+            kind == insitu::ErrorKind::invalid_argument || kind == insitu::ErrorKind::parse;
+        return bad_input ? 2 : 1;
     }
 }

@@ -1,14 +1,10 @@
 // Relighting from depth proxies (seed 000 §5, §6.5); the definitions are written out in
 // libinsitu/include/insitu/relighting.hpp. One work-item per pixel. Depth images may have
-// several channels (pixel-interleaved); `channels` and `channel` pick one. Camera arguments as
-// in common.cl camera_ray(). Kernels that loop per pixel (over lights, intervals, neighbours)
-// run one work-item at a time on PoCL's CPU device, so their loop bodies are kept lean.
-
-// Image-plane coordinates (world units for orthographic, tangent units for perspective).
-inline float2 plane_coordinates(int x, int y, int2 size, float4 half_extent) {
-    return (float2)((2.0f * ((float)x + 0.5f) / (float)size.x - 1.0f) * half_extent.x,
-                    (1.0f - 2.0f * ((float)y + 0.5f) / (float)size.y) * half_extent.y);
-}
+// several channels (pixel-interleaved); `channels` and `channel` pick one. Cameras arrive as
+// the host's camera_axes() packs them (forward, right, up, half extent); pixel centres come from
+// plane_coordinates() in common.cl. Kernels that loop per pixel (over lights, intervals,
+// neighbours) run one work-item at a time on PoCL's CPU device, so their loop bodies are kept
+// lean.
 
 // Ray geometry of one pixel, shared by every depth channel. With D = dP/dZ (forward for
 // orthographic; forward + lateral for perspective, whose forward . D = 1) and s_x, s_y the

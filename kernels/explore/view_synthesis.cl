@@ -5,7 +5,8 @@
 // Camera-local coordinates (a, b, z): offsets along right, up and forward from the camera's
 // position (orthographic: centre of the camera plane; perspective: the eye), world units, so z is
 // the depth of DESIGN.md. `extent` = (half width, half height, projection 0 orthographic /
-// 1 perspective, tan(tilt) of a volume distortion camera or 0). The host passes the rigid map
+// 1 perspective, tan(tilt) of a volume distortion camera or 0); each camera arrives as its image
+// size followed by its extent (the host's camera_plane()). The host passes the rigid map
 // between two cameras' local coordinates as three rows (R | t): seed 000 Eq. 4, M_new M_orig^-1.
 // Layer images are planar (layer l of pixel p at l * pixel_count + p); per-interval images are
 // interleaved (interval j of pixel p at p * interval_count + j), as ProxyFrame stores them.
@@ -33,13 +34,6 @@ inline uint depth_key(float depth) {
 
 inline float key_depth(uint key) {
     return as_float((key & 0x80000000u) != 0 ? (key & 0x7fffffffu) : ~key);
-}
-
-// Camera-plane position (u, v) of pixel (x, y)'s centre (orthographic: world units; perspective:
-// tangents of the ray), as camera_ray() in common.cl computes it.
-inline float2 plane_position(int x, int y, int2 size, float4 extent) {
-    return (float2)((2.0f * ((float)x + 0.5f) / (float)size.x - 1.0f) * extent.x,
-                    (1.0f - 2.0f * ((float)y + 0.5f) / (float)size.y) * extent.y);
 }
 
 // Local point of a stored sample at `depth`; `distortion` is the stored in-plane distortion of a
@@ -190,7 +184,7 @@ inline bool source_point(__global const float* depth, __global const float* dist
     const float ds = has_distortion == 1   ? distortion[index]
                      : has_distortion == 2 ? z * extent.w
                                            : 0.0f;
-    *point = stored_point(plane_position(x, y, size, extent), z, ds, extent);
+    *point = stored_point(plane_coordinates(x, y, size, extent), z, ds, extent);
     return true;
 }
 
@@ -275,7 +269,7 @@ inline bool target_ray_in_source(int x, int y, int2 target_size, float4 target_e
                                  float4 inverse0, float4 inverse1, float4 inverse2,
                                  float4 sphere_target, int2 source_size, float4 source_extent,
                                  SourceRay* ray) {
-    const float2 uv = plane_position(x, y, target_size, target_extent);
+    const float2 uv = plane_coordinates(x, y, target_size, target_extent);
     float3 origin = (float3)(uv, 0.0f);
     float3 direction = (float3)(0.0f, 0.0f, 1.0f);
     if (target_extent.z != 0.0f) {
@@ -684,7 +678,7 @@ __kernel void radiality_angles(__global const float* depth, __global const float
     if (x >= size.x || y >= size.y) return;
     const int pixel = y * size.x + x;
     const int count = size.x * size.y;
-    const float2 uv = plane_position(x, y, size, extent);
+    const float2 uv = plane_coordinates(x, y, size, extent);
     float3 direction = (float3)(0.0f, 0.0f, 1.0f);
     if (extent.z != 0.0f) {
         direction = normalize((float3)(uv, 1.0f));

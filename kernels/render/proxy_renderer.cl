@@ -1,5 +1,6 @@
 // Proxy images in one ray-marching pass per camera (seed 000 §3-§6); the definition is written
-// out in libinsitu/include/insitu/proxy_renderer.hpp. One work-item per pixel.
+// out in libinsitu/include/insitu/render/proxy_renderer.hpp. Rays and samples come from
+// ray_march.cl, shared with the ground truth. One work-item per pixel.
 // Layer outputs are planar (layer l of pixel p at l * pixel_count + p: one image per layer);
 // per-interval outputs are interleaved (interval j of pixel p at p * interval_count + j), and
 // the kernel accumulates into them in place: a pixel's intervals share one or two cache lines,
@@ -46,18 +47,9 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
     const float sin_tilt = march.z;
     const float cos_tilt = march.w;
 
-    float3 ray_origin;
-    float3 ray_direction;
-    camera_ray(x, y, size, cam_position, cam_forward, cam_right, cam_up, cam_half_extent,
-               &ray_origin, &ray_direction);
-    if (sin_tilt != 0.0f) {
-        // Volume distortion camera (seed 000 Eq. 1): tilt towards the pole line through the
-        // image centre.
-        const float3 offset = ray_origin - cam_position.xyz;
-        const float offset_length = length(offset);
-        const float3 radial = offset_length > 0.0f ? offset / offset_length : (float3)(0.0f);
-        ray_direction = normalize(cam_forward.xyz * cos_tilt - radial * sin_tilt);
-    }
+    const MarchRay ray = march_ray(x, y, size, cam_position, cam_forward, cam_right, cam_up,
+                                   cam_half_extent, sin_tilt, cos_tilt, origin_world,
+                                   inv_spacing, box_lower, box_upper);
 
     const bool want_layers = (wanted & WANT_DEPTH) != 0 && layer_count > 0;
     const bool want_attenuation = (wanted & WANT_ATTENUATION) != 0;
@@ -80,21 +72,17 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
         }
     }
 
-    const float2 span = intersect_box(ray_origin, ray_direction, box_lower.xyz, box_upper.xyz);
-    const float depth_origin = dot(ray_origin - cam_position.xyz, cam_forward.xyz);
-    const float depth_per_t = dot(ray_direction, cam_forward.xyz);
-    if (span.x <= span.y) {
-        const float3 start_voxels = (ray_origin - origin_world.xyz) * inv_spacing.xyz;
-        const float3 direction_voxels = ray_direction * inv_spacing.xyz;
+    if (ray_hits_box(&ray)) {
         float transmittance = 1.0f;
         bool accumulating = accumulate;
         float previous_value = NAN;
         float previous_t = 0.0f;
         float next_block_t = -INFINITY;  // t where the ray leaves the block looked up last
         for (int i = 0;; ++i) {
-            const float t = span.x + ((float)i + 0.5f) * step;
-            if (t >= span.y) break;
-            const float value = sample_trilinear(volume, dims, start_voxels + t * direction_voxels);
+            const float t = sample_t(&ray, i, step);
+            if (t >= ray.t_far) break;
+            const float3 p = sample_position_voxels(&ray, t);
+            const float value = sample_trilinear(volume, dims, p);
             if (isnan(value)) {
                 previous_value = NAN;
                 continue;
@@ -122,16 +110,13 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
                             ? clamp((int)((value - interval_edges[0]) * uniform_interval_scale), 0,
                                     interval_count - 1)
                             : interval_of(interval_edges, interval_count, value);
-                    const float weight = transmittance * alpha;  // seed 000 Eq. 7
+                    const float weight = absorb(&transmittance, alpha);  // seed 000 Eq. 7
                     attenuation[j] += weight;
-                    if (want_mean_depth) {
-                        weighted_depth[j] += weight * (depth_origin + t * depth_per_t);
-                    }
+                    if (want_mean_depth) weighted_depth[j] += weight * sample_depth(&ray, t);
                     if (want_optical_depth) {
                         // alpha = 1 would be infinite optical depth; clamp to float's largest.
                         optical_depth[j] += alpha < 1.0f ? -log(1.0f - alpha) : FLT_MAX;
                     }
-                    transmittance *= 1.0f - alpha;
                     if (1.0f - transmittance >= stop_opacity) accumulating = false;
                 }
             }
@@ -143,19 +128,19 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
             // samples and nothing between them could have contributed. Blocks are looked up once
             // per block the ray enters, not per sample.
             if (block_size > 0 && t >= next_block_t) {
-                const float3 p = start_voxels + t * direction_voxels;
                 const int3 block = clamp(convert_int3(floor(p / (float)block_size)), (int3)(0),
                                          block_counts.xyz - 1);
                 const float3 lower = convert_float3(block * block_size);
                 const float3 upper = lower + (float3)(block_size);
-                const float3 exit_plane = select(lower, upper, direction_voxels > 0.0f);
-                const float3 t_axis = select((exit_plane - start_voxels) / direction_voxels,
-                                             (float3)(INFINITY), direction_voxels == 0.0f);
+                const float3 exit_plane = select(lower, upper, ray.direction_voxels > 0.0f);
+                const float3 t_axis =
+                    select((exit_plane - ray.start_voxels) / ray.direction_voxels,
+                           (float3)(INFINITY), ray.direction_voxels == 0.0f);
                 next_block_t = fmin(fmin(t_axis.x, t_axis.y), t_axis.z);
                 const int block_index =
                     (block.z * block_counts.y + block.y) * block_counts.x + block.x;
                 if (skippable_blocks[block_index]) {
-                    const int last = (int)ceil((next_block_t - span.x) / step - 0.5f) - 1;
+                    const int last = (int)ceil((next_block_t - ray.t_near) / step - 0.5f) - 1;
                     if (last > i + 1) i = last - 1;
                 }
             }
@@ -165,7 +150,7 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
     if (want_layers) {
         for (int l = 0; l < layer_count; ++l) {
             const float t = layer_t[l];
-            depth_out[l * pixel_count + pixel] = depth_origin + t * depth_per_t;
+            depth_out[l * pixel_count + pixel] = sample_depth(&ray, t);
             if ((wanted & WANT_DISTORTION) != 0) {
                 distortion_out[l * pixel_count + pixel] = isinf(t) ? INFINITY : t * sin_tilt;
             }

@@ -5,9 +5,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <initializer_list>
 #include <limits>
 #include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "insitu/error.hpp"
 #include "insitu/core/layers.hpp"
@@ -17,10 +18,8 @@ namespace insitu {
 namespace {
 
 using nlohmann::json;
+using Unknown = std::vector<std::string>;
 
-// Names of the "proxies" list, in the order to_json writes them.
-constexpr std::array<const char*, 5> kProxyNames = {"depth", "distortion", "attenuation",
-                                                    "multi_attenuation", "optical_depth"};
 // OpenEXR's lossless and lossy codecs that every OpenEXR 3 build has.
 constexpr std::array<const char*, 7> kCompressions = {"none", "rle",   "zips", "zip",
                                                       "piz",  "pxr24", "b44"};
@@ -53,12 +52,20 @@ std::string text_of(const Value& value) {
     return out.str();
 }
 
-void collect_unknown(const json& object, const std::string& parent,
-                     std::initializer_list<const char*> known, std::vector<std::string>& unknown) {
-    for (const auto& item : object.items()) {
-        const bool is_known = std::any_of(known.begin(), known.end(),
-                                          [&](const char* name) { return item.key() == name; });
-        if (!is_known) unknown.push_back(child_key(parent, item.key()));
+std::string list_text(const std::vector<double>& values) {
+    std::string text = "[";
+    for (std::size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + text_of(values[i]);
+    return text + "]";
+}
+
+// Runs one of the library's own parsers or checks, so that a configuration accepts exactly what
+// the library does; its InvalidArgument gains the key and the value.
+template <typename Check>
+auto checked(const std::string& key, const std::string& value, Check check) -> decltype(check()) {
+    try {
+        return check();
+    } catch (const InvalidArgument& error) {
+        fail<InvalidArgument>("configuration \"", key, "\" = ", value, ": ", error.what());
     }
 }
 
@@ -101,15 +108,121 @@ std::string text(const json& value, const std::string& key) {
     return value.get<std::string>();
 }
 
+bool boolean(const json& value, const std::string& key) {
+    if (!value.is_boolean()) wrong_type(key, value, "true or false");
+    return value.get<bool>();
+}
+
+template <typename Element>
+std::vector<Element> list_of(const json& value, const std::string& key,
+                             Element (*element)(const json&, const std::string&)) {
+    require_array(value, key);
+    std::vector<Element> list;
+    for (std::size_t i = 0; i < value.size(); ++i) {
+        list.push_back(element(value[i], element_key(key, i)));
+    }
+    return list;
+}
+
+// The words of a configuration value that names one of a few choices.
+template <typename Value>
+struct Choice {
+    const char* name;
+    Value value;
+};
+
+constexpr Choice<StoragePrecision> kPrecisions[] = {{"half", StoragePrecision::half},
+                                                    {"float", StoragePrecision::single}};
+constexpr Choice<WhenFull> kWhenFull[] = {{"block", WhenFull::block}, {"drop", WhenFull::drop}};
+// "proxies" names members of ProxySelection; to_json writes them in this order.
+constexpr Choice<bool ProxySelection::*> kProxies[] = {
+    {"depth", &ProxySelection::depth},
+    {"distortion", &ProxySelection::distortion},
+    {"attenuation", &ProxySelection::attenuation},
+    {"multi_attenuation", &ProxySelection::multi_attenuation},
+    {"optical_depth", &ProxySelection::optical_depth}};
+
+/// "a, b or c".
+template <typename Value, std::size_t N>
+std::string alternatives(const Choice<Value> (&choices)[N]) {
+    std::string words;
+    for (std::size_t i = 0; i < N; ++i) {
+        words += (i == 0 ? "" : i + 1 == N ? " or " : ", ") + std::string(choices[i].name);
+    }
+    return words;
+}
+
+template <typename Value, std::size_t N>
+Value choose(const json& value, const std::string& key, const Choice<Value> (&choices)[N]) {
+    const std::string name = text(value, key);
+    for (const Choice<Value>& choice : choices) {
+        if (name == choice.name) return choice.value;
+    }
+    out_of_range(key, value.dump(), "expected ", alternatives(choices));
+}
+
+template <typename Value, std::size_t N>
+const char* name_of(Value value, const Choice<Value> (&choices)[N]) {
+    for (const Choice<Value>& choice : choices) {
+        if (value == choice.value) return choice.name;
+    }
+    fail<Error>("configuration: a value without a name");  // a bug: every enumerator is listed
+}
+
+// One table per JSON object of the configuration: each entry spells its key once and says how
+// to parse its value into the target and how to write it back. Parsing, the detection of
+// unknown keys and to_json all run from the table.
+template <typename Target>
+struct Key {
+    const char* name;
+    /// `key` is the dotted path of the value, for errors; nested objects add their unknown keys.
+    void (*parse)(const json& value, const std::string& key, Target& target, Unknown& unknown);
+    /// Null leaves the key out (the cadence: one of "every" and "steps").
+    json (*write)(const Target& target);
+};
+
+template <typename Target, std::size_t N>
+void parse_object(const json& value, const std::string& key, const Key<Target> (&keys)[N],
+                  Target& target, Unknown& unknown) {
+    require_object(value, key);
+    for (const auto& item : value.items()) {
+        const bool known = std::any_of(std::begin(keys), std::end(keys), [&](const Key<Target>& k) {
+            return item.key() == k.name;
+        });
+        if (!known) unknown.push_back(child_key(key, item.key()));
+    }
+    for (const Key<Target>& entry : keys) {
+        const auto found = value.find(entry.name);
+        if (found != value.end()) entry.parse(*found, child_key(key, entry.name), target, unknown);
+    }
+}
+
+template <typename Target, std::size_t N>
+json write_object(const Target& target, const Key<Target> (&keys)[N]) {
+    json result = json::object();
+    for (const Key<Target>& entry : keys) {
+        json value = entry.write(target);
+        if (!value.is_null()) result[entry.name] = std::move(value);
+    }
+    return result;
+}
+
 // A transfer function object: its own unknown keys are collected here (TransferFunction's parser
 // would reject them), its errors are prefixed with the key and keep their type.
+constexpr std::array<const char*, 3> kTransferFunctionKeys = {"points", "gradient_rows",
+                                                              "unit_length"};
+
 TransferFunction parse_transfer_function(const json& value, const std::string& key,
-                                         std::vector<std::string>& unknown) {
+                                         Unknown& unknown) {
     require_object(value, key);
-    collect_unknown(value, key, {"points", "gradient_rows", "unit_length"}, unknown);
     json known = json::object();
-    for (const char* name : {"points", "gradient_rows", "unit_length"}) {
-        if (value.contains(name)) known[name] = value[name];
+    for (const auto& item : value.items()) {
+        if (std::find(kTransferFunctionKeys.begin(), kTransferFunctionKeys.end(), item.key()) ==
+            kTransferFunctionKeys.end()) {
+            unknown.push_back(child_key(key, item.key()));
+        } else {
+            known[item.key()] = item.value();
+        }
     }
     try {
         return TransferFunction::from_json(known);
@@ -120,122 +233,219 @@ TransferFunction parse_transfer_function(const json& value, const std::string& k
     }
 }
 
-ViewConfig parse_view(const json& value, const std::string& key,
-                      std::vector<std::string>& unknown) {
-    require_object(value, key);
-    collect_unknown(value, key,
-                    {"azimuth", "elevation", "camera", "fov", "size", "distortion_tilt"}, unknown);
-    ViewConfig view;
-    OrbitView& orbit = view.orbit;
-    if (value.contains("azimuth")) {
-        orbit.azimuth_deg = number(value["azimuth"], child_key(key, "azimuth"));
-    }
-    if (value.contains("elevation")) {
-        orbit.elevation_deg = number(value["elevation"], child_key(key, "elevation"));
-    }
-    if (value.contains("camera")) {
-        const std::string camera_key = child_key(key, "camera");
-        const std::string camera = text(value["camera"], camera_key);
-        if (camera == "ortho" || camera == "orthographic") {
-            orbit.projection = Projection::orthographic;
-        } else if (camera == "perspective") {
-            orbit.projection = Projection::perspective;
-        } else {
-            out_of_range(camera_key, value["camera"].dump(),
-                         "expected ortho, orthographic or perspective");
-        }
-    }
-    if (value.contains("fov")) orbit.fov_y_deg = number(value["fov"], child_key(key, "fov"));
-    if (value.contains("size")) {
-        const std::string size_key = child_key(key, "size");
-        const json& size = value["size"];
-        if (!size.is_array() || size.size() != 2) wrong_type(size_key, size, "[width, height]");
-        orbit.width = small_integer(size[0], element_key(size_key, 0));
-        orbit.height = small_integer(size[1], element_key(size_key, 1));
-    }
-    if (value.contains("distortion_tilt")) {
-        view.distortion_tilt_deg =
-            number(value["distortion_tilt"], child_key(key, "distortion_tilt"));
-    }
-    return view;
-}
+const Key<ViewConfig> kViewKeys[] = {
+    {"azimuth",
+     [](const json& value, const std::string& key, ViewConfig& view, Unknown&) {
+         view.orbit.azimuth_deg = number(value, key);
+     },
+     [](const ViewConfig& view) { return json(view.orbit.azimuth_deg); }},
+    {"elevation",
+     [](const json& value, const std::string& key, ViewConfig& view, Unknown&) {
+         view.orbit.elevation_deg = number(value, key);
+     },
+     [](const ViewConfig& view) { return json(view.orbit.elevation_deg); }},
+    {"camera",
+     [](const json& value, const std::string& key, ViewConfig& view, Unknown&) {
+         const std::string name = text(value, key);
+         view.orbit.projection = checked(key, value.dump(), [&] { return parse_projection(name); });
+     },
+     [](const ViewConfig& view) { return json(to_string(view.orbit.projection)); }},
+    {"fov",
+     [](const json& value, const std::string& key, ViewConfig& view, Unknown&) {
+         view.orbit.fov_y_deg = number(value, key);
+     },
+     [](const ViewConfig& view) { return json(view.orbit.fov_y_deg); }},
+    {"size",
+     [](const json& value, const std::string& key, ViewConfig& view, Unknown&) {
+         if (!value.is_array() || value.size() != 2) wrong_type(key, value, "[width, height]");
+         view.orbit.width = small_integer(value[0], element_key(key, 0));
+         view.orbit.height = small_integer(value[1], element_key(key, 1));
+     },
+     [](const ViewConfig& view) { return json{view.orbit.width, view.orbit.height}; }},
+    {"distortion_tilt",
+     [](const json& value, const std::string& key, ViewConfig& view, Unknown&) {
+         view.distortion_tilt_deg = number(value, key);
+     },
+     [](const ViewConfig& view) { return json(view.distortion_tilt_deg); }},
+};
 
-ProxySelection proxies_from_json(const json& value) {
-    require_array(value, "proxies");
-    // A given list replaces the default one: only what it names is emitted.
-    ProxySelection selection{false, false, false, false, false};
-    for (std::size_t i = 0; i < value.size(); ++i) {
-        const std::string key = element_key("proxies", i);
-        const std::string name = text(value[i], key);
-        if (name == "depth") {
-            selection.depth = true;
-        } else if (name == "distortion") {
-            selection.distortion = true;
-        } else if (name == "attenuation") {
-            selection.attenuation = true;
-        } else if (name == "multi_attenuation") {
-            selection.multi_attenuation = true;
-        } else if (name == "optical_depth") {
-            selection.optical_depth = true;
-        } else {
-            out_of_range(key, value[i].dump(),
-                         "expected depth, distortion, attenuation, multi_attenuation or "
-                         "optical_depth");
-        }
-    }
-    return selection;
-}
+const Key<InstrumentConfig> kIntervalKeys[] = {
+    {"count",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.interval_count = small_integer(value, key);
+     },
+     [](const InstrumentConfig& config) { return json(config.interval_count); }},
+    {"mode",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         const std::string name = text(value, key);
+         config.interval_mode =
+             checked(key, value.dump(), [&] { return parse_interval_mode(name); });
+     },
+     [](const InstrumentConfig& config) { return json(to_string(config.interval_mode)); }},
+};
 
-void parse_intervals(const json& value, InstrumentConfig& config,
-                     std::vector<std::string>& unknown) {
-    require_object(value, "intervals");
-    collect_unknown(value, "intervals", {"count", "mode"}, unknown);
-    if (value.contains("count")) {
-        config.interval_count = small_integer(value["count"], "intervals.count");
-    }
-    if (value.contains("mode")) {
-        const std::string mode = text(value["mode"], "intervals.mode");
-        if (mode == "uniform") {
-            config.interval_mode = IntervalMode::uniform;
-        } else if (mode == "histogram" || mode == "histogram_equalized") {
-            config.interval_mode = IntervalMode::histogram_equalized;
-        } else {
-            out_of_range("intervals.mode", value["mode"].dump(),
-                         "expected uniform, histogram or histogram_equalized");
-        }
-    }
-}
+const Key<InstrumentConfig> kWriterKeys[] = {
+    {"queue",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.writer_queue = small_integer(value, key);
+     },
+     [](const InstrumentConfig& config) { return json(config.writer_queue); }},
+    {"when_full",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.when_full = choose(value, key, kWhenFull);
+     },
+     [](const InstrumentConfig& config) { return json(name_of(config.when_full, kWhenFull)); }},
+};
 
-void parse_writer(const json& value, InstrumentConfig& config, std::vector<std::string>& unknown) {
-    require_object(value, "writer");
-    collect_unknown(value, "writer", {"queue", "when_full"}, unknown);
-    if (value.contains("queue"))
-        config.writer_queue = small_integer(value["queue"], "writer.queue");
-    if (value.contains("when_full")) {
-        const std::string policy = text(value["when_full"], "writer.when_full");
-        if (policy == "block") {
-            config.when_full = WhenFull::block;
-        } else if (policy == "drop") {
-            config.when_full = WhenFull::drop;
-        } else {
-            out_of_range("writer.when_full", value["when_full"].dump(), "expected block or drop");
-        }
-    }
-}
+const Key<ColourModelConfig> kColourModelKeys[] = {
+    {"clusters",
+     [](const json& value, const std::string& key, ColourModelConfig& model, Unknown&) {
+         model.clusters = small_integer(value, key);
+     },
+     [](const ColourModelConfig& model) { return json(model.clusters); }},
+    {"enabled",
+     [](const json& value, const std::string& key, ColourModelConfig& model, Unknown&) {
+         model.enabled = boolean(value, key);
+     },
+     [](const ColourModelConfig& model) { return json(model.enabled); }},
+};
 
-void parse_colour_model(const json& value, InstrumentConfig& config,
-                        std::vector<std::string>& unknown) {
-    require_object(value, "colour_model");
-    collect_unknown(value, "colour_model", {"clusters", "enabled"}, unknown);
-    if (value.contains("clusters")) {
-        config.colour_model.clusters = small_integer(value["clusters"], "colour_model.clusters");
-    }
-    if (value.contains("enabled")) {
-        const json& enabled = value["enabled"];
-        if (!enabled.is_boolean()) wrong_type("colour_model.enabled", enabled, "true or false");
-        config.colour_model.enabled = enabled.get<bool>();
-    }
-}
+const Key<InstrumentConfig> kTopLevelKeys[] = {
+    {"fields",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.fields = list_of(value, key, text);
+     },
+     [](const InstrumentConfig& config) { return json(config.fields); }},
+    {"views",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
+         require_array(value, key);
+         config.views.clear();
+         for (std::size_t i = 0; i < value.size(); ++i) {
+             ViewConfig view;
+             parse_object(value[i], element_key(key, i), kViewKeys, view, unknown);
+             config.views.push_back(view);
+         }
+     },
+     [](const InstrumentConfig& config) {
+         json views = json::array();
+         for (const ViewConfig& view : config.views) views.push_back(view.to_json());
+         return views;
+     }},
+    {"transfer_function",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
+         config.transfer_function = parse_transfer_function(value, key, unknown);
+     },
+     [](const InstrumentConfig& config) { return config.transfer_function.to_json(); }},
+    {"training_transfer_functions",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
+         require_array(value, key);
+         for (std::size_t i = 0; i < value.size(); ++i) {
+             config.training_transfer_functions.push_back(
+                 parse_transfer_function(value[i], element_key(key, i), unknown));
+         }
+     },
+     [](const InstrumentConfig& config) {
+         json functions = json::array();
+         for (const TransferFunction& tf : config.training_transfer_functions) {
+             functions.push_back(tf.to_json());
+         }
+         return functions;
+     }},
+    {"layers",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         if (value.is_string()) {
+             if (value.get<std::string>() != "auto") {
+                 out_of_range(key, value.dump(), "expected \"auto\" or a list of isovalues");
+             }
+             config.layers.reset();
+         } else if (value.is_array()) {
+             config.layers = list_of(value, key, number);
+         } else {
+             wrong_type(key, value, "\"auto\" or a list of isovalues");
+         }
+     },
+     [](const InstrumentConfig& config) {
+         return config.layers ? json(*config.layers) : json("auto");
+     }},
+    {"max_layers",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.max_auto_layers = small_integer(value, key);
+     },
+     [](const InstrumentConfig& config) { return json(config.max_auto_layers); }},
+    {"intervals",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
+         parse_object(value, key, kIntervalKeys, config, unknown);
+     },
+     [](const InstrumentConfig& config) { return write_object(config, kIntervalKeys); }},
+    {"proxies",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         require_array(value, key);
+         // A given list replaces the default one: only what it names is emitted.
+         config.proxies = ProxySelection{false, false, false, false, false};
+         for (std::size_t i = 0; i < value.size(); ++i) {
+             config.proxies.*choose(value[i], element_key(key, i), kProxies) = true;
+         }
+     },
+     [](const InstrumentConfig& config) {
+         json names = json::array();
+         for (const auto& proxy : kProxies) {
+             if (config.proxies.*proxy.value) names.push_back(proxy.name);
+         }
+         return names;
+     }},
+    {"step",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.step_voxels = number(value, key);
+     },
+     [](const InstrumentConfig& config) { return json(config.step_voxels); }},
+    // One cadence key, as from_json accepts: an explicit list replaces "every".
+    {"every",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.every = integer(value, key);
+     },
+     [](const InstrumentConfig& config) {
+         return config.steps.empty() ? json(config.every) : json();
+     }},
+    {"steps",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.steps = list_of(value, key, integer);
+     },
+     [](const InstrumentConfig& config) {
+         return config.steps.empty() ? json() : json(config.steps);
+     }},
+    {"archive",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.archive = text(value, key);
+     },
+     [](const InstrumentConfig& config) { return json(config.archive); }},
+    {"precision",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.precision = choose(value, key, kPrecisions);
+     },
+     [](const InstrumentConfig& config) { return json(name_of(config.precision, kPrecisions)); }},
+    {"compression",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.compression = text(value, key);
+     },
+     [](const InstrumentConfig& config) { return json(config.compression); }},
+    {"writer",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
+         parse_object(value, key, kWriterKeys, config, unknown);
+     },
+     [](const InstrumentConfig& config) { return write_object(config, kWriterKeys); }},
+    {"keep_training_images",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.keep_training_images = boolean(value, key);
+     },
+     [](const InstrumentConfig& config) { return json(config.keep_training_images); }},
+    {"colour_model",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
+         parse_object(value, key, kColourModelKeys, config.colour_model, unknown);
+     },
+     [](const InstrumentConfig& config) {
+         return write_object(config.colour_model, kColourModelKeys);
+     }},
+};
 
 std::string join(const std::vector<std::string>& names) {
     std::string joined;
@@ -245,105 +455,23 @@ std::string join(const std::vector<std::string>& names) {
 
 }  // namespace
 
+nlohmann::json ViewConfig::to_json() const {
+    return write_object(*this, kViewKeys);
+}
+
 InstrumentConfig InstrumentConfig::from_json(const nlohmann::json& document,
                                              std::vector<std::string>* unknown_keys) {
     if (!document.is_object()) {
         fail<ParseError>("configuration: expected a JSON object, got ", document.dump());
     }
-    std::vector<std::string> unknown;
-    collect_unknown(
-        document, "",
-        {"fields", "views", "transfer_function", "training_transfer_functions", "layers",
-         "max_layers", "intervals", "proxies", "step", "every", "steps", "archive", "precision",
-         "compression", "writer", "keep_training_images", "colour_model"},
-        unknown);
-
-    InstrumentConfig config;
-    if (document.contains("fields")) {
-        const json& fields = require_array(document["fields"], "fields");
-        config.fields.clear();
-        for (std::size_t i = 0; i < fields.size(); ++i) {
-            config.fields.push_back(text(fields[i], element_key("fields", i)));
-        }
-    }
-    if (document.contains("views")) {
-        const json& views = require_array(document["views"], "views");
-        config.views.clear();
-        for (std::size_t i = 0; i < views.size(); ++i) {
-            config.views.push_back(parse_view(views[i], element_key("views", i), unknown));
-        }
-    }
-    if (document.contains("transfer_function")) {
-        config.transfer_function =
-            parse_transfer_function(document["transfer_function"], "transfer_function", unknown);
-    }
-    if (document.contains("training_transfer_functions")) {
-        const std::string key = "training_transfer_functions";
-        const json& list = require_array(document[key], key);
-        for (std::size_t i = 0; i < list.size(); ++i) {
-            config.training_transfer_functions.push_back(
-                parse_transfer_function(list[i], element_key(key, i), unknown));
-        }
-    }
-    if (document.contains("layers")) {
-        const json& layers = document["layers"];
-        if (layers.is_string()) {
-            if (layers.get<std::string>() != "auto") {
-                out_of_range("layers", layers.dump(), "expected \"auto\" or a list of isovalues");
-            }
-            config.layers.reset();
-        } else if (layers.is_array()) {
-            std::vector<double> isovalues;
-            for (std::size_t i = 0; i < layers.size(); ++i) {
-                isovalues.push_back(number(layers[i], element_key("layers", i)));
-            }
-            config.layers = std::move(isovalues);
-        } else {
-            wrong_type("layers", layers, "\"auto\" or a list of isovalues");
-        }
-    }
-    if (document.contains("max_layers")) {
-        config.max_auto_layers = small_integer(document["max_layers"], "max_layers");
-    }
-    if (document.contains("intervals")) parse_intervals(document["intervals"], config, unknown);
-    if (document.contains("proxies")) config.proxies = proxies_from_json(document["proxies"]);
-    if (document.contains("step")) config.step_voxels = number(document["step"], "step");
     if (document.contains("every") && document.contains("steps")) {
         fail<InvalidArgument>("configuration: \"every\" = ", document["every"].dump(),
                               " and \"steps\" = ", document["steps"].dump(),
                               " (give one cadence, not both)");
     }
-    if (document.contains("every")) config.every = integer(document["every"], "every");
-    if (document.contains("steps")) {
-        const json& steps = require_array(document["steps"], "steps");
-        for (std::size_t i = 0; i < steps.size(); ++i) {
-            config.steps.push_back(integer(steps[i], element_key("steps", i)));
-        }
-    }
-    if (document.contains("archive")) config.archive = text(document["archive"], "archive");
-    if (document.contains("precision")) {
-        const std::string precision = text(document["precision"], "precision");
-        if (precision == "half") {
-            config.precision = StoragePrecision::half;
-        } else if (precision == "float") {
-            config.precision = StoragePrecision::single;
-        } else {
-            out_of_range("precision", document["precision"].dump(), "expected half or float");
-        }
-    }
-    if (document.contains("compression")) {
-        config.compression = text(document["compression"], "compression");
-    }
-    if (document.contains("writer")) parse_writer(document["writer"], config, unknown);
-    if (document.contains("keep_training_images")) {
-        const json& keep = document["keep_training_images"];
-        if (!keep.is_boolean()) wrong_type("keep_training_images", keep, "true or false");
-        config.keep_training_images = keep.get<bool>();
-    }
-    if (document.contains("colour_model")) {
-        parse_colour_model(document["colour_model"], config, unknown);
-    }
-
+    Unknown unknown;
+    InstrumentConfig config;
+    parse_object(document, "", kTopLevelKeys, config, unknown);
     config.validate();
     if (unknown_keys != nullptr) {
         unknown_keys->insert(unknown_keys->end(), unknown.begin(), unknown.end());
@@ -393,22 +521,18 @@ void InstrumentConfig::validate() const {
     for (std::size_t i = 0; i < views.size(); ++i) {
         const std::string key = element_key("views", i);
         const OrbitView& orbit = views[i].orbit;
-        if (!std::isfinite(orbit.azimuth_deg)) {
-            out_of_range(child_key(key, "azimuth"), text_of(orbit.azimuth_deg), "must be finite");
-        }
-        if (!(std::abs(orbit.elevation_deg) <= 90.0)) {
-            out_of_range(child_key(key, "elevation"), text_of(orbit.elevation_deg),
-                         "degrees, must be in [-90, 90]");
-        }
-        if (!(orbit.fov_y_deg > 0.0 && orbit.fov_y_deg < 180.0)) {
-            out_of_range(child_key(key, "fov"), text_of(orbit.fov_y_deg),
-                         "degrees, must be in (0, 180)");
-        }
-        if (orbit.width < 1 || orbit.height < 1 || orbit.width > kMaxImageSide ||
-            orbit.height > kMaxImageSide) {
-            out_of_range(child_key(key, "size"),
-                         "[" + text_of(orbit.width) + ", " + text_of(orbit.height) + "]",
-                         "pixels, each side in [1, ", kMaxImageSide, "]");
+        checked(child_key(key, "azimuth"), text_of(orbit.azimuth_deg),
+                [&] { check_orbit_azimuth(orbit.azimuth_deg); });
+        checked(child_key(key, "elevation"), text_of(orbit.elevation_deg),
+                [&] { check_orbit_elevation(orbit.elevation_deg); });
+        // Whatever the projection: to_json records every view's fov, and it must read back.
+        checked(child_key(key, "fov"), text_of(orbit.fov_y_deg),
+                [&] { check_orbit_fov(orbit.fov_y_deg); });
+        const std::string size = "[" + text_of(orbit.width) + ", " + text_of(orbit.height) + "]";
+        checked(child_key(key, "size"), size, [&] { check_orbit_size(orbit.width, orbit.height); });
+        if (orbit.width > kMaxImageSide || orbit.height > kMaxImageSide) {
+            out_of_range(child_key(key, "size"), size, "pixels, each side in [1, ", kMaxImageSide,
+                         "]");
         }
         const double tilt = views[i].distortion_tilt_deg;
         if (!(tilt >= 0.0 && tilt < 90.0)) {
@@ -416,16 +540,7 @@ void InstrumentConfig::validate() const {
                          "degrees, must be in [0, 90)");
         }
     }
-    if (layers) {
-        if (layers->size() > static_cast<std::size_t>(kMaxLayers)) {
-            out_of_range("layers", text_of(layers->size()) + " isovalues", "at most ", kMaxLayers);
-        }
-        for (std::size_t i = 0; i < layers->size(); ++i) {
-            if (!std::isfinite((*layers)[i])) {
-                out_of_range(element_key("layers", i), text_of((*layers)[i]), "must be finite");
-            }
-        }
-    }
+    if (layers) checked("layers", list_text(*layers), [&] { validate_isovalues(*layers); });
     if (max_auto_layers < 1 || max_auto_layers > kMaxLayers) {
         out_of_range("max_layers", text_of(max_auto_layers), "must be in [1, ", kMaxLayers, "]");
     }
@@ -450,48 +565,7 @@ void InstrumentConfig::validate() const {
 }
 
 nlohmann::json InstrumentConfig::to_json() const {
-    json result;
-    result["fields"] = fields;
-    json view_list = json::array();
-    for (const ViewConfig& view : views) {
-        view_list.push_back({{"azimuth", view.orbit.azimuth_deg},
-                             {"elevation", view.orbit.elevation_deg},
-                             {"camera", to_string(view.orbit.projection)},
-                             {"fov", view.orbit.fov_y_deg},
-                             {"size", {view.orbit.width, view.orbit.height}},
-                             {"distortion_tilt", view.distortion_tilt_deg}});
-    }
-    result["views"] = view_list;
-    result["transfer_function"] = transfer_function.to_json();
-    result["training_transfer_functions"] = json::array();
-    for (const TransferFunction& tf : training_transfer_functions) {
-        result["training_transfer_functions"].push_back(tf.to_json());
-    }
-    result["layers"] = layers ? json(*layers) : json("auto");
-    result["max_layers"] = max_auto_layers;
-    result["intervals"] = {{"count", interval_count}, {"mode", to_string(interval_mode)}};
-    const std::array<bool, 5> selected = {proxies.depth, proxies.distortion, proxies.attenuation,
-                                          proxies.multi_attenuation, proxies.optical_depth};
-    result["proxies"] = json::array();
-    for (std::size_t i = 0; i < kProxyNames.size(); ++i) {
-        if (selected[i]) result["proxies"].push_back(kProxyNames[i]);
-    }
-    result["step"] = step_voxels;
-    // One cadence key, as from_json accepts: an explicit list replaces "every".
-    if (steps.empty()) {
-        result["every"] = every;
-    } else {
-        result["steps"] = steps;
-    }
-    result["archive"] = archive;
-    result["precision"] = precision == StoragePrecision::half ? "half" : "float";
-    result["compression"] = compression;
-    result["writer"] = {{"queue", writer_queue},
-                        {"when_full", when_full == WhenFull::block ? "block" : "drop"}};
-    result["keep_training_images"] = keep_training_images;
-    result["colour_model"] = {{"clusters", colour_model.clusters},
-                              {"enabled", colour_model.enabled}};
-    return result;
+    return write_object(*this, kTopLevelKeys);
 }
 
 bool InstrumentConfig::selects(std::int64_t step) const {

@@ -21,4 +21,15 @@ ErrorKind classify(const std::exception_ptr& error) {
     }
 }
 
+std::string one_line(const std::string& message) {
+    std::string line;
+    for (char c : message) {
+        const bool is_break = c == '\n' || c == '\r';
+        if (is_break && (line.empty() || line.back() == ' ')) continue;
+        line += is_break ? ' ' : c;
+    }
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    return line;
+}
+
 }  // namespace insitu

@@ -36,6 +36,13 @@ std::string to_string(Status status) {
     return "unknown";
 }
 
+std::ostream& operator<<(std::ostream& out, Status status) { return out << to_string(status); }
+
+std::ostream& operator<<(std::ostream& out, const InstrumentOptions& options) {
+    return out << "InstrumentOptions{rethrow_errors " << std::boolalpha << options.rethrow_errors
+               << ", log " << options.log << std::noboolalpha << "}";
+}
+
 std::ostream& operator<<(std::ostream& out, const InstrumentStatistics& s) {
     std::ostringstream line;
     line << std::fixed << std::setprecision(3) << "executed " << s.steps_executed << ", written "
@@ -53,12 +60,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-/// Messages may carry OpenCL build logs; a log line stays one line.
-std::string one_line(std::string text) {
-    std::replace(text.begin(), text.end(), '\n', ' ');
-    return text;
 }
 
 std::string joined_names(const std::vector<Field>& fields) {

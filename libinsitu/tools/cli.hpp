@@ -6,8 +6,8 @@
 // Exit status: 0 on success; 2 for bad arguments and bad input (a UsageError, or the library's
 // InvalidArgument, ParseError, IoError); 1 for anything else (no OpenCL platform, a failed
 // kernel, out of memory: not the user's input).
+#include <exception>
 #include <iostream>
-#include <stdexcept>
 #include <string>
 
 #include "insitu/error.hpp"
@@ -18,22 +18,26 @@ constexpr int kExitRuntimeError = 1;
 constexpr int kExitBadInput = 2;
 
 /// A command line or input that cannot be acted on (exit 2); the message names the flag and
-/// the value.
-class UsageError : public std::runtime_error {
+/// the value. An invalid argument of the program, so every boundary classifies it as one.
+class UsageError : public InvalidArgument {
 public:
-    using std::runtime_error::runtime_error;
+    using InvalidArgument::InvalidArgument;
 };
 
-/// The message on one line: nested errors and OpenCL build logs may span several.
-inline std::string one_line(const std::string& message) {
-    std::string line;
-    for (char c : message) {
-        const bool is_break = c == '\n' || c == '\r';
-        if (is_break && (line.empty() || line.back() == ' ')) continue;
-        line += is_break ? ' ' : c;
+/// The exit status of a failure of this kind.
+inline int exit_status(ErrorKind kind) {
+    switch (kind) {
+        case ErrorKind::invalid_argument:
+        case ErrorKind::parse:
+        case ErrorKind::io:
+            return kExitBadInput;
+        case ErrorKind::none:
+        case ErrorKind::compute:
+        case ErrorKind::state:
+        case ErrorKind::unknown:
+            break;
     }
-    while (!line.empty() && line.back() == ' ') line.pop_back();
-    return line;
+    return kExitRuntimeError;
 }
 
 /// "program: message" on stderr, one line; returns `status`.
@@ -48,16 +52,8 @@ template <typename Body>
 int run_reporting(const char* program, Body&& body) {
     try {
         return body();
-    } catch (const UsageError& error) {
-        return report(program, error.what(), kExitBadInput);
-    } catch (const InvalidArgument& error) {
-        return report(program, error.what(), kExitBadInput);
-    } catch (const ParseError& error) {
-        return report(program, error.what(), kExitBadInput);
-    } catch (const IoError& error) {
-        return report(program, error.what(), kExitBadInput);
     } catch (const std::exception& error) {
-        return report(program, error.what(), kExitRuntimeError);
+        return report(program, error.what(), exit_status(classify(std::current_exception())));
     }
 }
 

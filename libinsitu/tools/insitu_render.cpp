@@ -7,7 +7,6 @@
 // Every failure is reported as one line on stderr that names the offending flag or value.
 #include <algorithm>
 #include <cctype>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
@@ -26,6 +25,7 @@
 #include <system_error>
 #include <vector>
 
+#include "arguments.hpp"
 #include "cli.hpp"
 #include "insitu/core/camera.hpp"
 #include "insitu/error.hpp"
@@ -37,6 +37,9 @@
 namespace {
 
 constexpr const char* kProgram = "insitu-render";
+using insitu::cli::parse_finite;
+using insitu::cli::parse_positive_integer;
+using insitu::cli::split_exactly;
 using insitu::cli::UsageError;
 
 struct Arguments {
@@ -54,49 +57,7 @@ struct Arguments {
 };
 
 // ---------------------------------------------------------------------------------------------
-// Value parsers. Each takes the whole token or fails, so "10x" or "1e" are errors, not 10 and 1.
-
-double parse_number(const std::string& flag, const std::string& text) {
-    double value = 0.0;
-    const char* end = text.data() + text.size();
-    const auto [stop, error] = std::from_chars(text.data(), end, value);
-    if (text.empty() || error != std::errc() || stop != end || !std::isfinite(value)) {
-        throw UsageError(flag + ": expected a finite number, got \"" + text + "\"");
-    }
-    return value;
-}
-
-std::int64_t parse_positive_integer(const std::string& flag, const std::string& text,
-                                    const std::string& full_value) {
-    std::int64_t value = 0;
-    const char* end = text.data() + text.size();
-    const auto [stop, error] = std::from_chars(text.data(), end, value);
-    if (text.empty() || error != std::errc() || stop != end || value < 1) {
-        throw UsageError(flag + ": expected a positive integer, got \"" + text + "\" in \"" +
-                         full_value + "\"");
-    }
-    return value;
-}
-
-std::vector<std::string> split(const std::string& text, char separator) {
-    std::vector<std::string> parts;
-    std::string::size_type begin = 0;
-    for (;;) {
-        const auto end = text.find(separator, begin);
-        parts.push_back(text.substr(begin, end - begin));
-        if (end == std::string::npos) return parts;
-        begin = end + 1;
-    }
-}
-
-std::vector<std::string> split_exactly(const std::string& flag, const std::string& text,
-                                       char separator, std::size_t count, const char* shape) {
-    std::vector<std::string> parts = split(text, separator);
-    if (parts.size() != count) {
-        throw UsageError(flag + ": expected " + shape + ", got \"" + text + "\"");
-    }
-    return parts;
-}
+// Value parsers (arguments.hpp: each takes the whole token or fails).
 
 insitu::Index3 parse_dims(const std::string& flag, const std::string& text) {
     const auto parts = split_exactly(flag, text, ',', 3, "NX,NY,NZ");
@@ -107,22 +68,16 @@ insitu::Index3 parse_dims(const std::string& flag, const std::string& text) {
 
 glm::dvec3 parse_vec3(const std::string& flag, const std::string& text, const char* shape) {
     const auto parts = split_exactly(flag, text, ',', 3, shape);
-    return {parse_number(flag, parts[0]), parse_number(flag, parts[1]),
-            parse_number(flag, parts[2])};
+    return {parse_finite(flag, parts[0]), parse_finite(flag, parts[1]),
+            parse_finite(flag, parts[2])};
 }
 
 void parse_size(const std::string& flag, const std::string& text, insitu::OrbitView& view) {
-    const auto parts = split_exactly(flag, text, 'x', 2, "WxH (e.g. 512x512)");
-    const std::int64_t width = parse_positive_integer(flag, parts[0], text);
-    const std::int64_t height = parse_positive_integer(flag, parts[1], text);
     // Kernels index pixels as int (y * width + x): 2^15 per side keeps that below 2^31.
-    constexpr std::int64_t kMaxSide = 1 << 15;
-    if (width > kMaxSide || height > kMaxSide) {
-        throw UsageError(flag + ": " + text + " is larger than " + std::to_string(kMaxSide) +
-                         " pixels per side");
-    }
-    view.width = static_cast<int>(width);
-    view.height = static_cast<int>(height);
+    constexpr int kMaxSide = 1 << 15;
+    const insitu::cli::PixelSize size = insitu::cli::parse_pixel_size(flag, text, kMaxSide);
+    view.width = size.width;
+    view.height = size.height;
 }
 
 /// Library parse errors (unknown type or projection) become usage errors naming the flag.
@@ -185,18 +140,18 @@ const std::vector<Option>& options() {
              a.view.projection = parse_with_library(f, v, insitu::parse_projection);
          }},
         {"--azimuth", "DEG", false, "orbit azimuth in degrees (default 0: looking down -z)",
-         [](Arguments& a, V f, V v) { a.view.azimuth_deg = parse_number(f, v); }},
+         [](Arguments& a, V f, V v) { a.view.azimuth_deg = parse_finite(f, v); }},
         {"--elevation", "DEG", false, "orbit elevation in degrees, [-90, 90] (default 0)",
-         [](Arguments& a, V f, V v) { a.view.elevation_deg = parse_number(f, v); }},
+         [](Arguments& a, V f, V v) { a.view.elevation_deg = parse_finite(f, v); }},
         {"--fov", "DEG", false, "vertical field of view in degrees, perspective (default 30)",
-         [](Arguments& a, V f, V v) { a.view.fov_y_deg = parse_number(f, v); }},
+         [](Arguments& a, V f, V v) { a.view.fov_y_deg = parse_finite(f, v); }},
         {"--size", "WxH", false, "image size in pixels (default 512x512)",
          [](Arguments& a, V f, V v) { parse_size(f, v, a.view); }},
         {"--step", "VOXELS", false, "ray step in units of the smallest spacing (default 1)",
-         [](Arguments& a, V f, V v) { a.settings.step_voxels = parse_number(f, v); }},
+         [](Arguments& a, V f, V v) { a.settings.step_voxels = parse_finite(f, v); }},
         {"--early-termination", "OPACITY", false,
          "stop a ray at this opacity (default 0.99; > 1: never)",
-         [](Arguments& a, V f, V v) { a.settings.early_termination_opacity = parse_number(f, v); }},
+         [](Arguments& a, V f, V v) { a.settings.early_termination_opacity = parse_finite(f, v); }},
         {"--shade", nullptr, false, "Phong shading with a headlight",
          [](Arguments& a, V, V) { a.settings.shading = true; }},
         {"--out", "OUT.png|OUT.exr", true, "image: 8-bit sRGB PNG or linear premultiplied EXR",

@@ -28,6 +28,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "support/expect_error.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/render/distortion_camera.hpp"
@@ -197,7 +199,7 @@ void expect_frames_match(const ProxyFrame& expected, const ProxyFrame& actual, b
     EXPECT_EQ(expected.distortion_tilt_deg, actual.distortion_tilt_deg);
     EXPECT_EQ(expected.isovalues, actual.isovalues);
     ASSERT_EQ(expected.intervals.has_value(), actual.intervals.has_value());
-    if (expected.intervals) EXPECT_EQ(expected.intervals->edges(), actual.intervals->edges());
+    if (expected.intervals) { EXPECT_EQ(expected.intervals->edges(), actual.intervals->edges()); }
     expect_layers_match(expected.depth_layers, actual.depth_layers, false, "depth");
     expect_layers_match(expected.distortion_layers, actual.distortion_layers, false, "distortion");
     expect_images_match(expected.attenuation, actual.attenuation, half, "attenuation");
@@ -726,7 +728,7 @@ TEST_F(Archive, ForeignFilesWithMatchingChecksumsAreIoErrorsNamingFileAndPart) {
         replace_consistently(9, 0, c.bytes);
         const ArchiveReader reader(archive().string());
         EXPECT_TRUE(reader.verify().empty());
-        if (!c.single_fails) EXPECT_NO_THROW(reader.load(9, 0));
+        if (!c.single_fails) { EXPECT_NO_THROW(reader.load(9, 0)); }
         for (const bool multi : {false, true}) {
             if (!multi && !c.single_fails) continue;
             try {
@@ -735,7 +737,7 @@ TEST_F(Archive, ForeignFilesWithMatchingChecksumsAreIoErrorsNamingFileAndPart) {
             } catch (const IoError& error) {
                 EXPECT_THAT(error.what(),
                             AllOf(HasSubstr("step000009_view0.exr"), HasSubstr("part \"")));
-                if (multi) EXPECT_THAT(error.what(), HasSubstr("part \"" + c.part + "\""));
+                if (multi) { EXPECT_THAT(error.what(), HasSubstr("part \"" + c.part + "\"")); }
             } catch (const std::exception& error) {
                 ADD_FAILURE() << "not an IoError: " << error.what();
             }

@@ -15,6 +15,7 @@
 #include <glm/trigonometric.hpp>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "insitu/error.hpp"
 
@@ -300,6 +301,106 @@ TEST(Camera, ProjectionNamesParseAndPrint) {
     } catch (const InvalidArgument& error) {
         EXPECT_THAT(error.what(), HasSubstr("fisheye"));
     }
+}
+
+void expect_same_camera(const Camera& actual, const Camera& expected) {
+    EXPECT_EQ(actual.projection(), expected.projection());
+    EXPECT_EQ(actual.width(), expected.width());
+    EXPECT_EQ(actual.height(), expected.height());
+    expect_near(actual.position(), expected.position(), kWorldTolerance, "position");
+    expect_near(actual.forward(), expected.forward(), kWorldTolerance, "forward");
+    expect_near(actual.right(), expected.right(), kWorldTolerance, "right");
+    expect_near(actual.up(), expected.up(), kWorldTolerance, "up");
+    EXPECT_NEAR(actual.half_width(), expected.half_width(), kWorldTolerance);
+    EXPECT_NEAR(actual.half_height(), expected.half_height(), kWorldTolerance);
+}
+
+TEST(Camera, JsonRoundTripsEveryOrbitCamera) {
+    for (const OrbitView& view : sample_views()) {
+        SCOPED_TRACE(to_string(view.projection) + " az " + std::to_string(view.azimuth_deg) +
+                     " el " + std::to_string(view.elevation_deg));
+        const Camera camera = Camera::orbit(view, kBounds);
+        const nlohmann::json json = camera.to_json();
+        EXPECT_EQ(json.at("projection"), to_string(view.projection));
+        EXPECT_EQ(json.at("size"), nlohmann::json({view.width, view.height}));
+        // An orthographic camera has no field of view to record.
+        EXPECT_EQ(json.contains("fov"), view.projection == Projection::perspective);
+        const Camera again = Camera::from_json(json);
+        expect_same_camera(again, camera);
+        // The JSON goes through text in archives; doubles must survive it.
+        expect_same_camera(Camera::from_json(nlohmann::json::parse(json.dump())), camera);
+    }
+}
+
+TEST(Camera, JsonKeepsTheOrbitSphere) {
+    for (Projection projection : {Projection::orthographic, Projection::perspective}) {
+        const Camera camera = Camera::orbit(make_view(25.0, 35.0, projection), kBounds);
+        const Camera again = Camera::from_json(camera.to_json());
+        expect_near(again.orbit_center(), kBounds.center(), kWorldTolerance, "orbit centre");
+        EXPECT_NEAR(again.orbit_radius(), kBounds.radius(), kWorldTolerance);
+        // A new view of the stored one orbits the same sphere.
+        expect_same_camera(again.reorbit(-60.0, 10.0), camera.reorbit(-60.0, 10.0));
+    }
+}
+
+TEST(Camera, JsonRecordsTheAnglesOfTheCameraItself) {
+    // Derived from the vectors: azimuth 400 is recorded as the 40 it looks from.
+    const Camera camera = Camera::orbit(make_view(400.0, -30.0, Projection::orthographic), kBounds);
+    const nlohmann::json json = camera.to_json();
+    EXPECT_NEAR(json.at("azimuth").get<double>(), 40.0, 1e-9);
+    EXPECT_NEAR(json.at("elevation").get<double>(), -30.0, 1e-9);
+}
+
+/// from_json must fail with `ErrorType` naming every one of `parts`.
+template <typename ErrorType>
+void expect_bad_json(const nlohmann::json& json, const std::vector<std::string>& parts) {
+    SCOPED_TRACE(json.dump());
+    try {
+        Camera::from_json(json);
+        ADD_FAILURE() << "no exception";
+    } catch (const ErrorType& error) {
+        for (const std::string& part : parts) EXPECT_THAT(error.what(), HasSubstr(part));
+    } catch (const std::exception& error) {
+        ADD_FAILURE() << "wrong exception type: " << error.what();
+    }
+}
+
+TEST(Camera, BadJsonIsRejectedNamingTheKey) {
+    const nlohmann::json good =
+        Camera::orbit(make_view(10.0, 20.0, Projection::perspective), kBounds).to_json();
+    for (const char* key : {"projection", "azimuth", "elevation", "size", "fov", "position",
+                            "forward", "right", "up", "half_width", "half_height"}) {
+        nlohmann::json missing = good;
+        missing.erase(key);
+        expect_bad_json<ParseError>(missing, {"missing key", key});
+    }
+    nlohmann::json json = good;
+    json["size"] = {64};
+    expect_bad_json<ParseError>(json, {"\"size\"", "[64]"});
+    json = good;
+    json["size"] = {64.5, 48};
+    expect_bad_json<ParseError>(json, {"\"size\"", "64.5"});
+    json = good;
+    json["forward"] = {0.0, "down", 1.0};
+    expect_bad_json<ParseError>(json, {"\"forward\"", "down"});
+    json = good;
+    json["half_width"] = "wide";
+    expect_bad_json<ParseError>(json, {"\"half_width\"", "wide"});
+    json = good;
+    json["projection"] = 3;
+    expect_bad_json<ParseError>(json, {"\"projection\"", "3"});
+    expect_bad_json<ParseError>(nlohmann::json::array({1, 2}), {"not an object"});
+    // Values the orbit factory rejects keep its message.
+    json = good;
+    json["projection"] = "fisheye";
+    expect_bad_json<InvalidArgument>(json, {"fisheye"});
+    json = good;
+    json["elevation"] = 95.0;
+    expect_bad_json<InvalidArgument>(json, {"elevation = 95"});
+    // Vectors that disagree with the orbit parameters are not a camera this library made.
+    json = good;
+    json["up"] = {0.0, -1.0, 0.0};
+    expect_bad_json<InvalidArgument>(json, {"inconsistent"});
 }
 
 TEST(Camera, PrintsItself) {

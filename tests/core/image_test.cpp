@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -93,6 +94,15 @@ TEST(Image, ConstructorSizesAndFills) {
     EXPECT_EQ(indexed.pixels.back(), 7.0f);
     EXPECT_THROW(Image(-1, 2, 1), InvalidArgument);
     EXPECT_THROW(Image(2, 2, 0), InvalidArgument);
+}
+
+TEST(Image, PrintsItsSizeAndValueRange) {
+    Image image(3, 2, 4, 0.25f);
+    image.at(1, 1, 2) = 0.75f;
+    image.at(2, 0, 0) = std::numeric_limits<float>::infinity();
+    std::ostringstream text;
+    text << image;
+    EXPECT_EQ(text.str(), "Image 3x2x4, values in [0.25, 0.75], 1 non-finite");
 }
 
 TEST(Image, LinearToSrgbKnownValues) {

@@ -21,6 +21,7 @@ namespace insitu {
 namespace {
 
 using ::testing::Contains;
+using ::testing::ContainsRegex;
 using ::testing::HasSubstr;
 
 template <typename Function>
@@ -45,7 +46,8 @@ TEST(ComputeDevice, EmbeddedFamiliesIncludeTheGroundTruthAndCommonHelpers) {
 }
 
 TEST(ComputeDevice, BuildsAndFindsTheVolumeRenderKernel) {
-    const cl::Kernel kernel = ComputeDevice::shared()->opencl().kernel("volume_renderer", "render_volume");
+    const cl::Kernel kernel =
+        ComputeDevice::shared()->opencl().kernel("volume_renderer", "render_volume");
     EXPECT_EQ(kernel.getInfo<CL_KERNEL_FUNCTION_NAME>(), "render_volume");
 }
 
@@ -59,8 +61,8 @@ TEST(ComputeDevice, UnknownKernelIsAComputeErrorNamingIt) {
 }
 
 TEST(ComputeDevice, UnknownFamilyIsAComputeErrorNamingIt) {
-    expect_compute_error_naming([] { ComputeDevice::shared()->opencl().kernel("no_such_family", "x"); },
-                                "no_such_family");
+    expect_compute_error_naming(
+        [] { ComputeDevice::shared()->opencl().kernel("no_such_family", "x"); }, "no_such_family");
 }
 
 TEST(ComputeDevice, SelectorThatMatchesNothingIsAComputeErrorNamingIt) {
@@ -98,6 +100,122 @@ TEST(ComputeDevice, BuffersGrowOnlyWhenTheyMust) {
     std::vector<float> back(host.size(), -1.0f);
     device.opencl().download(buffer, back.data(), back.size() * sizeof(float), "test data");
     EXPECT_EQ(back, host);
+}
+
+// A kernel that writes back its scalar and vector arguments, built through the same path as
+// the embedded families.
+cl::Kernel echo_arguments_kernel() {
+    static const detail::EmbeddedKernel echo{
+        "tests/device/echo_arguments.cl",
+        "__kernel void echo_arguments(int a, int2 b, float4 c, __global float* out) {\n"
+        "    out[0] = (float)a;\n"
+        "    vstore2(convert_float2(b), 0, out + 1);\n"
+        "    vstore4(c, 0, out + 3);\n"
+        "}\n"};
+    cl::Program program = ComputeDevice::shared()->opencl().build_program({&echo});
+    return cl::Kernel(program, "echo_arguments");
+}
+
+TEST(ComputeDevice, PacksExpandIntoConsecutiveArgumentsInOrder) {
+    detail::OpenClDevice& opencl = ComputeDevice::shared()->opencl();
+    cl::Kernel kernel = echo_arguments_kernel();
+    cl::Buffer out;
+    std::size_t capacity = 0;
+    opencl.ensure_buffer(out, capacity, 7 * sizeof(float), CL_MEM_WRITE_ONLY);
+    // Nested packs flatten: (1, ((2, 3), (4, 5, 6, 7))) sets arguments a, b and c.
+    const cl_int2 b = {{2, 3}};
+    const cl_float4 c = {{4.0f, 5.0f, 6.0f, 7.0f}};
+    opencl.launch(kernel, cl::NDRange(1), cl::NullRange,
+                  detail::pack_args(cl_int{1}, detail::pack_args(b, c)), out);
+    std::vector<float> values(7, -1.0f);
+    opencl.download(out, values.data(), values.size() * sizeof(float), "echoed arguments");
+    EXPECT_EQ(values, (std::vector<float>{1, 2, 3, 4, 5, 6, 7}));
+}
+
+TEST(ComputeDevice, LaunchWithTheWrongArgumentCountNamesTheKernelAndBothCounts) {
+    detail::OpenClDevice& opencl = ComputeDevice::shared()->opencl();
+    cl::Kernel kernel = echo_arguments_kernel();
+    cl::Buffer out;
+    std::size_t capacity = 0;
+    opencl.ensure_buffer(out, capacity, 7 * sizeof(float), CL_MEM_WRITE_ONLY);
+    const cl_int2 b = {{2, 3}};
+    const cl_float4 c = {{4.0f, 5.0f, 6.0f, 7.0f}};
+    auto launch_expecting = [&](auto&& launch, const std::string& given) {
+        try {
+            launch();
+            ADD_FAILURE() << "no ComputeError for a launch that gave " << given << " arguments";
+        } catch (const ComputeError& error) {
+            EXPECT_THAT(error.what(), HasSubstr("\"echo_arguments\""));
+            EXPECT_THAT(error.what(), HasSubstr("takes 4 arguments"));
+            EXPECT_THAT(error.what(), HasSubstr("the launch gave " + given));
+        }
+    };
+    launch_expecting([&] { opencl.launch(kernel, cl::NDRange(1), cl::NullRange, cl_int{1}, out); },
+                     "2");
+    // A pack counts as the arguments it expands into, not as one.
+    launch_expecting(
+        [&] {
+            opencl.launch(kernel, cl::NDRange(1), cl::NullRange,
+                          detail::pack_args(cl_int{1}, b, c, cl_int{0}), out);
+        },
+        "5");
+    launch_expecting(
+        [&] {
+            opencl.launch(kernel, cl::NDRange(1), cl::NullRange, detail::pack_args(b, c), out);
+        },
+        "3");
+}
+
+TEST(ComputeDevice, FamiliesAreBuiltFromCommonTheirSharedFilesAndTheirOwn) {
+    auto paths_of = [](const std::string& family) {
+        std::vector<std::string> paths;
+        for (const auto* part : detail::OpenClDevice::family_sources(family)) {
+            paths.push_back(part->path);
+        }
+        return paths;
+    };
+    using Paths = std::vector<std::string>;
+    // The ground truth and the proxies march with one skeleton (seed 000: the same samples).
+    EXPECT_EQ(paths_of("volume_renderer"),
+              (Paths{"kernels/device/common.cl", "kernels/render/ray_march.cl",
+                     "kernels/render/volume_renderer.cl"}));
+    EXPECT_EQ(paths_of("proxy_renderer"),
+              (Paths{"kernels/device/common.cl", "kernels/render/ray_march.cl",
+                     "kernels/render/proxy_renderer.cl"}));
+    EXPECT_EQ(paths_of("relighting"),
+              (Paths{"kernels/device/common.cl", "kernels/explore/relighting.cl"}));
+    EXPECT_EQ(paths_of("common"), (Paths{"kernels/device/common.cl"}));
+    expect_compute_error_naming([] { detail::OpenClDevice::family_sources("no_such_family"); },
+                                "no_such_family");
+
+    // Each part starts at line 1 of its own file.
+    const auto parts = detail::OpenClDevice::family_sources("proxy_renderer");
+    const std::string text = detail::OpenClDevice::compose_source(parts);
+    for (const auto* part : parts) {
+        EXPECT_NE(text.find("#line 1 \"" + part->path + "\"\n" + part->source), std::string::npos)
+            << part->path;
+    }
+}
+
+TEST(ComputeDevice, BuildErrorsNameTheFileAndLineOfThePartThatFailed) {
+    // The broken part follows common.cl, so its line 3 is only reported as line 3 of its own
+    // file if the #line directives work.
+    const detail::EmbeddedKernel broken{
+        "tests/device/broken_kernel.cl",
+        "// A deliberate build error on line 3.\n"
+        "__kernel void broken(__global float* out) {\n"
+        "    out[0] = no_such_value;\n"
+        "}\n"};
+    const auto* common = detail::OpenClDevice::family_sources("common").front();
+    try {
+        ComputeDevice::shared()->opencl().build_program({common, &broken});
+        ADD_FAILURE() << "a broken kernel built";
+    } catch (const ComputeError& error) {
+        EXPECT_THAT(error.what(), HasSubstr("building tests/device/broken_kernel.cl"));
+        EXPECT_THAT(error.what(), HasSubstr("no_such_value"));
+        // Compilers write "file:line:column" (clang, PoCL) or "file(line)".
+        EXPECT_THAT(error.what(), ContainsRegex("broken_kernel\\.cl[:(]3[:)]"));
+    }
 }
 
 TEST(ComputeDevice, StatusNamesAreReadable) {

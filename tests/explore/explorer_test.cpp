@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "support/expect_error.hpp"
 #include "explore_options.hpp"
 #include "insitu/testing/analytic_fields.hpp"

@@ -298,7 +298,7 @@ TEST(EstimateAttenuation, ExtremeScalesGiveFiniteDefinedResults) {
             }
             // Sum a' = 1 - T' <= 1 (to rounding).
             EXPECT_LE(sum_worst, 1.0 + 1e-5);
-            if (extreme == 0.0) EXPECT_EQ(sum_worst, 0.0);
+            if (extreme == 0.0) { EXPECT_EQ(sum_worst, 0.0); }
             // Scale 1000 is ill-conditioned where t is near 1 (d t^s / dt = s t^(s-1)); the
             // estimate still lands within 1e-3 of the exact edit.
             EXPECT_LE(max_difference(result, expected), 1e-3);

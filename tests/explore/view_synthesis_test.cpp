@@ -383,7 +383,7 @@ TEST(ViewSynthesis, RevealedPixelsAreFlaggedNotInvented) {
         // around the front sphere, so what it trusts must be right: within 2.5 voxels, about two
         // target pixels, because its tilted rays meet this part of the back sphere obliquely and
         // sample it coarsely (measured 2.1 voxels; a wrong sphere would be off by 10 or more).
-        if (!frame->multi_perspective) EXPECT_EQ(revealed_trusted, 0);
+        if (!frame->multi_perspective) { EXPECT_EQ(revealed_trusted, 0); }
         EXPECT_LE(worst_trusted, 2.5);
     }
 }

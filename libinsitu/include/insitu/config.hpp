@@ -28,7 +28,7 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include "insitu/core/camera.hpp"
 #include "insitu/core/intervals.hpp"
@@ -40,6 +40,9 @@ namespace insitu {
 struct ViewConfig {
     OrbitView orbit{30.0, 20.0};        ///< default: azimuth 30, elevation 20, ortho, 512x512
     double distortion_tilt_deg = 45.0;  ///< "distortion_tilt", degrees in [0, 90)
+
+    /// The view's keys as a configuration names them (the archive stores this with each view).
+    nlohmann::json to_json() const;
 };
 
 enum class StoragePrecision { half, single };  ///< "half" / "float"

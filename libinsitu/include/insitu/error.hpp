@@ -44,11 +44,16 @@ public:
     using Error::Error;
 };
 
-/// The kind of an error, for boundaries that turn exceptions into status (Instrument, C API).
+/// The kind of an error, for boundaries that turn exceptions into status: Instrument, the C API,
+/// the tools' exit statuses, the viewer's HTTP codes (each a small table from this kind).
 enum class ErrorKind { none, invalid_argument, parse, compute, io, state, unknown };
 
 /// Kind of the exception `error` points at (unknown for non-libinsitu exceptions).
 ErrorKind classify(const std::exception_ptr& error);
+
+/// `message` on one line, for logs and one-line reports: nested errors and OpenCL build logs
+/// may span several. Line breaks become one space; trailing spaces go.
+std::string one_line(const std::string& message);
 
 namespace detail {
 template <typename... Parts>

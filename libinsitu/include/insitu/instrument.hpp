@@ -26,6 +26,7 @@ enum class Status {
     error,        ///< see last_error(); nothing already written was lost
 };
 std::string to_string(Status status);
+std::ostream& operator<<(std::ostream& out, Status status);
 
 struct InstrumentStatistics {
     std::int64_t steps_executed = 0;   ///< execute() calls that computed proxies
@@ -47,6 +48,7 @@ struct InstrumentOptions {
     /// Print warnings and the finalize() summary to stderr.
     bool log = true;
 };
+std::ostream& operator<<(std::ostream& out, const InstrumentOptions& options);
 
 class Instrument {
 public:

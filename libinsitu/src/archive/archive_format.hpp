@@ -18,11 +18,9 @@
 // libinsitu.model_intervals (L), libinsitu.model_clusters (K), libinsitu.model_layout (the row
 // layout in words) and libinsitu.model_training_transfer_functions (the functions it was
 // fitted on, JSON); it is written whenever the frame has a model, kept training images or not.
-#include <cstddef>
 #include <cstdint>
-#include <nlohmann/json.hpp>
+#include <cstdio>
 #include <string>
-#include <vector>
 
 namespace insitu::archive_format {
 
@@ -97,18 +95,18 @@ inline std::string interval_channel(const std::string& part, const char* suffix,
     return part + suffix + (digits.size() < 2 ? "0" : "") + digits;
 }
 
+/// "step000010_view0": the stem of the files of one step and view.
+inline std::string step_stem(std::int64_t step, int view) {
+    char stem[64];
+    std::snprintf(stem, sizeof stem, "step%06lld_view%d", static_cast<long long>(step), view);
+    return stem;
+}
 /// "proxies/step000010_view0.exr" and "previews/step000010_view0.png", relative to the archive.
-std::string proxy_relative_path(std::int64_t step, int view);
-std::string preview_relative_path(std::int64_t step, int view);
-
-/// zlib CRC-32 of a buffer.
-std::uint32_t crc32_of(const void* data, std::size_t size);
-/// The whole file; IoError naming it when it cannot be read.
-std::vector<char> read_whole_file(const std::string& path);
-
-/// Reads and validates ARCHIVE/manifest.json: schema version, required keys and their types,
-/// safe relative paths, no duplicate steps or views. IoError when unreadable, ParseError naming
-/// the file and the key otherwise.
-nlohmann::json read_manifest(const std::string& archive_path);
+inline std::string proxy_relative_path(std::int64_t step, int view) {
+    return std::string(kProxyFolder) + "/" + step_stem(step, view) + ".exr";
+}
+inline std::string preview_relative_path(std::int64_t step, int view) {
+    return std::string(kPreviewFolder) + "/" + step_stem(step, view) + ".png";
+}
 
 }  // namespace insitu::archive_format

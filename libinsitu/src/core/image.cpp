@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <ostream>
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
@@ -21,6 +23,27 @@ Image::Image(int width_pixels, int height_pixels, int channel_count, float fill)
                               " (sizes must be >= 0, channels >= 1)");
     }
     pixels.assign(pixel_count() * static_cast<std::size_t>(channels), fill);
+}
+
+std::ostream& operator<<(std::ostream& out, const Image& image) {
+    out << "Image " << image.width << "x" << image.height << "x" << image.channels;
+    float low = std::numeric_limits<float>::infinity();
+    float high = -low;
+    std::size_t non_finite = 0;
+    for (float value : image.pixels) {
+        if (!std::isfinite(value)) {
+            ++non_finite;
+            continue;
+        }
+        low = std::min(low, value);
+        high = std::max(high, value);
+    }
+    if (low <= high) out << ", values in [" << low << ", " << high << "]";
+    if (non_finite > 0) out << ", " << non_finite << " non-finite";
+    if (image.pixels.size() != image.pixel_count() * static_cast<std::size_t>(image.channels)) {
+        out << ", " << image.pixels.size() << " floats (inconsistent with its size)";
+    }
+    return out;
 }
 
 float linear_to_srgb(float linear) {

@@ -81,9 +81,10 @@ Choice choose_device(const std::string& selector) {
     }
 
     const auto colon = selector.find(':');
-    if (colon != std::string::npos && colon > 0 &&
-        std::all_of(selector.begin(), selector.end(),
-                    [](char c) { return std::isdigit(static_cast<unsigned char>(c)) || c == ':'; })) {
+    const bool numeric = std::all_of(selector.begin(), selector.end(), [](char c) {
+        return std::isdigit(static_cast<unsigned char>(c)) || c == ':';
+    });
+    if (colon != std::string::npos && colon > 0 && numeric) {
         const std::size_t p = std::stoul(selector.substr(0, colon));
         const std::size_t d = std::stoul(selector.substr(colon + 1));
         if (p < platforms.size()) {
@@ -163,38 +164,74 @@ std::string OpenClDevice::build_options() {
     return options;
 }
 
-cl::Program& OpenClDevice::program(const std::string& family) {
-    std::lock_guard<std::mutex> lock(program_mutex_);
-    auto found = programs_.find(family);
-    if (found != programs_.end()) return found->second;
+namespace {
 
+// Shared kernel files a family needs after common.cl and before its own file, in order, by
+// stem. The ground truth and the proxies march with one skeleton, so they take the same samples
+// (seed 000; DESIGN.md "Proxies").
+const std::map<std::string, std::vector<std::string>>& shared_files_of_families() {
+    static const std::map<std::string, std::vector<std::string>> shared{
+        {"volume_renderer", {"ray_march"}},
+        {"proxy_renderer", {"ray_march"}},
+    };
+    return shared;
+}
+
+const EmbeddedKernel& embedded(const std::string& stem) {
     const auto& sources = embedded_kernel_sources();
-    const auto source = sources.find(family);
-    if (source == sources.end()) {
-        fail<ComputeError>("no embedded kernel family \"", family, "\" (kernels/**/", family,
+    const auto found = sources.find(stem);
+    if (found == sources.end()) {
+        fail<ComputeError>("no embedded kernel family \"", stem, "\" (kernels/**/", stem,
                            ".cl)");
     }
-    // Every family starts with the shared helpers of kernels/device/common.cl. The #line
-    // directives make build logs name the right file and line in both parts.
-    std::string text;
-    const auto common = sources.find("common");
-    if (common != sources.end() && family != "common") {
-        text += "#line 1 \"" + common->second.path + "\"\n" + common->second.source + "\n";
+    return found->second;
+}
+
+}  // namespace
+
+std::vector<const EmbeddedKernel*> OpenClDevice::family_sources(const std::string& family) {
+    const EmbeddedKernel& own = embedded(family);
+    std::vector<const EmbeddedKernel*> parts;
+    if (family != "common") parts.push_back(&embedded("common"));
+    const auto& shared = shared_files_of_families();
+    const auto listed = shared.find(family);
+    if (listed != shared.end()) {
+        for (const std::string& stem : listed->second) parts.push_back(&embedded(stem));
     }
-    text += "#line 1 \"" + source->second.path + "\"\n" + source->second.source;
-    cl::Program program(context_, text);
+    parts.push_back(&own);
+    return parts;
+}
+
+std::string OpenClDevice::compose_source(const std::vector<const EmbeddedKernel*>& parts) {
+    std::string text;
+    for (const EmbeddedKernel* part : parts) {
+        text += "#line 1 \"" + part->path + "\"\n" + part->source + "\n";
+    }
+    return text;
+}
+
+cl::Program OpenClDevice::build_program(const std::vector<const EmbeddedKernel*>& parts) {
+    const std::string& path = parts.back()->path;
+    cl::Program program(context_, compose_source(parts));
     try {
         program.build({device_}, build_options().c_str());
     } catch (const cl::BuildError& error) {
         std::string log;
         for (const auto& entry : error.getBuildLog()) log += entry.second;
-        fail<ComputeError>("building ", source->second.path, " for ", description_, " failed: ",
+        fail<ComputeError>("building ", path, " for ", description_, " failed: ",
                            opencl_status_name(error.err()), "\nbuild log:\n", log);
     } catch (const cl::Error& error) {
-        fail<ComputeError>("building ", source->second.path, " failed: ",
-                           opencl_status_name(error.err()));
+        fail<ComputeError>("building ", path, " failed: ", opencl_status_name(error.err()));
     }
-    return programs_.emplace(family, std::move(program)).first->second;
+    return program;
+}
+
+cl::Program& OpenClDevice::program(const std::string& family) {
+    std::lock_guard<std::mutex> lock(program_mutex_);
+    auto found = programs_.find(family);
+    if (found != programs_.end()) return found->second;
+    cl::Program built = build_program(family_sources(family));
+    return programs_.emplace(family, std::move(built)).first->second;
 }
 
 cl::Kernel OpenClDevice::kernel(const std::string& family, const std::string& kernel_name) {

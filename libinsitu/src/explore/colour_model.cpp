@@ -385,4 +385,12 @@ std::ostream& operator<<(std::ostream& out, const ColourModel& model) {
     return out << "ColourModel(L = " << model.intervals() << ", K = " << model.clusters() << ")";
 }
 
+std::ostream& operator<<(std::ostream& out, const ColourModelSettings& settings) {
+    return out << "ColourModelSettings{K " << settings.clusters << ", iterations "
+               << settings.max_iterations << ", regularisation " << settings.regularisation
+               << ", seed " << settings.seed << ", training pixels "
+               << settings.max_training_pixels << ", empty below " << settings.empty_threshold
+               << "}";
+}
+
 }  // namespace insitu

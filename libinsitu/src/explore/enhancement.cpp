@@ -1,5 +1,6 @@
 #include "insitu/explore/enhancement.hpp"
 
+#include <ostream>
 #include <cmath>
 
 #include "device/device_image.hpp"
@@ -67,7 +68,7 @@ Image enhance_depth_aware(const Image& colour, const Image& attenuation,
     colour_device.upload(device, colour, "colour");
     attenuation_device.upload(device, attenuation, "attenuation");
     enhanced_device.allocate(device, colour.width, colour.height, 4);
-    const cl_int2 size = {{colour.width, colour.height}};
+    const cl_int2 size = detail::image_size(colour);
     cl::Kernel kernel = device.opencl().kernel("enhancement", "enhance_depth_aware");
     device.opencl().launch(kernel, detail::image_global_range(colour.width, colour.height),
                   detail::image_local_range(), colour_device.buffer(), attenuation_device.buffer(),
@@ -86,15 +87,20 @@ Image enhance_image_edges(const Image& colour, const EnhancementSettings& settin
     colour_device.upload(device, colour, "colour");
     luminance_device.allocate(device, colour.width, colour.height, 1);
     enhanced_device.allocate(device, colour.width, colour.height, 4);
-    const cl_int2 size = {{colour.width, colour.height}};
+    const cl_int2 size = detail::image_size(colour);
     const cl::NDRange global = detail::image_global_range(colour.width, colour.height);
     cl::Kernel luminance = device.opencl().kernel("enhancement", "luminance");
-    device.opencl().launch(luminance, global, detail::image_local_range(), colour_device.buffer(), size,
-                  luminance_device.buffer());
+    device.opencl().launch(luminance, global, detail::image_local_range(), colour_device.buffer(),
+                           size, luminance_device.buffer());
     cl::Kernel enhance = device.opencl().kernel("enhancement", "enhance_image_edges");
     device.opencl().launch(enhance, global, detail::image_local_range(), colour_device.buffer(),
                   luminance_device.buffer(), size, law(settings), enhanced_device.buffer());
     return enhanced_device.download(device, "edge-enhanced colour");
+}
+
+std::ostream& operator<<(std::ostream& out, const EnhancementSettings& settings) {
+    return out << "EnhancementSettings{lambda " << settings.lambda << ", gamma " << settings.gamma
+               << "}";
 }
 
 }  // namespace insitu

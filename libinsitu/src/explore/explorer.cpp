@@ -1,9 +1,12 @@
 #include "insitu/explore/explorer.hpp"
 
+#include <ostream>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
+
+#include <nlohmann/json.hpp>
 
 #include "archive/archive_format.hpp"
 #include "device/device_image.hpp"
@@ -473,6 +476,21 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
     frame.milliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return frame;
+}
+
+std::ostream& operator<<(std::ostream& out, const ExploreRequest& request) {
+    out << "ExploreRequest{step " << request.step << ", view " << request.view;
+    if (request.azimuth_deg) out << ", azimuth " << *request.azimuth_deg << " deg";
+    if (request.elevation_deg) out << ", elevation " << *request.elevation_deg << " deg";
+    if (request.transfer_function) out << ", edited " << *request.transfer_function;
+    for (const auto& [interval, scale] : request.opacity_scales) {
+        out << ", opacity x" << scale << " on interval " << interval;
+    }
+    out << ", colour " << to_string(request.colour) << ", source " << to_string(request.source);
+    if (request.lighting) out << ", " << *request.lighting;
+    if (request.ambient_occlusion) out << ", " << *request.ambient_occlusion;
+    if (request.enhancement) out << ", " << *request.enhancement;
+    return out << ", " << request.synthesis << "}";
 }
 
 }  // namespace insitu

@@ -1,5 +1,6 @@
 #include "insitu/explore/relighting.hpp"
 
+#include <ostream>
 #include <cmath>
 #include <cstddef>
 #include <vector>
@@ -40,17 +41,6 @@ void check_image(const Image& image, const char* what, int channels, const Camer
         fail<InvalidArgument>(what, " image holds ", image.pixels.size(), " floats for ",
                               image.width, "x", image.height, "x", image.channels);
     }
-}
-
-/// The camera as the relighting kernels take it: forward, right, up, half extent.
-struct CameraArgs {
-    cl_float4 forward, right, up, half_extent;
-    cl_int2 size;
-};
-
-CameraArgs camera_args(const Camera& camera) {
-    return {to_float4(camera.forward()), to_float4(camera.right()), to_float4(camera.up()),
-            detail::camera_extent(camera), cl_int2{{camera.width(), camera.height()}}};
 }
 
 /// Three float4 per light (kernels/explore/relighting.cl illuminate()); one zero light when there are
@@ -125,11 +115,11 @@ Image normals_from_depth(const Image& depth, const Camera& camera, ComputeDevice
     DeviceImage normals_device;
     depth_device.upload(device, depth, "depth");
     normals_device.allocate(device, depth.width, depth.height, 3);
-    const CameraArgs cam = camera_args(camera);
     cl::Kernel kernel = device.opencl().kernel("relighting", "normals_from_depth");
     device.opencl().launch(kernel, detail::image_global_range(depth.width, depth.height),
-                  detail::image_local_range(), depth_device.buffer(), cam.size, cam.forward,
-                  cam.right, cam.up, cam.half_extent, normals_device.buffer());
+                           detail::image_local_range(), depth_device.buffer(),
+                           detail::image_size(camera), detail::camera_axes(camera),
+                           normals_device.buffer());
     return normals_device.download(device, "normals");
 }
 
@@ -145,13 +135,13 @@ Image shade(const Image& base_colour, const Image& normals, const Camera& camera
     normals_device.upload(device, normals, "normals");
     colour_device.allocate(device, base_colour.width, base_colour.height, 4);
     cl::Buffer lights = upload_lights(device, lighting);
-    const CameraArgs cam = camera_args(camera);
     cl::Kernel kernel = device.opencl().kernel("relighting", "shade");
-    device.opencl().launch(kernel, detail::image_global_range(base_colour.width, base_colour.height),
-                  detail::image_local_range(), base_device.buffer(), normals_device.buffer(),
-                  cam.size, cam.forward, cam.right, cam.up, cam.half_extent,
-                  static_cast<cl_float>(lighting.ambient),
-                  static_cast<cl_int>(lighting.lights.size()), lights, colour_device.buffer());
+    device.opencl().launch(
+        kernel, detail::image_global_range(base_colour.width, base_colour.height),
+        detail::image_local_range(), base_device.buffer(), normals_device.buffer(),
+        detail::image_size(camera), detail::camera_axes(camera),
+        static_cast<cl_float>(lighting.ambient), static_cast<cl_int>(lighting.lights.size()),
+        lights, colour_device.buffer());
     return colour_device.download(device, "shaded colour");
 }
 
@@ -175,9 +165,9 @@ Image ambient_occlusion(const Image& depth, const Camera& camera,
     occlusion_device.allocate(device, depth.width, depth.height, 1);
     cl::Kernel kernel = device.opencl().kernel("relighting", "ambient_occlusion");
     device.opencl().launch(kernel, detail::image_global_range(depth.width, depth.height),
-                  detail::image_local_range(), depth_device.buffer(),
-                  cl_int2{{depth.width, depth.height}}, detail::camera_extent(camera),
-                  static_cast<cl_int>(radius), occlusion, occlusion_device.buffer());
+                           detail::image_local_range(), depth_device.buffer(),
+                           detail::camera_plane(camera), static_cast<cl_int>(radius), occlusion,
+                           occlusion_device.buffer());
     return occlusion_device.download(device, "ambient occlusion");
 }
 
@@ -202,9 +192,9 @@ Image unsharp_mask_occlusion(const Image& depth, const Camera& camera,
     occlusion_device.allocate(device, depth.width, depth.height, 1);
     cl::Kernel kernel = device.opencl().kernel("relighting", "unsharp_mask_occlusion");
     device.opencl().launch(kernel, detail::image_global_range(depth.width, depth.height),
-                  detail::image_local_range(), depth_device.buffer(),
-                  cl_int2{{depth.width, depth.height}}, static_cast<cl_int>(radius),
-                  gaussian_device, occlusion, occlusion_device.buffer());
+                           detail::image_local_range(), depth_device.buffer(),
+                           detail::image_size(depth), static_cast<cl_int>(radius),
+                           gaussian_device, occlusion, occlusion_device.buffer());
     return occlusion_device.download(device, "unsharp-mask occlusion");
 }
 
@@ -231,15 +221,34 @@ Image light_volume(const Image& attenuation, const Image& mean_depth,
         detail::upload_read_only(device, interval_colours.data(),
                                  interval_colours.size() * sizeof(float), "interval colours");
     cl::Buffer lights = upload_lights(device, lighting);
-    const CameraArgs cam = camera_args(camera);
     cl::Kernel kernel = device.opencl().kernel("relighting", "light_volume");
-    device.opencl().launch(kernel, detail::image_global_range(attenuation.width, attenuation.height),
-                  detail::image_local_range(), attenuation_device.buffer(),
-                  mean_depth_device.buffer(), static_cast<cl_int>(intervals), colours, cam.size,
-                  cam.forward, cam.right, cam.up, cam.half_extent,
-                  static_cast<cl_float>(lighting.ambient),
-                  static_cast<cl_int>(lighting.lights.size()), lights, colour_device.buffer());
+    device.opencl().launch(
+        kernel, detail::image_global_range(attenuation.width, attenuation.height),
+        detail::image_local_range(), attenuation_device.buffer(), mean_depth_device.buffer(),
+        static_cast<cl_int>(intervals), colours, detail::image_size(camera),
+        detail::camera_axes(camera), static_cast<cl_float>(lighting.ambient),
+        static_cast<cl_int>(lighting.lights.size()), lights, colour_device.buffer());
     return colour_device.download(device, "lit volume");
+}
+
+std::ostream& operator<<(std::ostream& out, const Light& light) {
+    const glm::dvec3& d = light.direction_world;
+    const glm::dvec3& c = light.colour;
+    return out << "Light{direction (" << d.x << ", " << d.y << ", " << d.z << "), colour ("
+               << c.x << ", " << c.y << ", " << c.z << "), diffuse " << light.diffuse
+               << ", specular " << light.specular << ", shininess " << light.shininess << "}";
+}
+
+std::ostream& operator<<(std::ostream& out, const LightingSettings& settings) {
+    out << "LightingSettings{ambient " << settings.ambient;
+    for (const Light& light : settings.lights) out << ", " << light;
+    return out << "}";
+}
+
+std::ostream& operator<<(std::ostream& out, const AmbientOcclusionSettings& settings) {
+    return out << "AmbientOcclusionSettings{radius " << settings.radius_pixels
+               << " pixels, strength " << settings.strength << ", depth scale "
+               << settings.depth_scale_world << " world units}";
 }
 
 }  // namespace insitu

@@ -1,9 +1,9 @@
 #include "insitu/explore/view_synthesis.hpp"
 
+#include <ostream>
 #include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
-#include <glm/trigonometric.hpp>
 #include <string>
 
 #include "device/device_image.hpp"
@@ -18,13 +18,6 @@ namespace {
 
 // The kernels track the open layers of a pixel in one 32-bit mask.
 constexpr int kMaxSynthesisLayers = 32;
-
-// (half width, half height, projection 0/1, tan(tilt)), as kernels/explore/view_synthesis.cl reads it.
-cl_float4 synthesis_extent(const Camera& camera, double tilt_deg) {
-    return to_float4(camera.half_width(), camera.half_height(),
-                     camera.projection() == Projection::perspective ? 1.0 : 0.0,
-                     std::tan(glm::radians(tilt_deg)));
-}
 
 // The rigid map from `from`'s local coordinates (right, up, forward offsets from its position)
 // to `to`'s, as three rows (R | t): seed 000 Eq. 4, M_new M_orig^-1. Computed in double; entries
@@ -150,10 +143,6 @@ cl::Buffer empty_keys(ComputeDevice& device, std::size_t count) {
     return keys;
 }
 
-cl_int2 size_of(const Camera& camera) {
-    return {{camera.width(), camera.height()}};
-}
-
 }  // namespace
 
 SynthesisedLayers synthesise_layers(const ProxyFrame& frame, const Camera& target,
@@ -171,28 +160,29 @@ SynthesisedLayers synthesise_layers(const ProxyFrame& frame, const Camera& targe
             ? detail::upload_read_only(device, planar(frame.distortion_layers), "distortion layers")
             : cl::Buffer();
     const cl::Buffer keys = empty_keys(device, target_pixels * layers);
-    const cl_float4 source_extent =
-        synthesis_extent(source, frame.multi_perspective ? frame.distortion_tilt_deg : 0.0);
-    const cl_float4 target_extent = synthesis_extent(target, 0.0);
+    const auto source_plane =
+        detail::camera_plane(source, frame.multi_perspective ? frame.distortion_tilt_deg : 0.0);
+    const auto target_plane = detail::camera_plane(target);
     const RigidRows forward = local_map(source, target);
     const RigidRows inverse = local_map(target, source);
 
     cl::Kernel splat = device.opencl().kernel("view_synthesis", "splat_layers");
     device.opencl().launch(splat, detail::image_global_range(source.width(), source.height()),
-                  detail::image_local_range(), depth, distortion,
-                  static_cast<cl_int>(frame.multi_perspective ? 1 : 0), static_cast<cl_int>(layers),
-                  size_of(source), source_extent, forward.rows[0], forward.rows[1], forward.rows[2],
-                  size_of(target), target_extent, keys);
+                           detail::image_local_range(), depth, distortion,
+                           static_cast<cl_int>(frame.multi_perspective ? 1 : 0),
+                           static_cast<cl_int>(layers), source_plane, forward.rows[0],
+                           forward.rows[1], forward.rows[2], target_plane, keys);
 
     const cl::Buffer depth_out = device_buffer(device, target_pixels * layers * sizeof(float));
     const cl::Buffer confidence_out = device_buffer(device, target_pixels * layers * sizeof(float));
     const cl::Buffer union_out = device_buffer(device, target_pixels * sizeof(float));
     cl::Kernel resolve = device.opencl().kernel("view_synthesis", "resolve_layers");
     device.opencl().launch(resolve, detail::image_global_range(target.width(), target.height()),
-                  detail::image_local_range(), keys, static_cast<cl_int>(layers), size_of(target),
-                  target_extent, static_cast<cl_int>(settings.hole_fill_radius_pixels), depth,
-                  size_of(source), source_extent, inverse.rows[0], inverse.rows[1], inverse.rows[2],
-                  bounding_sphere_in(source, target), depth_out, confidence_out, union_out);
+                           detail::image_local_range(), keys, static_cast<cl_int>(layers),
+                           target_plane, static_cast<cl_int>(settings.hole_fill_radius_pixels),
+                           depth, source_plane, inverse.rows[0], inverse.rows[1],
+                           inverse.rows[2], bounding_sphere_in(source, target), depth_out,
+                           confidence_out, union_out);
 
     SynthesisedLayers result;
     std::vector<float> values(target_pixels * layers);
@@ -241,9 +231,9 @@ SynthesisedAttenuation synthesise_attenuation(const ProxyFrame& frame, const Cam
                       static_cast<cl_int>(count));
     }
     const cl::Buffer source_total = device_buffer(device, source_pixels * sizeof(float));
-    const cl_float4 source_extent =
-        synthesis_extent(source, frame.multi_perspective ? frame.distortion_tilt_deg : 0.0);
-    const cl_float4 target_extent = synthesis_extent(target, 0.0);
+    const auto source_plane =
+        detail::camera_plane(source, frame.multi_perspective ? frame.distortion_tilt_deg : 0.0);
+    const auto target_plane = detail::camera_plane(target);
     const RigidRows forward = local_map(source, target);
     const RigidRows inverse = local_map(target, source);
     // Multi-perspective contributions sit on their pixel's tilted ray: distortion z tan(tilt).
@@ -252,14 +242,14 @@ SynthesisedAttenuation synthesise_attenuation(const ProxyFrame& frame, const Cam
     const cl::NDRange source_range = detail::image_global_range(source.width(), source.height());
     cl::Kernel splat_depth = device.opencl().kernel("view_synthesis", "splat_attenuation_depth");
     device.opencl().launch(splat_depth, source_range, detail::image_local_range(), mean_depth,
-                  static_cast<cl_int>(intervals), has_distortion, size_of(source), source_extent,
-                  forward.rows[0], forward.rows[1], forward.rows[2], size_of(target), target_extent,
-                  keys, attenuation, source_total);
+                           static_cast<cl_int>(intervals), has_distortion, source_plane,
+                           forward.rows[0], forward.rows[1], forward.rows[2], target_plane, keys,
+                           attenuation, source_total);
     cl::Kernel splat_values = device.opencl().kernel("view_synthesis", "splat_attenuation_values");
     device.opencl().launch(splat_values, source_range, detail::image_local_range(), mean_depth,
-                  static_cast<cl_int>(intervals), has_distortion, size_of(source), source_extent,
-                  forward.rows[0], forward.rows[1], forward.rows[2], size_of(target), target_extent,
-                  keys, attenuation, values, owners);
+                           static_cast<cl_int>(intervals), has_distortion, source_plane,
+                           forward.rows[0], forward.rows[1], forward.rows[2], target_plane, keys,
+                           attenuation, values, owners);
 
     SynthesisedAttenuation result;
     result.attenuation = Image(target.width(), target.height(), intervals);
@@ -272,10 +262,10 @@ SynthesisedAttenuation synthesise_attenuation(const ProxyFrame& frame, const Cam
     cl::Kernel resolve = device.opencl().kernel("view_synthesis", "resolve_attenuation");
     device.opencl().launch(
         resolve, detail::image_global_range(target.width(), target.height()),
-        detail::image_local_range(), keys, values, static_cast<cl_int>(intervals), size_of(target),
-        target_extent, static_cast<cl_int>(settings.hole_fill_radius_pixels), source_total,
-        size_of(source), source_extent, inverse.rows[0], inverse.rows[1], inverse.rows[2],
-        bounding_sphere_in(source, target), attenuation_out, mean_depth_out, confidence_out);
+        detail::image_local_range(), keys, values, static_cast<cl_int>(intervals), target_plane,
+        static_cast<cl_int>(settings.hole_fill_radius_pixels), source_total, source_plane,
+        inverse.rows[0], inverse.rows[1], inverse.rows[2], bounding_sphere_in(source, target),
+        attenuation_out, mean_depth_out, confidence_out);
     device.opencl().download(attenuation_out, result.attenuation.pixels.data(), interval_bytes,
                     "synthesised attenuation");
     device.opencl().download(mean_depth_out, result.mean_depth.pixels.data(), interval_bytes,
@@ -308,9 +298,9 @@ RadialityHistogram radiality_histogram(const ProxyFrame& multi_frame, int bins,
         kernel, detail::image_global_range(camera.width(), camera.height()),
         detail::image_local_range(), depth, distortion,
         static_cast<cl_int>(multi_frame.multi_perspective ? 1 : 0), static_cast<cl_int>(layers),
-        size_of(camera),
-        synthesis_extent(camera,
-                         multi_frame.multi_perspective ? multi_frame.distortion_tilt_deg : 0.0),
+        detail::camera_plane(camera, multi_frame.multi_perspective
+                                         ? multi_frame.distortion_tilt_deg
+                                         : 0.0),
         angles);
     std::vector<float> angle_deg(pixels * layers);
     device.opencl().download(angles, angle_deg.data(), angle_deg.size() * sizeof(float), "radiality angles");
@@ -329,6 +319,11 @@ RadialityHistogram radiality_histogram(const ProxyFrame& multi_frame, int bins,
     }
     histogram.mean_deg = total > 0 ? sum / total : 0.0;
     return histogram;
+}
+
+std::ostream& operator<<(std::ostream& out, const SynthesisSettings& settings) {
+    return out << "SynthesisSettings{hole fill radius " << settings.hole_fill_radius_pixels
+               << " pixels}";
 }
 
 }  // namespace insitu

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <ostream>
 
 #include "insitu/error.hpp"
 #include "device/kernel_args.hpp"
@@ -101,46 +102,52 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
     const double step_world = volume_.step_world(settings.step_voxels);
     const TransferTable table = step_corrected_table(tf, step_world, settings);
     const std::size_t table_bytes = table.rgba.size() * sizeof(float);
-    device_->opencl().ensure_buffer(state_->table.buffer, state_->table.capacity, table_bytes, CL_MEM_READ_ONLY);
-    device_->opencl().upload(state_->table.buffer, table.rgba.data(), table_bytes, "transfer-function table");
+    detail::OpenClDevice& opencl = device_->opencl();
+    opencl.ensure_buffer(state_->table.buffer, state_->table.capacity, table_bytes,
+                         CL_MEM_READ_ONLY);
+    opencl.upload(state_->table.buffer, table.rgba.data(), table_bytes, "transfer-function table");
 
     const int width = camera.width();
     const int height = camera.height();
     const std::size_t pixels = static_cast<std::size_t>(width) * height;
-    device_->opencl().ensure_buffer(state_->rgba_out.buffer, state_->rgba_out.capacity, pixels * 4 * sizeof(float),
-                           CL_MEM_WRITE_ONLY);
-    device_->opencl().ensure_buffer(state_->depth_out.buffer, state_->depth_out.capacity, pixels * sizeof(float), CL_MEM_WRITE_ONLY);
+    opencl.ensure_buffer(state_->rgba_out.buffer, state_->rgba_out.capacity,
+                         pixels * 4 * sizeof(float), CL_MEM_WRITE_ONLY);
+    opencl.ensure_buffer(state_->depth_out.buffer, state_->depth_out.capacity,
+                         pixels * sizeof(float), CL_MEM_WRITE_ONLY);
 
     const bool needs_gradient = settings.shading || tf.is_2d();
-    const Index3& d = volume_.dims;
-    const cl_int4 dims = {{static_cast<cl_int>(d[0]), static_cast<cl_int>(d[1]),
-                           static_cast<cl_int>(d[2]), 0}};
-    const cl_int2 tf_bins = {{table.value_bins, table.gradient_bins}};
-    const cl_int2 size = {{width, height}};
     const cl_float4 march = to_float4(step_world, settings.early_termination_opacity,
                                       settings.shading ? 1.0 : 0.0, needs_gradient ? 1.0 : 0.0);
     const PhongParameters& phong = settings.phong;
     const cl_float4 phong_parameters =
         to_float4(phong.ambient, phong.diffuse, phong.specular, phong.shininess);
 
-    device_->opencl().launch(state_->kernel, detail::image_global_range(width, height),
-                    detail::image_local_range(), volume_.memory->buffer, dims,
-                    to_float4(volume_.origin), to_float4(1.0 / volume_.spacing),
-                    to_float4(0.5 / volume_.spacing), to_float4(volume_.bounds.lower),
-                    to_float4(volume_.bounds.upper), state_->table.buffer, tf_bins,
-                    detail::transfer_domain(table), to_float4(camera.position()),
-                    to_float4(camera.forward()), to_float4(camera.right()),
-                    to_float4(camera.up()), detail::camera_extent(camera), size, march,
-                    phong_parameters, state_->rgba_out.buffer, state_->depth_out.buffer);
+    opencl.launch(state_->kernel, detail::image_global_range(width, height),
+                  detail::image_local_range(), detail::volume_args(volume_),
+                  detail::transfer_args(state_->table.buffer, table), detail::camera_args(camera),
+                  detail::image_size(camera), march, phong_parameters, state_->rgba_out.buffer,
+                  state_->depth_out.buffer);
 
     Rendering result;
     result.rgba = Image(width, height, 4);
     result.depth = Image(width, height, 1);
-    device_->opencl().download(state_->rgba_out.buffer, result.rgba.pixels.data(), pixels * 4 * sizeof(float),
-                      "rendered RGBA");
-    device_->opencl().download(state_->depth_out.buffer, result.depth.pixels.data(), pixels * sizeof(float),
-                      "rendered depth");
+    opencl.download(state_->rgba_out.buffer, result.rgba.pixels.data(),
+                    pixels * 4 * sizeof(float), "rendered RGBA");
+    opencl.download(state_->depth_out.buffer, result.depth.pixels.data(), pixels * sizeof(float),
+                    "rendered depth");
     return result;
+}
+
+std::ostream& operator<<(std::ostream& out, const PhongParameters& phong) {
+    return out << "Phong{ambient " << phong.ambient << ", diffuse " << phong.diffuse
+               << ", specular " << phong.specular << ", shininess " << phong.shininess << "}";
+}
+
+std::ostream& operator<<(std::ostream& out, const RenderSettings& settings) {
+    out << "RenderSettings{step " << settings.step_voxels << " voxels, early termination at "
+        << settings.early_termination_opacity << ", shading " << (settings.shading ? "on" : "off");
+    if (settings.shading) out << " " << settings.phong;
+    return out << ", table " << settings.tf_value_bins << "x" << settings.tf_gradient_bins << "}";
 }
 
 }  // namespace insitu

@@ -15,6 +15,7 @@
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include "insitu/field.hpp"
 
@@ -35,6 +36,13 @@ struct OrbitView {
     int height = 512;
 };
 
+/// The checks Camera::orbit makes, one per OrbitView member, for callers that name the member
+/// their own way (configuration keys). Each throws InvalidArgument naming the value.
+void check_orbit_size(int width, int height);      ///< both >= 1
+void check_orbit_azimuth(double azimuth_deg);      ///< finite
+void check_orbit_elevation(double elevation_deg);  ///< in [-90, 90]
+void check_orbit_fov(double fov_y_deg);            ///< in (0, 180)
+
 /// A ray in world space; `direction` has unit length.
 struct Ray {
     glm::dvec3 origin{0.0};
@@ -46,6 +54,15 @@ public:
     /// Orbit camera around `bounds`; throws InvalidArgument for sizes < 1, |elevation| > 90,
     /// a field of view outside (0, 180) or non-finite angles.
     static Camera orbit(const OrbitView& view, const Bounds& bounds);
+
+    /// Orbit parameters (derived from the camera's own vectors, so that they describe exactly
+    /// this camera, e.g. the orthographic base of a distortion camera), the vectors and the
+    /// orbit's sphere; "fov" for perspective cameras only. The archive stores this.
+    nlohmann::json to_json() const;
+    /// The camera to_json() describes, rebuilt through orbit() and checked against the stored
+    /// vectors. ParseError names a missing or mistyped key; InvalidArgument an out-of-range value
+    /// or vectors that disagree with the orbit parameters (not a camera this library made).
+    static Camera from_json(const nlohmann::json& json);
 
     Projection projection() const { return projection_; }
     int width() const { return width_; }

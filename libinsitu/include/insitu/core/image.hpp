@@ -2,8 +2,11 @@
 // Images: row-major, pixel (0, 0) at the top-left, linear float, premultiplied alpha (DESIGN.md).
 #include <cstddef>
 #include <cstdint>
+#include <iosfwd>
 #include <string>
 #include <vector>
+
+#include "insitu/core/check.hpp"
 
 namespace insitu {
 
@@ -17,13 +20,20 @@ struct Image {
     Image() = default;
     Image(int width_pixels, int height_pixels, int channel_count, float fill = 0.0f);
     std::size_t pixel_count() const { return static_cast<std::size_t>(width) * height; }
-    float& at(int x, int y, int channel) {
-        return pixels[(static_cast<std::size_t>(y) * width + x) * channels + channel];
-    }
-    float at(int x, int y, int channel) const {
-        return pixels[(static_cast<std::size_t>(y) * width + x) * channels + channel];
+    float& at(int x, int y, int channel) { return pixels[index(x, y, channel)]; }
+    float at(int x, int y, int channel) const { return pixels[index(x, y, channel)]; }
+
+private:
+    std::size_t index(int x, int y, int channel) const {
+        INSITU_DCHECK(x >= 0 && x < width && y >= 0 && y < height);
+        INSITU_DCHECK(channel >= 0 && channel < channels);
+        return (static_cast<std::size_t>(y) * width + x) * channels + channel;
     }
 };
+
+/// "Image 512x512x4, values in [0, 0.93], 3 non-finite": size and a summary, so a failing
+/// comparison says what it compared.
+std::ostream& operator<<(std::ostream& out, const Image& image);
 
 /// Linear -> sRGB transfer curve for one component in [0, 1] (IEC 61966-2-1).
 float linear_to_srgb(float linear);

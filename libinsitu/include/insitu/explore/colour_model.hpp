@@ -43,6 +43,7 @@ struct ColourModelSettings {
     /// fit (prediction needs no threshold: the [0, alpha] clamp makes them transparent), >= 0.
     double empty_threshold = 1e-6;
 };
+std::ostream& operator<<(std::ostream& out, const ColourModelSettings& settings);
 
 class ColourModel {
 public:

@@ -8,6 +8,7 @@
 // one pixel long). The factor scales the premultiplied RGB only and keeps alpha: edges darken
 // over any background instead of turning transparent. Where every gradient is 0 (a constant
 // attenuation image) r = 0 and the colour is returned exactly.
+#include <iosfwd>
 #include "insitu/device/compute_device.hpp"
 #include "insitu/core/image.hpp"
 
@@ -17,6 +18,7 @@ struct EnhancementSettings {
     double lambda = 1.0;  ///< strength, finite and >= 0
     double gamma = 0.5;   ///< contrast, finite and > 0
 };
+std::ostream& operator<<(std::ostream& out, const EnhancementSettings& settings);
 
 /// RGBA premultiplied colour darkened by Eq. 11 from the L-channel attenuation image (the same
 /// size as `colour`).

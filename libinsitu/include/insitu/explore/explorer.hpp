@@ -19,6 +19,7 @@
 //  7. depth-aware enhancement (Eq. 11).
 // Without attenuation proxies the front-most depth layer is drawn as a surface in the transfer
 // function's colour at its isovalue.
+#include <iosfwd>
 #include <cstdint>
 #include <list>
 #include <memory>
@@ -73,6 +74,7 @@ struct ExploreRequest {
     std::optional<EnhancementSettings> enhancement;
     SynthesisSettings synthesis;
 };
+std::ostream& operator<<(std::ostream& out, const ExploreRequest& request);
 
 /// One explored frame.
 struct ExploreFrame {

@@ -16,6 +16,7 @@
 // one-sided across a silhouette: when one side's depth step exceeds twice the other side's plus
 // two pixel footprints (world units at that depth), that side is taken to be another surface
 // and the other side is used alone. An axis with no usable neighbour has no derivative.
+#include <iosfwd>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -36,12 +37,14 @@ struct Light {
     double specular = 0.3;                      ///< >= 0
     double shininess = 32.0;                    ///< Blinn-Phong exponent, >= 0
 };
+std::ostream& operator<<(std::ostream& out, const Light& light);
 
 struct LightingSettings {
     /// One default light; may be empty (ambient only), at most kMaxLights.
     std::vector<Light> lights = std::vector<Light>(1);
     double ambient = 0.2;  ///< >= 0
 };
+std::ostream& operator<<(std::ostream& out, const LightingSettings& settings);
 
 struct AmbientOcclusionSettings {
     /// Neighbourhood of Eq. 5: the pixels q with |q - p| <= radius (pixels), in [0, 64];
@@ -52,6 +55,7 @@ struct AmbientOcclusionSettings {
     /// camera's orbit radius (the orthographic camera's half height for square images).
     double depth_scale_world = 0.0;
 };
+std::ostream& operator<<(std::ostream& out, const AmbientOcclusionSettings& settings);
 
 /// 3-channel unit normals (world space) per pixel, n . (-ray direction) >= 0; (0, 0, 0) where
 /// depth is +inf or NaN. The normal is the cross product of the world-space tangents along image

@@ -29,6 +29,7 @@
 // front to back in target depth order, a'_j = (a_j / T_j) T', T' = 1 - sum of the a' in front.
 // Hence sum_j a'_j <= 1, and an unchanged camera gives a'_j = a_j exactly. A hole surrounded by
 // data takes the composite of its nearest surrounding pixel.
+#include <iosfwd>
 #include <cstdint>
 #include <vector>
 
@@ -46,6 +47,7 @@ struct SynthesisSettings {
     /// ones stay holes. In [0, kMaxHoleFillRadiusPixels]; 0 fills nothing.
     int hole_fill_radius_pixels = 1;
 };
+std::ostream& operator<<(std::ostream& out, const SynthesisSettings& settings);
 
 struct SynthesisedLayers {
     std::vector<Image> depth;  ///< per layer, depth in the target camera (world units), +inf none

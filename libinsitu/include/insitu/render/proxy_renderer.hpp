@@ -16,7 +16,7 @@
 // keep marching until every layer is found or the ray leaves the volume.
 // Training renderings are ground-truth renderings (VolumeRenderer) of the single-perspective
 // camera, one per training transfer function.
-#include <cstdint>
+#include <iosfwd>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -56,6 +56,7 @@ struct ProxyRequest {
         return settings;
     }();
 };
+std::ostream& operator<<(std::ostream& out, const ProxyRequest& request);
 
 /// Every proxy of one camera. Images are planar: one Image per layer, L-channel images for the
 /// per-interval proxies (channel j = interval j). Empty images for what was not requested.
@@ -74,6 +75,8 @@ struct ProxyFrame {
     /// Colour model fitted on the training renderings (seed 000 §6.2), single perspective only.
     std::optional<ColourModel> colour_model;
 };
+/// Camera, layers, intervals and the size of every image present, one line.
+std::ostream& operator<<(std::ostream& out, const ProxyFrame& frame);
 
 class ProxyRenderer {
 public:
@@ -113,22 +116,12 @@ private:
     ProxyFrame march(const Camera& camera, double tilt_deg, bool multi_perspective,
                      const ProxyRequest& request);
 
-    /// Flags, per block, whether the pass may skip it for this request.
-    std::vector<std::uint8_t> skippable_blocks(const TransferTable& table,
-                                               const std::vector<double>& isovalues,
-                                               bool accumulates);
-
     std::shared_ptr<ComputeDevice> device_;
     VolumeRenderer renderer_;
-    /// Kernel and reused device buffers (libinsitu/src/render/proxy_renderer.cpp).
+    /// Kernel, reused device buffers and the empty-space blocks of the uploaded volume
+    /// (libinsitu/src/render/proxy_renderer.cpp, render/empty_space.hpp).
     struct DeviceState;
     std::unique_ptr<DeviceState> state_;
-    /// Value range of every block of the uploaded volume (min > max: the block holds NaN).
-    struct BlockRanges {
-        std::uint64_t generation = 0;
-        Index3 counts{0, 0, 0};
-        std::vector<float> min, max;
-    } blocks_;
     double last_skippable_fraction_ = 0.0;
 };
 

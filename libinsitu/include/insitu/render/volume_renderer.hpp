@@ -24,6 +24,7 @@
 //  * Depth: depth (Camera::depth_of) of the first sample with alpha > 0; +inf where none.
 #include <cstddef>
 #include <cstdint>
+#include <iosfwd>
 #include <memory>
 #include <vector>
 
@@ -45,6 +46,7 @@ struct PhongParameters {
     float specular = 0.3f;
     float shininess = 32.0f;
 };
+std::ostream& operator<<(std::ostream& out, const PhongParameters& phong);
 
 struct RenderSettings {
     /// Distance between samples along a ray, in units of the smallest grid spacing (> 0).
@@ -57,6 +59,7 @@ struct RenderSettings {
     int tf_value_bins = 1024;
     int tf_gradient_bins = 64;
 };
+std::ostream& operator<<(std::ostream& out, const RenderSettings& settings);
 
 /// What one render produces: premultiplied RGBA and first-hit depth (+inf where nothing).
 struct Rendering {

@@ -1,0 +1,140 @@
+// The ray-marching skeleton of the ground truth (volume_renderer.cl, seed 002) and the proxies
+// (proxy_renderer.cl, seed 000), prepended to both families by ComputeDevice. Proxies must take
+// the samples the ground truth takes, so that Σ_j a_j = 1 − T and Σ_j c_j a_j equal its image;
+// both march with these functions instead of two copies that could drift apart.
+// Volumes are float32 buffers, x fastest (buffers, not image3d: image3d is emulated on PoCL and
+// several times slower). Coordinates named *_voxels are in grid units of the volume. Argument
+// groups arrive as the host packs them (libinsitu/src/device/kernel_args.hpp): camera_args(),
+// volume_args(), transfer_args().
+
+// Trilinear sample at a position in voxel coordinates, clamped to the grid. dims must be >= 2 on
+// every axis (the host checks). NaN samples propagate, which callers treat as empty space.
+inline float sample_trilinear(__global const float* volume, int4 dims, float3 position_voxels) {
+    // Scalar code on purpose: PoCL compiles float3 clamp/floor/convert into padded 4-wide
+    // sequences that cost more than the arithmetic they replace.
+    const float px = clamp(position_voxels.x, 0.0f, (float)(dims.x - 1));
+    const float py = clamp(position_voxels.y, 0.0f, (float)(dims.y - 1));
+    const float pz = clamp(position_voxels.z, 0.0f, (float)(dims.z - 1));
+    const int ix = min((int)px, dims.x - 2);
+    const int iy = min((int)py, dims.y - 2);
+    const int iz = min((int)pz, dims.z - 2);
+    const float fx = px - (float)ix;
+    const float fy = py - (float)iy;
+    const float fz = pz - (float)iz;
+    const uint stride_y = (uint)dims.x;
+    const uint stride_z = (uint)dims.x * (uint)dims.y;
+    __global const float* c = volume + ((uint)iz * stride_z + (uint)iy * stride_y + (uint)ix);
+    const float c00 = mix(c[0], c[1], fx);
+    const float c10 = mix(c[stride_y], c[stride_y + 1], fx);
+    const float c01 = mix(c[stride_z], c[stride_z + 1], fx);
+    const float c11 = mix(c[stride_z + stride_y], c[stride_z + stride_y + 1], fx);
+    return mix(mix(c00, c10, fy), mix(c01, c11, fy), fz);
+}
+
+// Central differences of trilinear samples one voxel apart, in field units per world unit;
+// inv_spacing in voxels per world unit.
+inline float3 gradient_central(__global const float* volume, int4 dims, float3 p,
+                               float3 inv_spacing) {
+    const float gx = sample_trilinear(volume, dims, p + (float3)(1, 0, 0)) -
+                     sample_trilinear(volume, dims, p - (float3)(1, 0, 0));
+    const float gy = sample_trilinear(volume, dims, p + (float3)(0, 1, 0)) -
+                     sample_trilinear(volume, dims, p - (float3)(0, 1, 0));
+    const float gz = sample_trilinear(volume, dims, p + (float3)(0, 0, 1)) -
+                     sample_trilinear(volume, dims, p - (float3)(0, 0, 1));
+    // Halving is exact in float, so this is 1 / (2 spacing) as the host would round it.
+    return (float3)(gx, gy, gz) * (0.5f * inv_spacing);
+}
+
+// Transfer-function table lookup, bilinear in (value, gradient magnitude). The table stores
+// colour and step-corrected opacity. domain = (value_min, 1 / (value_max - value_min),
+// 1 / gradient_max or 0 for 1D, unused).
+inline float4 lookup_transfer(__global const float4* table, int2 bins, float4 domain, float value,
+                              float gradient_magnitude) {
+    const float x = clamp((value - domain.x) * domain.y, 0.0f, 1.0f) * (float)(bins.x - 1);
+    const int ix = min((int)x, bins.x - 2);
+    const float fx = x - (float)ix;
+    if (bins.y == 1) return mix(table[ix], table[ix + 1], fx);
+    const float y = clamp(gradient_magnitude * domain.z, 0.0f, 1.0f) * (float)(bins.y - 1);
+    const int iy = min((int)y, bins.y - 2);
+    const float fy = y - (float)iy;
+    const int row0 = iy * bins.x;
+    const int row1 = row0 + bins.x;
+    return mix(mix(table[row0 + ix], table[row0 + ix + 1], fx),
+               mix(table[row1 + ix], table[row1 + ix + 1], fx), fy);
+}
+
+// One pixel's ray through the volume's box. Sample i lies at t_i = t_near + (i + 1/2) step,
+// t in world units along the unit direction: the midpoints of equal segments from where the ray
+// enters the box, so every march of the same camera and step takes the same samples.
+typedef struct {
+    float3 origin;            // world space: on the camera plane (orthographic) or the eye
+    float3 direction;         // world space, unit length
+    float t_near, t_far;      // the span inside the box; t_near > t_far where the ray misses
+    float3 start_voxels;      // the position in voxel coordinates is start + t direction_voxels
+    float3 direction_voxels;
+    float depth_origin;       // depth from the camera plane is depth_origin + t depth_per_t
+    float depth_per_t;
+} MarchRay;
+
+// The ray of pixel (x, y) (centre (x + 0.5, y + 0.5), see insitu/core/camera.hpp), clipped to
+// the box [box_lower, box_upper]. half_extent.z is the projection: 0 orthographic, 1
+// perspective. A non-zero tilt makes the volume distortion camera (seed 000 Eq. 1): the ray
+// heads for the pole line through the image centre, v cos θ − r̂(p) sin θ.
+inline MarchRay march_ray(int x, int y, int2 size, float4 cam_position, float4 cam_forward,
+                          float4 cam_right, float4 cam_up, float4 cam_half_extent,
+                          float sin_tilt, float cos_tilt, float4 origin_world,
+                          float4 inv_spacing, float4 box_lower, float4 box_upper) {
+    MarchRay ray;
+    const float2 uv = plane_coordinates(x, y, size, cam_half_extent);
+    if (cam_half_extent.z == 0.0f) {
+        ray.origin = cam_position.xyz + uv.x * cam_right.xyz + uv.y * cam_up.xyz;
+        ray.direction = cam_forward.xyz;
+    } else {
+        ray.origin = cam_position.xyz;
+        ray.direction = normalize(cam_forward.xyz + uv.x * cam_right.xyz + uv.y * cam_up.xyz);
+    }
+    if (sin_tilt != 0.0f) {
+        const float3 offset = ray.origin - cam_position.xyz;
+        const float offset_length = length(offset);
+        const float3 radial = offset_length > 0.0f ? offset / offset_length : (float3)(0.0f);
+        ray.direction = normalize(cam_forward.xyz * cos_tilt - radial * sin_tilt);
+    }
+
+    // Slabs; +-inf in `inv` for axis-parallel rays is what they need.
+    const float3 inv = 1.0f / ray.direction;
+    const float3 t0 = (box_lower.xyz - ray.origin) * inv;
+    const float3 t1 = (box_upper.xyz - ray.origin) * inv;
+    const float3 t_small = fmin(t0, t1);
+    const float3 t_large = fmax(t0, t1);
+    ray.t_near = fmax(fmax(t_small.x, t_small.y), fmax(t_small.z, 0.0f));
+    ray.t_far = fmin(fmin(t_large.x, t_large.y), t_large.z);
+
+    ray.start_voxels = (ray.origin - origin_world.xyz) * inv_spacing.xyz;
+    ray.direction_voxels = ray.direction * inv_spacing.xyz;
+    ray.depth_origin = dot(ray.origin - cam_position.xyz, cam_forward.xyz);
+    ray.depth_per_t = dot(ray.direction, cam_forward.xyz);
+    return ray;
+}
+
+inline bool ray_hits_box(const MarchRay* ray) { return ray->t_near <= ray->t_far; }
+
+// t of sample i; the march ends at the first i with t >= t_far.
+inline float sample_t(const MarchRay* ray, int i, float step) {
+    return ray->t_near + ((float)i + 0.5f) * step;
+}
+
+inline float3 sample_position_voxels(const MarchRay* ray, float t) {
+    return ray->start_voxels + t * ray->direction_voxels;
+}
+
+inline float sample_depth(const MarchRay* ray, float t) {
+    return ray->depth_origin + t * ray->depth_per_t;
+}
+
+// Front-to-back compositing of one sample of opacity alpha: returns its weight α_i Π_{k<i}
+// (1 − α_k) (seed 002's emission weight, seed 000 Eq. 7's attenuation term) and attenuates T.
+inline float absorb(float* transmittance, float alpha) {
+    const float weight = *transmittance * alpha;
+    *transmittance *= 1.0f - alpha;
+    return weight;
+}

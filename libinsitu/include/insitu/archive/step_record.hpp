@@ -1,0 +1,35 @@
+#pragma once
+// What one timestep hands the archive (insitu/archive/archive.hpp describes the archive), and
+// the schema version both sides of the archive agree on.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "insitu/config.hpp"
+#include "insitu/core/image.hpp"
+#include "insitu/render/proxy_renderer.hpp"
+
+namespace insitu {
+
+constexpr int kArchiveSchemaVersion = 1;
+
+/// Everything of one view at one timestep, copied off the simulation's memory.
+struct ViewRecord {
+    int view_index = 0;
+    ViewConfig view;
+    std::optional<ProxyFrame> single;  ///< depth layers, attenuation, training images
+    std::optional<ProxyFrame> multi;   ///< distortion-camera depth and distortion layers
+    Image preview;                     ///< RGBA, ground truth of the configured TF
+    TransferFunction transfer_function{std::vector<ControlPoint>{{0.0, {0, 0, 0, 0}}}};
+    std::vector<TransferFunction> training_transfer_functions;
+};
+
+struct StepRecord {
+    std::int64_t step = 0;
+    double time = 0.0;
+    std::string field;  ///< name of the field the proxies came from
+    std::vector<ViewRecord> views;
+};
+
+}  // namespace insitu

@@ -1,0 +1,142 @@
+#include "archive/atomic_file.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include "archive/archive_format.hpp"
+#include "insitu/error.hpp"
+
+namespace insitu::archive_format {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string errno_text(int error) {
+    return std::strerror(error);
+}
+
+void fsync_directory(const fs::path& directory) {
+    const int fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0)
+        fail<IoError>("cannot open directory \"", directory.string(),
+                      "\" to sync it: ", errno_text(errno));
+    const int status = ::fsync(fd);
+    const int error = errno;
+    ::close(fd);
+    if (status != 0) {
+        fail<IoError>("cannot sync directory \"", directory.string(), "\": ", errno_text(error));
+    }
+}
+
+}  // namespace
+
+TempFile::TempFile(fs::path final_path) : final_(std::move(final_path)) {
+    // pid + counter: unique within the folder without asking the file system.
+    static std::atomic<unsigned> counter{0};
+    temp_ = final_.parent_path() /
+            (std::string(kTempPrefix) + std::to_string(::getpid()) + "-" +
+             std::to_string(counter++) + "-" + final_.filename().string());
+}
+
+TempFile::~TempFile() {
+    if (!committed_) ::unlink(temp_.c_str());
+}
+
+void TempFile::write(const void* data, std::size_t size) {
+    const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) failed("create", errno);
+    const char* bytes = static_cast<const char*>(data);
+    std::size_t done = 0;
+    while (done < size) {
+        const ssize_t written = ::write(fd, bytes + done, size - done);
+        if (written < 0) {
+            if (errno == EINTR) continue;
+            const int error = errno;
+            ::close(fd);
+            failed("write", error);
+        }
+        done += static_cast<std::size_t>(written);
+    }
+    sync_and_close(fd);
+}
+
+void TempFile::sync() {
+    const int fd = ::open(temp_.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) failed("reopen", errno);
+    sync_and_close(fd);
+}
+
+void TempFile::commit() {
+    if (::rename(temp_.c_str(), final_.c_str()) != 0) failed("rename", errno);
+    committed_ = true;
+    fsync_directory(final_.parent_path());
+}
+
+void TempFile::sync_and_close(int fd) {
+    if (::fsync(fd) != 0) {
+        const int error = errno;
+        ::close(fd);
+        failed("sync", error);
+    }
+    // close() reports deferred write errors on some file systems (NFS).
+    if (::close(fd) != 0) failed("close", errno);
+}
+
+void TempFile::failed(const char* what, int error) const {
+    fail<IoError>("cannot write \"", final_.string(), "\": ", what, " of temp file \"",
+                  temp_.filename().string(), "\" failed: ", errno_text(error));
+}
+
+void write_file_atomically(const fs::path& path, const std::string& bytes) {
+    TempFile file(path);
+    file.write(bytes.data(), bytes.size());
+    file.commit();
+}
+
+void remove_temp_files(const fs::path& folder) {
+    std::error_code error;
+    for (fs::directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
+        if (it->path().filename().string().rfind(kTempPrefix, 0) == 0) {
+            std::error_code ignored;
+            fs::remove(it->path(), ignored);
+        }
+    }
+}
+
+std::uint32_t crc32_of(const void* data, std::size_t size) {
+    // zlib's crc32 takes uInt lengths; feed it in chunks so files over 4 GiB are fine.
+    uLong crc = ::crc32(0L, Z_NULL, 0);
+    const auto* bytes = static_cast<const Bytef*>(data);
+    while (size > 0) {
+        const uInt chunk = static_cast<uInt>(std::min<std::size_t>(size, 1u << 30));
+        crc = ::crc32(crc, bytes, chunk);
+        bytes += chunk;
+        size -= chunk;
+    }
+    return static_cast<std::uint32_t>(crc);
+}
+
+std::vector<char> read_whole_file(const std::string& path) {
+    std::error_code error;
+    if (!fs::is_regular_file(path, error)) {
+        fail<IoError>("cannot read \"", path,
+                      "\": ", fs::exists(path, error) ? "not a regular file" : "no such file");
+    }
+    std::ifstream in(path, std::ios::binary);
+    if (!in) fail<IoError>("cannot open \"", path, "\"");
+    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) fail<IoError>("cannot read \"", path, "\"");
+    return bytes;
+}
+
+}  // namespace insitu::archive_format

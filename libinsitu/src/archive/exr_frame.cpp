@@ -1,0 +1,608 @@
+// The EXR frame codec (exr_frame.hpp). Both directions work on bytes in memory: the writer
+// checksums what it encodes and stores it through the crash-safe path (errors such as EFBIG or
+// ENOSPC come back with errno), and the reader parses only bytes it already checked against the
+// manifest. OpenEXR reports damage with Iex exceptions; each becomes an IoError naming the file
+// and the part.
+#include "archive/exr_frame.hpp"
+
+#include <Imath/half.h>
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfDoubleAttribute.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfIO.h>
+#include <OpenEXR/ImfInputPart.h>
+#include <OpenEXR/ImfIntAttribute.h>
+#include <OpenEXR/ImfMultiPartInputFile.h>
+#include <OpenEXR/ImfMultiPartOutputFile.h>
+#include <OpenEXR/ImfOutputPart.h>
+#include <OpenEXR/ImfPartType.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfThreading.h>
+
+#include <algorithm>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "archive/archive_format.hpp"
+#include "insitu/error.hpp"
+
+namespace insitu::archive_format {
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Encoding
+
+/// Collects the encoded EXR in memory, so that the bytes are checksummed and written by the same
+/// durable path as every other file (errors such as EFBIG or ENOSPC come back with errno).
+class MemoryOutputStream : public Imf::OStream {
+public:
+    explicit MemoryOutputStream(const std::string& name) : Imf::OStream(name.c_str()) {}
+    void write(const char c[], int n) override {
+        if (position_ + n > bytes_.size()) bytes_.resize(position_ + n);
+        std::memcpy(&bytes_[position_], c, static_cast<std::size_t>(n));
+        position_ += static_cast<std::size_t>(n);
+    }
+    std::uint64_t tellp() override { return position_; }
+    void seekp(std::uint64_t position) override { position_ = position; }
+    std::string& bytes() { return bytes_; }
+
+private:
+    std::string bytes_;
+    std::size_t position_ = 0;
+};
+
+Imf::Compression parse_compression(const std::string& name) {
+    if (name == "none") return Imf::NO_COMPRESSION;
+    if (name == "rle") return Imf::RLE_COMPRESSION;
+    if (name == "zips") return Imf::ZIPS_COMPRESSION;
+    if (name == "zip") return Imf::ZIP_COMPRESSION;
+    if (name == "piz") return Imf::PIZ_COMPRESSION;
+    if (name == "pxr24") return Imf::PXR24_COMPRESSION;
+    if (name == "b44") return Imf::B44_COMPRESSION;
+    fail<InvalidArgument>("compression \"", name,
+                          "\" (expected none, rle, zips, zip, piz, pxr24 or b44)");
+}
+
+/// One channel of an EXR part: channel `channel` of `image`.
+struct ChannelSource {
+    std::string name;
+    const Image* image = nullptr;
+    int channel = 0;
+    Imf::PixelType type = Imf::FLOAT;
+};
+
+struct PartSource {
+    std::string name;
+    std::vector<ChannelSource> channels;
+    nlohmann::json training_function;  ///< train<k> parts only
+    const ColourModel* model = nullptr;  ///< model parts only
+    /// Pixels made for the part (the model's table as an image); shared so that channel
+    /// pointers stay valid when the part is moved.
+    std::shared_ptr<const Image> storage{};
+};
+
+void add_channels(PartSource& part, const Image& image, const char* suffix, Imf::PixelType type) {
+    for (int c = 0; c < image.channels; ++c) {
+        part.channels.push_back({interval_channel(part.name, suffix, c), &image, c, type});
+    }
+}
+
+/// Checks that every image of a part has the same size; `what` names them for the message.
+void check_same_size(const PartSource& part, const std::string& where) {
+    const Image* first = part.channels.front().image;
+    for (const ChannelSource& channel : part.channels) {
+        if (channel.image->width != first->width || channel.image->height != first->height) {
+            fail<InvalidArgument>(where, ": part \"", part.name, "\": channel \"", channel.name,
+                                  "\" is ", channel.image->width, "x", channel.image->height,
+                                  ", not ", first->width, "x", first->height);
+        }
+    }
+}
+
+/// The parts of one frame, in file order; empty images make no part.
+std::vector<PartSource> frame_parts(const ProxyFrame& frame, const ViewRecord& view,
+                                    StoragePrecision precision, const std::string& where) {
+    // Depth and distortion are world distances of up to a few hundred voxels; half's 11-bit
+    // mantissa would round them by up to ~0.1 voxel at 256 voxels, visible as terracing in
+    // relighting and re-projection, so they are always FLOAT. The attenuation family and the
+    // training images are fractions and colours where half's 1e-3 relative error is invisible.
+    const Imf::PixelType compact = precision == StoragePrecision::half ? Imf::HALF : Imf::FLOAT;
+    const bool multi = frame.multi_perspective;
+    std::vector<PartSource> parts;
+
+    auto layers_part = [&](const char* base, const std::vector<Image>& layers) {
+        if (layers.empty()) return;
+        PartSource part{part_name(base, multi), {}, {}};
+        for (std::size_t k = 0; k < layers.size(); ++k) {
+            if (layers[k].channels != 1 || layers[k].pixels.empty()) {
+                fail<InvalidArgument>(where, ": ", part.name, " layer ", k, " has ",
+                                      layers[k].channels, " channels and ", layers[k].pixel_count(),
+                                      " pixels (expected 1 channel)");
+            }
+            part.channels.push_back(
+                {layer_channel(part.name, static_cast<int>(k)), &layers[k], 0, Imf::FLOAT});
+        }
+        parts.push_back(std::move(part));
+    };
+    layers_part(kDepthPart, frame.depth_layers);
+    if (multi) layers_part(kDistortionPart, frame.distortion_layers);
+
+    PartSource attenuation{part_name(kAttenuationPart, multi), {}, {}};
+    const Image* interval_images[3] = {&frame.attenuation, &frame.mean_depth, &frame.optical_depth};
+    const char* interval_suffixes[3] = {kAttenuationChannel, kMeanDepthChannel,
+                                        kOpticalDepthChannel};
+    int interval_count = -1;
+    for (int i = 0; i < 3; ++i) {
+        const Image& image = *interval_images[i];
+        if (image.pixels.empty()) continue;
+        if (interval_count >= 0 && image.channels != interval_count) {
+            fail<InvalidArgument>(where, ": ", attenuation.name, interval_suffixes[i], ": ",
+                                  image.channels, " intervals, not ", interval_count);
+        }
+        if (image.channels > kMaxIntervals) {
+            fail<InvalidArgument>(where, ": ", attenuation.name, ": ", image.channels,
+                                  " intervals (at most ", kMaxIntervals, ")");
+        }
+        interval_count = image.channels;
+        add_channels(attenuation, image, interval_suffixes[i], compact);
+    }
+    if (!attenuation.channels.empty()) parts.push_back(std::move(attenuation));
+
+    for (std::size_t t = 0; t < frame.training.size(); ++t) {
+        const Image& image = frame.training[t];
+        const std::string name = kTrainingPartPrefix + std::to_string(t);
+        if (image.channels != 4 || image.pixels.empty()) {
+            fail<InvalidArgument>(where, ": training image ", t, " has ", image.channels,
+                                  " channels and ", image.pixel_count(), " pixels (expected RGBA)");
+        }
+        PartSource part{name, {}, nullptr};
+        for (int c = 0; c < 4; ++c) {
+            part.channels.push_back({name + kTrainingChannels[c], &image, c, compact});
+        }
+        if (t < view.training_transfer_functions.size()) {
+            part.training_function = view.training_transfer_functions[t].to_json();
+        }
+        parts.push_back(std::move(part));
+    }
+    if (frame.colour_model) {
+        const ColourModel& model = *frame.colour_model;
+        if (interval_count >= 0 && model.intervals() != interval_count) {
+            fail<InvalidArgument>(where, ": colour model has ", model.intervals(),
+                                  " intervals, the attenuation proxies ", interval_count);
+        }
+        auto table = std::make_shared<Image>(model.row_floats(), model.clusters(), 1);
+        table->pixels = model.table();
+        PartSource part{part_name(kModelPart, multi), {}, {}, &model, table};
+        part.channels.push_back({part.name + kModelChannel, table.get(), 0, Imf::FLOAT});
+        parts.push_back(std::move(part));
+    }
+    for (const PartSource& part : parts) check_same_size(part, where);
+    return parts;
+}
+
+/// The frame-level attributes, on every part of that frame so that each part describes itself.
+void add_frame_attributes(Imf::Header& header, const StepRecord& record, const ViewRecord& view,
+                          const ProxyFrame& frame) {
+    header.insert(kSchemaAttribute, Imf::IntAttribute(kArchiveSchemaVersion));
+    // Steps are 64-bit; EXR has no 64-bit integer attribute, and a decimal string is exact.
+    header.insert(kStepAttribute, Imf::StringAttribute(std::to_string(record.step)));
+    header.insert(kTimeAttribute, Imf::DoubleAttribute(record.time));
+    header.insert(kFieldAttribute, Imf::StringAttribute(record.field));
+    header.insert(kViewAttribute, Imf::IntAttribute(view.view_index));
+    header.insert(kViewConfigAttribute,
+                  Imf::StringAttribute(view.view.to_json().dump()));
+    header.insert(kPerspectiveAttribute,
+                  Imf::StringAttribute(frame.multi_perspective ? "multi" : "single"));
+    header.insert(kCameraAttribute, Imf::StringAttribute(frame.camera.to_json().dump()));
+    if (frame.multi_perspective) {
+        header.insert(kTiltAttribute, Imf::DoubleAttribute(frame.distortion_tilt_deg));
+    }
+    // JSON keeps doubles exact (shortest round-trip form); a FloatVectorAttribute would not.
+    header.insert(kIsovaluesAttribute,
+                  Imf::StringAttribute(nlohmann::json(frame.isovalues).dump()));
+    if (frame.intervals) {
+        header.insert(kIntervalsAttribute,
+                      Imf::StringAttribute(frame.intervals->to_json().dump()));
+    }
+    header.insert(kTransferFunctionAttribute,
+                  Imf::StringAttribute(view.transfer_function.to_json().dump()));
+    nlohmann::json training = nlohmann::json::array();
+    for (const TransferFunction& tf : view.training_transfer_functions) {
+        training.push_back(tf.to_json());
+    }
+    header.insert(kTrainingFunctionsAttribute, Imf::StringAttribute(training.dump()));
+}
+
+/// Encodes the multi-part EXR of one view; returns its bytes and the part names in file order.
+std::string encode_parts(const StepRecord& record, const ViewRecord& view,
+                         StoragePrecision precision, Imf::Compression compression,
+                         const std::string& relative_path, std::vector<std::string>& part_names) {
+    const std::string where = "step " + std::to_string(record.step) + " view " +
+                              std::to_string(view.view_index) + " (" + relative_path + ")";
+    struct FramedPart {
+        const ProxyFrame* frame;
+        PartSource source;
+    };
+    std::vector<FramedPart> parts;
+    for (const std::optional<ProxyFrame>* frame : {&view.single, &view.multi}) {
+        if (!frame->has_value()) continue;
+        if ((*frame)->multi_perspective != (frame == &view.multi)) {
+            fail<InvalidArgument>(where, ": the ", frame == &view.multi ? "multi" : "single",
+                                  " frame has multi_perspective = ", (*frame)->multi_perspective);
+        }
+        for (PartSource& part : frame_parts(**frame, view, precision, where)) {
+            parts.push_back({&**frame, std::move(part)});
+        }
+    }
+    if (parts.empty()) fail<InvalidArgument>(where, ": no proxy images to store");
+
+    // Multi-part files must share one display window; the union of the parts' sizes holds each
+    // part's data window (all parts of a view normally have the view's size).
+    int display_width = 1, display_height = 1;
+    for (const FramedPart& part : parts) {
+        display_width = std::max(display_width, part.source.channels.front().image->width);
+        display_height = std::max(display_height, part.source.channels.front().image->height);
+    }
+    const Imath::Box2i display(Imath::V2i(0, 0), Imath::V2i(display_width - 1, display_height - 1));
+
+    std::vector<Imf::Header> headers;
+    part_names.clear();
+    for (const FramedPart& part : parts) {
+        const Image& image = *part.source.channels.front().image;
+        const Imath::Box2i data(Imath::V2i(0, 0), Imath::V2i(image.width - 1, image.height - 1));
+        Imf::Header header(display, data);
+        header.setName(part.source.name);
+        header.setType(Imf::SCANLINEIMAGE);
+        header.compression() = compression;
+        for (const ChannelSource& channel : part.source.channels) {
+            header.channels().insert(channel.name, Imf::Channel(channel.type));
+        }
+        add_frame_attributes(header, record, view, *part.frame);
+        if (!part.source.training_function.is_null()) {
+            header.insert(kTrainingFunctionAttribute,
+                          Imf::StringAttribute(part.source.training_function.dump()));
+        }
+        if (part.source.model) {
+            header.insert(kModelIntervalsAttribute,
+                          Imf::IntAttribute(part.source.model->intervals()));
+            header.insert(kModelClustersAttribute,
+                          Imf::IntAttribute(part.source.model->clusters()));
+            header.insert(kModelLayoutAttribute, Imf::StringAttribute(kModelLayout));
+            nlohmann::json functions = nlohmann::json::array();
+            for (const TransferFunction& tf : view.training_transfer_functions) {
+                functions.push_back(tf.to_json());
+            }
+            header.insert(kModelFunctionsAttribute, Imf::StringAttribute(functions.dump()));
+        }
+        headers.push_back(std::move(header));
+        part_names.push_back(part.source.name);
+    }
+
+    MemoryOutputStream stream(relative_path);
+    std::string current_part;
+    try {
+        Imf::MultiPartOutputFile file(stream, headers.data(), static_cast<int>(headers.size()));
+        for (std::size_t p = 0; p < parts.size(); ++p) {
+            current_part = parts[p].source.name;
+            Imf::FrameBuffer frame_buffer;
+            // OpenEXR writes a slice only into a channel of its own type, so HALF channels get
+            // a converted copy (round to nearest); FLOAT channels are read in place.
+            std::vector<std::vector<half>> halves;
+            halves.reserve(parts[p].source.channels.size());
+            for (const ChannelSource& channel : parts[p].source.channels) {
+                const Image& image = *channel.image;
+                if (channel.type == Imf::HALF) {
+                    std::vector<half>& plane = halves.emplace_back(image.pixel_count());
+                    for (std::size_t i = 0; i < plane.size(); ++i) {
+                        plane[i] = half(image.pixels[i * image.channels + channel.channel]);
+                    }
+                    frame_buffer.insert(channel.name,
+                                        Imf::Slice(Imf::HALF, reinterpret_cast<char*>(plane.data()),
+                                                   sizeof(half), sizeof(half) * image.width));
+                    continue;
+                }
+                const std::size_t x_stride = sizeof(float) * image.channels;
+                char* base = reinterpret_cast<char*>(const_cast<float*>(image.pixels.data()) +
+                                                     channel.channel);
+                frame_buffer.insert(channel.name,
+                                    Imf::Slice(Imf::FLOAT, base, x_stride, x_stride * image.width));
+            }
+            Imf::OutputPart part(file, static_cast<int>(p));
+            part.setFrameBuffer(frame_buffer);
+            part.writePixels(parts[p].source.channels.front().image->height);
+        }
+    } catch (const std::exception& error) {
+        fail<IoError>("cannot encode EXR \"", relative_path, "\" part \"", current_part,
+                      "\": ", error.what());
+    }
+    return std::move(stream.bytes());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Decoding
+
+/// Lets OpenEXR parse a file already read (and checksummed) into memory.
+class MemoryInputStream : public Imf::IStream {
+public:
+    MemoryInputStream(const std::vector<char>& bytes, const std::string& name)
+        : Imf::IStream(name.c_str()), bytes_(bytes) {}
+    bool read(char c[], int n) override {
+        if (n < 0 || position_ > bytes_.size() || bytes_.size() - position_ < std::size_t(n)) {
+            throw std::runtime_error("unexpected end of file at byte " + std::to_string(position_));
+        }
+        std::memcpy(c, bytes_.data() + position_, static_cast<std::size_t>(n));
+        position_ += static_cast<std::size_t>(n);
+        return position_ < bytes_.size();
+    }
+    std::uint64_t tellg() override { return position_; }
+    void seekg(std::uint64_t position) override { position_ = position; }
+
+private:
+    const std::vector<char>& bytes_;
+    std::uint64_t position_ = 0;
+};
+
+/// Where an error happened, for messages: file and part.
+struct PartContext {
+    const std::string& file;
+    std::string part;
+    [[noreturn]] void error(const std::string& what) const {
+        fail<IoError>("\"", file, "\" part \"", part, "\": ", what);
+    }
+};
+
+const std::string& string_attribute(const Imf::Header& header, const char* name,
+                                    const PartContext& where) {
+    const auto* attribute = header.findTypedAttribute<Imf::StringAttribute>(name);
+    if (!attribute) where.error(std::string("no string attribute \"") + name + "\"");
+    return attribute->value();
+}
+
+nlohmann::json json_attribute(const Imf::Header& header, const char* name,
+                              const PartContext& where) {
+    try {
+        return nlohmann::json::parse(string_attribute(header, name, where));
+    } catch (const nlohmann::json::exception& error) {
+        where.error(std::string("attribute \"") + name + "\" is not valid JSON: " + error.what());
+    }
+}
+
+/// The frame-level metadata every part of a frame carries.
+void read_frame_attributes(const Imf::Header& header, ProxyFrame& frame, const PartContext& where) {
+    const auto* schema = header.findTypedAttribute<Imf::IntAttribute>(kSchemaAttribute);
+    if (!schema) where.error(std::string("no int attribute \"") + kSchemaAttribute + "\"");
+    if (schema->value() != kArchiveSchemaVersion) {
+        where.error("schema version " + std::to_string(schema->value()) +
+                    " (this libinsitu reads " + std::to_string(kArchiveSchemaVersion) + ")");
+    }
+    const nlohmann::json camera = json_attribute(header, kCameraAttribute, where);
+    try {
+        frame.camera = Camera::from_json(camera);
+    } catch (const std::exception& error) {
+        where.error("attribute \"" + std::string(kCameraAttribute) + "\": " + error.what());
+    }
+    if (frame.multi_perspective) {
+        const auto* tilt = header.findTypedAttribute<Imf::DoubleAttribute>(kTiltAttribute);
+        if (!tilt) where.error(std::string("no double attribute \"") + kTiltAttribute + "\"");
+        frame.distortion_tilt_deg = tilt->value();
+    }
+    try {
+        frame.isovalues =
+            json_attribute(header, kIsovaluesAttribute, where).get<std::vector<double>>();
+        if (header.findTypedAttribute<Imf::StringAttribute>(kIntervalsAttribute)) {
+            const nlohmann::json intervals = json_attribute(header, kIntervalsAttribute, where);
+            frame.intervals = IntervalSet(intervals.at("edges").get<std::vector<double>>());
+        }
+    } catch (const IoError&) {
+        throw;
+    } catch (const std::exception& error) {
+        where.error(std::string("isovalues or intervals attribute: ") + error.what());
+    }
+}
+
+/// Reads the channels `names` of one part into one image (channel c = names[c]).
+Image read_channels(Imf::InputPart& part, const std::vector<std::string>& names,
+                    const PartContext& where) {
+    const Imath::Box2i window = part.header().dataWindow();
+    const long long width = static_cast<long long>(window.max.x) - window.min.x + 1;
+    const long long height = static_cast<long long>(window.max.y) - window.min.y + 1;
+    // A header that passed the checksum can still be foreign; refuse absurd sizes before
+    // allocating (2^28 pixels = 16384^2).
+    if (width < 1 || height < 1 || width * height > (1ll << 28)) {
+        where.error("data window " + std::to_string(width) + "x" + std::to_string(height) +
+                    " is empty or too large");
+    }
+    Image image(static_cast<int>(width), static_cast<int>(height), static_cast<int>(names.size()));
+    Imf::FrameBuffer frame_buffer;
+    const std::size_t x_stride = sizeof(float) * image.channels;
+    const std::size_t y_stride = x_stride * image.width;
+    for (int c = 0; c < image.channels; ++c) {
+        // HALF channels convert to float on read. The base is shifted so that data-window
+        // coordinates index the zero-based buffer.
+        char* base = reinterpret_cast<char*>(image.pixels.data() + c) -
+                     static_cast<std::ptrdiff_t>(window.min.x * x_stride + window.min.y * y_stride);
+        frame_buffer.insert(names[c], Imf::Slice(Imf::FLOAT, base, x_stride, y_stride));
+    }
+    part.setFrameBuffer(frame_buffer);
+    part.readPixels(window.min.y, window.max.y);
+    return image;
+}
+
+/// How many channels name_of(0), name_of(1), ... the part has, in a row.
+template <typename NameOf>
+int count_channels(const Imf::ChannelList& channels, NameOf name_of) {
+    int count = 0;
+    while (count < 1024 && channels.findChannel(name_of(count))) ++count;
+    return count;
+}
+
+template <typename NameOf>
+std::vector<std::string> names_of(int count, NameOf name_of) {
+    std::vector<std::string> names;
+    for (int i = 0; i < count; ++i) names.push_back(name_of(i));
+    return names;
+}
+
+/// One single-channel image per layer channel of a "depth"/"distortion" part.
+std::vector<Image> read_layers(Imf::InputPart& part, const PartContext& where) {
+    auto name_of = [&](int k) { return layer_channel(where.part, k); };
+    const int count = count_channels(part.header().channels(), name_of);
+    if (count == 0) where.error("no channel \"" + name_of(0) + "\"");
+    const Image all = read_channels(part, names_of(count, name_of), where);
+    std::vector<Image> layers(static_cast<std::size_t>(count), Image(all.width, all.height, 1));
+    for (std::size_t p = 0; p < all.pixel_count(); ++p) {
+        for (int k = 0; k < count; ++k) layers[k].pixels[p] = all.pixels[p * count + k];
+    }
+    return layers;
+}
+
+/// Splits an interleaved image into consecutive groups of `count` channels.
+Image channel_range(const Image& all, int first, int count) {
+    Image image(all.width, all.height, count);
+    for (std::size_t p = 0; p < all.pixel_count(); ++p) {
+        for (int c = 0; c < count; ++c) {
+            image.pixels[p * count + c] = all.pixels[p * all.channels + first + c];
+        }
+    }
+    return image;
+}
+
+/// a_j, and z-mean and tau when present, of an "attenuation" part.
+void read_attenuation(Imf::InputPart& part, ProxyFrame& frame, const PartContext& where) {
+    const Imf::ChannelList& channels = part.header().channels();
+    const char* suffixes[3] = {kAttenuationChannel, kMeanDepthChannel,
+                               kOpticalDepthChannel};
+    Image* targets[3] = {&frame.attenuation, &frame.mean_depth, &frame.optical_depth};
+    int counts[3];
+    std::vector<std::string> names;
+    for (int i = 0; i < 3; ++i) {
+        auto name_of = [&](int j) { return interval_channel(where.part, suffixes[i], j); };
+        counts[i] = count_channels(channels, name_of);
+        for (int j = 0; j < counts[i]; ++j) names.push_back(name_of(j));
+    }
+    const int intervals = std::max({counts[0], counts[1], counts[2]});
+    for (int i = 0; i < 3; ++i) {
+        if (counts[i] != 0 && counts[i] != intervals) {
+            where.error("channels \"" + where.part + suffixes[i] +
+                        "..\": " + std::to_string(counts[i]) + " intervals, expected " +
+                        std::to_string(intervals));
+        }
+    }
+    if (intervals == 0) {
+        where.error("no channel \"" + interval_channel(where.part, suffixes[0], 0) + "\"");
+    }
+    const Image all = read_channels(part, names, where);
+    int first = 0;
+    for (int i = 0; i < 3; ++i) {
+        if (counts[i] == 0) continue;
+        *targets[i] = channel_range(all, first, counts[i]);
+        first += counts[i];
+    }
+}
+
+Image read_training(Imf::InputPart& part, const PartContext& where) {
+    std::vector<std::string> names;
+    for (const char* suffix : kTrainingChannels) {
+        names.push_back(where.part + suffix);
+        if (!part.header().channels().findChannel(names.back())) {
+            where.error("no channel \"" + names.back() + "\"");
+        }
+    }
+    return read_channels(part, names, where);
+}
+
+/// The colour model of a "model" part: its table image, checked against L and K.
+ColourModel read_model(Imf::InputPart& part, const PartContext& where) {
+    const Imf::Header& header = part.header();
+    const auto* intervals =
+        header.findTypedAttribute<Imf::IntAttribute>(kModelIntervalsAttribute);
+    const auto* clusters =
+        header.findTypedAttribute<Imf::IntAttribute>(kModelClustersAttribute);
+    if (!intervals || !clusters) {
+        where.error(std::string("no int attributes \"") + kModelIntervalsAttribute +
+                    "\" and \"" + kModelClustersAttribute + "\"");
+    }
+    const std::string channel = where.part + kModelChannel;
+    if (!header.channels().findChannel(channel)) where.error("no channel \"" + channel + "\"");
+    const Image table = read_channels(part, {channel}, where);
+    const long long row = 4ll * intervals->value() + 3;
+    if (table.width != row || table.height != clusters->value()) {
+        where.error("table is " + std::to_string(table.width) + "x" + std::to_string(table.height) +
+                    ", expected (4 L + 3) x K = " + std::to_string(row) + "x" +
+                    std::to_string(clusters->value()));
+    }
+    try {
+        return ColourModel::from_table(intervals->value(), clusters->value(), table.pixels);
+    } catch (const InvalidArgument& error) {
+        where.error(error.what());
+    }
+}
+
+}  // namespace
+
+void check_compression(const std::string& name) {
+    parse_compression(name);
+}
+
+EncodedView encode_view(const StepRecord& record, const ViewRecord& view,
+                        StoragePrecision precision, const std::string& compression,
+                        const std::string& relative_path) {
+    EncodedView encoded;
+    encoded.bytes = encode_parts(record, view, precision, parse_compression(compression),
+                                 relative_path, encoded.parts);
+    return encoded;
+}
+
+ProxyFrame decode_frame(const std::vector<char>& bytes, const std::string& path,
+                        const std::vector<std::string>& parts, bool multi_perspective) {
+    ProxyFrame frame;
+    frame.multi_perspective = multi_perspective;
+    PartContext where{path, "(header)"};
+    try {
+        MemoryInputStream stream(bytes, path);
+        // No reconstruction of a damaged chunk offset table: damage is an error here.
+        Imf::MultiPartInputFile file(stream, Imf::globalThreadCount(), false);
+        std::map<std::string, int> part_index;
+        for (int p = 0; p < file.parts(); ++p) {
+            if (file.header(p).hasName()) part_index[file.header(p).name()] = p;
+        }
+        bool first = true;
+        for (const std::string& name : parts) {
+            where.part = name;
+            const auto found_part = part_index.find(name);
+            if (found_part == part_index.end()) where.error("missing from the file");
+            Imf::InputPart part(file, found_part->second);
+            if (first) read_frame_attributes(part.header(), frame, where);
+            first = false;
+            const std::string base =
+                multi_perspective ? name.substr(std::strlen(kMultiPrefix)) : name;
+            if (base == kDepthPart) {
+                frame.depth_layers = read_layers(part, where);
+            } else if (base == kDistortionPart) {
+                frame.distortion_layers = read_layers(part, where);
+            } else if (base == kAttenuationPart) {
+                read_attenuation(part, frame, where);
+            } else if (base.rfind(kTrainingPartPrefix, 0) == 0 &&
+                       base == kTrainingPartPrefix + std::to_string(frame.training.size())) {
+                frame.training.push_back(read_training(part, where));
+            } else if (base == kModelPart && !frame.colour_model) {
+                frame.colour_model = read_model(part, where);
+            } else {
+                where.error("unknown or out-of-order part");
+            }
+        }
+    } catch (const Error&) {
+        throw;
+    } catch (const std::exception& error) {
+        where.error(error.what());
+    }
+    return frame;
+}
+
+}  // namespace insitu::archive_format

@@ -1,0 +1,225 @@
+#include "archive/manifest.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "archive/archive_format.hpp"
+#include "archive/atomic_file.hpp"
+#include "insitu/archive/step_record.hpp"
+#include "insitu/error.hpp"
+
+namespace insitu::archive_format {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// What a manifest key must hold.
+enum class Expect { number, integer, count, crc32, string, object, array };
+
+bool holds(const nlohmann::json& value, Expect expect) {
+    switch (expect) {
+        case Expect::number:
+            return value.is_number();
+        case Expect::integer:
+            return value.is_number_integer();
+        case Expect::count:
+            return value.is_number_unsigned();
+        case Expect::crc32:
+            return value.is_number_unsigned() && value.get<std::uint64_t>() <= 0xFFFFFFFFu;
+        case Expect::string:
+            return value.is_string();
+        case Expect::object:
+            return value.is_object();
+        case Expect::array:
+            return value.is_array();
+    }
+    return false;
+}
+
+/// Checks one key of a JSON object; ParseError names the file and the dotted key.
+const nlohmann::json& require(const nlohmann::json& object, const char* key, Expect expect,
+                              const std::string& file, const std::string& where) {
+    const std::string name = where.empty() ? key : where + "." + key;
+    if (!object.is_object() || !object.contains(key)) {
+        fail<ParseError>("\"", file, "\": missing key \"", name, "\"");
+    }
+    const nlohmann::json& value = object.at(key);
+    if (!holds(value, expect)) {
+        fail<ParseError>("\"", file, "\": key \"", name, "\" has the wrong type: ", value.dump());
+    }
+    return value;
+}
+
+/// Paths in the manifest must stay inside the archive.
+void check_relative_path(const std::string& path, const std::string& file,
+                         const std::string& where) {
+    const fs::path relative(path);
+    bool escapes = path.empty() || relative.is_absolute();
+    for (const fs::path& component : relative) escapes = escapes || component == "..";
+    if (escapes) {
+        fail<ParseError>("\"", file, "\": ", where, ".path \"", path,
+                         "\" is not a relative path inside the archive");
+    }
+}
+
+}  // namespace
+
+nlohmann::json empty_manifest() {
+    return {{"schema_version", kArchiveSchemaVersion}, {"steps", nlohmann::json::array()}};
+}
+
+nlohmann::json read_manifest(const std::string& archive_path) {
+    const std::string file = (fs::path(archive_path) / kManifestFile).string();
+    std::error_code error;
+    if (!fs::is_directory(archive_path, error)) {
+        fail<IoError>("archive \"", archive_path, "\" is not a directory");
+    }
+    const std::vector<char> bytes = read_whole_file(file);
+    nlohmann::json manifest;
+    try {
+        manifest = nlohmann::json::parse(bytes.begin(), bytes.end());
+    } catch (const nlohmann::json::exception& parse_error) {
+        fail<ParseError>("\"", file, "\": not valid JSON: ", parse_error.what());
+    }
+    if (!manifest.is_object()) fail<ParseError>("\"", file, "\": not a JSON object");
+    const auto version = require(manifest, "schema_version", Expect::integer, file, "");
+    if (version.get<long long>() != kArchiveSchemaVersion) {
+        fail<ParseError>("\"", file, "\": schema_version ", version.dump(),
+                         " (this libinsitu reads ", kArchiveSchemaVersion, ")");
+    }
+    require(manifest, "producer", Expect::string, file, "");
+    require(manifest, "configuration", Expect::object, file, "");
+    std::set<std::int64_t> steps_seen;
+    const auto& steps = require(manifest, "steps", Expect::array, file, "");
+    for (std::size_t s = 0; s < steps.size(); ++s) {
+        const std::string where = "steps[" + std::to_string(s) + "]";
+        const auto& step = steps[s];
+        const auto number = require(step, "step", Expect::integer, file, where);
+        if (!steps_seen.insert(number.get<std::int64_t>()).second) {
+            fail<ParseError>("\"", file, "\": ", where, ": step ", number.dump(), " is repeated");
+        }
+        require(step, "time", Expect::number, file, where);
+        require(step, "field", Expect::string, file, where);
+        std::set<int> views_seen;
+        const auto& views = require(step, "views", Expect::array, file, where);
+        for (std::size_t v = 0; v < views.size(); ++v) {
+            const std::string view_where = where + ".views[" + std::to_string(v) + "]";
+            const auto& view = views[v];
+            const auto index = require(view, "view", Expect::count, file, view_where);
+            if (!views_seen.insert(index.get<int>()).second) {
+                fail<ParseError>("\"", file, "\": ", view_where, ": view ", index.dump(),
+                                 " is repeated");
+            }
+            require(view, "phi", Expect::number, file, view_where);
+            require(view, "theta", Expect::number, file, view_where);
+            for (const auto& part : require(view, "parts", Expect::array, file, view_where)) {
+                if (!part.is_string()) {
+                    fail<ParseError>("\"", file, "\": ", view_where, ".parts: ", part.dump(),
+                                     " is not a part name");
+                }
+            }
+            std::set<std::string> kinds;
+            const auto& files = require(view, "files", Expect::array, file, view_where);
+            for (std::size_t f = 0; f < files.size(); ++f) {
+                const std::string file_where = view_where + ".files[" + std::to_string(f) + "]";
+                kinds.insert(require(files[f], "kind", Expect::string, file, file_where));
+                check_relative_path(require(files[f], "path", Expect::string, file, file_where),
+                                    file, file_where);
+                require(files[f], "bytes", Expect::count, file, file_where);
+                require(files[f], "crc32", Expect::crc32, file, file_where);
+            }
+            for (const char* kind : {kProxyKind, kPreviewKind}) {
+                if (!kinds.count(kind)) {
+                    fail<ParseError>("\"", file, "\": ", view_where, " lists no ", kind, " file");
+                }
+            }
+        }
+    }
+    return manifest;
+}
+
+void write_manifest(const std::string& archive_path, const nlohmann::json& manifest) {
+    write_file_atomically(fs::path(archive_path) / kManifestFile, manifest.dump(2) + "\n");
+}
+
+std::vector<std::int64_t> manifest_steps(const nlohmann::json& manifest) {
+    std::vector<std::int64_t> steps;
+    for (const nlohmann::json& step : manifest.at("steps")) {
+        steps.push_back(step.at("step").get<std::int64_t>());
+    }
+    std::sort(steps.begin(), steps.end());
+    return steps;
+}
+
+void insert_step(nlohmann::json& manifest, nlohmann::json step_entry) {
+    nlohmann::json& steps = manifest["steps"];
+    const std::int64_t step = step_entry.at("step").get<std::int64_t>();
+    const auto position = std::find_if(steps.begin(), steps.end(), [&](const auto& entry) {
+        return entry.at("step").template get<std::int64_t>() > step;
+    });
+    steps.insert(position, std::move(step_entry));
+}
+
+nlohmann::json file_entry(const WrittenFile& file, const char* kind) {
+    return {
+        {"kind", kind}, {"path", file.relative_path}, {"bytes", file.bytes}, {"crc32", file.crc32}};
+}
+
+namespace {
+ListedFile listed(const std::string& archive, const nlohmann::json& file) {
+    return {(fs::path(archive) / file.at("path").get<std::string>()).string(),
+            file.at("bytes").get<std::uint64_t>(), file.at("crc32").get<std::uint32_t>()};
+}
+}  // namespace
+
+ListedFile listed_file(const std::string& archive, const nlohmann::json& view, const char* kind) {
+    for (const nlohmann::json& file : view.at("files")) {
+        if (file.at("kind") == kind) return listed(archive, file);
+    }
+    // read_manifest() guarantees both kinds; reaching this is a bug, not bad input.
+    fail<Error>("archive \"", archive, "\": view lists no ", kind, " file");
+}
+
+std::vector<ListedFile> listed_files(const std::string& archive, const nlohmann::json& manifest) {
+    std::vector<ListedFile> files;
+    for (const nlohmann::json& step : manifest.at("steps")) {
+        for (const nlohmann::json& view : step.at("views")) {
+            for (const nlohmann::json& file : view.at("files")) {
+                files.push_back(listed(archive, file));
+            }
+        }
+    }
+    return files;
+}
+
+std::vector<char> read_listed_file(const ListedFile& file) {
+    std::vector<char> bytes = read_whole_file(file.absolute_path);
+    if (bytes.size() != file.bytes) {
+        fail<IoError>("\"", file.absolute_path, "\": ", bytes.size(),
+                      " bytes, the manifest records ", file.bytes, " (truncated or replaced)");
+    }
+    const std::uint32_t crc = crc32_of(bytes.data(), bytes.size());
+    if (crc != file.crc32) {
+        fail<IoError>("\"", file.absolute_path, "\": CRC-32 ", crc, ", the manifest records ",
+                      file.crc32, " (corrupt)");
+    }
+    return bytes;
+}
+
+ViewEntry find_view(const nlohmann::json& manifest, const std::string& archive, std::int64_t step,
+                    int view) {
+    for (const nlohmann::json& step_entry : manifest.at("steps")) {
+        if (step_entry.at("step").get<std::int64_t>() != step) continue;
+        for (const nlohmann::json& view_entry : step_entry.at("views")) {
+            if (view_entry.at("view").get<int>() == view) return {&step_entry, &view_entry};
+        }
+        fail<InvalidArgument>("archive \"", archive, "\": step ", step, " has no view ", view);
+    }
+    fail<InvalidArgument>("archive \"", archive, "\" has no step ", step);
+}
+
+}  // namespace insitu::archive_format
