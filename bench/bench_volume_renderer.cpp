@@ -4,11 +4,11 @@
 // with the OpenCL renderer, unshaded and shaded, with early ray termination disabled and
 // enabled, and prints milliseconds per frame (median after warm-up) and million samples per
 // second. The sample count is counted per pixel on the host with the renderer's own rule
-// (insitu/volume_renderer.hpp): samples at t_near + (i + 0.5) * step while t < t_far along the
+// (insitu/render/volume_renderer.hpp): samples at t_near + (i + 0.5) * step while t < t_far along the
 // ray's span through the field's box. With early termination on, rays stop before the end of
 // their span, so that row's rate is "span-equivalent": the work a full march would have done,
 // divided by the time the terminated march took.
-// The scalar reference renderer (tests/reference_renderer.hpp) is timed on a smaller image with
+// The scalar reference renderer (insitu/testing/reference_renderer.hpp) is timed on a smaller image with
 // the same framing, and the ratio of the two rates is printed.
 //
 // This program measures and prints; it asserts nothing and is never run as a test.

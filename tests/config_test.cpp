@@ -300,6 +300,64 @@ TEST(InstrumentConfig, ValidateNamesTheKeyOfAProgrammaticMistake) {
     EXPECT_NO_THROW(InstrumentConfig{}.validate());
 }
 
+// Issue 19: "steps": [5, 5, -1] was accepted; the second 5 can never run, -1 has no file name.
+TEST(InstrumentConfig, RepeatedAndNegativeListedStepsAreNamedWithTheirIndex) {
+    expect_error<InvalidArgument>(R"({"steps": [5, 5, -1]})",
+                                  {"steps[1]", "5", "repeats steps[0]"});
+    expect_error<InvalidArgument>(R"({"steps": [5, 7, -1]})", {"steps[2]", "-1", ">= 0"});
+    expect_error<InvalidArgument>(R"({"steps": [3, 1, 2, 1]})", {"steps[3]", "repeats steps[1]"});
+    EXPECT_NO_THROW(InstrumentConfig::from_json_text(R"({"steps": [0, 7, 3]})"));
+}
+
+// Issue 19: the cost of a step grows as 1 / "step"; 1e-9 made one execute run for more than 11
+// minutes. The floor and the ceiling are refused at start-up, naming what set them.
+TEST(InstrumentConfig, StepBelowTheFloorIsRefusedNamingTheBound) {
+    expect_error<InvalidArgument>(R"({"step": 1e-9})", {"\"step\" = 1e-09", ">= 0.001"});
+    expect_error<InvalidArgument>(R"({"step": 0.000999})", {"step", "0.000999"});
+    const InstrumentConfig floor = InstrumentConfig::from_json_text(R"({"step": 0.001})");
+    EXPECT_EQ(floor.step_voxels, kMinStepVoxels);
+}
+
+TEST(InstrumentConfig, EstimatedSamplesPerStepFollowTheCostModel) {
+    InstrumentConfig config;  // one 512^2 view; depth, distortion, attenuation; step 1
+    EXPECT_EQ(config.passes_per_view(), 3);  // single, multi-perspective, preview
+    EXPECT_DOUBLE_EQ(config.estimated_samples_per_step(), 512.0 * 512.0 * 3 * kWorstDiagonalVoxels);
+    config.step_voxels = 0.5;
+    EXPECT_DOUBLE_EQ(config.estimated_samples_per_step(), 512.0 * 512.0 * 6 * kWorstDiagonalVoxels);
+    // Two training functions, fitted: a ground truth and an attenuation pass each.
+    config.training_transfer_functions = {config.transfer_function, config.transfer_function};
+    EXPECT_EQ(config.passes_per_view(), 7);
+    config.colour_model.enabled = false;  // not fitted, not kept: not rendered
+    EXPECT_EQ(config.passes_per_view(), 3);
+    config.keep_training_images = true;
+    EXPECT_EQ(config.passes_per_view(), 5);
+    // The largest view at a 1-voxel step with the default proxies is within the ceiling.
+    InstrumentConfig largest;
+    largest.views[0].orbit.width = 16384;
+    largest.views[0].orbit.height = 16384;
+    EXPECT_NO_THROW(largest.validate());
+}
+
+TEST(InstrumentConfig, AStepCostAboveTheCeilingIsRefusedNamingTheKeys) {
+    const std::string fine_and_large =
+        R"({"step": 0.001, "views": [{"size": [4096, 4096]}, {"azimuth": 90}]})";
+    expect_error<InvalidArgument>(fine_and_large,
+                                  {"samples per step", "ceiling", "\"step\" = 0.001",
+                                   "\"views\": 2 views", "\"proxies\"",
+                                   "\"training_transfer_functions\""});
+    // The same views at a coarser step are fine, and so is the fine step with one small view.
+    EXPECT_NO_THROW(InstrumentConfig::from_json_text(
+        R"({"step": 1, "views": [{"size": [4096, 4096]}, {"azimuth": 90}]})"));
+    EXPECT_NO_THROW(InstrumentConfig::from_json_text(
+        R"({"step": 0.001, "views": [{"size": [256, 256]}]})"));
+    // Configurations built in code are checked the same way.
+    InstrumentConfig config;
+    config.step_voxels = 0.001;
+    config.views[0].orbit.width = 4096;
+    config.views[0].orbit.height = 4096;
+    EXPECT_THROW(config.validate(), InvalidArgument);
+}
+
 TEST(InstrumentConfig, FromFileNamesTheFile) {
     const std::filesystem::path path =
         std::filesystem::temp_directory_path() /

@@ -216,7 +216,7 @@ TEST_F(InstrumentTest, AutoLayersAndIntervalsAreChosenFromTheData) {
     ASSERT_EQ(instrument.finalize(), Status::ok) << instrument.last_error();
     const ProxyFrame frame = ArchiveReader(archive().string()).load(0, 0);
     // The function's opacity rises to its end at 1.0; the blobs peak below it, so one layer sits
-    // where opacity reaches half its largest value over the data (insitu/layers.hpp).
+    // where opacity reaches half its largest value over the data (insitu/core/layers.hpp).
     EXPECT_FALSE(frame.isovalues.empty());
     const ValueRange range = volume_.field().value_range();
     ASSERT_TRUE(frame.intervals.has_value());
@@ -268,6 +268,60 @@ TEST_F(InstrumentTest, DuplicateAndDecreasingStepsAreErrorsAndTheArchiveStaysInt
     EXPECT_THAT(reader.steps(), ElementsAre(2, 3));
     EXPECT_THAT(reader.verify(), ElementsAre());
     EXPECT_EQ(reader.entry(2, 0).time, 0.2);
+}
+
+// Issue 19: a NaN time used to be written into the manifest as null, after which the archive,
+// with every step already in it, no longer opened.
+TEST_F(InstrumentTest, NonFiniteTimesAndUnrepresentableStepsAreRefusedAndTheArchiveStaysIntact) {
+    Instrument instrument(small_config(archive(), 16), quiet());
+    ASSERT_EQ(instrument.execute(1, 0.1, {volume_.field()}), Status::ok);
+    const double refused_times[] = {std::numeric_limits<double>::quiet_NaN(),
+                                    std::numeric_limits<double>::infinity(),
+                                    -std::numeric_limits<double>::infinity()};
+    for (const double time : refused_times) {
+        EXPECT_EQ(instrument.execute(2, time, {volume_.field()}), Status::error) << time;
+        EXPECT_EQ(instrument.last_error_kind(), ErrorKind::invalid_argument);
+        EXPECT_THAT(instrument.last_error(), HasSubstr("time = "));
+        EXPECT_THAT(instrument.last_error(), HasSubstr("finite"));
+    }
+    EXPECT_THAT(instrument.last_error(), HasSubstr("-inf"));
+    // 2^53 is the first integer a JSON reader working in doubles cannot tell from its neighbour.
+    const std::int64_t too_large = std::int64_t{1} << 53;
+    EXPECT_EQ(instrument.execute(too_large, 3.0, {volume_.field()}), Status::error);
+    EXPECT_THAT(instrument.last_error(), HasSubstr(std::to_string(too_large)));
+    EXPECT_EQ(instrument.execute(std::numeric_limits<std::int64_t>::max(), 3.0,
+                                 {volume_.field()}),
+              Status::error);
+    EXPECT_EQ(instrument.last_error_kind(), ErrorKind::invalid_argument);
+    // Refused steps use nothing up: step 2 still goes through, and so does the largest step.
+    EXPECT_EQ(instrument.execute(2, 0.2, {volume_.field()}), Status::ok) << instrument.last_error();
+    EXPECT_EQ(instrument.execute(too_large - 1, 0.3, {volume_.field()}), Status::ok)
+        << instrument.last_error();
+    ASSERT_EQ(instrument.finalize(), Status::ok) << instrument.last_error();
+    EXPECT_EQ(instrument.statistics().errors, 5);
+
+    const ArchiveReader reader(archive().string());
+    EXPECT_THAT(reader.steps(), ElementsAre(1, 2, too_large - 1));
+    EXPECT_THAT(reader.verify(), ElementsAre());
+    EXPECT_EQ(reader.entry(2, 0).time, 0.2);
+}
+
+// Issue 19: a float64 field of +-1e308 used to fail deep in the interval code with
+// "interval edges[0] = -nan", naming neither the field nor the cause.
+TEST_F(InstrumentTest, AFieldBeyondFloat32IsRefusedNamingTheFieldAndItsRange) {
+    Instrument instrument(small_config(archive(), 16), quiet());
+    std::vector<double> huge(8 * 8 * 8, 0.5);
+    huge.front() = -1e308;
+    huge.back() = 1e308;
+    const Field field("f", huge.data(), ScalarType::float64, {8, 8, 8});
+    EXPECT_EQ(instrument.execute(0, 0.0, {field}), Status::error);
+    EXPECT_EQ(instrument.last_error_kind(), ErrorKind::invalid_argument);
+    EXPECT_THAT(instrument.last_error(), HasSubstr("field \"f\""));
+    EXPECT_THAT(instrument.last_error(), HasSubstr("-1e+308, 1e+308"));
+    EXPECT_THAT(instrument.last_error(), HasSubstr("float32"));
+    EXPECT_EQ(instrument.execute(0, 0.0, {volume_.field()}), Status::ok) << instrument.last_error();
+    ASSERT_EQ(instrument.finalize(), Status::ok);
+    EXPECT_THAT(ArchiveReader(archive().string()).steps(), ElementsAre(0));
 }
 
 TEST_F(InstrumentTest, ARestartContinuesTheArchiveAndRefusesStepsItHolds) {

@@ -74,11 +74,13 @@ int insitu_set_field_strided(insitu_instrument* instrument, const char* name, co
                              const int64_t strides_samples[3]);
 
 /* Compute and queue the proxies of the fields set since the last execute, then forget those
- * fields (their pointers are not used again). step: >= 0 and increasing; time: simulation time.
+ * fields (their pointers are not used again). step: in [0, 2^53 - 1] and increasing; time:
+ * simulation time, finite (the archive's JSON manifest holds neither NaN nor Inf).
  * Returns INSITU_OK (queued), INSITU_NOT_SELECTED (the cadence skipped the step; nothing is
  * computed), INSITU_DROPPED, or an error, after which the run may go on:
- *   INSITU_ERROR_INVALID_ARGUMENT  duplicate or decreasing step; the first configured field
- *                                  not set (on steps the cadence skips too)
+ *   INSITU_ERROR_INVALID_ARGUMENT  duplicate, decreasing or out-of-range step; non-finite
+ *                                  time; the first configured field not set (on steps the
+ *                                  cadence skips too); values beyond float32
  *   INSITU_ERROR_COMPUTE           OpenCL failure while computing the proxies
  *   INSITU_ERROR_STATE             called after insitu_finalize
  * A step the writer thread fails to store is reported by insitu_finalize. */

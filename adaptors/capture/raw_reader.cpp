@@ -121,29 +121,26 @@ Field RawVolume::field(const std::string& name) const {
 }
 
 RawVolume read_raw(const std::string& path, const RawOptions& options) {
-    const std::size_t sample_bytes = raw_size_bytes(options.type);
-    std::uint64_t samples = 1;
+    const auto sample_bytes = static_cast<std::int64_t>(raw_size_bytes(options.type));
+    const std::string dims_text = "\"" + path + "\": raw dims " +
+                                  std::to_string(options.dims[0]) + "," +
+                                  std::to_string(options.dims[1]) + "," +
+                                  std::to_string(options.dims[2]);
+    std::int64_t samples = 1;
     for (int axis = 0; axis < 3; ++axis) {
-        const std::int64_t n = options.dims[axis];
-        if (n < 1) {
-            fail<InvalidArgument>("\"", path, "\": raw dims ", options.dims[0], ",",
-                                  options.dims[1], ",", options.dims[2],
-                                  " (every dimension must be positive)");
+        if (options.dims[axis] < 1) {
+            fail<InvalidArgument>(dims_text, " (every dimension must be positive)");
         }
-        if (samples > std::numeric_limits<std::uint64_t>::max() / sample_bytes /
-                          static_cast<std::uint64_t>(n)) {
-            fail<InvalidArgument>("\"", path, "\": raw dims ", options.dims[0], ",",
-                                  options.dims[1], ",", options.dims[2],
-                                  ": the volume size overflows 64 bits");
-        }
-        samples *= static_cast<std::uint64_t>(n);
+        samples = checked_multiply(samples, options.dims[axis], dims_text);
     }
-    const std::uint64_t expected_bytes = samples * sample_bytes;
+    // In int64, like the Field that views the samples.
+    const std::int64_t expected_bytes =
+        checked_multiply(samples, sample_bytes, dims_text + ", in bytes");
 
     std::error_code error;
     const std::uint64_t actual_bytes = std::filesystem::file_size(path, error);
     if (error) fail<IoError>("\"", path, "\": ", error.message());
-    if (actual_bytes != expected_bytes) {
+    if (actual_bytes != static_cast<std::uint64_t>(expected_bytes)) {
         fail<InvalidArgument>("\"", path, "\" has ", actual_bytes, " bytes but raw dims ",
                               options.dims[0], ",", options.dims[1], ",", options.dims[2], " ",
                               to_string(options.type), " need ", expected_bytes, " (", samples,
@@ -159,7 +156,7 @@ RawVolume read_raw(const std::string& path, const RawOptions& options) {
     // Read straight into the Field's buffer when no conversion follows, else into a scratch one.
     std::vector<std::byte> scratch;
     std::vector<std::byte>& target = volume.converted_ ? scratch : volume.storage_;
-    target.resize(expected_bytes);
+    target.resize(static_cast<std::size_t>(expected_bytes));
     auto* bytes = reinterpret_cast<unsigned char*>(target.data());
     std::ifstream in(path, std::ios::binary);
     in.read(reinterpret_cast<char*>(bytes), static_cast<std::streamsize>(expected_bytes));
@@ -174,8 +171,11 @@ RawVolume read_raw(const std::string& path, const RawOptions& options) {
         }
     }
     if (volume.converted_) {
-        volume.storage_.resize(samples * sizeof(float));
-        convert_to_float(options.type, bytes, samples,
+        const std::int64_t converted_bytes =
+            checked_multiply(samples, static_cast<std::int64_t>(sizeof(float)),
+                             dims_text + ", as float32 bytes");
+        volume.storage_.resize(static_cast<std::size_t>(converted_bytes));
+        convert_to_float(options.type, bytes, static_cast<std::size_t>(samples),
                          reinterpret_cast<float*>(volume.storage_.data()));
     }
     return volume;

@@ -16,7 +16,8 @@ public:
     std::vector<double> default_isovalues() const override { return grid_.default_isovalues(); }
     std::string describe() const override {
         const Index3 dims = grid_.dims();
-        const double dense_voxels = static_cast<double>(dims[0] * dims[1] * dims[2]);
+        // In double: a ratio needs no exact count, and the product cannot wrap.
+        const double dense_voxels = static_cast<double>(dims[0]) * dims[1] * dims[2];
         std::ostringstream text;
         text.precision(3);
         text << "vdb " << openvdb_adaptor::to_string(grid_.grid_class()) << " \"" << grid_.name()

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 #include <ios>
+#include <limits>
 #include <mutex>
 #include <sstream>
 
@@ -149,10 +150,21 @@ DenseGrid densify(const openvdb::GridBase& grid, const std::string& field_name) 
     // active voxel on every axis.
     openvdb::Coord lower;
     openvdb::Coord upper;
+    Index3 box_dims{};
     for (int axis = 0; axis < 3; ++axis) {
-        lower[axis] = static_cast<openvdb::Int32>(leaf_floor(std::int64_t{active.min()[axis]} - 1));
-        upper[axis] = static_cast<openvdb::Int32>(leaf_floor(std::int64_t{active.max()[axis]} + 1) +
-                                                  kLeafVoxels - 1);
+        const std::int64_t low = leaf_floor(std::int64_t{active.min()[axis]} - 1);
+        const std::int64_t high =
+            leaf_floor(std::int64_t{active.max()[axis]} + 1) + kLeafVoxels - 1;
+        // Active voxels at the ends of OpenVDB's int32 index space have no padded box in it.
+        if (low < std::numeric_limits<openvdb::Int32>::min() ||
+            high > std::numeric_limits<openvdb::Int32>::max()) {
+            fail<InvalidArgument>("OpenVDB ", grid_label(grid), ": active voxels ",
+                                  active.min()[axis], "..", active.max()[axis], " on ", "xyz"[axis],
+                                  " leave no room for the background border in 32-bit indices");
+        }
+        lower[axis] = static_cast<openvdb::Int32>(low);
+        upper[axis] = static_cast<openvdb::Int32>(high);
+        box_dims[axis] = high - low + 1;
         dense.lower_[axis] = lower[axis];
         dense.upper_[axis] = upper[axis];
         dense.active_lower_[axis] = active.min()[axis];
@@ -160,6 +172,13 @@ DenseGrid densify(const openvdb::GridBase& grid, const std::string& field_name) 
     }
     axis_aligned_geometry(grid, lower, dense.origin_world_, dense.voxel_size_world_);
 
+    // Checked before anything is allocated: OpenVDB's own volume() would wrap silently.
+    const std::string what = "OpenVDB " + grid_label(grid) + ": dense box " +
+                             std::to_string(box_dims[0]) + " x " + std::to_string(box_dims[1]) +
+                             " x " + std::to_string(box_dims[2]);
+    checked_multiply(checked_multiply(checked_multiply(box_dims[0], box_dims[1], what),
+                                      box_dims[2], what),
+                     is_double ? 8 : 4, what + ", in bytes");
     const openvdb::CoordBBox box(lower, upper);
     try {
         if (is_double) {

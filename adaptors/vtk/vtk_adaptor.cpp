@@ -52,9 +52,17 @@ struct StructuredGeometry {
 };
 
 Index3 point_dims(const StructuredGeometry& geometry) {
-    return {geometry.extent[1] - geometry.extent[0] + 1,
-            geometry.extent[3] - geometry.extent[2] + 1,
-            geometry.extent[5] - geometry.extent[4] + 1};
+    // In 64 bits: an extent of [INT_MIN, INT_MAX] has 2^32 points, which int cannot hold.
+    const auto& e = geometry.extent;
+    return {std::int64_t{e[1]} - e[0] + 1, std::int64_t{e[3]} - e[2] + 1,
+            std::int64_t{e[5]} - e[4] + 1};
+}
+
+/// Entries of a dims[0] x dims[1] x dims[2] array; InvalidArgument naming `where` on overflow.
+std::int64_t entry_count(const Index3& dims, const std::string& where) {
+    const std::string what = "VTK " + where + ": extent " + std::to_string(dims[0]) + " x " +
+                             std::to_string(dims[1]) + " x " + std::to_string(dims[2]);
+    return checked_multiply(checked_multiply(dims[0], dims[1], what), dims[2], what);
 }
 
 /// VTK counts one cell along an axis with a single point (a flat image still has cells).
@@ -131,7 +139,7 @@ bool ghost_layers(vtkDataSetAttributes& attributes, const Index3& dims, const st
     vtkUnsignedCharArray* ghosts = vtkUnsignedCharArray::SafeDownCast(
         attributes.GetArray(vtkDataSetAttributes::GhostArrayName()));
     if (!ghosts) return false;
-    const std::int64_t count = dims[0] * dims[1] * dims[2];
+    const std::int64_t count = entry_count(dims, where + " ghost array");
     if (ghosts->GetNumberOfTuples() != count || ghosts->GetNumberOfComponents() != 1) {
         fail<InvalidArgument>(
             "VTK ", where, " ghost array \"", vtkDataSetAttributes::GhostArrayName(), "\" has ",
@@ -195,7 +203,7 @@ struct VtkFieldFactory {
         const std::string where = to_string(association) + " array \"" + array_name + "\"";
 
         const Index3 dims = cells ? cell_dims(geometry) : point_dims(geometry);
-        const std::int64_t tuples = dims[0] * dims[1] * dims[2];
+        const std::int64_t tuples = entry_count(dims, where);
         if (array.GetNumberOfTuples() != tuples) {
             fail<InvalidArgument>("VTK ", where, " has ", array.GetNumberOfTuples(),
                                   " tuples, but the extent has ", dims[0], " x ", dims[1], " x ",
@@ -212,7 +220,11 @@ struct VtkFieldFactory {
         std::vector<float> copy;
         std::string copy_reason;
         const void* data = nullptr;
-        Index3 strides{components, components * dims[0], components * dims[0] * dims[1]};
+        // Checked: components times a row or plane of tuples is an offset of the array.
+        const std::string stride_what = "VTK " + where + ": strides of " +
+                                        std::to_string(components) + " components";
+        const std::int64_t row = checked_multiply(components, dims[0], stride_what);
+        Index3 strides{components, row, checked_multiply(row, dims[1], stride_what)};
         if (!field_type_of(array.GetDataType(), type)) {
             copy_reason = std::string("value type ") + array.GetDataTypeAsString() +
                           " has no Field equivalent";
@@ -265,6 +277,11 @@ struct VtkFieldFactory {
 
 VtkField to_field(vtkImageData& image, const ArraySelection& selection,
                   const std::string& field_name) {
+    StructuredGeometry geometry;
+    image.GetExtent(geometry.extent.data());
+    // Before VTK's own count, which wraps: 2^31 x 2^31 x 4 points would count as none.
+    const Index3 points = point_dims(geometry);
+    if (points[0] > 0 && points[1] > 0 && points[2] > 0) entry_count(points, "vtkImageData");
     if (image.GetNumberOfPoints() < 1) fail<InvalidArgument>("VTK vtkImageData: no points");
     if (vtkMatrix3x3* direction = image.GetDirectionMatrix();
         direction && !direction->IsIdentity()) {
@@ -273,8 +290,6 @@ VtkField to_field(vtkImageData& image, const ArraySelection& selection,
                               "; ", m[3], " ", m[4], " ", m[5], "; ", m[6], " ", m[7], " ", m[8],
                               ") is not the identity; rotated images are not supported");
     }
-    StructuredGeometry geometry;
-    image.GetExtent(geometry.extent.data());
     double origin[3];
     double spacing[3];
     image.GetOrigin(origin);
@@ -292,10 +307,11 @@ VtkField to_field(vtkImageData& image, const ArraySelection& selection,
 
 VtkField to_field(vtkRectilinearGrid& grid, const ArraySelection& selection,
                   const std::string& field_name) {
-    if (grid.GetNumberOfPoints() < 1) fail<InvalidArgument>("VTK vtkRectilinearGrid: no points");
     StructuredGeometry geometry;
     grid.GetExtent(geometry.extent.data());
     const Index3 dims = point_dims(geometry);
+    if (dims[0] > 0 && dims[1] > 0 && dims[2] > 0) entry_count(dims, "vtkRectilinearGrid");
+    if (grid.GetNumberOfPoints() < 1) fail<InvalidArgument>("VTK vtkRectilinearGrid: no points");
     vtkDataArray* coordinates[3] = {grid.GetXCoordinates(), grid.GetYCoordinates(),
                                     grid.GetZCoordinates()};
     const char axis_names[3] = {'x', 'y', 'z'};

@@ -315,7 +315,7 @@ def write_markdown(d, path, prefix, elapsed):
              "Errors are against the ground-truth renderer on the same view and transfer function "
              "(unshaded, 1-voxel step, no early termination); PSNR on premultiplied RGB over black, "
              "SSIM on luminance (11x11 Gaussian window), depth correlation = Pearson r over pixels finite "
-             "in both (bench/evaluation/metrics.hpp). Stored view: orthographic, azimuth 30°, elevation 20°; "
+             "in both (insitu/testing/metrics.hpp). Stored view: orthographic, azimuth 30°, elevation 20°; "
              "the primary field is the Gray-Scott v field (%s)." % primary, "",
              "## Goals", "",
              table(["goal", "target", "measured", ""], [

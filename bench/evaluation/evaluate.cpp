@@ -2,7 +2,7 @@
 // For fields (analytic, Gray-Scott timesteps, raw files) and configurations it measures cost
 // (emission ms per camera, archive bytes per step, synthesis ms per frame) and error against the
 // ground-truth renderer on the same view and transfer function (PSNR, SSIM, max abs error, depth
-// correlation; bench/evaluation/metrics.hpp), and sweeps each method into where it fails. Writes
+// correlation; insitu/testing/metrics.hpp), and sweeps each method into where it fails. Writes
 // CSV files; bench/evaluation/charts.py draws them. Measures and prints; asserts nothing.
 //
 //   insitu_evaluate --out DIR [--smoke] [--sections a,b,...] [--raw PATH:NXxNYxNZ:TYPE ...]

@@ -133,6 +133,10 @@ program heat_fortran
         failures = failures + 1
     end if
     call insitu_destroy(instrument)
+    ! The main program's allocatables are saved, never freed on their own: freed here, so that
+    ! this loop copied into a subroutine that runs once per simulation does not leak each run.
+    deallocate (temperature, next, config_path)
+    if (allocated(temperature_float)) deallocate (temperature_float)
     write (*, '(a, i0, a, i0, 3a, i0, a)') "heat_fortran: ", steps, " steps, ", stored, &
         " stored in ", trim(archive), ", ", failures, " failures"
     if (failures /= 0) stop 1, quiet=.true.

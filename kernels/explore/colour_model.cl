@@ -1,5 +1,5 @@
 // Colour model prediction (seed 000 §6.2-6.3): one work-item per pixel. Host side and the table
-// layout: libinsitu/src/colour_model.cpp, insitu/colour_model.hpp. The host reference is
+// layout: libinsitu/src/explore/colour_model.cpp, insitu/explore/colour_model.hpp. The host reference is
 // ColourModel::predict_pixel; both clamp the same way, so they agree to float rounding.
 
 // MAX_INTERVALS: -D option from the host (kMaxIntervals, libinsitu/src/device/kernel_constants.hpp).

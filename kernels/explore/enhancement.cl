@@ -1,5 +1,5 @@
 // Depth-aware enhancement (seed 000 §6.5, Eq. 11) and its image-space baseline; definitions in
-// libinsitu/include/insitu/enhancement.hpp. One work-item per pixel.
+// libinsitu/include/insitu/explore/enhancement.hpp. One work-item per pixel.
 
 // Neighbours of pixel (x, y) for central differences in pixels: one-sided at the border, none
 // along an axis one pixel long. Offsets are in pixels (x) and rows (y); inverse spacings are 0

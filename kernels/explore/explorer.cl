@@ -1,4 +1,4 @@
-// Per-pixel steps of Explorer::render that belong to no single method (libinsitu/src/explorer.cpp):
+// Per-pixel steps of Explorer::render that belong to no single method (libinsitu/src/explore/explorer.cpp):
 // combining the colour with lighting and occlusion factors, and drawing depth layers as surfaces
 // when an archive holds no attenuation proxies. One work-item per pixel.
 

@@ -1,5 +1,5 @@
 // Relighting from depth proxies (seed 000 §5, §6.5); the definitions are written out in
-// libinsitu/include/insitu/relighting.hpp. One work-item per pixel. Depth images may have
+// libinsitu/include/insitu/explore/relighting.hpp. One work-item per pixel. Depth images may have
 // several channels (pixel-interleaved); `channels` and `channel` pick one. Cameras arrive as
 // the host's camera_axes() packs them (forward, right, up, half extent); pixel centres come from
 // plane_coordinates() in common.cl. Kernels that loop per pixel (over lights, intervals,

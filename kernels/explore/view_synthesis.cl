@@ -1,5 +1,5 @@
 // View synthesis from proxies (seed 000 §4.3-4.4); the method is written out in
-// libinsitu/include/insitu/view_synthesis.hpp. One work-item per source pixel for splatting,
+// libinsitu/include/insitu/explore/view_synthesis.hpp. One work-item per source pixel for splatting,
 // one per target pixel for resolving.
 //
 // Camera-local coordinates (a, b, z): offsets along right, up and forward from the camera's

@@ -551,7 +551,22 @@ void InstrumentConfig::validate() const {
     if (!(step_voxels > 0.0) || !std::isfinite(step_voxels)) {
         out_of_range("step", text_of(step_voxels), "voxels, must be finite and > 0");
     }
+    if (step_voxels < kMinStepVoxels) {
+        out_of_range("step", text_of(step_voxels), "voxels, must be >= ", kMinStepVoxels,
+                     ": finer steps resample the same cells and float positions stop advancing");
+    }
     if (every < 1) out_of_range("every", text_of(every), "must be an integer >= 1");
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+        // Archive files are named by step number, and a listed step can be executed only once.
+        if (steps[i] < 0) {
+            out_of_range(element_key("steps", i), text_of(steps[i]), "step numbers must be >= 0");
+        }
+        const auto first = std::find(steps.begin(), steps.begin() + i, steps[i]);
+        if (first != steps.begin() + i) {
+            out_of_range(element_key("steps", i), text_of(steps[i]), "repeats ",
+                         element_key("steps", static_cast<std::size_t>(first - steps.begin())));
+        }
+    }
     if (archive.empty()) out_of_range("archive", "\"\"", "name the archive directory");
     if (std::find(kCompressions.begin(), kCompressions.end(), compression) == kCompressions.end()) {
         out_of_range("compression", "\"" + compression + "\"",
@@ -562,6 +577,42 @@ void InstrumentConfig::validate() const {
         out_of_range("colour_model.clusters", text_of(colour_model.clusters), "must be in [1, ",
                      kMaxColourModelClusters, "]");
     }
+    // Last: the estimate needs every value above in range. A step's cost would otherwise be
+    // bounded by nothing the simulation can see before its run stalls.
+    const double samples = estimated_samples_per_step();
+    if (samples > kMaxSamplesPerStep) {
+        double pixels = 0.0;
+        for (const ViewConfig& view : views) {
+            pixels += static_cast<double>(view.orbit.width) * view.orbit.height;
+        }
+        fail<InvalidArgument>(
+            "configuration: about ", samples, " samples per step, above the ceiling of ",
+            kMaxSamplesPerStep, " (", kWorstDiagonalVoxels, "-voxel rays at \"step\" = ",
+            step_voxels, " over \"views\": ", views.size(), " views, ", pixels,
+            " pixels in all, ", passes_per_view(),
+            " passes each from \"proxies\" and \"training_transfer_functions\"); raise \"step\" "
+            "or reduce the others");
+    }
+}
+
+int InstrumentConfig::passes_per_view() const {
+    const int training = static_cast<int>(training_transfer_functions.size());
+    const bool fits_model = colour_model.enabled && training > 0 && proxies.attenuation;
+    const bool renders_training = keep_training_images || fits_model;
+    const bool single = proxies.depth || proxies.attenuation || proxies.optical_depth ||
+                        (renders_training && training > 0);
+    const bool multi = proxies.distortion || proxies.multi_attenuation;
+    const int preview = 1;
+    return preview + (single ? 1 : 0) + (multi ? 1 : 0) + (renders_training ? training : 0) +
+           (fits_model ? training : 0);
+}
+
+double InstrumentConfig::estimated_samples_per_step() const {
+    double pixels = 0.0;
+    for (const ViewConfig& view : views) {
+        pixels += static_cast<double>(view.orbit.width) * view.orbit.height;
+    }
+    return pixels * passes_per_view() * (kWorstDiagonalVoxels / step_voxels);
 }
 
 nlohmann::json InstrumentConfig::to_json() const {

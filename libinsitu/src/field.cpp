@@ -57,8 +57,28 @@ std::ostream& operator<<(std::ostream& out, const Bounds& bounds) {
                << ")}";
 }
 
+std::int64_t checked_multiply(std::int64_t a, std::int64_t b, const std::string& what) {
+    std::int64_t product = 0;
+    if (__builtin_mul_overflow(a, b, &product)) {
+        fail<InvalidArgument>(what, ": ", a, " * ", b, " overflows 64-bit integers");
+    }
+    return product;
+}
+
+std::int64_t checked_add(std::int64_t a, std::int64_t b, const std::string& what) {
+    std::int64_t sum = 0;
+    if (__builtin_add_overflow(a, b, &sum)) {
+        fail<InvalidArgument>(what, ": ", a, " + ", b, " overflows 64-bit integers");
+    }
+    return sum;
+}
+
 namespace {
 const char* axis_name(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
+
+std::string triple(const Index3& values) {
+    return detail::concat("(", values[0], ", ", values[1], ", ", values[2], ")");
+}
 }  // namespace
 
 Field::Field(std::string name, const void* data, ScalarType type, Index3 allocated_dims)
@@ -71,7 +91,25 @@ Field::Field(std::string name, const void* data, ScalarType type, Index3 allocat
                                   allocated_dims[axis], " (must be >= 1)");
         }
     }
-    strides_ = {1, allocated_dims[0], allocated_dims[0] * allocated_dims[1]};
+    // Unchecked, dims of 2^31 x 2^31 x 4 wrapped to 0 samples, passed every size bound and
+    // crashed the first execute.
+    const std::string what = "field \"" + name_ + "\": dims " + triple(allocated_dims);
+    const std::int64_t plane = checked_multiply(allocated_dims[0], allocated_dims[1], what);
+    const Index3 strides{1, allocated_dims[0], plane};
+    check_extent(strides);
+    strides_ = strides;
+}
+
+void Field::check_extent(const Index3& strides) const {
+    const std::string what = "field \"" + name_ + "\": dims " + triple(allocated_dims_) +
+                             " with strides " + triple(strides);
+    std::int64_t last_offset = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+        last_offset = checked_add(
+            last_offset, checked_multiply(allocated_dims_[axis] - 1, strides[axis], what), what);
+    }
+    const auto sample_bytes = static_cast<std::int64_t>(scalar_size_bytes(type_));
+    checked_multiply(checked_add(last_offset, 1, what), sample_bytes, what + ", in bytes");
 }
 
 Field& Field::set_origin(glm::dvec3 origin_world) {
@@ -102,10 +140,15 @@ Field& Field::set_ghost_layers(Index3 low, Index3 high) {
             fail<InvalidArgument>("field \"", name_, "\": ghost layers on ", axis_name(axis),
                                   " = (", low[axis], ", ", high[axis], ") (must be >= 0)");
         }
-        if (allocated_dims_[axis] - low[axis] - high[axis] < 1) {
+        // Checked: ghost layers of INT64_MAX on both sides used to wrap into a large interior.
+        const std::int64_t ghosts = checked_add(
+            low[axis], high[axis],
+            "field \"" + name_ + "\": ghost layers on " + axis_name(axis));
+        if (allocated_dims_[axis] - ghosts < 1) {
             fail<InvalidArgument>("field \"", name_, "\": ghost layers on ", axis_name(axis),
-                                  " = (", low[axis], ", ", high[axis], ") leave no interior of dims.",
-                                  axis_name(axis), " = ", allocated_dims_[axis]);
+                                  " = (", low[axis], ", ", high[axis],
+                                  ") leave no interior of dims.", axis_name(axis), " = ",
+                                  allocated_dims_[axis]);
         }
     }
     ghost_low_ = low;
@@ -124,6 +167,7 @@ Field& Field::set_strides(Index3 strides_samples) {
                                   strides_samples[axis], " (must be >= 1 sample)");
         }
     }
+    check_extent(strides_samples);
     strides_ = strides_samples;
     return *this;
 }
@@ -135,6 +179,8 @@ Index3 Field::dims() const {
 }
 
 std::int64_t Field::sample_count() const {
+    // Cannot overflow: the interior is within the allocation, whose extent the constructor
+    // checked.
     const Index3 d = dims();
     return d[0] * d[1] * d[2];
 }

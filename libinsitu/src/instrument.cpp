@@ -1,12 +1,14 @@
 #include "insitu/instrument.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <condition_variable>
 #include <deque>
 #include <exception>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -57,6 +59,9 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
+
+// Largest step number the manifest holds exactly (see Impl::execute).
+constexpr std::int64_t kMaxStep = (std::int64_t{1} << 53) - 1;
 
 double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
@@ -140,6 +145,17 @@ Status Instrument::Impl::execute(std::int64_t step, double time, const std::vect
     if (finalized) fail<StateError>("execute(step ", step, ") after finalize()");
     // Archive files are named by step number; a negative one has no name.
     if (step < 0) fail<InvalidArgument>("step ", step, ": step numbers must be >= 0");
+    // The manifest is JSON, which the viewer's JavaScript reads as doubles: beyond 2^53 two
+    // steps could read back as one, and the reader refuses a manifest with a repeated step.
+    if (step > kMaxStep) {
+        fail<InvalidArgument>("step ", step, ": step numbers must be <= ", kMaxStep,
+                              " (2^53 - 1, the largest integer every JSON reader holds exactly)");
+    }
+    // JSON has no NaN or Inf: such a time would be written as null and the manifest, with every
+    // step already in it, would no longer read.
+    if (!std::isfinite(time)) {
+        fail<InvalidArgument>("step ", step, ": time = ", time, " (must be finite)");
+    }
     if (last_step && step <= *last_step) {
         if (step == *last_step) fail<InvalidArgument>("step ", step, ": duplicate step number");
         fail<InvalidArgument>("step ", step, ": not after the previous step ", *last_step,
@@ -175,6 +191,15 @@ StepRecord Instrument::Impl::compute(std::int64_t step, double time, const Field
     // host staging vector and the device buffer; everything below reads those copies.
     renderer->upload(field);
     const DeviceVolume& volume = renderer->volume();
+    // The renderers sample float32: a finite double beyond its range becomes Inf there, and the
+    // intervals and layers chosen from the range would describe values no sample holds.
+    const double float_max = std::numeric_limits<float>::max();
+    if (volume.range.min < -float_max || volume.range.max > float_max) {
+        fail<InvalidArgument>("step ", step, ": field \"", field.name(), "\" has values in [",
+                              volume.range.min, ", ", volume.range.max,
+                              "], beyond the float32 range +-", float_max,
+                              " the renderers sample in");
+    }
     if (volume.range.nonfinite_count > 0) {
         {
             std::lock_guard<std::mutex> lock(mutex);

@@ -53,6 +53,12 @@ endfunction()
 
 c_api_example_tests(heat_c heat_c)
 c_api_example_tests(heat_fortran heat_fortran)
+if(TARGET heat_fortran)
+  add_test(NAME heat_fortran.deallocates
+           COMMAND ${CMAKE_COMMAND}
+                   -DSOURCE=${PROJECT_SOURCE_DIR}/examples/fortran/heat_fortran.f90
+                   -P ${CMAKE_CURRENT_LIST_DIR}/expect_deallocated.cmake)
+endif()
 # The interior as a non-contiguous array section, passed with strides instead of ghost counts.
 c_api_example_tests(heat_fortran_interior heat_fortran 40 interior)
 # A real(c_float) copy: the other specific procedure of the generic insitu_set_field.

@@ -219,6 +219,48 @@ TEST_F(CApiTest, BadDimsGhostsAndStridesAreInvalidArguments) {
     EXPECT_STRNE(insitu_last_error(), "");
 }
 
+// Issue 19: each of these returned INSITU_OK and the next insitu_execute crashed the simulation
+// (SIGSEGV), the products wrapping past every bound. Each names the field and the value.
+TEST_F(CApiTest, OverflowingDimsStridesAndGhostsAreInvalidArgumentsAndTheRunGoesOn) {
+    const std::vector<float> buffer(16 * 16 * 16, 0.5f);
+    constexpr std::int64_t k2to31 = std::int64_t{1} << 31;
+    constexpr std::int64_t k2to40 = std::int64_t{1} << 40;
+    const std::int64_t overflowing_dims[][3] = {
+        {k2to31, k2to31, k2to31}, {k2to31, k2to31, 4}, {k2to40, k2to40, k2to40}};
+    for (const auto& dims : overflowing_dims) {
+        EXPECT_EQ(insitu_set_field(instrument_, "v", buffer.data(), INSITU_FLOAT32, dims, nullptr,
+                                   nullptr, nullptr),
+                  INSITU_ERROR_INVALID_ARGUMENT)
+            << dims[0] << " x " << dims[1] << " x " << dims[2];
+        EXPECT_TRUE(contains(insitu_last_error(), "field \"v\": dims (" +
+                                                      std::to_string(dims[0]) + ", "))
+            << insitu_last_error();
+        EXPECT_TRUE(contains(insitu_last_error(), "overflows")) << insitu_last_error();
+    }
+    const std::int64_t dims[3] = {16, 16, 16};
+    const std::int64_t huge_strides[3] = {1, 16, INT64_MAX / 8};
+    EXPECT_EQ(insitu_set_field_strided(instrument_, "v", buffer.data(), INSITU_FLOAT32, dims,
+                                       nullptr, nullptr, nullptr, huge_strides),
+              INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), std::to_string(INT64_MAX / 8)))
+        << insitu_last_error();
+    const std::int64_t huge_ghosts[3] = {INT64_MAX, INT64_MAX, INT64_MAX};
+    EXPECT_EQ(insitu_set_field(instrument_, "v", buffer.data(), INSITU_FLOAT32, dims, nullptr,
+                               nullptr, huge_ghosts),
+              INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "ghost layers")) << insitu_last_error();
+    EXPECT_TRUE(contains(insitu_last_error(), std::to_string(INT64_MAX))) << insitu_last_error();
+
+    // Nothing refused was kept: execute finds no field, and with a good one the run goes on.
+    EXPECT_EQ(insitu_execute(instrument_, 2, 0.2), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "field \"v\" missing")) << insitu_last_error();
+    ASSERT_EQ(insitu_set_field(instrument_, "v", buffer.data(), INSITU_FLOAT32, dims, nullptr,
+                               nullptr, nullptr),
+              INSITU_OK)
+        << insitu_last_error();
+    EXPECT_EQ(insitu_execute(instrument_, 2, 0.2), INSITU_OK) << insitu_last_error();
+}
+
 TEST(CApiCreate, MalformedJsonIsAParseError) {
     insitu_instrument* out = nullptr;
     EXPECT_EQ(insitu_create_from_json(R"({"fields": ["v"], "every": )", &out), INSITU_ERROR_PARSE);
@@ -314,6 +356,41 @@ TEST_F(CApiTest, DuplicateOrDecreasingStepIsAnInvalidArgument) {
     EXPECT_EQ(insitu_finalize(instrument_), INSITU_OK) << insitu_last_error();
     EXPECT_TRUE(fs::is_regular_file(archive_ / "proxies" / "step000002_view0.exr"));
     EXPECT_TRUE(fs::is_regular_file(archive_ / "proxies" / "step000004_view0.exr"));
+}
+
+// Issue 19: a NaN time was accepted (INSITU_OK) and written into the manifest as null, after
+// which the archive no longer opened. Now it is refused, and the archive still continues.
+TEST_F(CApiTest, NonFiniteTimeIsAnInvalidArgumentAndTheArchiveStillOpens) {
+    ASSERT_EQ(set_ball(), INSITU_OK) << insitu_last_error();
+    ASSERT_EQ(insitu_execute(instrument_, 2, 0.2), INSITU_OK) << insitu_last_error();
+    for (const double time : {NAN, INFINITY, -INFINITY}) {
+        ASSERT_EQ(set_ball(), INSITU_OK) << insitu_last_error();
+        EXPECT_EQ(insitu_execute(instrument_, 4, time), INSITU_ERROR_INVALID_ARGUMENT) << time;
+        EXPECT_TRUE(contains(insitu_last_error(), "insitu_execute: step 4: time = "))
+            << insitu_last_error();
+    }
+    ASSERT_EQ(set_ball(), INSITU_OK) << insitu_last_error();
+    EXPECT_EQ(insitu_execute(instrument_, INT64_MAX, 1.0), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), std::to_string(INT64_MAX))) << insitu_last_error();
+    ASSERT_EQ(set_ball(), INSITU_OK) << insitu_last_error();
+    EXPECT_EQ(insitu_execute(instrument_, 4, 0.4), INSITU_OK) << insitu_last_error();
+    ASSERT_EQ(insitu_finalize(instrument_), INSITU_OK) << insitu_last_error();
+    EXPECT_TRUE(fs::is_regular_file(archive_ / "proxies" / "step000004_view0.exr"));
+
+    insitu_destroy(instrument_);  // one writer at a time
+    instrument_ = nullptr;
+
+    // Continuing the archive reads its manifest back: it fails if a step's time is not a number.
+    insitu_instrument* again = nullptr;
+    EXPECT_EQ(insitu_create_from_json(small_config(archive_).c_str(), &again), INSITU_OK)
+        << insitu_last_error();
+    ASSERT_EQ(insitu_set_field(again, "v", ball_.samples.data(), INSITU_FLOAT32, ball_.dims,
+                               ball_.origin, ball_.spacing, ball_.ghosts),
+              INSITU_OK)
+        << insitu_last_error();
+    EXPECT_EQ(insitu_execute(again, 4, 0.4), INSITU_ERROR_INVALID_ARGUMENT);  // already there
+    EXPECT_TRUE(contains(insitu_last_error(), "already in archive")) << insitu_last_error();
+    insitu_destroy(again);
 }
 
 // --- Success ---

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <glm/geometric.hpp>
+#include <limits>
 #include <string>
 
 #include "adaptors/adaptor_test_support.hpp"
@@ -258,6 +259,26 @@ TEST_F(OpenVdbAdaptor, RejectsTransformsAndTypesItCannotPlace) {
     empty->setName("nothing");
     expect_error_naming<InvalidArgument>([&] { openvdb_adaptor::densify(*empty); },
                                          "grid \"nothing\" has no active voxels");
+}
+
+// Issue 19: two voxels far apart span a dense box whose size wraps 64 bits; it must be refused
+// before anything is allocated, naming the box. Voxels at the ends of the int32 index space
+// leave no room for the box's background border.
+TEST_F(OpenVdbAdaptor, DenseBoxesThatOverflowAreRefusedNamingThem) {
+    auto sparse = openvdb::FloatGrid::create(0.0f);
+    sparse->setName("sparse");
+    const int far = 1 << 30;
+    sparse->tree().setValue(openvdb::Coord(-far, -far, -far), 1.0f);
+    sparse->tree().setValue(openvdb::Coord(far, far, far), 1.0f);
+    expect_error_naming<InvalidArgument>([&] { openvdb_adaptor::densify(*sparse); },
+                                         "grid \"sparse\"");
+    expect_error_naming<InvalidArgument>([&] { openvdb_adaptor::densify(*sparse); },
+                                         "dense box 2147483664 x 2147483664 x 2147483664");
+    auto edge = openvdb::FloatGrid::create(0.0f);
+    edge->setName("edge");
+    edge->tree().setValue(openvdb::Coord(std::numeric_limits<openvdb::Int32>::max(), 0, 0), 1.0f);
+    expect_error_naming<InvalidArgument>([&] { openvdb_adaptor::densify(*edge); },
+                                         "32-bit indices");
 }
 
 class VdbFiles : public OpenVdbAdaptor {

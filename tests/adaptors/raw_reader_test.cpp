@@ -184,6 +184,21 @@ TEST_F(RawReader, WrongSizeMissingFileAndUnknownTypeAreNamed) {
                                          "unsupported raw type \"float16\" (uint8, int8");
 }
 
+// Issue 19: sizes are checked in int64, like the Field that views the samples: 2^63 samples
+// used to pass as an unsigned size and reach the file-size comparison.
+TEST_F(RawReader, DimsWhoseSizeOverflowsAreNamed) {
+    const std::string path = write("small.raw", std::vector<float>(10 * 10 * 10, 1.0f), false);
+    RawOptions o = options(RawType::uint8);
+    const std::int64_t k2to21 = std::int64_t{1} << 21;
+    o.dims = {k2to21, k2to21, k2to21};
+    expect_error_naming<InvalidArgument>([&] { capture::read_raw(path, o); },
+                                         "raw dims 2097152,2097152,2097152");
+    expect_error_naming<InvalidArgument>([&] { capture::read_raw(path, o); }, "overflows");
+    o = options(RawType::float64);
+    o.dims = {std::int64_t{1} << 31, std::int64_t{1} << 31, 4};
+    expect_error_naming<InvalidArgument>([&] { capture::read_raw(path, o); }, "overflows");
+}
+
 TEST_F(RawReader, LoadStepNeedsRawOptionsForUnknownExtensions) {
     EXPECT_EQ(capture::input_kind("a/b/c.VTI"), capture::InputKind::vti);
     EXPECT_EQ(capture::input_kind("x.vdb"), capture::InputKind::vdb);

@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -259,6 +260,16 @@ TEST_F(VtkAdaptor, RejectsWhatItCannotPlace) {
         array_of<vtkFloatArray>(std::vector<float>(100, 0.0f), "short"));
     expect_error_naming<InvalidArgument>([&] { vtk::to_field(*wrong_size, {"short"}); },
                                          "has 100 tuples, but the extent has 48 x 48 x 48");
+}
+
+// Issue 19: 2^31 x 2^31 x 4 points wrapped to 0 tuples, which an empty array then matched.
+TEST_F(VtkAdaptor, AnExtentWhoseSizeOverflowsIsRejectedNamingIt) {
+    vtkNew<vtkImageData> image;
+    image->SetExtent(0, std::numeric_limits<int>::max(), 0, std::numeric_limits<int>::max(), 0, 3);
+    image->GetPointData()->AddArray(array_of<vtkFloatArray>(std::vector<float>(), "f"));
+    expect_error_naming<InvalidArgument>([&] { vtk::to_field(*image, {"f"}); },
+                                         "extent 2147483648 x 2147483648 x 4");
+    expect_error_naming<InvalidArgument>([&] { vtk::to_field(*image, {"f"}); }, "overflows");
 }
 
 // --- insitu-capture's .vti and .pvd readers -----------------------------------------------------

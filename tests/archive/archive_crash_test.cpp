@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstdint>
 #include <filesystem>
 #include <random>
@@ -17,13 +18,14 @@
 #include <vector>
 
 #include "insitu/archive/archive.hpp"
+#include "insitu/error.hpp"
 
 namespace insitu {
 namespace {
 
 constexpr int kRuns = 30;
-// Delays span opening the archive (a few ms) to several steps written (each step fsyncs six
-// files); the whole test stays well under 20 s.
+// Delays span opening the archive (a few ms) to several steps written (each step fsyncs four
+// files, their folders and two index appends); the whole test stays well under 20 s.
 constexpr int kMinDelayMs = 1;
 constexpr int kMaxDelayMs = 40;
 constexpr int kImageSize = 16;
@@ -137,6 +139,58 @@ TEST(ArchiveCrash, KilledWriterLeavesAnArchiveWithEveryCompletedStep) {
     }
     EXPECT_EQ(ArchiveReader(config.archive).steps().size(),
               static_cast<std::size_t>(next_step + 1));
+    std::filesystem::remove_all(directory);
+}
+
+
+// One writer at a time (issue 19): a child process holds the archive's lock; a writer here is
+// refused naming the child's pid; once the child is SIGKILLed the kernel has dropped its lock and
+// a new writer succeeds, with every step the child wrote.
+TEST(ArchiveCrash, LockOfAKilledWriterIsReleased) {
+    const std::filesystem::path directory = std::filesystem::temp_directory_path() /
+                                            ("insitu_archive_lock_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(directory);
+    InstrumentConfig config;
+    config.archive = (directory / "run.cdb").string();
+
+    int pipe_fds[2];
+    ASSERT_EQ(::pipe(pipe_fds), 0);
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        ::close(pipe_fds[0]);
+        try {
+            ArchiveWriter writer(config);
+            writer.write(small_step(0));
+            const std::int64_t ready = 0;
+            if (::write(pipe_fds[1], &ready, sizeof ready) != sizeof ready) ::_exit(3);
+            for (;;) ::pause();
+        } catch (const std::exception& error) {
+            std::fprintf(stderr, "child: %s\n", error.what());
+            ::_exit(2);
+        }
+    }
+    ::close(pipe_fds[1]);
+    std::int64_t ready = -1;
+    ASSERT_EQ(::read(pipe_fds[0], &ready, sizeof ready), static_cast<ssize_t>(sizeof ready));
+    ::close(pipe_fds[0]);
+    try {
+        ArchiveWriter second(config);
+        ADD_FAILURE() << "a second writer was let in";
+    } catch (const IoError& error) {
+        EXPECT_NE(std::string(error.what()).find("pid " + std::to_string(child)),
+                  std::string::npos)
+            << error.what();
+        EXPECT_NE(std::string(error.what()).find(config.archive), std::string::npos)
+            << error.what();
+    }
+    ::kill(child, SIGKILL);
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+
+    ArchiveWriter writer(config);
+    writer.write(small_step(1));
+    EXPECT_EQ(ArchiveReader(config.archive).steps(), (std::vector<std::int64_t>{0, 1}));
     std::filesystem::remove_all(directory);
 }
 

@@ -4,6 +4,8 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -105,6 +107,49 @@ TEST(Crc32, MatchesTheStandardCheckValue) {
     const std::string digits = "123456789";
     EXPECT_EQ(crc32_of(digits.data(), digits.size()), 0xCBF43926u);
     EXPECT_EQ(crc32_of(nullptr, 0), 0u);
+}
+
+
+// The append-only indexes (issue 19): an append that the disk refuses part-way is cut back, so
+// the next append does not land behind a torn line.
+TEST_F(AtomicFile, FailedAppendIsCutBackAndTruncateUndoesAnAppend) {
+    const fs::path journal = directory_ / "manifest.journal";
+    EXPECT_EQ(append_to_file(journal, "one\n"), 0u);
+    EXPECT_EQ(append_to_file(journal, "two\n"), 4u);
+    {
+        // RLIMIT_FSIZE with SIGXFSZ ignored: write() fails with EFBIG past 10 bytes, after
+        // writing the first two of these, as on a disk that fills mid-append.
+        rlimit saved{};
+        ::getrlimit(RLIMIT_FSIZE, &saved);
+        const sighandler_t handler = ::signal(SIGXFSZ, SIG_IGN);
+        rlimit limit = saved;
+        limit.rlim_cur = 10;
+        ::setrlimit(RLIMIT_FSIZE, &limit);
+        expect_error_naming<IoError>([&] { append_to_file(journal, "three\n"); },
+                                     "cannot append to \"" + journal.string() + "\"");
+        ::setrlimit(RLIMIT_FSIZE, &saved);
+        ::signal(SIGXFSZ, handler);
+    }
+    EXPECT_EQ(contents(journal), "one\ntwo\n");
+    truncate_file(journal, 4);
+    EXPECT_EQ(contents(journal), "one\n");
+    remove_file_durably(journal);
+    remove_file_durably(journal);  // already gone: nothing to do
+    EXPECT_THAT(names(), ::testing::ElementsAre());
+}
+
+TEST_F(AtomicFile, LockIsExclusiveNamesItsHolderAndSurvivesTempCleanup) {
+    const fs::path path = directory_ / ".lock";
+    {
+        const FileLock lock(path, "archive \"x\"");
+        EXPECT_EQ(contents(path), std::to_string(::getpid()) + "\n");
+        expect_error_naming<IoError>([&] { FileLock second(path, "archive \"x\""); },
+                                     "archive \"x\" is locked by another writer (pid " +
+                                         std::to_string(::getpid()) + ",");
+        remove_temp_files(directory_);
+        EXPECT_TRUE(fs::exists(path));
+    }
+    EXPECT_NO_THROW(FileLock again(path, "archive \"x\""));
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 
@@ -66,6 +67,32 @@ TEST(Manifest, ListsFilesUnderTheArchiveAndFindsViews) {
                                          "has no step 9");
     expect_error_naming<InvalidArgument>([&] { find_view(manifest, "run.cdb", 8, 3); },
                                          "has no view 3");
+}
+
+
+// Issue 19: a NaN time reached manifest.json as null, which the reader then refused, archive and
+// all. The writer's own checks now run before anything is written.
+TEST(Manifest, NeverWritesWhatItsReaderWouldRefuse) {
+    const fs::path archive = fs::temp_directory_path() /
+                             ("insitu_manifest_nan_" + std::to_string(::getpid()));
+    fs::remove_all(archive);
+    fs::create_directories(archive);
+    nlohmann::json manifest = empty_manifest();
+    manifest["producer"] = "libinsitu test";
+    manifest["configuration"] = nlohmann::json::object();
+    insert_step(manifest, step_entry(1));
+    write_manifest(archive.string(), manifest);
+    nlohmann::json bad = manifest;
+    nlohmann::json entry = step_entry(7);
+    entry["time"] = std::nan("");
+    insert_step(bad, entry);
+    expect_error_naming<ParseError>([&] { write_manifest(archive.string(), bad); },
+                                    "key \"steps[1].time\" has the wrong type: nan");
+    expect_error_naming<ParseError>([&] { append_journal(archive.string(), entry); },
+                                    "time\" has the wrong type: nan");
+    EXPECT_EQ(read_manifest(archive.string()), manifest);
+    EXPECT_FALSE(fs::exists(archive / kJournalFile));
+    fs::remove_all(archive);
 }
 
 }  // namespace

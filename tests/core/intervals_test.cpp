@@ -4,6 +4,8 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -42,6 +44,25 @@ TEST(IntervalSet, DegenerateRangeIsWidenedSoWidthsStayPositive) {
     EXPECT_DOUBLE_EQ(intervals.edges().front(), 1.5);
     EXPECT_DOUBLE_EQ(intervals.edges().back(), 2.5);
     EXPECT_EQ(intervals.index_of(2.0), 1);
+}
+
+// Issue 19: a float64 range of +-1e308 is wider than the largest double; its width overflowed
+// to Inf and the edges came out NaN ("interval edges[0] = -nan").
+TEST(IntervalSet, RangesWiderThanTheLargestDoubleGiveFiniteEvenEdges) {
+    const double max = std::numeric_limits<double>::max();
+    for (const auto& [lo, hi] : {std::pair{-1e308, 1e308}, std::pair{-max, max}}) {
+        const IntervalSet intervals = IntervalSet::uniform(lo, hi, 4);
+        ASSERT_EQ(intervals.count(), 4);
+        EXPECT_EQ(intervals.edges().front(), lo);
+        EXPECT_EQ(intervals.edges().back(), hi);
+        EXPECT_DOUBLE_EQ(intervals.edges()[2], 0.0 + 0.5 * hi + 0.5 * lo);
+        EXPECT_DOUBLE_EQ(intervals.edges()[1], 0.75 * lo + 0.25 * hi);
+        EXPECT_TRUE(intervals.is_uniform()) << intervals;
+        EXPECT_EQ(intervals.index_of(0.6 * hi), 3);
+        const std::vector<float> values{-1.0f, 0.0f, 1.0f, 2.0f};
+        const IntervalSet equalized = IntervalSet::histogram_equalized(values, lo, hi, 4);
+        for (double edge : equalized.edges()) EXPECT_TRUE(std::isfinite(edge)) << equalized;
+    }
 }
 
 TEST(IntervalSet, HistogramEqualizedIntervalsHoldAboutEqualCounts) {

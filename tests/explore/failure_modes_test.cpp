@@ -4,7 +4,7 @@
 // interval, K = 1 — every result stays finite and bounded (never garbage), and what view
 // synthesis could not see is flagged by its confidence mask. How large the errors grow is
 // charted by bench/evaluate; here only the contract is asserted. Also the error metrics the
-// harness measures with (bench/evaluation/metrics.hpp), against known answers.
+// harness measures with (insitu/testing/metrics.hpp), against known answers.
 #include <gtest/gtest.h>
 #include <unistd.h>
 

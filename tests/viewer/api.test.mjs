@@ -7,6 +7,7 @@ import assert from 'node:assert/strict';
 import { spawn, spawnSync } from 'node:child_process';
 import { copyFileSync, cpSync, existsSync, readFileSync, rmSync, symlinkSync, writeFileSync } from 'node:fs';
 import http from 'node:http';
+import net from 'node:net';
 import path from 'node:path';
 import { after, before, test } from 'node:test';
 
@@ -94,6 +95,7 @@ test('absurd or malformed parameters are 4xx with a JSON error, and logged', asy
     [`api/frame?step=${first}&light=${encodeURIComponent(tenLights)}`, 400],
     [`api/frame?step=${first}&enhance=1`, 400],
     [`api/frame?step=${first}&colour=rainbow`, 400],
+    [`api/frame?step=${first}&colour=%ff`, 400],                 // not UTF-8: was a 500
     [`api/frame?step=${first}&session=${encodeURIComponent('../x')}`, 400],
     [`api/frame?step=${first}&session=${'s'.repeat(65)}`, 400],
     [`api/mask?step=zzz`, 400],
@@ -255,5 +257,70 @@ test('an archive that a running simulation writes is viewable and grows without 
     assert.equal((await fetch(`${liveServer.url}api/frame?step=400`)).status, 200);
   } finally {
     assert.equal(await stopServer(liveServer), 0);
+  }
+});
+
+/// A GET from the given local address, resolving with the status (or the error's code).
+function getFrom(base, rawPath, localAddress) {
+  const url = new URL(base);
+  return new Promise((resolve) => {
+    const request = http.request({ host: url.hostname, port: url.port, path: rawPath, localAddress,
+      agent: false }, (response) => {
+      response.resume();
+      response.on('end', () => resolve(response.statusCode));
+    });
+    request.on('error', (error) => resolve(error.code));
+    request.setTimeout(5000, () => { request.destroy(); resolve('timeout'); });
+    request.end();
+  });
+}
+
+test('slow clients (Slowloris) cannot take the workers: others are answered at once', async () => {
+  // 40 connections from one address, each sending a header line every 2 s: never idle long
+  // enough for a read timeout. Before the per-client bound and the request deadline they held
+  // every worker and the viewer stopped answering.
+  const guarded = await startServer(binary, archive);
+  const url = new URL(guarded.url);
+  const sockets = [];
+  const timers = [];
+  let refusedSockets = 0;
+  try {
+    for (let i = 0; i < 40; ++i) {
+      const socket = net.connect({ host: url.hostname, port: Number(url.port) });
+      socket.on('error', () => {});
+      socket.once('data', (chunk) => {
+        if (chunk.toString('latin1').startsWith('HTTP/1.1 503')) ++refusedSockets;
+      });
+      socket.write('GET /api/status HTTP/1.1\r\nHost: x\r\n');
+      timers.push(setInterval(() => socket.write(`X-Slow-${i}: 1\r\n`), 2000));
+      sockets.push(socket);
+    }
+    // All but the 8 a client may hold open are answered 503 at once, before any header ends.
+    const opened = Date.now();
+    while (refusedSockets < 32) {
+      assert.ok(Date.now() - opened < 10000, `only ${refusedSockets} of 40 slow ones refused`);
+      await new Promise((resolve) => setTimeout(resolve, 50));
+    }
+    // Another client (another loopback address) is served within a few seconds.
+    const started = Date.now();
+    assert.equal(await getFrom(guarded.url, '/api/status', '127.0.0.2'), 200);
+    assert.ok(Date.now() - started < 3000, `answered after ${Date.now() - started} ms`);
+    // The slow client's address is at its bound: refused at once, not queued.
+    const refused = await getFrom(guarded.url, '/api/status', '127.0.0.1');
+    assert.ok(refused === 503 || refused === 'ECONNRESET', `same address: ${refused}`);
+    for (const timer of timers) clearInterval(timer);
+    for (const socket of sockets) socket.destroy();
+    // Its connections gone, the slow client is served again.
+    const since = Date.now();
+    let status = await getFrom(guarded.url, '/api/status', '127.0.0.1');
+    while (status !== 200 && Date.now() - since < 5000) {
+      await new Promise((resolve) => setTimeout(resolve, 100));
+      status = await getFrom(guarded.url, '/api/status', '127.0.0.1');
+    }
+    assert.equal(status, 200);
+  } finally {
+    for (const timer of timers) clearInterval(timer);
+    for (const socket of sockets) socket.destroy();
+    assert.equal(await stopServer(guarded), 0);
   }
 });

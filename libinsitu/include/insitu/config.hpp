@@ -15,7 +15,9 @@
 //
 // Every key is optional; defaults are listed on the members below. Unknown keys (at any level)
 // are collected by name, not silently ignored; invalid values raise InvalidArgument/ParseError
-// naming the key and the value. Cadence: "every": N (N >= 1) or "steps": [s0, s1, ...], not both.
+// naming the key and the value. Cadence: "every": N (N >= 1) or "steps": [s0, s1, ...] (distinct,
+// >= 0), not both. "step" is at least kMinStepVoxels, and the estimated cost of a step at most
+// kMaxSamplesPerStep samples.
 // A view's keys: "azimuth", "elevation" (degrees), "camera" ("ortho" | "orthographic" |
 // "perspective"), "fov" (degrees, perspective only), "size" ([width, height] pixels),
 // "distortion_tilt" (degrees).
@@ -58,7 +60,7 @@ struct ProxySelection {
     bool optical_depth = false;      ///< "optical_depth": tau_j as well
 };
 
-/// "colour_model": the in-situ fit of seed 000 §6.2 (insitu/colour_model.hpp).
+/// "colour_model": the in-situ fit of seed 000 §6.2 (insitu/explore/colour_model.hpp).
 struct ColourModelConfig {
     int clusters = 24;    ///< "clusters": K, in [1, kMaxColourModelClusters]
     bool enabled = true;  ///< "enabled": fit when training transfer functions are given
@@ -66,6 +68,20 @@ struct ColourModelConfig {
 
 /// Largest K a configuration may ask for (the fit's cost grows with K, and K rows are stored).
 constexpr int kMaxColourModelClusters = 1024;
+
+/// Smallest ray step ("step", voxels). Below it consecutive samples fall into the same trilinear
+/// cell thousands of times and add nothing, and float32 ray positions, which resolve 2^-23 of
+/// their magnitude (1.2e-4 voxels deep in a 1024^3 volume), stop advancing; the cost per step
+/// grows as 1 / step (issue 19: a step of 1e-9 ran for more than 11 minutes).
+constexpr double kMinStepVoxels = 1e-3;
+/// The longest ray a step's cost is estimated for: the diagonal of the largest cube a device
+/// buffer addresses (2^32 samples, 1625^3), in voxels.
+constexpr double kWorstDiagonalVoxels = 2815.0;
+/// Ceiling on InstrumentConfig::estimated_samples_per_step(), 2^42: the largest view (16384^2
+/// pixels) with the default proxies at a 1-voxel step fits under it. At the performance model's
+/// rate on 2 CPU cores (about 4.7e8 samples/s) that is some hours, on a GPU minutes; beyond it a
+/// configuration is orders of magnitude off rather than tuned, so it is refused at start-up.
+constexpr double kMaxSamplesPerStep = 4398046511104.0;
 
 struct InstrumentConfig {
     std::vector<std::string> fields{"v"};  ///< "fields": names of the fields to visualise
@@ -109,8 +125,16 @@ struct InstrumentConfig {
     /// otherwise divisible by `every`.
     bool selects(std::int64_t step) const;
     /// Throws InvalidArgument naming the configuration key and value of the first member that is
-    /// out of range (for configurations built in code; from_json checks the same).
+    /// out of range (for configurations built in code; from_json checks the same), and, naming
+    /// the keys that set it, when estimated_samples_per_step() exceeds kMaxSamplesPerStep.
     void validate() const;
+    /// Ray-marching passes per view and step: the single- and multi-perspective proxies (when
+    /// any is requested), the preview, and per training function its ground truth and, when the
+    /// colour model is fitted, its attenuation (as Instrument::execute renders them).
+    int passes_per_view() const;
+    /// Samples one step costs at most: the views' pixels x passes_per_view() x samples per ray
+    /// along kWorstDiagonalVoxels at "step" (seed 002's cost model, DESIGN.md "Performance").
+    double estimated_samples_per_step() const;
 };
 
 }  // namespace insitu

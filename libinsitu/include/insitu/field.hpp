@@ -25,6 +25,12 @@ ScalarType parse_scalar_type(const std::string& text);
 
 using Index3 = std::array<std::int64_t, 3>;
 
+/// a * b and a + b, or InvalidArgument "`what`: a * b overflows 64-bit integers". Every size,
+/// offset and stride product made of values a simulation or a file supplies goes through these,
+/// so that none can wrap into a small number that defeats a later bound (issue 19).
+std::int64_t checked_multiply(std::int64_t a, std::int64_t b, const std::string& what);
+std::int64_t checked_add(std::int64_t a, std::int64_t b, const std::string& what);
+
 /// Finite value range of a field and how many samples were NaN or +-Inf (treated as empty).
 struct ValueRange {
     double min = 0.0;
@@ -48,7 +54,8 @@ std::ostream& operator<<(std::ostream& out, const Bounds& bounds);
 class Field {
 public:
     /// A view of a contiguous x-fastest array of `allocated_dims` samples.
-    /// Throws InvalidArgument for a null pointer or a non-positive dimension.
+    /// Throws InvalidArgument for a null pointer, a non-positive dimension, or dims whose extent
+    /// in bytes does not fit in 64-bit integers.
     Field(std::string name, const void* data, ScalarType type, Index3 allocated_dims);
 
     /// World position of the first interior sample (world units). Default (0, 0, 0).
@@ -62,8 +69,8 @@ public:
     Field& set_ghost_layers(std::int64_t layers);
     /// Distance between neighbours along x, y, z in samples (not bytes), for arrays that are
     /// padded, transposed or interleaved. Default: x-fastest contiguous, {1, nx, nx*ny}.
-    /// Strides must be positive; the whole allocated extent must not address memory twice
-    /// along one axis (|stride| checks are left to the simulation; we check positivity).
+    /// Strides must be positive, and the last allocated sample's offset in bytes must fit in
+    /// 64-bit integers; whether the extent addresses memory twice is left to the simulation.
     Field& set_strides(Index3 strides_samples);
 
     const std::string& name() const { return name_; }
@@ -93,6 +100,9 @@ public:
     ValueRange copy_interior_as_float(std::vector<float>& out) const;
 
 private:
+    /// Throws unless the offset in bytes of the last allocated sample, through `strides`, fits in
+    /// int64: then every offset and count below it does too, and no index product can wrap.
+    void check_extent(const Index3& strides) const;
     std::int64_t offset_of(std::int64_t i, std::int64_t j, std::int64_t k) const;
 
     std::string name_;

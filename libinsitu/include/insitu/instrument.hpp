@@ -66,10 +66,12 @@ public:
 
     /// One timestep: fields are matched by name against the configuration's "fields". Only the
     /// first configured field is visualised (and must be present); several fields per step are
-    /// future work. Checks, in order: not finalized; `step` greater than every step executed
-    /// before and not already in the archive (else error naming it, nothing written); the first
-    /// configured field present (else error naming it); the cadence (else not_selected, nothing
-    /// computed). Then computes the proxies and preview of every view and queues them; with the
+    /// future work. Checks, in order: not finalized; `step` in [0, 2^53 - 1] (what the JSON
+    /// manifest holds exactly), `time` finite (JSON has no NaN/Inf), `step` greater than every
+    /// step executed before and not already in the archive (else error naming it, nothing
+    /// written); the first configured field present (else error naming it); the cadence (else
+    /// not_selected, nothing computed); the field's values within float32, which the renderers
+    /// sample. Then computes the proxies and preview of every view and queues them; with the
     /// queue full it waits (when_full = block, timed in blocked_seconds) or returns dropped.
     /// The Fields are not referenced after execute() returns.
     Status execute(std::int64_t step, double time, const std::vector<Field>& fields);

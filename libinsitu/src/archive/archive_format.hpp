@@ -27,6 +27,11 @@ namespace insitu::archive_format {
 // Files and folders of an archive.
 inline constexpr const char* kManifestFile = "manifest.json";
 inline constexpr const char* kCsvFile = "data.csv";
+/// Step entries written since manifest.json was last compacted, one JSON object a line
+/// (manifest.hpp); readers replay it, writers fold it into manifest.json.
+inline constexpr const char* kJournalFile = "manifest.journal";
+/// flock()ed by the one writer of the archive, holding its pid; readers never look at it.
+inline constexpr const char* kLockFile = ".lock";
 inline constexpr const char* kProxyFolder = "proxies";
 inline constexpr const char* kPreviewFolder = "previews";
 /// Temp files start with this; the reader never looks at them and a writer removes leftovers.

@@ -7,10 +7,15 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
 #include "archive/archive_format.hpp"
+#include "archive/cinema_csv.hpp"
 #include "archive/exr_frame.hpp"
 #include "archive/manifest.hpp"
 #include "archive/preview_png.hpp"
@@ -21,8 +26,47 @@ namespace insitu {
 namespace fs = std::filesystem;
 namespace af = archive_format;
 
-ArchiveReader::ArchiveReader(const std::string& path)
-    : path_(path), manifest_(std::make_shared<const nlohmann::json>(af::read_manifest(path))) {}
+namespace {
+/// The relative path of the file of `kind` a validated view entry lists.
+std::string view_file(const nlohmann::json& view, const char* kind) {
+    for (const nlohmann::json& file : view.at("files")) {
+        if (file.at("kind") == kind) return file.at("path").get<std::string>();
+    }
+    return {};
+}
+/// The largest image `view` was configured with in any configuration the archive recorded (a
+/// restart may have changed it); the codec's general bound when one does not list the view.
+af::FrameLimits frame_limits(const nlohmann::json& manifest, int view) {
+    std::vector<const nlohmann::json*> configurations{&manifest.at("configuration")};
+    for (const nlohmann::json& previous :
+         manifest.value("previous_configurations", nlohmann::json::array())) {
+        configurations.push_back(&previous);
+    }
+    af::FrameLimits limits{0, 0};
+    for (const nlohmann::json* configuration : configurations) {
+        const nlohmann::json views = configuration->value("views", nlohmann::json());
+        const nlohmann::json size =
+            views.is_array() && static_cast<std::size_t>(view) < views.size() &&
+                    views[static_cast<std::size_t>(view)].is_object()
+                ? views[static_cast<std::size_t>(view)].value("size", nlohmann::json())
+                : nlohmann::json();
+        if (!size.is_array() || size.size() != 2 || !size[0].is_number_integer() ||
+            !size[1].is_number_integer()) {
+            return af::FrameLimits{};
+        }
+        limits.max_width = std::max(limits.max_width, size[0].get<int>());
+        limits.max_height = std::max(limits.max_height, size[1].get<int>());
+    }
+    return limits;
+}
+
+}  // namespace
+
+ArchiveReader::ArchiveReader(const std::string& path) : path_(path) {
+    af::Index index = af::read_index(path);
+    manifest_ = std::make_shared<const nlohmann::json>(std::move(index.manifest));
+    diagnostics_ = std::move(index.diagnostics);
+}
 
 InstrumentConfig ArchiveReader::configuration() const {
     const std::string file = (fs::path(path_) / af::kManifestFile).string();
@@ -76,7 +120,7 @@ ProxyFrame ArchiveReader::load(std::int64_t step, int view, bool multi_perspecti
                               listed.absolute_path, ")");
     }
     return af::decode_frame(af::read_listed_file(listed), listed.absolute_path, wanted,
-                            multi_perspective);
+                            multi_perspective, frame_limits(*manifest_, view));
 }
 
 Image ArchiveReader::load_preview(std::int64_t step, int view) const {
@@ -85,16 +129,127 @@ Image ArchiveReader::load_preview(std::int64_t step, int view) const {
     return af::decode_preview_png(af::read_listed_file(listed), listed.absolute_path);
 }
 
+namespace {
+
+/// Where `path` really is, symbolic links resolved (lexically normal when it does not exist).
+fs::path resolved(const fs::path& path) {
+    std::error_code error;
+    fs::path real = fs::weakly_canonical(path, error);
+    if (error) real = path.lexically_normal();
+    // "run.cdb/" would otherwise end in an empty component that no file path shares.
+    return real.has_filename() ? real : real.parent_path();
+}
+
+/// Whether `path`, links resolved, stays inside `root` (itself resolved).
+bool inside(const fs::path& root, const fs::path& path) {
+    const fs::path real = resolved(path);
+    auto r = root.begin();
+    auto p = real.begin();
+    for (; r != root.end(); ++r, ++p) {
+        if (p == real.end() || *r != *p) return false;
+    }
+    return true;
+}
+
+}  // namespace
+
 std::vector<std::string> ArchiveReader::verify() const {
-    std::vector<std::string> problems;
+    std::vector<std::string> problems = diagnostics_;
+    const fs::path root = resolved(fs::absolute(path_));
+    std::set<fs::path> outside;
     for (const af::ListedFile& file : af::listed_files(path_, *manifest_)) {
+        // The viewer's server refuses files outside the archive; so does verify, rather than
+        // check the bytes a link points at elsewhere.
+        if (!inside(root, file.absolute_path)) {
+            outside.insert(fs::absolute(file.absolute_path).lexically_normal());
+            problems.push_back("\"" + file.absolute_path + "\" resolves to \"" +
+                               resolved(file.absolute_path).string() +
+                               "\", outside the archive");
+            continue;
+        }
         try {
             af::read_listed_file(file);
         } catch (const IoError& error) {
             problems.push_back(error.what());
         }
     }
+    verify_cinema_csv(root, outside, problems);
     return problems;
+}
+
+void ArchiveReader::verify_cinema_csv(const fs::path& root, const std::set<fs::path>& outside,
+                                      std::vector<std::string>& problems) const {
+    // data.csv must have a row per manifest step x view naming the manifest's files, and every
+    // row must name files inside the archive that exist. A row for a step the manifest lacks is
+    // what a run killed between data.csv and the journal leaves (the next writer drops it):
+    // not a problem while its files are there.
+    const std::string file = (fs::path(path_) / af::kCsvFile).string();
+    std::vector<af::CsvRow> rows;
+    try {
+        rows = af::read_cinema_csv(path_);
+    } catch (const Error& error) {
+        problems.push_back(error.what());
+        return;
+    }
+    std::map<std::pair<std::int64_t, int>, const af::CsvRow*> by_key;
+    for (const af::CsvRow& row : rows) {
+        const std::string where = "\"" + file + "\" line " + std::to_string(row.line) + ": ";
+        if (row.columns.size() != 7) {
+            problems.push_back(where + std::to_string(row.columns.size()) +
+                               " columns, expected 7");
+            continue;
+        }
+        std::int64_t step = 0;
+        int view = 0;
+        try {
+            std::size_t used = 0;
+            step = std::stoll(row.columns[1], &used);
+            if (used != row.columns[1].size()) throw std::invalid_argument("step");
+            view = std::stoi(row.columns[2], &used);
+            if (used != row.columns[2].size()) throw std::invalid_argument("view");
+        } catch (const std::exception&) {
+            problems.push_back(where + "step \"" + row.columns[1] + "\" or view \"" +
+                               row.columns[2] + "\" is not an integer");
+            continue;
+        }
+        if (!by_key.emplace(std::pair{step, view}, &row).second) {
+            problems.push_back(where + "step " + std::to_string(step) + " view " +
+                               std::to_string(view) + " is repeated");
+        }
+        for (const std::size_t column : {std::size_t{5}, std::size_t{6}}) {
+            const fs::path named = fs::path(path_) / row.columns[column];
+            std::error_code error;
+            // A file the manifest lists and that resolves elsewhere is reported once, above.
+            if (outside.count(fs::absolute(named).lexically_normal())) continue;
+            if (row.columns[column].empty() || fs::path(row.columns[column]).is_absolute() ||
+                !inside(root, fs::absolute(named))) {
+                problems.push_back(where + "\"" + row.columns[column] +
+                                   "\" is not a file inside the archive");
+            } else if (!fs::is_regular_file(named, error)) {
+                problems.push_back(where + "\"" + row.columns[column] + "\" does not exist");
+            }
+        }
+    }
+    for (const nlohmann::json& step : manifest_->at("steps")) {
+        const auto number = step.at("step").get<std::int64_t>();
+        for (const nlohmann::json& view : step.at("views")) {
+            const int index = view.at("view").get<int>();
+            const auto row = by_key.find({number, index});
+            const std::string what =
+                "step " + std::to_string(number) + " view " + std::to_string(index);
+            if (row == by_key.end()) {
+                problems.push_back("\"" + file + "\" has no row for " + what);
+                continue;
+            }
+            const std::string exr = view_file(view, af::kProxyKind);
+            const std::string png = view_file(view, af::kPreviewKind);
+            if (row->second->columns[5] != exr || row->second->columns[6] != png) {
+                problems.push_back("\"" + file + "\" line " + std::to_string(row->second->line) +
+                                   ": " + what + " names other files than the manifest (" +
+                                   exr + ", " + png + ")");
+            }
+        }
+    }
 }
 
 }  // namespace insitu

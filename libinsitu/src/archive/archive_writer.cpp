@@ -1,13 +1,25 @@
 // The timestep proxy archive, writing side (DESIGN.md "Archive"; names in archive_format.hpp).
 //
-// Every file goes through the crash-safe path of atomic_file.hpp. The indexes (manifest.json,
-// then data.csv) are rewritten whole, the same way, only after every file of the step is in
-// place: a run killed at any moment leaves indexes that name complete files only.
+// Every file goes through the crash-safe path of atomic_file.hpp. The indexes are written only
+// after every file of the step is in place, so a run killed at any moment leaves indexes that
+// name complete files only. A step costs O(1) in the length of the run (issue 19): its rows are
+// appended to data.csv, then its entry to manifest.journal (the commit point: once that line is
+// synced the step is in the archive); manifest.json is the compacted index, rewritten whole
+// (temp, fsync, rename) with data.csv (rows back in step order) only at open, at close and when
+// the journal has grown as long as it.
+//
+// What a killed run can leave: a torn last line in data.csv or the journal (readers skip it; the
+// next writer rewrites both indexes whole), or data.csv rows of a step the journal never got
+// (complete files; the next writer's data.csv drops them). data.csv is a valid Cinema database
+// at every other moment.
 #include "insitu/archive/archive_writer.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <optional>
 #include <set>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -57,10 +69,24 @@ WrittenFile place_png(const fs::path& archive, const std::string& relative_path,
     return {relative_path, bytes.size(), af::crc32_of(bytes.data(), bytes.size())};
 }
 
+/// "nan", "inf" or the number: what a message shows of a value the archive refused.
+std::string number_text(double value) {
+    if (std::isnan(value)) return "nan";
+    if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+    std::ostringstream text;
+    text << value;
+    return text.str();
+}
+
 void validate_record(const StepRecord& record, const ArchiveWriter& writer) {
     const std::string where = "step " + std::to_string(record.step);
     if (record.step < 0) {
         fail<InvalidArgument>(where, ": step numbers must be >= 0 (they name archive files)");
+    }
+    // JSON has no NaN or Inf: such a time would reach the manifest as null, which no reader
+    // takes back (issue 19).
+    if (!std::isfinite(record.time)) {
+        fail<InvalidArgument>(where, ": time = ", number_text(record.time), " cannot be stored");
     }
     if (writer.contains(record.step)) {
         fail<InvalidArgument>(where, ": duplicate step, already in archive \"", writer.path(),
@@ -77,6 +103,12 @@ void validate_record(const StepRecord& record, const ArchiveWriter& writer) {
         if (view.preview.pixels.empty()) {
             fail<InvalidArgument>(where, " view ", view.view_index,
                                   ": no preview image (data.csv's FILE column needs one)");
+        }
+        for (const double angle : {view.view.orbit.azimuth_deg, view.view.orbit.elevation_deg}) {
+            if (!std::isfinite(angle)) {
+                fail<InvalidArgument>(where, " view ", view.view_index, ": angle = ",
+                                      number_text(angle), " cannot be stored");
+            }
         }
         if (view.preview.channels != 1 && view.preview.channels != 3 &&
             view.preview.channels != 4) {
@@ -101,13 +133,24 @@ ArchiveWriter::ArchiveWriter(const InstrumentConfig& config)
             fail<IoError>("cannot create archive directory \"", folder.string(),
                           "\": ", error ? error.message() : "exists and is not a directory");
         }
+        // One writer at a time (issue 19): taken before anything in the archive is touched, held
+        // until this writer is destroyed or its process dies.
+        if (folder == archive) {
+            lock_ = std::make_unique<af::FileLock>(archive / af::kLockFile,
+                                                   "archive \"" + path_ + "\"");
+        }
     }
 
     nlohmann::json configuration = config_.to_json();
     nlohmann::json manifest;
     if (fs::exists(archive / af::kManifestFile)) {
-        // A restarted run appends. A corrupt manifest throws here and is never overwritten.
-        manifest = af::read_manifest(path_);
+        // A restarted run appends. A manifest whose top level is corrupt throws here and is never
+        // overwritten; malformed step entries are kept aside, verbatim (manifest.hpp).
+        af::Index index = af::read_index(path_);
+        manifest = std::move(index.manifest);
+        for (nlohmann::json& skipped : index.skipped) {
+            manifest[af::kMalformedKey].push_back(std::move(skipped));
+        }
         if (manifest.at("configuration") != configuration) {
             manifest["previous_configurations"].push_back(manifest.at("configuration"));
         }
@@ -117,11 +160,39 @@ ArchiveWriter::ArchiveWriter(const InstrumentConfig& config)
     manifest["producer"] = std::string("libinsitu ") + INSITU_VERSION;
     manifest["configuration"] = std::move(configuration);
     for (const fs::path& folder : folders) af::remove_temp_files(folder);
-    // Writing both indexes now makes a fresh archive open (with no steps), catches an unwritable
-    // directory at start-up, and brings a data.csv a crash left one step behind up to date.
+    // Writing both indexes whole now makes a fresh archive open (with no steps), catches an
+    // unwritable directory at start-up, folds in the journal a killed run left and repairs a
+    // data.csv it left behind or torn. The journal goes only once manifest.json holds its steps.
     af::write_manifest(path_, manifest);
+    af::remove_file_durably(archive / af::kJournalFile);
     af::write_cinema_csv(path_, manifest);
     steps_ = af::manifest_steps(manifest);
+    compacted_steps_ = steps_.size();
+}
+
+ArchiveWriter::~ArchiveWriter() {
+    // At close the journal is folded into manifest.json, so that a finished run leaves one
+    // self-contained index. Best effort: the journal is as good an index, readers replay it.
+    try {
+        if (journal_steps_ > 0) compact();
+    } catch (const std::exception&) {
+    }
+}
+
+void ArchiveWriter::compact() {
+    // Everything read back was validated on the way in, and write_manifest() checks it again.
+    af::Index index = af::read_index(path_);
+    for (nlohmann::json& skipped : index.skipped) {
+        index.manifest[af::kMalformedKey].push_back(std::move(skipped));
+    }
+    af::write_manifest(path_, index.manifest);
+    // Killed here, the journal repeats steps manifest.json has: readers skip those (manifest.cpp).
+    af::remove_file_durably(fs::path(path_) / af::kJournalFile);
+    compacted_steps_ = steps_.size();
+    journal_steps_ = 0;
+    // Rows were appended in write order; the rewrite puts them back in step order (same cost as
+    // the manifest's, so still O(1) a step, amortised).
+    af::write_cinema_csv(path_, index.manifest);
 }
 
 bool ArchiveWriter::contains(std::int64_t step) const {
@@ -138,6 +209,7 @@ StepWriteResult ArchiveWriter::write(const StepRecord& record) {
                               {"field", record.field},
                               {"views", nlohmann::json::array()}};
     bool indexed = false;
+    std::optional<std::uint64_t> csv_size_before;
     try {
         for (const ViewRecord& view : record.views) {
             const std::string exr_path = af::proxy_relative_path(record.step, view.view_index);
@@ -155,21 +227,43 @@ StepWriteResult ArchiveWriter::write(const StepRecord& record) {
                   {af::file_entry(result.files[result.files.size() - 2], af::kProxyKind),
                    af::file_entry(result.files.back(), af::kPreviewKind)}}});
         }
+        // The entry must read back before anything names it (issue 19).
+        try {
+            af::check_step_entry(step_entry, (archive / af::kJournalFile).string(), "new entry");
+        } catch (const ParseError& error) {
+            fail<InvalidArgument>("step ", record.step, ": cannot be stored: ", error.what());
+        }
 
-        // Read back rather than kept: memory stays flat over a long run (the file is ours,
-        // written by this writer, and validated again on the way in).
-        nlohmann::json manifest = af::read_manifest(path_);
-        af::insert_step(manifest, std::move(step_entry));
-        af::write_manifest(path_, manifest);
-        // From here the step is in the archive, whatever happens to data.csv.
+        // data.csv first: a row names complete files, and a killed run that got no further
+        // leaves rows the next writer drops, never a step data.csv lacks.
+        csv_size_before = af::append_cinema_rows(path_, step_entry);
+        af::append_journal(path_, step_entry);
+        // From here the step is in the archive, whatever happens to the compaction.
         steps_.insert(std::upper_bound(steps_.begin(), steps_.end(), record.step), record.step);
         indexed = true;
-        af::write_cinema_csv(path_, manifest);
+        ++journal_steps_;
+        // Compacting when the journal is as long as manifest.json makes each compaction's O(n)
+        // paid for by the n steps before it: O(1) a step, amortised, and a reader never replays
+        // more lines than manifest.json holds entries. The floor keeps short runs from
+        // rewriting manifest.json every few steps.
+        if (journal_steps_ >= std::max<std::size_t>(kMinCompactionSteps, compacted_steps_)) {
+            compact();
+        }
     } catch (...) {
         if (!indexed) {
             // Nothing names these files; remove them so the archive is as it was (best effort,
-            // a leftover would only be clutter that the next write of this step replaces).
+            // a leftover would only be clutter that the next write of this step replaces). Rows
+            // already in data.csv are cut back first; should that fail they still name files.
+            bool rows_named = false;
+            if (csv_size_before) {
+                try {
+                    af::truncate_file(archive / af::kCsvFile, *csv_size_before);
+                } catch (const IoError&) {
+                    rows_named = true;
+                }
+            }
             for (const WrittenFile& file : result.files) {
+                if (rows_named) break;
                 std::error_code ignored;
                 fs::remove(archive / file.relative_path, ignored);
             }

@@ -1,6 +1,7 @@
 #include "archive/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
@@ -101,6 +102,110 @@ void write_file_atomically(const fs::path& path, const std::string& bytes) {
     TempFile file(path);
     file.write(bytes.data(), bytes.size());
     file.commit();
+}
+
+namespace {
+
+/// write() all of `bytes`, retrying on EINTR; the errno of the failure, 0 on success.
+int write_all(int fd, const std::string& bytes) {
+    std::size_t done = 0;
+    while (done < bytes.size()) {
+        const ssize_t written = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (written < 0) {
+            if (errno == EINTR) continue;
+            return errno;
+        }
+        done += static_cast<std::size_t>(written);
+    }
+    return 0;
+}
+
+}  // namespace
+
+std::uint64_t append_to_file(const fs::path& path, const std::string& bytes) {
+    std::error_code ignored;
+    const bool created = !fs::exists(path, ignored);
+    const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) fail<IoError>("cannot append to \"", path.string(), "\": ", errno_text(errno));
+    struct stat info {};
+    if (::fstat(fd, &info) != 0) {
+        const int error = errno;
+        ::close(fd);
+        fail<IoError>("cannot append to \"", path.string(), "\": fstat: ", errno_text(error));
+    }
+    const auto previous = static_cast<std::uint64_t>(info.st_size);
+    int error = write_all(fd, bytes);
+    const char* what = "write";
+    if (error == 0 && ::fsync(fd) != 0) {
+        error = errno;
+        what = "sync";
+    }
+    if (error != 0) {
+        // Best effort: a cut that fails too leaves a torn last line, which readers skip.
+        if (::ftruncate(fd, static_cast<off_t>(previous)) == 0) ::fsync(fd);
+        ::close(fd);
+        fail<IoError>("cannot append to \"", path.string(), "\": ", what, ": ",
+                      errno_text(error));
+    }
+    if (::close(fd) != 0) {
+        fail<IoError>("cannot append to \"", path.string(), "\": close: ", errno_text(errno));
+    }
+    if (created) fsync_directory(path.parent_path());
+    return previous;
+}
+
+void truncate_file(const fs::path& path, std::uint64_t size) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    if (fd < 0) fail<IoError>("cannot truncate \"", path.string(), "\": ", errno_text(errno));
+    const bool done = ::ftruncate(fd, static_cast<off_t>(size)) == 0 && ::fsync(fd) == 0;
+    const int error = errno;
+    ::close(fd);
+    if (!done) fail<IoError>("cannot truncate \"", path.string(), "\": ", errno_text(error));
+}
+
+void remove_file_durably(const fs::path& path) {
+    if (::unlink(path.c_str()) != 0) {
+        if (errno == ENOENT) return;
+        fail<IoError>("cannot remove \"", path.string(), "\": ", errno_text(errno));
+    }
+    fsync_directory(path.parent_path());
+}
+
+FileLock::FileLock(const fs::path& path, const std::string& what) {
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) {
+        fail<IoError>(what, ": cannot open lock file \"", path.string(), "\": ", errno_text(errno));
+    }
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+        const int error = errno;
+        // The holder wrote its pid when it took the lock; read it for the message.
+        char text[32] = {};
+        const ssize_t got = ::pread(fd_, text, sizeof text - 1, 0);
+        std::string holder = got > 0 ? std::string(text, static_cast<std::size_t>(got)) : "";
+        holder.erase(std::remove(holder.begin(), holder.end(), '\n'), holder.end());
+        ::close(fd_);
+        fd_ = -1;
+        if (error == EWOULDBLOCK) {
+            fail<IoError>(what, " is locked by another writer (pid ",
+                          holder.empty() ? std::string("unknown") : holder,
+                          ", lock file \"", path.string(), "\"): one writer at a time");
+        }
+        fail<IoError>(what, ": cannot lock \"", path.string(), "\": ", errno_text(error));
+    }
+    // Only the holder writes the file, so a stale pid from a killed holder is simply replaced.
+    const std::string pid = std::to_string(::getpid()) + "\n";
+    if (::ftruncate(fd_, 0) != 0 || ::pwrite(fd_, pid.data(), pid.size(), 0) < 0) {
+        const int error = errno;
+        ::close(fd_);
+        fd_ = -1;
+        fail<IoError>(what, ": cannot write lock file \"", path.string(), "\": ",
+                      errno_text(error));
+    }
+}
+
+FileLock::~FileLock() {
+    // Closing the last descriptor of the open file releases the flock.
+    if (fd_ >= 0) ::close(fd_);
 }
 
 void remove_temp_files(const fs::path& folder) {

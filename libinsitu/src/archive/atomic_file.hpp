@@ -41,6 +41,32 @@ private:
 /// `path` holds exactly `bytes`, or (on IoError) is as it was.
 void write_file_atomically(const std::filesystem::path& path, const std::string& bytes);
 
+/// Appends `bytes` to `path` (created when missing, its folder then synced so that the name
+/// survives a crash) and fsync()s it: the append-only indexes (manifest.journal, data.csv) cost
+/// O(1) a step this way. Returns the size the file had before, for truncate_file(). When the
+/// write fails part-way the file is cut back to that size, so a failed append leaves no torn
+/// line for the next append to run into. IoError naming the file otherwise.
+std::uint64_t append_to_file(const std::filesystem::path& path, const std::string& bytes);
+/// Cuts `path` back to `size` bytes and syncs it (undoes an append_to_file); IoError naming it.
+void truncate_file(const std::filesystem::path& path, std::uint64_t size);
+/// Removes `path` if it exists and syncs its folder; IoError naming it.
+void remove_file_durably(const std::filesystem::path& path);
+
+/// An exclusive flock() on `path` (created when missing) holding the holder's pid as text, kept
+/// for this object's lifetime; the kernel drops it when the process dies, even by SIGKILL.
+/// IoError naming `what` and the holder's pid when another open file (this process or another)
+/// holds it.
+class FileLock {
+public:
+    FileLock(const std::filesystem::path& path, const std::string& what);
+    ~FileLock();
+    FileLock(const FileLock&) = delete;
+    FileLock& operator=(const FileLock&) = delete;
+
+private:
+    int fd_ = -1;
+};
+
 /// Removes the temp files killed runs left in `folder` (best effort: a leftover is only clutter).
 void remove_temp_files(const std::filesystem::path& folder);
 

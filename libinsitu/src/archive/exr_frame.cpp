@@ -19,8 +19,10 @@
 #include <OpenEXR/ImfPartType.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfThreading.h>
+#include <OpenEXR/ImfVersion.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <map>
 #include <memory>
@@ -559,12 +561,119 @@ EncodedView encode_view(const StepRecord& record, const ViewRecord& view,
     return encoded;
 }
 
+namespace {
+
+/// Walks the attribute list of one header from `at` without allocating anything: each attribute
+/// is name\0 type\0 int32 size value[size], and a size past the end of the file is refused here
+/// (OpenEXR would allocate it first). Returns where the header ends; an empty header (the
+/// multi-part terminator) ends right after its null byte.
+std::size_t skip_header(const std::vector<char>& bytes, std::size_t at, const PartContext& where) {
+    const auto name_end = [&](std::size_t from) {
+        // OpenEXR names are at most 255 bytes (31 in older files).
+        const std::size_t limit = std::min(bytes.size(), from + 256);
+        const auto end = std::find(bytes.begin() + static_cast<std::ptrdiff_t>(from),
+                                   bytes.begin() + static_cast<std::ptrdiff_t>(limit), '\0');
+        if (end == bytes.begin() + static_cast<std::ptrdiff_t>(limit)) {
+            where.error("attribute name or type at byte " + std::to_string(from) +
+                        " is unterminated");
+        }
+        return static_cast<std::size_t>(end - bytes.begin());
+    };
+    for (;;) {
+        if (at >= bytes.size()) where.error("header runs past the end of the file");
+        const std::size_t name = name_end(at);
+        if (name == at) return at + 1;  // the empty name that ends the header
+        const std::size_t type = name_end(name + 1);
+        if (bytes.size() - (type + 1) < 4) where.error("header runs past the end of the file");
+        std::int32_t size = 0;
+        for (int b = 3; b >= 0; --b) {  // little-endian, as every EXR integer
+            size = static_cast<std::int32_t>(static_cast<std::uint32_t>(size) << 8 |
+                                             static_cast<unsigned char>(bytes[type + 1 + b]));
+        }
+        const std::size_t value = type + 5;
+        if (size < 0 || static_cast<std::size_t>(size) > bytes.size() - value) {
+            where.error("attribute \"" + std::string(&bytes[at], name - at) + "\" declares " +
+                        std::to_string(size) + " bytes, past the end of the file (" +
+                        std::to_string(bytes.size()) + " bytes)");
+        }
+        at = value + static_cast<std::size_t>(size);
+    }
+}
+
+/// Refuses, before OpenEXR allocates what a header declares (issue 19: a 1 373-byte file asked
+/// for 531 MB), data windows larger than the view the archive was configured with, more
+/// channels than a libinsitu part has, and chunk tables the file is too small to hold.
+void check_headers(const std::vector<char>& bytes, const FrameLimits& limits,
+                   const std::string& path) {
+    PartContext where{path, "(header)"};
+    if (bytes.size() < 8) where.error("too short for an OpenEXR file");
+    std::int32_t magic = 0;
+    std::int32_t version = 0;
+    std::memcpy(&magic, bytes.data(), 4);  // little-endian hosts only, as the rest of libinsitu
+    std::memcpy(&version, bytes.data() + 4, 4);
+    if (magic != Imf::MAGIC) where.error("not an OpenEXR file (bad magic number)");
+    const bool multi_part = Imf::isMultiPart(version);
+    std::size_t at = 8;
+    for (int index = 0;; ++index) {
+        where.part = "(header)";
+        const std::size_t end = skip_header(bytes, at, where);
+        if (end == at + 1) {
+            if (multi_part && index > 0) break;
+            where.error("empty header");
+        }
+        // Every attribute size is now known to fit the file: parsing allocates at most that.
+        MemoryInputStream stream(bytes, path);
+        stream.seekg(at);
+        Imf::Header header;
+        header.readFrom(stream, version);
+        if (header.hasName()) where.part = header.name();
+        if (header.hasType() && header.type() != Imf::SCANLINEIMAGE) {
+            where.error("part type \"" + header.type() + "\" (libinsitu writes scan lines)");
+        }
+        const Imath::Box2i window = header.dataWindow();
+        const long long width = static_cast<long long>(window.max.x) - window.min.x + 1;
+        const long long height = static_cast<long long>(window.max.y) - window.min.y + 1;
+        const bool model = header.hasName() && header.name() == kModelPart;
+        // The model is a (4 L + 3) x K table (archive_format.hpp); every other part is an image
+        // of the view.
+        const long long max_width = model ? 4ll * kMaxIntervals + 3 : limits.max_width;
+        const long long max_height = model ? kMaxColourModelClusters : limits.max_height;
+        if (width < 1 || height < 1 || width > max_width || height > max_height) {
+            where.error("data window " + std::to_string(width) + "x" + std::to_string(height) +
+                        " is empty or larger than " + std::to_string(max_width) + "x" +
+                        std::to_string(max_height) +
+                        (model ? " (the largest model)" : " (the view)"));
+        }
+        // Attenuation, mean depth and optical depth: three channels per interval.
+        constexpr long long kMaxChannels = 3ll * kMaxIntervals;
+        long long channels = 0;
+        for (auto it = header.channels().begin(); it != header.channels().end(); ++it) ++channels;
+        if (channels > kMaxChannels) {
+            where.error(std::to_string(channels) + " channels (a libinsitu part has at most " +
+                        std::to_string(kMaxChannels) + ")");
+        }
+        // The chunk offset table (8 bytes a chunk, at least one chunk per 256 lines for every
+        // compression) is in the file, so the file bounds it.
+        if ((height + 255) / 256 * 8 > static_cast<long long>(bytes.size())) {
+            where.error("data window height " + std::to_string(height) +
+                        " needs a chunk table larger than the file (" +
+                        std::to_string(bytes.size()) + " bytes)");
+        }
+        at = end;
+        if (!multi_part) break;
+    }
+}
+
+}  // namespace
+
 ProxyFrame decode_frame(const std::vector<char>& bytes, const std::string& path,
-                        const std::vector<std::string>& parts, bool multi_perspective) {
+                        const std::vector<std::string>& parts, bool multi_perspective,
+                        const FrameLimits& limits) {
     ProxyFrame frame;
     frame.multi_perspective = multi_perspective;
     PartContext where{path, "(header)"};
     try {
+        check_headers(bytes, limits, path);
         MemoryInputStream stream(bytes, path);
         // No reconstruction of a damaged chunk offset table: damage is an error here.
         Imf::MultiPartInputFile file(stream, Imf::globalThreadCount(), false);

@@ -27,9 +27,19 @@ EncodedView encode_view(const StepRecord& record, const ViewRecord& view,
                         StoragePrecision precision, const std::string& compression,
                         const std::string& relative_path);
 
+/// What a decoded image part may be: the size of the view the archive recorded it for (the
+/// reader takes it from the manifest's configurations), so a foreign header cannot make the
+/// decoder allocate more than the view needs.
+struct FrameLimits {
+    int max_width = 1 << 14;
+    int max_height = 1 << 14;
+};
+
 /// The frame held by the parts `parts` (all of one perspective, in file order) of the EXR
-/// `bytes`; `path` names the file in errors.
+/// `bytes`; `path` names the file in errors. Every header is checked against `limits` before
+/// OpenEXR sees the file (IoError naming file and part).
 ProxyFrame decode_frame(const std::vector<char>& bytes, const std::string& path,
-                        const std::vector<std::string>& parts, bool multi_perspective);
+                        const std::vector<std::string>& parts, bool multi_perspective,
+                        const FrameLimits& limits = {});
 
 }  // namespace insitu::archive_format

@@ -1,7 +1,9 @@
 #include "archive/manifest.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <optional>
 #include <set>
 
 #include <nlohmann/json.hpp>
@@ -23,13 +25,19 @@ enum class Expect { number, integer, count, crc32, string, object, array };
 bool holds(const nlohmann::json& value, Expect expect) {
     switch (expect) {
         case Expect::number:
-            return value.is_number();
+            // nlohmann keeps NaN and Inf as numbers but writes them as null, which no reader
+            // takes back: a non-finite number is never a valid value.
+            return value.is_number() &&
+                   (!value.is_number_float() || std::isfinite(value.get<double>()));
         case Expect::integer:
             return value.is_number_integer();
+        // An entry built in memory holds signed integers, one parsed back unsigned ones: a
+        // count is any integer >= 0 (the writer checks entries before they reach the disk).
         case Expect::count:
-            return value.is_number_unsigned();
+            return value.is_number_unsigned() ||
+                   (value.is_number_integer() && value.get<std::int64_t>() >= 0);
         case Expect::crc32:
-            return value.is_number_unsigned() && value.get<std::uint64_t>() <= 0xFFFFFFFFu;
+            return holds(value, Expect::count) && value.get<std::uint64_t>() <= 0xFFFFFFFFu;
         case Expect::string:
             return value.is_string();
         case Expect::object:
@@ -38,6 +46,15 @@ bool holds(const nlohmann::json& value, Expect expect) {
             return value.is_array();
     }
     return false;
+}
+
+/// A value as a message shows it: non-finite numbers by name (dump() would say null).
+std::string value_text(const nlohmann::json& value) {
+    if (value.is_number_float() && !std::isfinite(value.get<double>())) {
+        const double number = value.get<double>();
+        return std::isnan(number) ? "nan" : number > 0 ? "inf" : "-inf";
+    }
+    return value.dump();
 }
 
 /// Checks one key of a JSON object; ParseError names the file and the dotted key.
@@ -49,7 +66,8 @@ const nlohmann::json& require(const nlohmann::json& object, const char* key, Exp
     }
     const nlohmann::json& value = object.at(key);
     if (!holds(value, expect)) {
-        fail<ParseError>("\"", file, "\": key \"", name, "\" has the wrong type: ", value.dump());
+        fail<ParseError>("\"", file, "\": key \"", name, "\" has the wrong type: ",
+                         value_text(value));
     }
     return value;
 }
@@ -72,7 +90,91 @@ nlohmann::json empty_manifest() {
     return {{"schema_version", kArchiveSchemaVersion}, {"steps", nlohmann::json::array()}};
 }
 
-nlohmann::json read_manifest(const std::string& archive_path) {
+void check_step_entry(const nlohmann::json& step, const std::string& file,
+                      const std::string& where) {
+    require(step, "step", Expect::integer, file, where);
+    require(step, "time", Expect::number, file, where);
+    require(step, "field", Expect::string, file, where);
+    std::set<int> views_seen;
+    const auto& views = require(step, "views", Expect::array, file, where);
+    for (std::size_t v = 0; v < views.size(); ++v) {
+        const std::string view_where = where + ".views[" + std::to_string(v) + "]";
+        const auto& view = views[v];
+        const auto index = require(view, "view", Expect::count, file, view_where);
+        // View indices name files and are ints everywhere else.
+        if (index.get<std::uint64_t>() > 1'000'000 || !views_seen.insert(index.get<int>()).second) {
+            fail<ParseError>("\"", file, "\": ", view_where, ": view ", index.dump(),
+                             " is repeated or out of range");
+        }
+        require(view, "phi", Expect::number, file, view_where);
+        require(view, "theta", Expect::number, file, view_where);
+        for (const auto& part : require(view, "parts", Expect::array, file, view_where)) {
+            if (!part.is_string()) {
+                fail<ParseError>("\"", file, "\": ", view_where, ".parts: ", part.dump(),
+                                 " is not a part name");
+            }
+        }
+        std::set<std::string> kinds;
+        const auto& files = require(view, "files", Expect::array, file, view_where);
+        for (std::size_t f = 0; f < files.size(); ++f) {
+            const std::string file_where = view_where + ".files[" + std::to_string(f) + "]";
+            kinds.insert(require(files[f], "kind", Expect::string, file, file_where));
+            check_relative_path(require(files[f], "path", Expect::string, file, file_where),
+                                file, file_where);
+            require(files[f], "bytes", Expect::count, file, file_where);
+            require(files[f], "crc32", Expect::crc32, file, file_where);
+        }
+        for (const char* kind : {kProxyKind, kPreviewKind}) {
+            if (!kinds.count(kind)) {
+                fail<ParseError>("\"", file, "\": ", view_where, " lists no ", kind, " file");
+            }
+        }
+    }
+}
+
+namespace {
+
+/// Validates `manifest` in place (no copy: compaction checks megabytes). Returns the indices of
+/// the malformed entries of "steps", each also appended to `skipped` as {"entry", "problem"};
+/// without `skipped` the first one is an error. A broken top level always is.
+std::vector<std::size_t> check_manifest(const nlohmann::json& manifest, const std::string& file,
+                                        nlohmann::json* skipped) {
+    if (!manifest.is_object()) fail<ParseError>("\"", file, "\": not a JSON object");
+    const auto version = require(manifest, "schema_version", Expect::integer, file, "");
+    if (version.get<long long>() != kArchiveSchemaVersion) {
+        fail<ParseError>("\"", file, "\": schema_version ", version.dump(),
+                         " (this libinsitu reads ", kArchiveSchemaVersion, ")");
+    }
+    require(manifest, "producer", Expect::string, file, "");
+    require(manifest, "configuration", Expect::object, file, "");
+    const auto& steps = require(manifest, "steps", Expect::array, file, "");
+    if (manifest.contains(kMalformedKey) && !manifest.at(kMalformedKey).is_array()) {
+        fail<ParseError>("\"", file, "\": key \"", kMalformedKey, "\" is not an array");
+    }
+    // One malformed step entry costs only itself (issue 19): it is set aside with a diagnostic
+    // and every other step stays readable.
+    std::vector<std::size_t> malformed;
+    std::set<std::int64_t> steps_seen;
+    for (std::size_t s = 0; s < steps.size(); ++s) {
+        const std::string where = "steps[" + std::to_string(s) + "]";
+        try {
+            check_step_entry(steps[s], file, where);
+            const auto number = steps[s].at("step").get<std::int64_t>();
+            if (!steps_seen.insert(number).second) {
+                fail<ParseError>("\"", file, "\": ", where, ": step ", number, " is repeated");
+            }
+        } catch (const ParseError& error) {
+            if (!skipped) throw;
+            skipped->push_back({{"entry", steps[s]}, {"problem", error.what()}});
+            malformed.push_back(s);
+        }
+    }
+    return malformed;
+}
+
+}  // namespace
+
+nlohmann::json read_manifest(const std::string& archive_path, nlohmann::json* skipped) {
     const std::string file = (fs::path(archive_path) / kManifestFile).string();
     std::error_code error;
     if (!fs::is_directory(archive_path, error)) {
@@ -85,65 +187,101 @@ nlohmann::json read_manifest(const std::string& archive_path) {
     } catch (const nlohmann::json::exception& parse_error) {
         fail<ParseError>("\"", file, "\": not valid JSON: ", parse_error.what());
     }
-    if (!manifest.is_object()) fail<ParseError>("\"", file, "\": not a JSON object");
-    const auto version = require(manifest, "schema_version", Expect::integer, file, "");
-    if (version.get<long long>() != kArchiveSchemaVersion) {
-        fail<ParseError>("\"", file, "\": schema_version ", version.dump(),
-                         " (this libinsitu reads ", kArchiveSchemaVersion, ")");
-    }
-    require(manifest, "producer", Expect::string, file, "");
-    require(manifest, "configuration", Expect::object, file, "");
-    std::set<std::int64_t> steps_seen;
-    const auto& steps = require(manifest, "steps", Expect::array, file, "");
-    for (std::size_t s = 0; s < steps.size(); ++s) {
-        const std::string where = "steps[" + std::to_string(s) + "]";
-        const auto& step = steps[s];
-        const auto number = require(step, "step", Expect::integer, file, where);
-        if (!steps_seen.insert(number.get<std::int64_t>()).second) {
-            fail<ParseError>("\"", file, "\": ", where, ": step ", number.dump(), " is repeated");
-        }
-        require(step, "time", Expect::number, file, where);
-        require(step, "field", Expect::string, file, where);
-        std::set<int> views_seen;
-        const auto& views = require(step, "views", Expect::array, file, where);
-        for (std::size_t v = 0; v < views.size(); ++v) {
-            const std::string view_where = where + ".views[" + std::to_string(v) + "]";
-            const auto& view = views[v];
-            const auto index = require(view, "view", Expect::count, file, view_where);
-            if (!views_seen.insert(index.get<int>()).second) {
-                fail<ParseError>("\"", file, "\": ", view_where, ": view ", index.dump(),
-                                 " is repeated");
-            }
-            require(view, "phi", Expect::number, file, view_where);
-            require(view, "theta", Expect::number, file, view_where);
-            for (const auto& part : require(view, "parts", Expect::array, file, view_where)) {
-                if (!part.is_string()) {
-                    fail<ParseError>("\"", file, "\": ", view_where, ".parts: ", part.dump(),
-                                     " is not a part name");
-                }
-            }
-            std::set<std::string> kinds;
-            const auto& files = require(view, "files", Expect::array, file, view_where);
-            for (std::size_t f = 0; f < files.size(); ++f) {
-                const std::string file_where = view_where + ".files[" + std::to_string(f) + "]";
-                kinds.insert(require(files[f], "kind", Expect::string, file, file_where));
-                check_relative_path(require(files[f], "path", Expect::string, file, file_where),
-                                    file, file_where);
-                require(files[f], "bytes", Expect::count, file, file_where);
-                require(files[f], "crc32", Expect::crc32, file, file_where);
-            }
-            for (const char* kind : {kProxyKind, kPreviewKind}) {
-                if (!kinds.count(kind)) {
-                    fail<ParseError>("\"", file, "\": ", view_where, " lists no ", kind, " file");
-                }
-            }
-        }
-    }
+    const std::vector<std::size_t> malformed = check_manifest(manifest, file, skipped);
+    nlohmann::json& steps = manifest["steps"];
+    for (auto it = malformed.rbegin(); it != malformed.rend(); ++it) steps.erase(*it);
     return manifest;
 }
 
+Index read_index(const std::string& archive_path) {
+    Index index;
+    nlohmann::json skipped = nlohmann::json::array();
+    const fs::path journal = fs::path(archive_path) / kJournalFile;
+    // The journal first: a compaction renames the new manifest.json into place before it
+    // removes the journal, so in this order a reader beside a running writer misses no step.
+    std::optional<std::vector<char>> journal_bytes;
+    std::error_code error;
+    if (fs::exists(journal, error)) {
+        try {
+            journal_bytes = read_whole_file(journal.string());
+        } catch (const IoError&) {
+            if (fs::exists(journal, error)) throw;  // else a compaction just removed it
+        }
+    }
+    index.manifest = read_manifest(archive_path, &skipped);
+    if (journal_bytes) {
+        const std::vector<char>& bytes = *journal_bytes;
+        std::set<std::int64_t> steps;
+        for (const nlohmann::json& step : index.manifest.at("steps")) {
+            steps.insert(step.at("step").get<std::int64_t>());
+        }
+        nlohmann::json& entries = index.manifest["steps"];
+        std::size_t line_number = 0;
+        for (auto begin = bytes.begin(); begin != bytes.end();) {
+            const auto end = std::find(begin, bytes.end(), '\n');
+            // A last line without its newline is an append a crash cut short: that step never
+            // completed (write() had not returned), so it is ignored, silently.
+            if (end == bytes.end()) break;
+            ++line_number;
+            const std::string where = "line " + std::to_string(line_number);
+            nlohmann::json entry;
+            try {
+                entry = nlohmann::json::parse(begin, end);
+                check_step_entry(entry, journal.string(), where);
+                const auto number = entry.at("step").get<std::int64_t>();
+                if (!steps.insert(number).second) {
+                    // The same entry in manifest.json too: a compaction was killed after its
+                    // rename and before the journal went. Anything else is a conflict.
+                    const auto same = std::find(entries.begin(), entries.end(), entry);
+                    if (same == entries.end()) {
+                        fail<ParseError>("\"", journal.string(), "\": ", where, ": step ",
+                                         number, " is repeated");
+                    }
+                } else {
+                    entries.push_back(std::move(entry));
+                    ++index.journal_steps;
+                }
+            } catch (const std::exception& problem) {
+                const std::string text =
+                    dynamic_cast<const ParseError*>(&problem)
+                        ? std::string(problem.what())
+                        : "\"" + journal.string() + "\": " + where + ": not valid JSON";
+                skipped.push_back(
+                    {{"entry", entry.is_null() ? nlohmann::json(std::string(begin, end)) : entry},
+                     {"problem", text}});
+            }
+            begin = end + 1;
+        }
+        // Journal lines arrive in write order; keep the steps sorted as manifest.json has them.
+        std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
+            return a.at("step").template get<std::int64_t>() <
+                   b.at("step").template get<std::int64_t>();
+        });
+    }
+    for (const nlohmann::json& set_aside : index.manifest.value(kMalformedKey, nlohmann::json())) {
+        index.diagnostics.push_back("set aside by an earlier writer: " +
+                                    set_aside.value("problem", std::string("(no reason given)")));
+    }
+    for (const nlohmann::json& entry : skipped) {
+        index.diagnostics.push_back("step entry skipped: " +
+                                    entry.at("problem").get<std::string>());
+    }
+    index.skipped = std::move(skipped);
+    return index;
+}
+
 void write_manifest(const std::string& archive_path, const nlohmann::json& manifest) {
+    // Never commit an index this library's own reader would refuse (issue 19): the same checks,
+    // strict, before anything reaches the disk.
+    const std::string file = (fs::path(archive_path) / kManifestFile).string();
+    check_manifest(manifest, file, nullptr);
     write_file_atomically(fs::path(archive_path) / kManifestFile, manifest.dump(2) + "\n");
+}
+
+void append_journal(const std::string& archive_path, const nlohmann::json& step_entry) {
+    const fs::path journal = fs::path(archive_path) / kJournalFile;
+    check_step_entry(step_entry, journal.string(), "new entry");
+    append_to_file(journal, step_entry.dump() + "\n");
 }
 
 std::vector<std::int64_t> manifest_steps(const nlohmann::json& manifest) {

@@ -5,26 +5,61 @@
 //    "steps": [{"step", "time", "field",
 //               "views": [{"view", "phi", "theta", "parts": [...],
 //                          "files": [{"kind", "path", "bytes", "crc32"}, ...]}]}]}
+//    "malformed_steps": [{"entry", "problem"}]   (only when a writer set entries aside)
 // Steps are kept sorted; each view lists one proxy_exr and one preview_png file.
+//
+// ARCHIVE/manifest.journal holds the steps written since manifest.json was last compacted: one
+// step entry (the object above) a line, appended and fsync'ed per step, so a step costs O(1)
+// whatever the length of the run (issue 19). Readers replay it on top of manifest.json; a
+// writer folds it into manifest.json when it opens the archive, when the journal holds as many
+// steps as the manifest (so compaction costs O(1) a step, amortised) and when it closes.
+//
+// One malformed step entry costs only itself: readers skip it with a diagnostic; a writer that
+// opens the archive moves it, verbatim, to "malformed_steps" with the reason (kept for whoever
+// repairs the archive, never read as a step). A broken top level is still refused whole.
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json_fwd.hpp>
+#include <nlohmann/json.hpp>  // Index holds values
 
 #include "insitu/archive/archive_writer.hpp"
 
 namespace insitu::archive_format {
 
+/// Where a writer keeps the step entries it set aside.
+inline constexpr const char* kMalformedKey = "malformed_steps";
+
 /// A manifest with no steps.
 nlohmann::json empty_manifest();
 
+/// Checks one step entry: required keys and their types (numbers finite), safe relative paths,
+/// no repeated views. ParseError naming `file`, `where` and the key.
+void check_step_entry(const nlohmann::json& step, const std::string& file,
+                      const std::string& where);
+
 /// Reads and validates ARCHIVE/manifest.json: schema version, required keys and their types,
-/// safe relative paths, no duplicate steps or views. IoError when unreadable, ParseError naming
-/// the file and the key otherwise.
-nlohmann::json read_manifest(const std::string& archive_path);
-/// Replaces ARCHIVE/manifest.json atomically.
+/// every step entry as check_step_entry(), no repeated steps. IoError when unreadable,
+/// ParseError naming the file and the key otherwise. With `skipped`, a malformed step entry is
+/// left out and appended there as {"entry", "problem"}; the top level is always strict.
+nlohmann::json read_manifest(const std::string& archive_path, nlohmann::json* skipped = nullptr);
+
+/// The whole index: manifest.json with the journal replayed on top.
+struct Index {
+    nlohmann::json manifest;               ///< valid steps only, sorted
+    nlohmann::json skipped;                ///< malformed entries left out: {"entry", "problem"}
+    std::vector<std::string> diagnostics;  ///< one line per entry skipped or set aside
+    std::size_t journal_steps = 0;         ///< steps that came from the journal
+};
+/// Reads the index as the reader and the writer see it; errors as read_manifest().
+Index read_index(const std::string& archive_path);
+
+/// Replaces ARCHIVE/manifest.json atomically, after checking it as strictly as read_manifest()
+/// would (ParseError naming the key; nothing written then).
 void write_manifest(const std::string& archive_path, const nlohmann::json& manifest);
+/// Appends one checked step entry to ARCHIVE/manifest.journal (ParseError, nothing written,
+/// when the entry would not read back; IoError when the disk refuses).
+void append_journal(const std::string& archive_path, const nlohmann::json& step_entry);
 
 /// Step numbers of a validated manifest, sorted.
 std::vector<std::int64_t> manifest_steps(const nlohmann::json& manifest);

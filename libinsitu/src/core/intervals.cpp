@@ -23,6 +23,16 @@ IntervalMode parse_interval_mode(const std::string& text) {
 }
 
 namespace {
+// lo + (hi - lo) * numerator / denominator, also where hi - lo overflows: a float64 field over
+// [-1e308, 1e308] made its width Inf and every edge NaN. Halves are subtracted then, and the
+// step added twice; otherwise the plain form, so that ordinary edges keep their exact values.
+double between(double lo, double hi, double numerator, double denominator) {
+    const double width = hi - lo;
+    if (std::isfinite(width)) return lo + width * numerator / denominator;
+    const double half_step = (0.5 * hi - 0.5 * lo) * (numerator / denominator);
+    return lo + half_step + half_step;
+}
+
 void check_count(int count) {
     if (count < 1 || count > kMaxIntervals) {
         fail<InvalidArgument>("interval count = ", count, " (must be in [1, ", kMaxIntervals,
@@ -54,7 +64,7 @@ IntervalSet IntervalSet::uniform(double min, double max, int count) {
         max += 0.5;
     }
     std::vector<double> edges(static_cast<std::size_t>(count) + 1);
-    for (int j = 0; j <= count; ++j) edges[j] = min + (max - min) * j / count;
+    for (int j = 0; j <= count; ++j) edges[j] = between(min, max, j, count);
     edges.back() = max;  // exact, whatever the rounding
     return IntervalSet(std::move(edges));
 }
@@ -71,7 +81,9 @@ IntervalSet IntervalSet::histogram_equalized(const std::vector<float>& values, d
     double total = 0.0;
     for (float value : values) {
         if (std::isnan(value)) continue;
-        const int bin = std::clamp(static_cast<int>((value - lo) / (hi - lo) * bins), 0, bins - 1);
+        // Halves: value - lo and hi - lo may overflow; halving is exact, the ratio unchanged.
+        const double position = (0.5 * value - 0.5 * lo) / (0.5 * hi - 0.5 * lo) * bins;
+        const int bin = static_cast<int>(std::clamp(position, 0.0, bins - 1.0));
         histogram[bin] += 1.0;
         total += 1.0;
     }
@@ -86,7 +98,7 @@ IntervalSet IntervalSet::histogram_equalized(const std::vector<float>& values, d
             // Interpolate the cumulative count inside the bin: dense data puts many quantiles
             // into few bins, and bin edges alone would be too coarse there.
             const double fraction = (total * next / count - before) / histogram[bin];
-            edges.push_back(lo + (hi - lo) * (bin + fraction) / bins);
+            edges.push_back(between(lo, hi, bin + fraction, bins));
             ++next;
         }
     }
@@ -96,11 +108,13 @@ IntervalSet IntervalSet::histogram_equalized(const std::vector<float>& values, d
 }
 
 bool IntervalSet::is_uniform() const {
-    const double range = edges_.back() - edges_.front();
-    if (!(range > 0.0)) return false;
-    const double width = range / count();
+    // In halves, exact scalings of the widths, so that no width overflows (see between()).
+    const double half_range = 0.5 * edges_.back() - 0.5 * edges_.front();
+    if (!(half_range > 0.0)) return false;
+    const double half_width = half_range / count();
     for (int j = 0; j < count(); ++j) {
-        if (std::abs(edges_[j + 1] - edges_[j] - width) > 1e-6 * range) return false;
+        const double half = 0.5 * edges_[j + 1] - 0.5 * edges_[j];
+        if (std::abs(half - half_width) > 1e-6 * half_range) return false;
     }
     return true;
 }

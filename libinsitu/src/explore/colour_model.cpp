@@ -11,6 +11,7 @@
 #include <random>
 
 #include "device/device_image.hpp"
+#include "insitu/core/check.hpp"
 #include "insitu/error.hpp"
 #include "insitu/core/intervals.hpp"
 
@@ -348,6 +349,7 @@ int ColourModel::nearest_cluster(const float* attenuation) const {
 
 void ColourModel::predict_pixel(const float* attenuation, float* rgb) const {
     // seed 000 Eq. 10, then Eq. 8.
+    INSITU_DCHECK_EQ(table_.size(), static_cast<std::size_t>(clusters_) * row_floats());
     const float* entry =
         &table_[static_cast<std::size_t>(nearest_cluster(attenuation)) * row_floats()];
     const float* c0 = entry + intervals_;

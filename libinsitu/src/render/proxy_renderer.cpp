@@ -8,6 +8,7 @@
 
 #include <glm/trigonometric.hpp>
 
+#include "insitu/core/check.hpp"
 #include "insitu/error.hpp"
 #include "insitu/core/layers.hpp"
 #include "device/kernel_args.hpp"
@@ -120,6 +121,9 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     const std::size_t pixels = static_cast<std::size_t>(width) * height;
     const int layer_count = want_layers ? static_cast<int>(request.isovalues.size()) : 0;
     const int interval_count = want_accumulation ? request.intervals->count() : 0;
+    // validate() bounded both; the kernel's private arrays are sized by these limits.
+    INSITU_CHECK_LE(layer_count, kMaxLayers);
+    INSITU_CHECK_LE(interval_count, kMaxIntervals);
 
     int wanted = 0;
     if (want_layers) wanted |= detail::kWantDepth;

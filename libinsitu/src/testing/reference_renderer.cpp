@@ -1,4 +1,4 @@
-// The ground-truth definition of insitu/volume_renderer.hpp, written as plainly as possible:
+// The ground-truth definition of insitu/render/volume_renderer.hpp, written as plainly as possible:
 // one ray per pixel, double precision, the field read sample by sample through Field::value and
 // the transfer function evaluated exactly (no table). Nothing here shares code with the OpenCL
 // kernels, so an error in either shows up as a difference between the two.

@@ -9,7 +9,7 @@
 // widened box, plus the tree itself.
 //
 // Empty space: the box starts on a leaf boundary, so the renderer's 8^3 skipping blocks
-// (insitu/proxy_renderer.hpp) coincide with VDB leaves: a block made only of inactive voxels
+// (insitu/render/proxy_renderer.hpp) coincide with VDB leaves: a block made only of inactive voxels
 // holds only the background value and is skipped whenever the transfer function is transparent
 // there (from the background value to a little above it, one table bin) and no isovalue equals the
 // background. The ray marcher then never samples inactive tiles.

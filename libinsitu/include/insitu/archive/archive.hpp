@@ -7,6 +7,8 @@
 // Layout of ARCHIVE/:
 //   data.csv                         time,step,view,phi,theta,proxy_exr,FILE   (FILE last: PNG)
 //   manifest.json                    schema_version, producer, configuration, steps[...]
+//   manifest.journal                 steps since manifest.json was compacted, one JSON a line
+//   .lock                            flock()ed by the one writer, holding its pid
 //   proxies/step000010_view0.exr     multi-part EXR, self-describing parts and channels
 //   previews/step000010_view0.png    ground-truth rendering of the configured transfer function
 //
@@ -24,8 +26,11 @@
 // (+ distortion_tilt on multi.* parts, training_transfer_function on train<k>); JSON text in
 // string attributes, doubles exact.
 //
-// One writer per archive at a time: a writer removes temp files (".tmp-*") that killed runs
-// left behind when it opens the archive.
+// One writer per archive at a time, enforced: a second ArchiveWriter (any process) is refused
+// while the first holds ARCHIVE/.lock; readers take no lock. A writer removes temp files
+// (".tmp-*") that killed runs left behind when it opens the archive, and folds the journal into
+// manifest.json. A step costs O(1) in the length of the run: its rows are appended to data.csv
+// and its entry to manifest.journal (src/archive/manifest.hpp).
 //
 // This header includes both sides: archive_writer.hpp (ArchiveWriter, StepRecord) and
 // archive_reader.hpp (ArchiveReader).

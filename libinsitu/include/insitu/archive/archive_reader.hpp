@@ -2,7 +2,9 @@
 // Reading side of the timestep proxy archive (layout: insitu/archive/archive.hpp). Include
 // <nlohmann/json.hpp> to look into manifest().
 #include <cstdint>
+#include <filesystem>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -25,8 +27,13 @@ struct ArchivedView {
 
 class ArchiveReader {
 public:
-    /// Opens an archive and validates its manifest; IoError/ParseError name the file.
+    /// Opens an archive and validates its index (manifest.json and the journal of steps written
+    /// since it was compacted); IoError/ParseError name the file. A malformed step entry is
+    /// skipped and reported in diagnostics(); a manifest whose top level is broken is refused.
     explicit ArchiveReader(const std::string& path);
+
+    /// One line per step entry the index held but could not use (empty for a sound archive).
+    const std::vector<std::string>& diagnostics() const { return diagnostics_; }
 
     const nlohmann::json& manifest() const { return *manifest_; }
     InstrumentConfig configuration() const;
@@ -44,12 +51,19 @@ public:
     /// precision), with the PNG's channel count (1, 3 or 4).
     Image load_preview(std::int64_t step, int view) const;
 
-    /// Checks every file the manifest names: present, size and CRC-32 as recorded. Returns one
-    /// line per problem (empty when the archive is intact).
+    /// Checks every file the manifest names: present, inside the archive once symbolic links
+    /// are resolved, size and CRC-32 as recorded; that data.csv has a row per step x view naming
+    /// the manifest's files and that each of its rows names files inside the archive that exist.
+    /// Returns one line per problem, diagnostics() first (empty when the archive is intact).
     std::vector<std::string> verify() const;
 
 private:
+    void verify_cinema_csv(const std::filesystem::path& root,
+                           const std::set<std::filesystem::path>& outside,
+                           std::vector<std::string>& problems) const;
+
     std::string path_;
+    std::vector<std::string> diagnostics_;
     // Shared rather than held by value, so this header needs only json_fwd.hpp; the manifest
     // never changes once read, so copies of a reader may share it.
     std::shared_ptr<const nlohmann::json> manifest_;

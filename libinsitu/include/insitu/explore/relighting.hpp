@@ -8,7 +8,7 @@
 //  * light_volume: attenuation proxies lit per interval with normals from each interval's mean
 //    depth (depth proxies combined with attenuation proxies, §6.5).
 //
-// Depth images follow the camera's convention (insitu/camera.hpp): world units along forward()
+// Depth images follow the camera's convention (insitu/core/camera.hpp): world units along forward()
 // from the camera plane, +inf (or NaN) = no surface. Every image must have the camera's size.
 //
 // Finite differences and silhouettes. Derivatives along image x and y are central differences

@@ -93,7 +93,7 @@ public:
     /// histogram-equalised over its samples.
     IntervalSet choose_intervals(int count, IntervalMode mode) const;
     /// Layers chosen from the data: the peaks of `tf`'s opacity inside the uploaded field's value
-    /// range (see opacity_peaks in insitu/layers.hpp).
+    /// range (see opacity_peaks in insitu/core/layers.hpp).
     std::vector<double> choose_layers(const TransferFunction& tf, int max_layers) const;
 
     /// Single-perspective proxies (orthographic or perspective camera) plus training renderings.

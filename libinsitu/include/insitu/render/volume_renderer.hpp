@@ -1,7 +1,7 @@
 #pragma once
 // The ground-truth volume renderer (seed 002): emission-absorption ray casting.
 //
-// The definition every accuracy figure depends on, and which tests/reference_renderer.cpp
+// The definition every accuracy figure depends on, and which libinsitu/src/testing/reference_renderer.cpp
 // implements independently:
 //  * Rays come from Camera::ray at pixel centres. They are clipped to the field's world bounds;
 //    sample i (i = 0, 1, ...) lies at t = t_near + (i + 0.5) * step while t < t_far, where

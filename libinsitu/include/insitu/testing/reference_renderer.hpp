@@ -1,6 +1,6 @@
 #pragma once
 // An independent scalar C++ implementation of the ground-truth definition written out in
-// insitu/volume_renderer.hpp, in double precision, reading the field through Field::value.
+// insitu/render/volume_renderer.hpp, in double precision, reading the field through Field::value.
 #include "insitu/core/camera.hpp"
 #include "insitu/field.hpp"
 #include "insitu/core/transfer_function.hpp"
