@@ -100,8 +100,8 @@ int main(int argc, char** argv) {
             }
         }
         const auto window_median = [&](int first) {
-            return median(std::vector<double>(step_ms.begin() + first,
-                                              step_ms.begin() + first + kWindow));
+            return median(
+                std::vector<double>(step_ms.begin() + first, step_ms.begin() + first + kWindow));
         };
         const double early = window_median(kEarlyStep - kWindow / 2);
         const double late = window_median(options.steps - kWindow + 1);
@@ -113,13 +113,12 @@ int main(int argc, char** argv) {
         std::printf("  write() median at step %d: %.3f ms\n", kEarlyStep, early);
         std::printf("  write() median at step %d: %.3f ms\n", options.steps, late);
         std::printf("  ratio late / early: %.2f (goal <= 1.2)\n", late / early);
-        std::printf("  mean over %d steps, compactions included: %.3f ms\n", options.steps,
-                    mean);
+        std::printf("  mean over %d steps, compactions included: %.3f ms\n", options.steps, mean);
         std::printf("  slowest step: %ld, %.3f ms (a compaction of the journal)\n",
                     static_cast<long>(slowest - step_ms.begin()), *slowest);
-        std::printf("  manifest.json at close: %ju KiB\n",
-                    static_cast<std::uintmax_t>(fs::file_size(root / "run.cdb" / "manifest.json")) /
-                        1024);
+        std::printf(
+            "  manifest.json at close: %ju KiB\n",
+            static_cast<std::uintmax_t>(fs::file_size(root / "run.cdb" / "manifest.json")) / 1024);
         fs::remove_all(root);
     } catch (const std::exception& error) {
         std::fprintf(stderr, "bench_archive_index: %s\n", error.what());

@@ -37,9 +37,9 @@
 #include <vector>
 
 #include "arguments.hpp"
-#include "insitu/core/camera.hpp"
 #include "insitu/capture_input.hpp"
 #include "insitu/config.hpp"
+#include "insitu/core/camera.hpp"
 #include "insitu/instrument.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 

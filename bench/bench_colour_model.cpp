@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "arguments.hpp"
-#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/explore/colour_model.hpp"
 #include "insitu/render/proxy_renderer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
 
 namespace {
 

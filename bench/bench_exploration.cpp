@@ -19,10 +19,10 @@
 #include <vector>
 
 #include "arguments.hpp"
-#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/explore/explorer.hpp"
 #include "insitu/instrument.hpp"
 #include "insitu/render/proxy_renderer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
 #include "median_time.hpp"
 
 namespace {

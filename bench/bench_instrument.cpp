@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "arguments.hpp"
-#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/archive/archive.hpp"
 #include "insitu/instrument.hpp"
+#include "insitu/testing/analytic_fields.hpp"
 
 namespace {
 
@@ -69,8 +69,10 @@ InstrumentConfig make_config(const std::string& archive, int image, StoragePreci
     config.fields = {"f"};
     config.views[0].orbit.width = image;
     config.views[0].orbit.height = image;
-    config.transfer_function = TransferFunction(
-        {{0.0, {0, 0, 1, 0}}, {0.3, {0, 1, 0, 0.02}}, {0.6, {1, 1, 0, 0.05}}, {1.0, {1, 0, 0, 0.1}}});
+    config.transfer_function = TransferFunction({{0.0, {0, 0, 1, 0}},
+                                                 {0.3, {0, 1, 0, 0.02}},
+                                                 {0.6, {1, 1, 0, 0.05}},
+                                                 {1.0, {1, 0, 0, 0.1}}});
     config.layers = std::vector<double>{0.2, 0.4, 0.6, 0.8};
     config.interval_count = 16;
     config.archive = archive;
@@ -98,7 +100,8 @@ RunFigures run(const InstrumentConfig& config, const SampledVolume& volume, int 
     for (int s = 0; s < steps; ++s) instrument.execute(s, s * 0.1, {field});
     instrument.finalize();
     RunFigures figures;
-    figures.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    figures.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     figures.statistics = instrument.statistics();
     figures.steps = steps;
     return figures;
@@ -108,14 +111,14 @@ void blocking(const Options& options, const SampledVolume& volume) {
     std::printf("\nBlocking: %lld^3, %dx%d, L = 16, 4 layers, %d steps, queue 4 (ms per step)\n",
                 static_cast<long long>(volume.dims[0]), options.image, options.image,
                 options.steps);
-    std::printf("  %-28s %10s %10s %10s %12s %8s\n", "writer target / policy", "compute",
-                "blocked", "write", "blocked/comp", "dropped");
-    for (const auto& [label, root] : {std::pair<const char*, std::string>{"fast (tmpfs)", options.fast},
-                                       std::pair<const char*, std::string>{"disk (fsync)", options.disk}}) {
+    std::printf("  %-28s %10s %10s %10s %12s %8s\n", "writer target / policy", "compute", "blocked",
+                "write", "blocked/comp", "dropped");
+    for (const auto& [label, root] :
+         {std::pair<const char*, std::string>{"fast (tmpfs)", options.fast},
+          std::pair<const char*, std::string>{"disk (fsync)", options.disk}}) {
         for (WhenFull policy : {WhenFull::block, WhenFull::drop}) {
-            const InstrumentConfig config =
-                make_config(root + "/blocking.cdb", options.image, StoragePrecision::half, "zip",
-                            4, policy);
+            const InstrumentConfig config = make_config(root + "/blocking.cdb", options.image,
+                                                        StoragePrecision::half, "zip", 4, policy);
             const RunFigures figures = run(config, volume, options.steps);
             const InstrumentStatistics& s = figures.statistics;
             const double executed = std::max<std::int64_t>(1, s.steps_executed);
@@ -130,18 +133,20 @@ void blocking(const Options& options, const SampledVolume& volume) {
 }
 
 void sizes(const Options& options) {
-    std::printf("\nArchive bytes per step vs the raw float field (%dx%d, L = 16, 4 layers, "
-                "no training images; one view)\n",
-                options.image, options.image);
-    std::printf("  %-6s %-6s %-7s %12s %12s %10s %12s\n", "size", "store", "codec",
-                "raw MB", "archive MB", "raw/arch", "write MB/s");
+    std::printf(
+        "\nArchive bytes per step vs the raw float field (%dx%d, L = 16, 4 layers, "
+        "no training images; one view)\n",
+        options.image, options.image);
+    std::printf("  %-6s %-6s %-7s %12s %12s %10s %12s\n", "size", "store", "codec", "raw MB",
+                "archive MB", "raw/arch", "write MB/s");
     for (std::int64_t n : options.sizes) {
         const SampledVolume volume = make_gaussian_blobs({n, n, n}, 12, 3);
         const double raw_bytes = static_cast<double>(n) * n * n * sizeof(float);
         for (StoragePrecision precision : {StoragePrecision::half, StoragePrecision::single}) {
             for (const char* codec : {"none", "zip", "piz", "pxr24", "b44"}) {
-                const InstrumentConfig config = make_config(
-                    options.disk + "/size.cdb", options.image, precision, codec, 4, WhenFull::block);
+                const InstrumentConfig config =
+                    make_config(options.disk + "/size.cdb", options.image, precision, codec, 4,
+                                WhenFull::block);
                 const RunFigures figures = run(config, volume, 2);
                 const InstrumentStatistics& s = figures.statistics;
                 const double per_step = static_cast<double>(s.bytes_written) /

@@ -6,17 +6,17 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "arguments.hpp"
 #include "gray_scott_simulation.hpp"
 #include "gray_scott_volume.hpp"
-#include "sample_count.hpp"
-#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/render/proxy_renderer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "sample_count.hpp"
 
 namespace {
 
@@ -36,11 +36,16 @@ Options parse(int argc, char** argv) {
         const std::string flag = argv[i];
         if (i + 1 >= argc) throw cli::UsageError(flag + " needs a value");
         const int value = cli::parse_integer<int>(flag, argv[++i], 1);
-        if (flag == "--size") options.size = value;
-        else if (flag == "--image") options.image = value;
-        else if (flag == "--repeats") options.repeats = value;
-        else if (flag == "--gray-scott-size") options.gray_scott_size = value;
-        else if (flag == "--gray-scott-steps") options.gray_scott_steps = value;
+        if (flag == "--size")
+            options.size = value;
+        else if (flag == "--image")
+            options.image = value;
+        else if (flag == "--repeats")
+            options.repeats = value;
+        else if (flag == "--gray-scott-size")
+            options.gray_scott_size = value;
+        else if (flag == "--gray-scott-steps")
+            options.gray_scott_steps = value;
         else
             throw cli::UsageError("unknown flag " + flag);
     }
@@ -67,7 +72,8 @@ ProxyRequest default_request(const ValueRange& range, const TransferFunction& tf
     ProxyRequest request;
     request.intervals = IntervalSet::uniform(range.min, range.max, 16);
     request.transfer_function = tf;
-    for (int l = 1; l <= 4; ++l) request.isovalues.push_back(range.min + (range.max - range.min) * l / 5.0);
+    for (int l = 1; l <= 4; ++l)
+        request.isovalues.push_back(range.min + (range.max - range.min) * l / 5.0);
     return request;
 }
 
@@ -87,11 +93,13 @@ void run_scene(const char* name, const SampledVolume& volume, const TransferFunc
     view.width = options.image;
     view.height = options.image;
     const Camera camera = Camera::orbit(view, proxies.volume().bounds);
-    const DistortionCamera distortion = DistortionCamera::orbit(view, proxies.volume().bounds, 45.0);
+    const DistortionCamera distortion =
+        DistortionCamera::orbit(view, proxies.volume().bounds, 45.0);
 
     RenderSettings unshaded;
     unshaded.early_termination_opacity = 2.0;  // no early termination: the fixed-cost reference
-    const double truth_ms = median_ms(options.repeats, [&] { ground_truth.render(camera, tf, unshaded); });
+    const double truth_ms =
+        median_ms(options.repeats, [&] { ground_truth.render(camera, tf, unshaded); });
 
     ProxyRequest request = default_request(proxies.volume().range, tf);
     std::printf("\n%s: %lldx%lldx%lld float, %dx%d, 1-voxel step, L = 16, 4 layers\n", name,
@@ -99,17 +107,22 @@ void run_scene(const char* name, const SampledVolume& volume, const TransferFunc
                 static_cast<long long>(volume.dims[2]), options.image, options.image);
     const Bounds& box = proxies.volume().bounds;
     const double step = proxies.volume().step_world(1.0);
-    const std::uint64_t single_samples = bench::samples_per_frame(camera, view.width, view.height, box, step);
-    const std::uint64_t multi_samples = bench::samples_per_frame(distortion, view.width, view.height, box, step);
-    std::printf("  %-46s %9.1f ms  %7.1f Msamples/s\n", "ground truth, unshaded, no early termination",
-                truth_ms, single_samples / truth_ms / 1e3);
+    const std::uint64_t single_samples =
+        bench::samples_per_frame(camera, view.width, view.height, box, step);
+    const std::uint64_t multi_samples =
+        bench::samples_per_frame(distortion, view.width, view.height, box, step);
+    std::printf("  %-46s %9.1f ms  %7.1f Msamples/s\n",
+                "ground truth, unshaded, no early termination", truth_ms,
+                single_samples / truth_ms / 1e3);
 
     auto time_request = [&](bool multi, bool skip, double stop_opacity) {
         request.skip_empty_space = skip;
         request.march.early_termination_opacity = stop_opacity;
         return median_ms(options.repeats, [&] {
-            if (multi) proxies.render(distortion, request);
-            else proxies.render(camera, request);
+            if (multi)
+                proxies.render(distortion, request);
+            else
+                proxies.render(camera, request);
         });
     };
     // The block min/max scan runs on the host once per upload (every timestep in situ).
@@ -119,8 +132,9 @@ void run_scene(const char* name, const SampledVolume& volume, const TransferFunc
         proxies.upload(volume.field());
         const auto start = std::chrono::steady_clock::now();
         proxies.render(camera, request);
-        const double first = std::chrono::duration<double, std::milli>(
-                                 std::chrono::steady_clock::now() - start).count();
+        const double first =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
         const double warm = median_ms(1, [&] { proxies.render(camera, request); });
         std::printf("  %-46s %9.1f ms\n", "first pass after an upload (block scan) minus next",
                     first - warm);
@@ -138,7 +152,8 @@ void run_scene(const char* name, const SampledVolume& volume, const TransferFunc
         report("all proxies, no skipping, no termination", plain, truth_ms);
         report("+ exact early termination", exact_stop, truth_ms);
         report("+ empty-space skipping (8^3 blocks)", skipping, truth_ms);
-        std::printf("  %-46s %8.1f%%\n", "blocks skippable", 100.0 * proxies.last_skippable_fraction());
+        std::printf("  %-46s %8.1f%%\n", "blocks skippable",
+                    100.0 * proxies.last_skippable_fraction());
         std::printf("  %-46s %8.1f%%\n", "saved by skipping and termination",
                     100.0 * (1.0 - skipping / plain));
     }
@@ -169,9 +184,10 @@ int main(int argc, char** argv) {
         const auto start = std::chrono::steady_clock::now();
         const SampledVolume gray_scott =
             gray_scott_field(options.gray_scott_size, options.gray_scott_steps);
-        std::printf("\n(Gray-Scott: %d steps at %d^3 took %.1f s)\n", options.gray_scott_steps,
-                    options.gray_scott_size,
-                    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        std::printf(
+            "\n(Gray-Scott: %d steps at %d^3 took %.1f s)\n", options.gray_scott_steps,
+            options.gray_scott_size,
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
         // v is ~0 away from the pattern: transparent there, as a user would set it.
         const TransferFunction gray_scott_tf({{0.0, {0, 0, 0, 0}},
                                               {0.1, {0.1, 0.3, 0.9, 0}},

@@ -4,12 +4,12 @@
 // with the OpenCL renderer, unshaded and shaded, with early ray termination disabled and
 // enabled, and prints milliseconds per frame (median after warm-up) and million samples per
 // second. The sample count is counted per pixel on the host with the renderer's own rule
-// (insitu/render/volume_renderer.hpp): samples at t_near + (i + 0.5) * step while t < t_far along the
-// ray's span through the field's box. With early termination on, rays stop before the end of
+// (insitu/render/volume_renderer.hpp): samples at t_near + (i + 0.5) * step while t < t_far along
+// the ray's span through the field's box. With early termination on, rays stop before the end of
 // their span, so that row's rate is "span-equivalent": the work a full march would have done,
 // divided by the time the terminated march took.
-// The scalar reference renderer (insitu/testing/reference_renderer.hpp) is timed on a smaller image with
-// the same framing, and the ratio of the two rates is printed.
+// The scalar reference renderer (insitu/testing/reference_renderer.hpp) is timed on a smaller image
+// with the same framing, and the ratio of the two rates is printed.
 //
 // This program measures and prints; it asserts nothing and is never run as a test.
 #include <algorithm>
@@ -25,13 +25,13 @@
 #include <vector>
 
 #include "arguments.hpp"
-#include "sample_count.hpp"
-#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/core/camera.hpp"
-#include "insitu/error.hpp"
 #include "insitu/core/transfer_function.hpp"
+#include "insitu/error.hpp"
 #include "insitu/render/volume_renderer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/reference_renderer.hpp"
+#include "sample_count.hpp"
 
 namespace {
 
@@ -179,8 +179,8 @@ int run(const BenchOptions& options) {
     const insitu::Camera reference_camera = insitu::Camera::orbit(reference_view, field.bounds());
 
     const double step_world = renderer.volume().step_world(options.step_voxels);
-    const std::uint64_t samples = insitu::bench::samples_per_frame(camera, camera.width(), camera.height(),
-                                          field.bounds(), step_world);
+    const std::uint64_t samples = insitu::bench::samples_per_frame(
+        camera, camera.width(), camera.height(), field.bounds(), step_world);
     const std::uint64_t reference_samples =
         insitu::bench::samples_per_frame(reference_camera, reference_camera.width(),
                                          reference_camera.height(), field.bounds(), step_world);

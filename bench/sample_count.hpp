@@ -1,8 +1,8 @@
 #pragma once
 // Samples a ray-marching pass takes, counted on the host with the renderers' rule
-// (insitu/render/volume_renderer.hpp): the ray is clipped to the field's box (slab test, t_near >= 0) and
-// sample i sits at t_near + (i + 0.5) * step while t < t_far. Benchmarks divide by time to get
-// samples per second, so they count rather than assume.
+// (insitu/render/volume_renderer.hpp): the ray is clipped to the field's box (slab test, t_near >=
+// 0) and sample i sits at t_near + (i + 0.5) * step while t < t_far. Benchmarks divide by time to
+// get samples per second, so they count rather than assume.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>

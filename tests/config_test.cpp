@@ -6,10 +6,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "insitu/error.hpp"
 
@@ -341,15 +340,14 @@ TEST(InstrumentConfig, EstimatedSamplesPerStepFollowTheCostModel) {
 TEST(InstrumentConfig, AStepCostAboveTheCeilingIsRefusedNamingTheKeys) {
     const std::string fine_and_large =
         R"({"step": 0.001, "views": [{"size": [4096, 4096]}, {"azimuth": 90}]})";
-    expect_error<InvalidArgument>(fine_and_large,
-                                  {"samples per step", "ceiling", "\"step\" = 0.001",
-                                   "\"views\": 2 views", "\"proxies\"",
-                                   "\"training_transfer_functions\""});
+    expect_error<InvalidArgument>(
+        fine_and_large, {"samples per step", "ceiling", "\"step\" = 0.001", "\"views\": 2 views",
+                         "\"proxies\"", "\"training_transfer_functions\""});
     // The same views at a coarser step are fine, and so is the fine step with one small view.
     EXPECT_NO_THROW(InstrumentConfig::from_json_text(
         R"({"step": 1, "views": [{"size": [4096, 4096]}, {"azimuth": 90}]})"));
-    EXPECT_NO_THROW(InstrumentConfig::from_json_text(
-        R"({"step": 0.001, "views": [{"size": [256, 256]}]})"));
+    EXPECT_NO_THROW(
+        InstrumentConfig::from_json_text(R"({"step": 0.001, "views": [{"size": [256, 256]}]})"));
     // Configurations built in code are checked the same way.
     InstrumentConfig config;
     config.step_voxels = 0.001;

@@ -3,6 +3,9 @@
 // developer gets for a bad hand-over.
 #include "insitu/field.hpp"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -11,11 +14,8 @@
 #include <string>
 #include <vector>
 
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
-
-#include "support/expect_error.hpp"
 #include "insitu/error.hpp"
+#include "support/expect_error.hpp"
 
 namespace insitu {
 namespace {
@@ -393,12 +393,12 @@ TEST(Field, DimsWhoseExtentOverflowsAreRejectedNamingTheFieldAndTheDims) {
     const std::vector<float> data(16 * 16 * 16, 0.5f);
     constexpr std::int64_t k2to31 = std::int64_t{1} << 31;
     constexpr std::int64_t k2to40 = std::int64_t{1} << 40;
-    const Index3 overflowing[] = {{k2to31, k2to31, k2to31},
-                                  {k2to31, k2to31, 4},
-                                  {k2to40, k2to40, k2to40},
-                                  // 2^61 samples fit, their 2^63 bytes of float32 do not.
-                                  {std::int64_t{1} << 21, std::int64_t{1} << 20,
-                                   std::int64_t{1} << 20}};
+    const Index3 overflowing[] = {
+        {k2to31, k2to31, k2to31},
+        {k2to31, k2to31, 4},
+        {k2to40, k2to40, k2to40},
+        // 2^61 samples fit, their 2^63 bytes of float32 do not.
+        {std::int64_t{1} << 21, std::int64_t{1} << 20, std::int64_t{1} << 20}};
     for (const Index3& dims : overflowing) {
         const std::string named = "(" + std::to_string(dims[0]) + ", " + std::to_string(dims[1]) +
                                   ", " + std::to_string(dims[2]) + ")";
@@ -423,10 +423,16 @@ TEST(Field, StridesWhoseExtentOverflowsAreRejectedAndLeaveTheFieldAsItWas) {
     const std::vector<float> data(16 * 16 * 16, 0.5f);
     Field field("pressure", data.data(), ScalarType::float32, {16, 16, 16});
     const std::int64_t huge = std::numeric_limits<std::int64_t>::max() / 8;
-    expect_error_naming<InvalidArgument>([&] { field.set_strides({1, 16, huge}); },
-                                         std::to_string(huge));
-    expect_error_naming<InvalidArgument>([&] { field.set_strides({1, 16, huge}); },
-                                         "field \"pressure\"");
+    expect_error_naming<InvalidArgument>(
+        [&] {
+            field.set_strides({1, 16, huge});
+        },
+        std::to_string(huge));
+    expect_error_naming<InvalidArgument>(
+        [&] {
+            field.set_strides({1, 16, huge});
+        },
+        "field \"pressure\"");
     expect_error_naming<InvalidArgument>([&] { field.set_strides({huge, 1, 1}); }, "overflows");
     EXPECT_EQ(field.strides(), (Index3{1, 16, 256}));
     EXPECT_EQ(field.value(15, 15, 15), 0.5);
@@ -436,12 +442,14 @@ TEST(Field, GhostLayersWhoseSumOverflowsAreRejectedNamingTheValue) {
     const std::vector<float> data(16 * 16 * 16, 0.5f);
     Field field("pressure", data.data(), ScalarType::float32, {16, 16, 16});
     const std::int64_t max = std::numeric_limits<std::int64_t>::max();
-    expect_error_naming<InvalidArgument>([&] { field.set_ghost_layers(max); },
-                                         std::to_string(max));
+    expect_error_naming<InvalidArgument>([&] { field.set_ghost_layers(max); }, std::to_string(max));
     expect_error_naming<InvalidArgument>([&] { field.set_ghost_layers(max); },
                                          "field \"pressure\": ghost layers on x");
-    expect_error_naming<InvalidArgument>([&] { field.set_ghost_layers({0, 0, max}, {0, 0, 0}); },
-                                         "leave no interior");
+    expect_error_naming<InvalidArgument>(
+        [&] {
+            field.set_ghost_layers({0, 0, max}, {0, 0, 0});
+        },
+        "leave no interior");
     EXPECT_EQ(field.dims(), (Index3{16, 16, 16}));
 }
 

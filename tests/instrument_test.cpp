@@ -22,16 +22,15 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
-#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/archive/archive.hpp"
 #include "insitu/error.hpp"
+#include "insitu/testing/analytic_fields.hpp"
 
 namespace insitu {
 namespace {
@@ -289,8 +288,7 @@ TEST_F(InstrumentTest, NonFiniteTimesAndUnrepresentableStepsAreRefusedAndTheArch
     const std::int64_t too_large = std::int64_t{1} << 53;
     EXPECT_EQ(instrument.execute(too_large, 3.0, {volume_.field()}), Status::error);
     EXPECT_THAT(instrument.last_error(), HasSubstr(std::to_string(too_large)));
-    EXPECT_EQ(instrument.execute(std::numeric_limits<std::int64_t>::max(), 3.0,
-                                 {volume_.field()}),
+    EXPECT_EQ(instrument.execute(std::numeric_limits<std::int64_t>::max(), 3.0, {volume_.field()}),
               Status::error);
     EXPECT_EQ(instrument.last_error_kind(), ErrorKind::invalid_argument);
     // Refused steps use nothing up: step 2 still goes through, and so does the largest step.
@@ -597,7 +595,8 @@ TEST_F(InstrumentTest, ThousandStepsRunWithFlatMemory) {
     {
         Instrument instrument(config, quiet());
         const auto resident_once_written = [&](std::int64_t steps) {
-            for (int wait = 0; wait < 2000 && instrument.statistics().steps_written < steps; ++wait) {
+            for (int wait = 0; wait < 2000 && instrument.statistics().steps_written < steps;
+                 ++wait) {
                 std::this_thread::sleep_for(std::chrono::milliseconds(5));
             }
             return resident_bytes();

@@ -19,18 +19,17 @@
 #include <exception>
 #include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "cli.hpp"
 #include "explore_options.hpp"
+#include "insitu/core/image.hpp"
 #include "insitu/error.hpp"
 #include "insitu/explore/explorer.hpp"
-#include "insitu/core/image.hpp"
 #include "server.hpp"
 
 namespace {

@@ -34,9 +34,9 @@
 #include "arguments.hpp"
 #include "cli.hpp"
 #include "explore_options.hpp"
+#include "insitu/core/image.hpp"
 #include "insitu/error.hpp"
 #include "insitu/explore/explorer.hpp"
-#include "insitu/core/image.hpp"
 #include "insitu/explore/transfer_function_edit.hpp"
 #include "insitu/explore/trust.hpp"
 
@@ -733,8 +733,7 @@ public:
 private:
     bool wait(short events, Milliseconds timeout) const {
         pollfd entry{sock_, events, 0};
-        const int ready =
-            retry([&] { return poll(&entry, 1, static_cast<int>(timeout.count())); });
+        const int ready = retry([&] { return poll(&entry, 1, static_cast<int>(timeout.count())); });
         return ready > 0 && (entry.revents & (events | POLLHUP | POLLERR)) != 0;
     }
 

@@ -80,13 +80,19 @@ insitu::ScalarType scalar_type_from_c(int scalar_type) {
 // (the Instrument is made with rethrow_errors = false: the simulation is sacred).
 int code_for_kind(insitu::ErrorKind kind) {
     switch (kind) {
-        case insitu::ErrorKind::invalid_argument: return INSITU_ERROR_INVALID_ARGUMENT;
-        case insitu::ErrorKind::parse: return INSITU_ERROR_PARSE;
-        case insitu::ErrorKind::compute: return INSITU_ERROR_COMPUTE;
-        case insitu::ErrorKind::io: return INSITU_ERROR_IO;
-        case insitu::ErrorKind::state: return INSITU_ERROR_STATE;
+        case insitu::ErrorKind::invalid_argument:
+            return INSITU_ERROR_INVALID_ARGUMENT;
+        case insitu::ErrorKind::parse:
+            return INSITU_ERROR_PARSE;
+        case insitu::ErrorKind::compute:
+            return INSITU_ERROR_COMPUTE;
+        case insitu::ErrorKind::io:
+            return INSITU_ERROR_IO;
+        case insitu::ErrorKind::state:
+            return INSITU_ERROR_STATE;
         case insitu::ErrorKind::none:
-        case insitu::ErrorKind::unknown: break;
+        case insitu::ErrorKind::unknown:
+            break;
     }
     return INSITU_ERROR_UNKNOWN;
 }

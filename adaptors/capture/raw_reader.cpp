@@ -122,9 +122,8 @@ Field RawVolume::field(const std::string& name) const {
 
 RawVolume read_raw(const std::string& path, const RawOptions& options) {
     const auto sample_bytes = static_cast<std::int64_t>(raw_size_bytes(options.type));
-    const std::string dims_text = "\"" + path + "\": raw dims " +
-                                  std::to_string(options.dims[0]) + "," +
-                                  std::to_string(options.dims[1]) + "," +
+    const std::string dims_text = "\"" + path + "\": raw dims " + std::to_string(options.dims[0]) +
+                                  "," + std::to_string(options.dims[1]) + "," +
                                   std::to_string(options.dims[2]);
     std::int64_t samples = 1;
     for (int axis = 0; axis < 3; ++axis) {
@@ -171,9 +170,8 @@ RawVolume read_raw(const std::string& path, const RawOptions& options) {
         }
     }
     if (volume.converted_) {
-        const std::int64_t converted_bytes =
-            checked_multiply(samples, static_cast<std::int64_t>(sizeof(float)),
-                             dims_text + ", as float32 bytes");
+        const std::int64_t converted_bytes = checked_multiply(
+            samples, static_cast<std::int64_t>(sizeof(float)), dims_text + ", as float32 bytes");
         volume.storage_.resize(static_cast<std::size_t>(converted_bytes));
         convert_to_float(options.type, bytes, static_cast<std::size_t>(samples),
                          reinterpret_cast<float*>(volume.storage_.data()));

@@ -176,9 +176,9 @@ DenseGrid densify(const openvdb::GridBase& grid, const std::string& field_name) 
     const std::string what = "OpenVDB " + grid_label(grid) + ": dense box " +
                              std::to_string(box_dims[0]) + " x " + std::to_string(box_dims[1]) +
                              " x " + std::to_string(box_dims[2]);
-    checked_multiply(checked_multiply(checked_multiply(box_dims[0], box_dims[1], what),
-                                      box_dims[2], what),
-                     is_double ? 8 : 4, what + ", in bytes");
+    checked_multiply(
+        checked_multiply(checked_multiply(box_dims[0], box_dims[1], what), box_dims[2], what),
+        is_double ? 8 : 4, what + ", in bytes");
     const openvdb::CoordBBox box(lower, upper);
     try {
         if (is_double) {

@@ -221,8 +221,8 @@ struct VtkFieldFactory {
         std::string copy_reason;
         const void* data = nullptr;
         // Checked: components times a row or plane of tuples is an offset of the array.
-        const std::string stride_what = "VTK " + where + ": strides of " +
-                                        std::to_string(components) + " components";
+        const std::string stride_what =
+            "VTK " + where + ": strides of " + std::to_string(components) + " components";
         const std::int64_t row = checked_multiply(components, dims[0], stride_what);
         Index3 strides{components, row, checked_multiply(row, dims[1], stride_what)};
         if (!field_type_of(array.GetDataType(), type)) {

@@ -25,16 +25,16 @@
 #include <vector>
 
 #include "arguments.hpp"
-#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/archive/archive.hpp"
 #include "insitu/explore/colour_model.hpp"
 #include "insitu/explore/explorer.hpp"
-#include "insitu/instrument.hpp"
-#include "insitu/render/proxy_renderer.hpp"
 #include "insitu/explore/transfer_function_edit.hpp"
 #include "insitu/explore/view_synthesis.hpp"
-#include "median_time.hpp"
+#include "insitu/instrument.hpp"
+#include "insitu/render/proxy_renderer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/metrics.hpp"
+#include "median_time.hpp"
 #include "scenes.hpp"
 
 namespace {

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/core/intervals.hpp"
 #include "insitu/core/transfer_function.hpp"
+#include "insitu/testing/analytic_fields.hpp"
 
 namespace insitu::evaluation {
 

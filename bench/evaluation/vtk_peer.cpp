@@ -35,10 +35,10 @@
 #include <vector>
 
 #include "arguments.hpp"
-#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/render/proxy_renderer.hpp"
-#include "median_time.hpp"
+#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/metrics.hpp"
+#include "median_time.hpp"
 
 namespace {
 

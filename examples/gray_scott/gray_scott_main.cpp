@@ -28,12 +28,12 @@
 #include "arguments.hpp"
 #include "cli.hpp"
 #include "gray_scott_simulation.hpp"
-#include "insitu/device/compute_device.hpp"
 #include "insitu/config.hpp"
+#include "insitu/core/transfer_function.hpp"
+#include "insitu/device/compute_device.hpp"
 #include "insitu/error.hpp"
 #include "insitu/field.hpp"
 #include "insitu/instrument.hpp"
-#include "insitu/core/transfer_function.hpp"
 
 namespace {
 

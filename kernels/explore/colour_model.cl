@@ -1,8 +1,10 @@
 // Colour model prediction (seed 000 §6.2-6.3): one work-item per pixel. Host side and the table
-// layout: libinsitu/src/explore/colour_model.cpp, insitu/explore/colour_model.hpp. The host reference is
-// ColourModel::predict_pixel; both clamp the same way, so they agree to float rounding.
+// layout: libinsitu/src/explore/colour_model.cpp, insitu/explore/colour_model.hpp. The host
+// reference is ColourModel::predict_pixel; both clamp the same way, so they agree to float
+// rounding.
 
-// MAX_INTERVALS: -D option from the host (kMaxIntervals, libinsitu/src/device/kernel_constants.hpp).
+// MAX_INTERVALS: -D option from the host (kMaxIntervals,
+// libinsitu/src/device/kernel_constants.hpp).
 
 // attenuation: pixel_count x intervals, pixel-interleaved. table: clusters rows of
 // 4 * intervals + 3 floats: a0 (L), c0 (RGB), J (3 x L, row-major). rgba_out: 4 per pixel.

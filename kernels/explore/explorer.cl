@@ -1,6 +1,7 @@
-// Per-pixel steps of Explorer::render that belong to no single method (libinsitu/src/explore/explorer.cpp):
-// combining the colour with lighting and occlusion factors, and drawing depth layers as surfaces
-// when an archive holds no attenuation proxies. One work-item per pixel.
+// Per-pixel steps of Explorer::render that belong to no single method
+// (libinsitu/src/explore/explorer.cpp): combining the colour with lighting and occlusion factors,
+// and drawing depth layers as surfaces when an archive holds no attenuation proxies. One work-item
+// per pixel.
 
 // colour.rgb *= lit.rgb / lit.a: `lit` is light_volume() of the same attenuation with white
 // interval colours, so lit.rgb / lit.a is the lighting factor of the pixel, whichever way its
@@ -34,8 +35,7 @@ __kernel void front_depth(__global float* front, __global const float* layer,
 
 // Where `layer` is the front-most surface, paint it opaque in `rgb` (its isovalue's colour).
 __kernel void paint_surface(__global float4* colour, __global const float* layer,
-                            __global const float* front, const float4 rgb,
-                            const uint pixel_count) {
+                            __global const float* front, const float4 rgb, const uint pixel_count) {
     const uint i = get_global_id(0);
     if (i >= pixel_count) return;
     const float d = layer[i];

@@ -1,8 +1,9 @@
 // Transfer-function edits from attenuation proxies (seed 000 §6): one work-item per pixel.
 // Host side and the estimator's definition: insitu/explore/transfer_function_edit.hpp.
 
-// MAX_INTERVALS: -D option from the host (kMaxIntervals, libinsitu/src/device/kernel_constants.hpp).
-// Light left behind a run below which the run counts as opaque (insitu/explore/transfer_function_edit.hpp).
+// MAX_INTERVALS: -D option from the host (kMaxIntervals,
+// libinsitu/src/device/kernel_constants.hpp). Light left behind a run below which the run counts as
+// opaque (insitu/explore/transfer_function_edit.hpp).
 #define EDIT_OPAQUE_LIGHT 1e-6f
 
 // rgb = sum_j c_j a_j, alpha = sum_j a_j (seed 000 Eq. 7 regrouped). colours: L RGB triples.

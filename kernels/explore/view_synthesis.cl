@@ -1,6 +1,6 @@
 // View synthesis from proxies (seed 000 §4.3-4.4); the method is written out in
-// libinsitu/include/insitu/explore/view_synthesis.hpp. One work-item per source pixel for splatting,
-// one per target pixel for resolving.
+// libinsitu/include/insitu/explore/view_synthesis.hpp. One work-item per source pixel for
+// splatting, one per target pixel for resolving.
 //
 // Camera-local coordinates (a, b, z): offsets along right, up and forward from the camera's
 // position (orthographic: centre of the camera plane; perspective: the eye), world units, so z is

@@ -15,25 +15,24 @@ inline int interval_of(__global const float* edges, int count, float value) {
     int high = count - 1;
     while (low < high) {
         const int mid = (low + high + 1) / 2;
-        if (value >= edges[mid]) low = mid; else high = mid - 1;
+        if (value >= edges[mid])
+            low = mid;
+        else
+            high = mid - 1;
     }
     return low;
 }
 
-__kernel void render_proxies(__global const float* volume, int4 dims, float4 origin_world,
-                             float4 inv_spacing, float4 box_lower, float4 box_upper,
-                             __global const float4* tf_table, int2 tf_bins, float4 tf_domain,
-                             float4 cam_position, float4 cam_forward, float4 cam_right,
-                             float4 cam_up, float4 cam_half_extent, int2 size,
-                             float4 march, int wanted, int layer_count,
-                             __global const float* isovalues, int interval_count,
-                             float uniform_interval_scale,
-                             __global const float* interval_edges, __global float* depth_out,
-                             __global float* distortion_out,
-                             __global float* attenuation_out,  // always given when accumulating
-                             __global float* mean_depth_out, __global float* optical_depth_out,
-                             __global const uchar* skippable_blocks, int4 block_counts,
-                             int block_size) {
+__kernel void render_proxies(
+    __global const float* volume, int4 dims, float4 origin_world, float4 inv_spacing,
+    float4 box_lower, float4 box_upper, __global const float4* tf_table, int2 tf_bins,
+    float4 tf_domain, float4 cam_position, float4 cam_forward, float4 cam_right, float4 cam_up,
+    float4 cam_half_extent, int2 size, float4 march, int wanted, int layer_count,
+    __global const float* isovalues, int interval_count, float uniform_interval_scale,
+    __global const float* interval_edges, __global float* depth_out, __global float* distortion_out,
+    __global float* attenuation_out,  // always given when accumulating
+    __global float* mean_depth_out, __global float* optical_depth_out,
+    __global const uchar* skippable_blocks, int4 block_counts, int block_size) {
     const int x = get_global_id(0);
     const int y = get_global_id(1);
     if (x >= size.x || y >= size.y) return;
@@ -47,9 +46,9 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
     const float sin_tilt = march.z;
     const float cos_tilt = march.w;
 
-    const MarchRay ray = march_ray(x, y, size, cam_position, cam_forward, cam_right, cam_up,
-                                   cam_half_extent, sin_tilt, cos_tilt, origin_world,
-                                   inv_spacing, box_lower, box_upper);
+    const MarchRay ray =
+        march_ray(x, y, size, cam_position, cam_forward, cam_right, cam_up, cam_half_extent,
+                  sin_tilt, cos_tilt, origin_world, inv_spacing, box_lower, box_upper);
 
     const bool want_layers = (wanted & WANT_DEPTH) != 0 && layer_count > 0;
     const bool want_attenuation = (wanted & WANT_ATTENUATION) != 0;
@@ -92,8 +91,8 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
                     const float iso = isovalues[l];
                     if (isinf(layer_t[l]) && ((previous_value >= iso) != (value >= iso))) {
                         // Linear refinement between the two bracketing samples.
-                        layer_t[l] = previous_t + (iso - previous_value) /
-                                                      (value - previous_value) * step;
+                        layer_t[l] =
+                            previous_t + (iso - previous_value) / (value - previous_value) * step;
                         ++layers_found;
                     }
                 }
@@ -133,9 +132,8 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
                 const float3 lower = convert_float3(block * block_size);
                 const float3 upper = lower + (float3)(block_size);
                 const float3 exit_plane = select(lower, upper, ray.direction_voxels > 0.0f);
-                const float3 t_axis =
-                    select((exit_plane - ray.start_voxels) / ray.direction_voxels,
-                           (float3)(INFINITY), ray.direction_voxels == 0.0f);
+                const float3 t_axis = select((exit_plane - ray.start_voxels) / ray.direction_voxels,
+                                             (float3)(INFINITY), ray.direction_voxels == 0.0f);
                 next_block_t = fmin(fmin(t_axis.x, t_axis.y), t_axis.z);
                 const int block_index =
                     (block.z * block_counts.y + block.y) * block_counts.x + block.x;
@@ -158,8 +156,8 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
     }
     if (want_mean_depth) {
         for (int j = 0; j < interval_count; ++j) {
-            weighted_depth[j] = attenuation[j] > 0.0f ? weighted_depth[j] / attenuation[j]
-                                                      : INFINITY;
+            weighted_depth[j] =
+                attenuation[j] > 0.0f ? weighted_depth[j] / attenuation[j] : INFINITY;
         }
     }
 }

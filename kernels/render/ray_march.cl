@@ -67,12 +67,12 @@ inline float4 lookup_transfer(__global const float4* table, int2 bins, float4 do
 // t in world units along the unit direction: the midpoints of equal segments from where the ray
 // enters the box, so every march of the same camera and step takes the same samples.
 typedef struct {
-    float3 origin;            // world space: on the camera plane (orthographic) or the eye
-    float3 direction;         // world space, unit length
-    float t_near, t_far;      // the span inside the box; t_near > t_far where the ray misses
-    float3 start_voxels;      // the position in voxel coordinates is start + t direction_voxels
+    float3 origin;        // world space: on the camera plane (orthographic) or the eye
+    float3 direction;     // world space, unit length
+    float t_near, t_far;  // the span inside the box; t_near > t_far where the ray misses
+    float3 start_voxels;  // the position in voxel coordinates is start + t direction_voxels
     float3 direction_voxels;
-    float depth_origin;       // depth from the camera plane is depth_origin + t depth_per_t
+    float depth_origin;  // depth from the camera plane is depth_origin + t depth_per_t
     float depth_per_t;
 } MarchRay;
 
@@ -81,9 +81,9 @@ typedef struct {
 // perspective. A non-zero tilt makes the volume distortion camera (seed 000 Eq. 1): the ray
 // heads for the pole line through the image centre, v cos θ − r̂(p) sin θ.
 inline MarchRay march_ray(int x, int y, int2 size, float4 cam_position, float4 cam_forward,
-                          float4 cam_right, float4 cam_up, float4 cam_half_extent,
-                          float sin_tilt, float cos_tilt, float4 origin_world,
-                          float4 inv_spacing, float4 box_lower, float4 box_upper) {
+                          float4 cam_right, float4 cam_up, float4 cam_half_extent, float sin_tilt,
+                          float cos_tilt, float4 origin_world, float4 inv_spacing, float4 box_lower,
+                          float4 box_upper) {
     MarchRay ray;
     const float2 uv = plane_coordinates(x, y, size, cam_half_extent);
     if (cam_half_extent.z == 0.0f) {
@@ -116,7 +116,9 @@ inline MarchRay march_ray(int x, int y, int2 size, float4 cam_position, float4 c
     return ray;
 }
 
-inline bool ray_hits_box(const MarchRay* ray) { return ray->t_near <= ray->t_far; }
+inline bool ray_hits_box(const MarchRay* ray) {
+    return ray->t_near <= ray->t_far;
+}
 
 // t of sample i; the march ends at the first i with t >= t_far.
 inline float sample_t(const MarchRay* ray, int i, float step) {

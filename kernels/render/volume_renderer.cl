@@ -8,8 +8,7 @@ __kernel void render_volume(__global const float* volume, int4 dims, float4 orig
                             __global const float4* tf_table, int2 tf_bins, float4 tf_domain,
                             float4 cam_position, float4 cam_forward, float4 cam_right,
                             float4 cam_up, float4 cam_half_extent, int2 size, float4 march,
-                            float4 phong, __global float4* rgba_out,
-                            __global float* depth_out) {
+                            float4 phong, __global float4* rgba_out, __global float* depth_out) {
     const int x = get_global_id(0);
     const int y = get_global_id(1);
     if (x >= size.x || y >= size.y) return;
@@ -22,9 +21,9 @@ __kernel void render_volume(__global const float* volume, int4 dims, float4 orig
     const bool shading = march.z != 0.0f;
     const bool needs_gradient = march.w != 0.0f;
 
-    const MarchRay ray = march_ray(x, y, size, cam_position, cam_forward, cam_right, cam_up,
-                                   cam_half_extent, 0.0f, 1.0f, origin_world, inv_spacing,
-                                   box_lower, box_upper);
+    const MarchRay ray =
+        march_ray(x, y, size, cam_position, cam_forward, cam_right, cam_up, cam_half_extent, 0.0f,
+                  1.0f, origin_world, inv_spacing, box_lower, box_upper);
     float3 colour = (float3)(0.0f);
     float transmittance = 1.0f;
     float depth = INFINITY;
@@ -44,8 +43,8 @@ __kernel void render_volume(__global const float* volume, int4 dims, float4 orig
                 gradient_magnitude = length(gradient);
                 if (!isfinite(gradient_magnitude)) gradient_magnitude = 0.0f;
             }
-            const float4 sample = lookup_transfer(tf_table, tf_bins, tf_domain, value,
-                                                  gradient_magnitude);
+            const float4 sample =
+                lookup_transfer(tf_table, tf_bins, tf_domain, value, gradient_magnitude);
             const float alpha = sample.w;
             if (alpha <= 0.0f) continue;
             if (isinf(depth)) depth = sample_depth(&ray, t);
@@ -54,8 +53,8 @@ __kernel void render_volume(__global const float* volume, int4 dims, float4 orig
             if (shading && gradient_magnitude > 1e-12f) {
                 float n_dot_l = dot(gradient / gradient_magnitude, light);
                 n_dot_l = fabs(n_dot_l);  // the normal is turned to face the light
-                sample_colour = sample_colour * (phong.x + phong.y * n_dot_l) +
-                                phong.z * pow(n_dot_l, phong.w);
+                sample_colour =
+                    sample_colour * (phong.x + phong.y * n_dot_l) + phong.z * pow(n_dot_l, phong.w);
             }
             colour += absorb(&transmittance, alpha) * sample_colour;
             if (1.0f - transmittance >= stop_opacity) break;

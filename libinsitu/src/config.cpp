@@ -6,12 +6,11 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
-#include <nlohmann/json.hpp>
-
-#include "insitu/error.hpp"
 #include "insitu/core/layers.hpp"
+#include "insitu/error.hpp"
 
 namespace insitu {
 
@@ -186,9 +185,8 @@ void parse_object(const json& value, const std::string& key, const Key<Target> (
                   Target& target, Unknown& unknown) {
     require_object(value, key);
     for (const auto& item : value.items()) {
-        const bool known = std::any_of(std::begin(keys), std::end(keys), [&](const Key<Target>& k) {
-            return item.key() == k.name;
-        });
+        const bool known = std::any_of(std::begin(keys), std::end(keys),
+                                       [&](const Key<Target>& k) { return item.key() == k.name; });
         if (!known) unknown.push_back(child_key(key, item.key()));
     }
     for (const Key<Target>& entry : keys) {
@@ -261,7 +259,9 @@ const Key<ViewConfig> kViewKeys[] = {
          view.orbit.width = small_integer(value[0], element_key(key, 0));
          view.orbit.height = small_integer(value[1], element_key(key, 1));
      },
-     [](const ViewConfig& view) { return json{view.orbit.width, view.orbit.height}; }},
+     [](const ViewConfig& view) {
+         return json{view.orbit.width, view.orbit.height};
+     }},
     {"distortion_tilt",
      [](const json& value, const std::string& key, ViewConfig& view, Unknown&) {
          view.distortion_tilt_deg = number(value, key);
@@ -587,9 +587,9 @@ void InstrumentConfig::validate() const {
         }
         fail<InvalidArgument>(
             "configuration: about ", samples, " samples per step, above the ceiling of ",
-            kMaxSamplesPerStep, " (", kWorstDiagonalVoxels, "-voxel rays at \"step\" = ",
-            step_voxels, " over \"views\": ", views.size(), " views, ", pixels,
-            " pixels in all, ", passes_per_view(),
+            kMaxSamplesPerStep, " (", kWorstDiagonalVoxels,
+            "-voxel rays at \"step\" = ", step_voxels, " over \"views\": ", views.size(),
+            " views, ", pixels, " pixels in all, ", passes_per_view(),
             " passes each from \"proxies\" and \"training_transfer_functions\"); raise \"step\" "
             "or reduce the others");
     }

@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <glm/geometric.hpp>
 #include <limits>
 #include <ostream>
-
-#include <glm/geometric.hpp>
 
 #include "insitu/error.hpp"
 
@@ -14,22 +13,32 @@ namespace insitu {
 
 std::size_t scalar_size_bytes(ScalarType type) {
     switch (type) {
-        case ScalarType::uint8: return 1;
-        case ScalarType::uint16: return 2;
-        case ScalarType::int16: return 2;
-        case ScalarType::float32: return 4;
-        case ScalarType::float64: return 8;
+        case ScalarType::uint8:
+            return 1;
+        case ScalarType::uint16:
+            return 2;
+        case ScalarType::int16:
+            return 2;
+        case ScalarType::float32:
+            return 4;
+        case ScalarType::float64:
+            return 8;
     }
     fail<InvalidArgument>("unknown ScalarType ", static_cast<int>(type));
 }
 
 std::string to_string(ScalarType type) {
     switch (type) {
-        case ScalarType::uint8: return "uint8";
-        case ScalarType::uint16: return "uint16";
-        case ScalarType::int16: return "int16";
-        case ScalarType::float32: return "float32";
-        case ScalarType::float64: return "float64";
+        case ScalarType::uint8:
+            return "uint8";
+        case ScalarType::uint16:
+            return "uint16";
+        case ScalarType::int16:
+            return "int16";
+        case ScalarType::float32:
+            return "float32";
+        case ScalarType::float64:
+            return "float64";
     }
     fail<InvalidArgument>("unknown ScalarType ", static_cast<int>(type));
 }
@@ -49,7 +58,9 @@ std::ostream& operator<<(std::ostream& out, const ValueRange& range) {
                << "}";
 }
 
-double Bounds::radius() const { return 0.5 * glm::length(upper - lower); }
+double Bounds::radius() const {
+    return 0.5 * glm::length(upper - lower);
+}
 
 std::ostream& operator<<(std::ostream& out, const Bounds& bounds) {
     return out << "Bounds{(" << bounds.lower.x << ", " << bounds.lower.y << ", " << bounds.lower.z
@@ -74,7 +85,9 @@ std::int64_t checked_add(std::int64_t a, std::int64_t b, const std::string& what
 }
 
 namespace {
-const char* axis_name(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
+const char* axis_name(int axis) {
+    return axis == 0 ? "x" : axis == 1 ? "y" : "z";
+}
 
 std::string triple(const Index3& values) {
     return detail::concat("(", values[0], ", ", values[1], ", ", values[2], ")");
@@ -142,8 +155,7 @@ Field& Field::set_ghost_layers(Index3 low, Index3 high) {
         }
         // Checked: ghost layers of INT64_MAX on both sides used to wrap into a large interior.
         const std::int64_t ghosts = checked_add(
-            low[axis], high[axis],
-            "field \"" + name_ + "\": ghost layers on " + axis_name(axis));
+            low[axis], high[axis], "field \"" + name_ + "\": ghost layers on " + axis_name(axis));
         if (allocated_dims_[axis] - ghosts < 1) {
             fail<InvalidArgument>("field \"", name_, "\": ghost layers on ", axis_name(axis),
                                   " = (", low[axis], ", ", high[axis],
@@ -207,11 +219,16 @@ double load(const void* data, std::int64_t offset) {
 
 double load_as_double(const void* data, ScalarType type, std::int64_t offset) {
     switch (type) {
-        case ScalarType::uint8: return load<std::uint8_t>(data, offset);
-        case ScalarType::uint16: return load<std::uint16_t>(data, offset);
-        case ScalarType::int16: return load<std::int16_t>(data, offset);
-        case ScalarType::float32: return load<float>(data, offset);
-        case ScalarType::float64: return load<double>(data, offset);
+        case ScalarType::uint8:
+            return load<std::uint8_t>(data, offset);
+        case ScalarType::uint16:
+            return load<std::uint16_t>(data, offset);
+        case ScalarType::int16:
+            return load<std::int16_t>(data, offset);
+        case ScalarType::float32:
+            return load<float>(data, offset);
+        case ScalarType::float64:
+            return load<double>(data, offset);
     }
     return 0.0;
 }
@@ -235,11 +252,21 @@ void for_each_interior(const Field& field, Visit&& visit) {
 template <typename Visit>
 void dispatch_interior(const Field& field, Visit&& visit) {
     switch (field.type()) {
-        case ScalarType::uint8: for_each_interior<std::uint8_t>(field, visit); break;
-        case ScalarType::uint16: for_each_interior<std::uint16_t>(field, visit); break;
-        case ScalarType::int16: for_each_interior<std::int16_t>(field, visit); break;
-        case ScalarType::float32: for_each_interior<float>(field, visit); break;
-        case ScalarType::float64: for_each_interior<double>(field, visit); break;
+        case ScalarType::uint8:
+            for_each_interior<std::uint8_t>(field, visit);
+            break;
+        case ScalarType::uint16:
+            for_each_interior<std::uint16_t>(field, visit);
+            break;
+        case ScalarType::int16:
+            for_each_interior<std::int16_t>(field, visit);
+            break;
+        case ScalarType::float32:
+            for_each_interior<float>(field, visit);
+            break;
+        case ScalarType::float64:
+            for_each_interior<double>(field, visit);
+            break;
     }
 }
 

@@ -17,9 +17,9 @@
 
 #include "insitu/archive/archive.hpp"
 #include "insitu/core/camera.hpp"
+#include "insitu/error.hpp"
 #include "insitu/explore/colour_model.hpp"
 #include "insitu/render/distortion_camera.hpp"
-#include "insitu/error.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 
 namespace insitu {
@@ -38,7 +38,9 @@ std::string to_string(Status status) {
     return "unknown";
 }
 
-std::ostream& operator<<(std::ostream& out, Status status) { return out << to_string(status); }
+std::ostream& operator<<(std::ostream& out, Status status) {
+    return out << to_string(status);
+}
 
 std::ostream& operator<<(std::ostream& out, const InstrumentOptions& options) {
     return out << "InstrumentOptions{rethrow_errors " << std::boolalpha << options.rethrow_errors

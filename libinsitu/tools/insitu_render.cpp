@@ -28,10 +28,10 @@
 #include "arguments.hpp"
 #include "cli.hpp"
 #include "insitu/core/camera.hpp"
-#include "insitu/error.hpp"
-#include "insitu/field.hpp"
 #include "insitu/core/image.hpp"
 #include "insitu/core/transfer_function.hpp"
+#include "insitu/error.hpp"
+#include "insitu/field.hpp"
 #include "insitu/render/volume_renderer.hpp"
 
 namespace {

@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "insitu/core/camera.hpp"
-#include "insitu/render/distortion_camera.hpp"
 #include "insitu/field.hpp"
+#include "insitu/render/distortion_camera.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 
 namespace insitu::testing {

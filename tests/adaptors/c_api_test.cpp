@@ -232,8 +232,8 @@ TEST_F(CApiTest, OverflowingDimsStridesAndGhostsAreInvalidArgumentsAndTheRunGoes
                                    nullptr, nullptr),
                   INSITU_ERROR_INVALID_ARGUMENT)
             << dims[0] << " x " << dims[1] << " x " << dims[2];
-        EXPECT_TRUE(contains(insitu_last_error(), "field \"v\": dims (" +
-                                                      std::to_string(dims[0]) + ", "))
+        EXPECT_TRUE(
+            contains(insitu_last_error(), "field \"v\": dims (" + std::to_string(dims[0]) + ", "))
             << insitu_last_error();
         EXPECT_TRUE(contains(insitu_last_error(), "overflows")) << insitu_last_error();
     }

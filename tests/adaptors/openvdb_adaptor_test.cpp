@@ -18,8 +18,8 @@
 #include <string>
 
 #include "adaptors/adaptor_test_support.hpp"
-#include "support/expect_error.hpp"
 #include "insitu/error.hpp"
+#include "support/expect_error.hpp"
 
 namespace insitu::testing {
 namespace {

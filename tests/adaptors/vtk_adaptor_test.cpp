@@ -24,9 +24,9 @@
 #include <vector>
 
 #include "adaptors/adaptor_test_support.hpp"
-#include "support/expect_error.hpp"
 #include "insitu/capture_input.hpp"
 #include "insitu/error.hpp"
+#include "support/expect_error.hpp"
 
 namespace insitu::testing {
 namespace {

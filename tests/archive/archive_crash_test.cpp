@@ -9,8 +9,8 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -142,7 +142,6 @@ TEST(ArchiveCrash, KilledWriterLeavesAnArchiveWithEveryCompletedStep) {
     std::filesystem::remove_all(directory);
 }
 
-
 // One writer at a time (issue 19): a child process holds the archive's lock; a writer here is
 // refused naming the child's pid; once the child is SIGKILLed the kernel has dropped its lock and
 // a new writer succeeds, with every step the child wrote.
@@ -178,8 +177,7 @@ TEST(ArchiveCrash, LockOfAKilledWriterIsReleased) {
         ArchiveWriter second(config);
         ADD_FAILURE() << "a second writer was let in";
     } catch (const IoError& error) {
-        EXPECT_NE(std::string(error.what()).find("pid " + std::to_string(child)),
-                  std::string::npos)
+        EXPECT_NE(std::string(error.what()).find("pid " + std::to_string(child)), std::string::npos)
             << error.what();
         EXPECT_NE(std::string(error.what()).find(config.archive), std::string::npos)
             << error.what();

@@ -26,17 +26,16 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
-#include "support/expect_error.hpp"
-#include "insitu/testing/analytic_fields.hpp"
-#include "insitu/render/distortion_camera.hpp"
 #include "insitu/error.hpp"
+#include "insitu/render/distortion_camera.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "support/expect_error.hpp"
 
 namespace insitu {
 namespace {
@@ -203,7 +202,9 @@ void expect_frames_match(const ProxyFrame& expected, const ProxyFrame& actual, b
     EXPECT_EQ(expected.distortion_tilt_deg, actual.distortion_tilt_deg);
     EXPECT_EQ(expected.isovalues, actual.isovalues);
     ASSERT_EQ(expected.intervals.has_value(), actual.intervals.has_value());
-    if (expected.intervals) { EXPECT_EQ(expected.intervals->edges(), actual.intervals->edges()); }
+    if (expected.intervals) {
+        EXPECT_EQ(expected.intervals->edges(), actual.intervals->edges());
+    }
     expect_layers_match(expected.depth_layers, actual.depth_layers, false, "depth");
     expect_layers_match(expected.distortion_layers, actual.distortion_layers, false, "distortion");
     expect_images_match(expected.attenuation, actual.attenuation, half, "attenuation");
@@ -728,7 +729,9 @@ TEST_F(Archive, ForeignFilesWithMatchingChecksumsAreIoErrorsNamingFileAndPart) {
         replace_consistently(9, 0, c.bytes);
         const ArchiveReader reader(archive().string());
         EXPECT_TRUE(reader.verify().empty());
-        if (!c.single_fails) { EXPECT_NO_THROW(reader.load(9, 0)); }
+        if (!c.single_fails) {
+            EXPECT_NO_THROW(reader.load(9, 0));
+        }
         for (const bool multi : {false, true}) {
             if (!multi && !c.single_fails) continue;
             try {
@@ -737,7 +740,9 @@ TEST_F(Archive, ForeignFilesWithMatchingChecksumsAreIoErrorsNamingFileAndPart) {
             } catch (const IoError& error) {
                 EXPECT_THAT(error.what(),
                             AllOf(HasSubstr("step000009_view0.exr"), HasSubstr("part \"")));
-                if (multi) { EXPECT_THAT(error.what(), HasSubstr("part \"" + c.part + "\"")); }
+                if (multi) {
+                    EXPECT_THAT(error.what(), HasSubstr("part \"" + c.part + "\""));
+                }
             } catch (const std::exception& error) {
                 ADD_FAILURE() << "not an IoError: " << error.what();
             }
@@ -840,7 +845,6 @@ TEST_F(Archive, UnknownStepOrViewIsAnInvalidArgument) {
     EXPECT_THROW(ArchiveReader(archive().string()).load(2, 0, true), InvalidArgument);
 }
 
-
 // Issue 19: nothing the simulation hands the archive can cost it the archive.
 
 TEST_F(Archive, NonFiniteTimeIsRefusedByValueAndTheArchiveStaysWhole) {
@@ -908,10 +912,10 @@ TEST_F(Archive, SecondWriterIsRefusedNamingTheHolderUntilTheFirstCloses) {
     {
         ArchiveWriter first(config_);
         first.write(record(1));
-        insitu::testing::expect_error_naming<IoError>(
-            [&] { ArchiveWriter second(config_); },
-            "archive \"" + config_.archive + "\" is locked by another writer (pid " +
-                std::to_string(::getpid()) + ",");
+        insitu::testing::expect_error_naming<IoError>([&] { ArchiveWriter second(config_); },
+                                                      "archive \"" + config_.archive +
+                                                          "\" is locked by another writer (pid " +
+                                                          std::to_string(::getpid()) + ",");
         // Readers take no lock, and the lock file is no part of the archive.
         const ArchiveReader reader(archive().string());
         EXPECT_EQ(reader.steps(), std::vector<std::int64_t>{1});
@@ -1000,15 +1004,14 @@ TEST_F(Archive, VerifyRefusesFilesThatResolveOutsideTheArchive) {
     std::filesystem::remove(exr(1, 0));
     std::filesystem::create_symlink(outside, exr(1, 0));
     EXPECT_THAT(ArchiveReader(archive().string()).verify(),
-                ::testing::ElementsAre(AllOf(HasSubstr("step000001_view0.exr"),
-                                             HasSubstr("outside the archive"))));
+                ::testing::ElementsAre(
+                    AllOf(HasSubstr("step000001_view0.exr"), HasSubstr("outside the archive"))));
     // A link that stays inside the archive is fine.
     std::filesystem::remove(exr(1, 0));
     std::filesystem::rename(outside, archive() / "proxies" / "real.exr");
     std::filesystem::create_symlink("real.exr", exr(1, 0));
     EXPECT_THAT(ArchiveReader(archive().string()).verify(), ::testing::ElementsAre());
 }
-
 
 // OpenEXR allocates what a header declares before it finds the file too short (issue 19: a
 // 1 373-byte file asked for 531 MB). The reader now refuses, before OpenEXR sees the file, data

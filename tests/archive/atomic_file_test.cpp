@@ -78,8 +78,7 @@ TEST_F(AtomicFile, AnUncommittedTempFileIsRemovedAndTheFinalNameNeverAppears) {
 
 TEST_F(AtomicFile, AFailedWriteNamesTheFileAndLeavesNothing) {
     const fs::path missing = directory_ / "no_such_folder" / "c.bin";
-    expect_error_naming<IoError>([&] { write_file_atomically(missing, "abc"); },
-                                 missing.string());
+    expect_error_naming<IoError>([&] { write_file_atomically(missing, "abc"); }, missing.string());
     EXPECT_TRUE(names().empty());
 }
 
@@ -108,7 +107,6 @@ TEST(Crc32, MatchesTheStandardCheckValue) {
     EXPECT_EQ(crc32_of(digits.data(), digits.size()), 0xCBF43926u);
     EXPECT_EQ(crc32_of(nullptr, 0), 0u);
 }
-
 
 // The append-only indexes (issue 19): an append that the disk refuses part-way is cut back, so
 // the next append does not land behind a torn line.
@@ -143,9 +141,9 @@ TEST_F(AtomicFile, LockIsExclusiveNamesItsHolderAndSurvivesTempCleanup) {
     {
         const FileLock lock(path, "archive \"x\"");
         EXPECT_EQ(contents(path), std::to_string(::getpid()) + "\n");
-        expect_error_naming<IoError>([&] { FileLock second(path, "archive \"x\""); },
-                                     "archive \"x\" is locked by another writer (pid " +
-                                         std::to_string(::getpid()) + ",");
+        expect_error_naming<IoError>(
+            [&] { FileLock second(path, "archive \"x\""); },
+            "archive \"x\" is locked by another writer (pid " + std::to_string(::getpid()) + ",");
         remove_temp_files(directory_);
         EXPECT_TRUE(fs::exists(path));
     }

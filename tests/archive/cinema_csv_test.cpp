@@ -13,15 +13,17 @@ namespace insitu::archive_format {
 namespace {
 
 nlohmann::json view_entry(int view, double phi, double theta, const std::string& stem) {
-    return {{"view", view},
-            {"phi", phi},
-            {"theta", theta},
-            {"parts", {"depth"}},
-            {"files",
-             {{{"kind", kProxyKind}, {"path", "proxies/" + stem + ".exr"}, {"bytes", 1},
-               {"crc32", 2}},
-              {{"kind", kPreviewKind}, {"path", "previews/" + stem + ".png"}, {"bytes", 3},
-               {"crc32", 4}}}}};
+    return {
+        {"view", view},
+        {"phi", phi},
+        {"theta", theta},
+        {"parts", {"depth"}},
+        {"files",
+         {{{"kind", kProxyKind}, {"path", "proxies/" + stem + ".exr"}, {"bytes", 1}, {"crc32", 2}},
+          {{"kind", kPreviewKind},
+           {"path", "previews/" + stem + ".png"},
+           {"bytes", 3},
+           {"crc32", 4}}}}};
 }
 
 TEST(CinemaCsv, AnArchiveWithoutStepsHasTheHeaderOnly) {

@@ -8,9 +8,8 @@
 
 #include <cmath>
 #include <filesystem>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "archive/archive_format.hpp"
 #include "insitu/error.hpp"
@@ -38,8 +37,8 @@ nlohmann::json step_entry(std::int64_t step) {
 }
 
 TEST(Manifest, WhatIsWrittenReadsBackValidated) {
-    const fs::path archive = fs::temp_directory_path() /
-                             ("insitu_manifest_test_" + std::to_string(::getpid()));
+    const fs::path archive =
+        fs::temp_directory_path() / ("insitu_manifest_test_" + std::to_string(::getpid()));
     fs::remove_all(archive);
     fs::create_directories(archive);
     nlohmann::json manifest = empty_manifest();
@@ -69,12 +68,11 @@ TEST(Manifest, ListsFilesUnderTheArchiveAndFindsViews) {
                                          "has no view 3");
 }
 
-
 // Issue 19: a NaN time reached manifest.json as null, which the reader then refused, archive and
 // all. The writer's own checks now run before anything is written.
 TEST(Manifest, NeverWritesWhatItsReaderWouldRefuse) {
-    const fs::path archive = fs::temp_directory_path() /
-                             ("insitu_manifest_nan_" + std::to_string(::getpid()));
+    const fs::path archive =
+        fs::temp_directory_path() / ("insitu_manifest_nan_" + std::to_string(::getpid()));
     fs::remove_all(archive);
     fs::create_directories(archive);
     nlohmann::json manifest = empty_manifest();

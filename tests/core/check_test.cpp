@@ -2,10 +2,10 @@
 // place and both values, and is an insitu::Error the boundaries turn into status.
 #include "insitu/core/check.hpp"
 
-#include <string>
-
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+#include <string>
 
 #include "insitu/core/image.hpp"
 
@@ -33,8 +33,8 @@ TEST(Check, PassingChecksDoNothing) {
 
 TEST(Check, FailedComparisonPrintsExpressionPlaceAndBothSides) {
     const std::string message = message_of_failed_check(3, 4);
-    EXPECT_THAT(message, AllOf(HasSubstr("check_test.cpp"), HasSubstr("a == b"),
-                               HasSubstr("3 vs 4")));
+    EXPECT_THAT(message,
+                AllOf(HasSubstr("check_test.cpp"), HasSubstr("a == b"), HasSubstr("3 vs 4")));
 }
 
 TEST(Check, EachSideIsEvaluatedOnce) {

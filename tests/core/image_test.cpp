@@ -2,6 +2,9 @@
 // extension, and errors that name the path.
 #include "insitu/core/image.hpp"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <png.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -15,10 +18,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
-#include <png.h>
 
 #include "insitu/error.hpp"
 

@@ -1,5 +1,7 @@
 #include "insitu/core/intervals.hpp"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <limits>
 #include <random>
@@ -7,10 +9,8 @@
 #include <utility>
 #include <vector>
 
-#include <gtest/gtest.h>
-
-#include "insitu/error.hpp"
 #include "insitu/core/layers.hpp"
+#include "insitu/error.hpp"
 
 namespace insitu {
 namespace {

@@ -2,21 +2,20 @@
 // configs and archives write it, errors naming the offending key or value, and the device table.
 #include "insitu/core/transfer_function.hpp"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
-#include "support/expect_error.hpp"
 #include "insitu/error.hpp"
+#include "support/expect_error.hpp"
 
 namespace insitu {
 namespace {

@@ -2,7 +2,8 @@
 // wrong (kernel, family, selector).
 #include "insitu/device/compute_device.hpp"
 
-#include "device/opencl_device.hpp"
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cctype>
@@ -10,12 +11,9 @@
 #include <string>
 #include <vector>
 
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
-
-#include "support/expect_error.hpp"
-
+#include "device/opencl_device.hpp"
 #include "insitu/error.hpp"
+#include "support/expect_error.hpp"
 
 namespace insitu {
 namespace {
@@ -160,9 +158,7 @@ TEST(ComputeDevice, LaunchWithTheWrongArgumentCountNamesTheKernelAndBothCounts) 
         },
         "5");
     launch_expecting(
-        [&] {
-            opencl.launch(kernel, cl::NDRange(1), cl::NullRange, detail::pack_args(b, c), out);
-        },
+        [&] { opencl.launch(kernel, cl::NDRange(1), cl::NullRange, detail::pack_args(b, c), out); },
         "3");
 }
 
@@ -200,12 +196,11 @@ TEST(ComputeDevice, FamiliesAreBuiltFromCommonTheirSharedFilesAndTheirOwn) {
 TEST(ComputeDevice, BuildErrorsNameTheFileAndLineOfThePartThatFailed) {
     // The broken part follows common.cl, so its line 3 is only reported as line 3 of its own
     // file if the #line directives work.
-    const detail::EmbeddedKernel broken{
-        "tests/device/broken_kernel.cl",
-        "// A deliberate build error on line 3.\n"
-        "__kernel void broken(__global float* out) {\n"
-        "    out[0] = no_such_value;\n"
-        "}\n"};
+    const detail::EmbeddedKernel broken{"tests/device/broken_kernel.cl",
+                                        "// A deliberate build error on line 3.\n"
+                                        "__kernel void broken(__global float* out) {\n"
+                                        "    out[0] = no_such_value;\n"
+                                        "}\n"};
     const auto* common = detail::OpenClDevice::family_sources("common").front();
     try {
         ComputeDevice::shared()->opencl().build_program({common, &broken});

@@ -2,7 +2,6 @@
 // training transfer functions, it predicts a third, held-out one, from attenuation estimated
 // by an opacity edit of the stored proxies and from a proxy pass under the held-out function.
 // Then the device against the host reference, the table round trip, and degenerate inputs.
-#include "insitu/error.hpp"
 #include "insitu/explore/colour_model.hpp"
 
 #include <gtest/gtest.h>
@@ -14,10 +13,11 @@
 #include <iostream>
 #include <random>
 
-#include "support/expect_error.hpp"
-#include "insitu/testing/analytic_fields.hpp"
-#include "insitu/render/proxy_renderer.hpp"
+#include "insitu/error.hpp"
 #include "insitu/explore/transfer_function_edit.hpp"
+#include "insitu/render/proxy_renderer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "support/expect_error.hpp"
 
 namespace insitu {
 namespace {

@@ -3,15 +3,15 @@
 // law; the image-space baseline beside it on nested structures it cannot see.
 #include "insitu/explore/enhancement.hpp"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <functional>
 #include <vector>
 
-#include <gtest/gtest.h>
-
-#include "support/expect_error.hpp"
 #include "insitu/error.hpp"
+#include "support/expect_error.hpp"
 
 namespace insitu {
 namespace {

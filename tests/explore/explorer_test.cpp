@@ -1,5 +1,5 @@
-// insitu::Explorer (exploration by proxy, seed 000 §4-§6) end to end on a small archive written by
-// an Instrument: the stored view is reproduced exactly and matches the ground truth; identity
+// insitu::Explorer (exploration by proxy, seed 000 §4-§6) end to end on a small archive written
+// by an Instrument: the stored view is reproduced exactly and matches the ground truth; identity
 // edits change nothing; opacity edits, new views, lighting, occlusion and enhancement give
 // finite, bounded frames; every bad request names what is wrong; steps written after the
 // Explorer opened appear after refresh(). Also the text options shared by the CLI and the viewer.
@@ -12,16 +12,15 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
-#include "support/expect_error.hpp"
 #include "explore_options.hpp"
-#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/instrument.hpp"
 #include "insitu/render/proxy_renderer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "support/expect_error.hpp"
 
 namespace insitu {
 namespace {

@@ -14,14 +14,14 @@
 #include <string>
 #include <vector>
 
-#include "insitu/testing/metrics.hpp"
-#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/explore/colour_model.hpp"
 #include "insitu/explore/explorer.hpp"
-#include "insitu/instrument.hpp"
-#include "insitu/render/proxy_renderer.hpp"
 #include "insitu/explore/transfer_function_edit.hpp"
 #include "insitu/explore/view_synthesis.hpp"
+#include "insitu/instrument.hpp"
+#include "insitu/render/proxy_renderer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "insitu/testing/metrics.hpp"
 
 namespace insitu {
 namespace {

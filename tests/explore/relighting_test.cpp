@@ -4,21 +4,21 @@
 // unsharp-masking baseline, and light_volume against shade() per interval.
 #include "insitu/explore/relighting.hpp"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 #include <limits>
 #include <string>
 #include <vector>
 
-#include <glm/geometric.hpp>
-#include <glm/trigonometric.hpp>
-#include <gtest/gtest.h>
-
-#include "support/expect_error.hpp"
-#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/error.hpp"
 #include "insitu/render/proxy_renderer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "support/expect_error.hpp"
 
 namespace insitu {
 namespace {

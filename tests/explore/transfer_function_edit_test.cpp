@@ -3,7 +3,6 @@
 // against synthetic rays built from known per-interval transmittances and against proxies
 // rendered under the edited function on a field whose intervals form one run per ray; then the
 // measured error where runs interleave, and extreme scales.
-#include "insitu/error.hpp"
 #include "insitu/explore/transfer_function_edit.hpp"
 
 #include <gtest/gtest.h>
@@ -15,9 +14,10 @@
 #include <numeric>
 #include <random>
 
-#include "support/expect_error.hpp"
-#include "insitu/testing/analytic_fields.hpp"
+#include "insitu/error.hpp"
 #include "insitu/render/proxy_renderer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "support/expect_error.hpp"
 
 namespace insitu {
 namespace {
@@ -298,7 +298,9 @@ TEST(EstimateAttenuation, ExtremeScalesGiveFiniteDefinedResults) {
             }
             // Sum a' = 1 - T' <= 1 (to rounding).
             EXPECT_LE(sum_worst, 1.0 + 1e-5);
-            if (extreme == 0.0) { EXPECT_EQ(sum_worst, 0.0); }
+            if (extreme == 0.0) {
+                EXPECT_EQ(sum_worst, 0.0);
+            }
             // Scale 1000 is ill-conditioned where t is near 1 (d t^s / dt = s t^(s-1)); the
             // estimate still lands within 1e-3 of the exact edit.
             EXPECT_LE(max_difference(result, expected), 1e-3);

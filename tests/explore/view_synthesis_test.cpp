@@ -14,10 +14,10 @@
 #include <limits>
 #include <vector>
 
-#include "support/expect_error.hpp"
-#include "insitu/testing/analytic_fields.hpp"
-#include "insitu/render/distortion_camera.hpp"
 #include "insitu/error.hpp"
+#include "insitu/render/distortion_camera.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "support/expect_error.hpp"
 
 namespace insitu {
 namespace {
@@ -383,7 +383,9 @@ TEST(ViewSynthesis, RevealedPixelsAreFlaggedNotInvented) {
         // around the front sphere, so what it trusts must be right: within 2.5 voxels, about two
         // target pixels, because its tilted rays meet this part of the back sphere obliquely and
         // sample it coarsely (measured 2.1 voxels; a wrong sphere would be off by 10 or more).
-        if (!frame->multi_perspective) { EXPECT_EQ(revealed_trusted, 0); }
+        if (!frame->multi_perspective) {
+            EXPECT_EQ(revealed_trusted, 0);
+        }
         EXPECT_LE(worst_trusted, 2.5);
     }
 }

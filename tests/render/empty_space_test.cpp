@@ -3,12 +3,12 @@
 // skipping leaves every proxy unchanged is checked in proxy_renderer_test.cpp.
 #include "render/empty_space.hpp"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 namespace insitu::detail {
 namespace {

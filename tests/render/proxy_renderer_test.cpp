@@ -3,15 +3,16 @@
 // distortion camera (Eq. 1-4).
 #include "insitu/render/proxy_renderer.hpp"
 
-#include <cmath>
-#include <limits>
-#include <string>
-
-#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
-#include "insitu/testing/analytic_fields.hpp"
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <limits>
+#include <sstream>
+#include <string>
+
 #include "insitu/error.hpp"
+#include "insitu/testing/analytic_fields.hpp"
 
 namespace insitu {
 namespace {
@@ -50,6 +51,24 @@ struct SphereScene {
     double radius = 13.0;
 };
 
+TEST(ProxyFrame, PrintsWhatItHolds) {
+    ProxyFrame frame;
+    frame.isovalues = {0.25, 0.5};
+    frame.depth_layers = {Image(4, 2, 1, 1.5f), Image(4, 2, 1, 2.5f)};
+    frame.attenuation = Image(4, 2, 3, 0.125f);
+    std::ostringstream text;
+    text << frame;
+    const std::string printed = text.str();
+    EXPECT_NE(printed.find("single perspective"), std::string::npos) << printed;
+    EXPECT_NE(printed.find("isovalues [0.25, 0.5]"), std::string::npos) << printed;
+    EXPECT_NE(printed.find("2 depth layers (Image 4x2x1, values in [1.5, 1.5])"), std::string::npos)
+        << printed;
+    EXPECT_NE(printed.find("attenuation (Image 4x2x3, values in [0.125, 0.125])"),
+              std::string::npos)
+        << printed;
+    EXPECT_EQ(printed.find("distortion"), std::string::npos) << printed;
+}
+
 TEST(ProxyRenderer, SphereDepthLayersMatchTheAnalyticDistance) {
     SphereScene scene;
     ProxyRenderer renderer;
@@ -76,8 +95,8 @@ TEST(ProxyRenderer, SphereDepthLayersMatchTheAnalyticDistance) {
                     for (int x = 0; x < view.width; ++x) {
                         const Ray ray = camera.ray(x + 0.5, y + 0.5);
                         double impact = 0.0;
-                        const double t = ray_sphere(ray, scene.centre,
-                                                    scene.radius + isovalues[l], &impact);
+                        const double t =
+                            ray_sphere(ray, scene.centre, scene.radius + isovalues[l], &impact);
                         const float depth = frame.depth_layers[l].at(x, y, 0);
                         if (impact > 1.02) {
                             EXPECT_TRUE(std::isinf(depth)) << "miss at " << x << "," << y;
@@ -131,8 +150,8 @@ TEST(ProxyRenderer, DistortionCameraUndistortsToTheSphereAndReprojects) {
                 worst = std::max(worst, glm::length(recovered - hit));
                 const glm::dvec2 reprojected =
                     camera.reproject(x + 0.5, y + 0.5, depth, distortion, target);
-                worst_pixels = std::max(worst_pixels,
-                                        glm::length(reprojected - target.project(hit)));
+                worst_pixels =
+                    std::max(worst_pixels, glm::length(reprojected - target.project(hit)));
                 ++checked;
             }
         }
@@ -155,7 +174,8 @@ TEST(ProxyRenderer, ZeroTiltMultiPerspectiveEqualsOrthographic) {
     const ProxyRequest request = depth_only({0.0, 4.0});
     const ProxyFrame multi =
         renderer.render(DistortionCamera::orbit(view, renderer.volume().bounds, 0.0), request);
-    const ProxyFrame single = renderer.render(Camera::orbit(view, renderer.volume().bounds), request);
+    const ProxyFrame single =
+        renderer.render(Camera::orbit(view, renderer.volume().bounds), request);
     for (std::size_t l = 0; l < 2; ++l) {
         for (std::size_t i = 0; i < single.depth_layers[l].pixels.size(); ++i) {
             const float a = multi.depth_layers[l].pixels[i];
@@ -172,7 +192,8 @@ TEST(ProxyRenderer, ZeroTiltMultiPerspectiveEqualsOrthographic) {
 
 // A transfer function whose colour is constant on each interval (duplicate control points at
 // the edges make the jumps) and whose opacity varies smoothly.
-TransferFunction colour_per_interval(const IntervalSet& intervals, std::vector<glm::vec3>* colours) {
+TransferFunction colour_per_interval(const IntervalSet& intervals,
+                                     std::vector<glm::vec3>* colours) {
     std::vector<ControlPoint> points;
     const auto& edges = intervals.edges();
     for (int j = 0; j < intervals.count(); ++j) {
@@ -197,11 +218,12 @@ TEST(ProxyRenderer, AttenuationSumsToOneMinusTransmittance) {
     renderer.upload(scene.volume.field());
     VolumeRenderer ground_truth;
     ground_truth.upload(scene.volume.field());
-    const TransferFunction tf({{0.0, {1, 1, 1, 0.0}}, {0.5, {1, 0, 0, 0.3}}, {1.2, {0, 0, 1, 0.9}}});
+    const TransferFunction tf(
+        {{0.0, {1, 1, 1, 0.0}}, {0.5, {1, 0, 0, 0.3}}, {1.2, {0, 0, 1, 0.9}}});
     for (int count : {1, 7, 16}) {
         ProxyRequest request;
-        request.intervals = IntervalSet::uniform(renderer.volume().range.min,
-                                                 renderer.volume().range.max, count);
+        request.intervals =
+            IntervalSet::uniform(renderer.volume().range.min, renderer.volume().range.max, count);
         request.transfer_function = tf;
         OrbitView view;
         view.azimuth_deg = 20.0 * count;
@@ -449,8 +471,11 @@ TEST(ProxyRenderer, ChoosesIntervalsAndLayersFromTheUploadedData) {
     const IntervalSet equalized = renderer.choose_intervals(5, IntervalMode::histogram_equalized);
     const auto& e = equalized.edges();
     EXPECT_LT(e[5] - e[4], e[1] - e[0]);
-    const TransferFunction tf({{0.0, {1, 1, 1, 0}}, {10.0, {1, 1, 1, 0.7}}, {12.0, {1, 1, 1, 0}},
-                               {50.0, {1, 1, 1, 0.9}}, {60.0, {1, 1, 1, 0}}});
+    const TransferFunction tf({{0.0, {1, 1, 1, 0}},
+                               {10.0, {1, 1, 1, 0.7}},
+                               {12.0, {1, 1, 1, 0}},
+                               {50.0, {1, 1, 1, 0.9}},
+                               {60.0, {1, 1, 1, 0}}});
     // The peak at 50 lies beyond the data (max distance ~32.9): one layer, at 10.
     const std::vector<double> layers = renderer.choose_layers(tf, 4);
     ASSERT_EQ(layers.size(), 1u);

@@ -4,9 +4,13 @@
 // functions and cameras.
 #include "insitu/render/volume_renderer.hpp"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <glm/geometric.hpp>
 #include <limits>
 #include <ostream>
 #include <sstream>
@@ -14,12 +18,8 @@
 #include <utility>
 #include <vector>
 
-#include <glm/geometric.hpp>
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
-
-#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/error.hpp"
+#include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/reference_renderer.hpp"
 
 namespace insitu {

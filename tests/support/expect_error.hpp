@@ -1,9 +1,9 @@
 #pragma once
 // Shared assertion of the test suites: a call raises a typed error whose message names a value.
-#include <string>
-
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+#include <string>
 
 namespace insitu::testing {
 

@@ -26,11 +26,10 @@
 // function gets a ground-truth rendering and attenuation proxies of its own, the model is fitted
 // on those pairs and stored in the archive (the renderings only with "keep_training_images").
 #include <cstdint>
+#include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json_fwd.hpp>
 
 #include "insitu/core/camera.hpp"
 #include "insitu/core/intervals.hpp"
@@ -48,14 +47,14 @@ struct ViewConfig {
 };
 
 enum class StoragePrecision { half, single };  ///< "half" / "float"
-enum class WhenFull { block, drop };            ///< writer policy when its queue is full
+enum class WhenFull { block, drop };           ///< writer policy when its queue is full
 
 /// Proxies a run emits ("proxies" list). "multi_attenuation" without "distortion" still makes a
 /// multi-perspective frame, holding only the attenuation proxies.
 struct ProxySelection {
-    bool depth = true;          ///< "depth": single-perspective depth layers
-    bool distortion = true;     ///< "distortion": multi-perspective depth + distortion layers
-    bool attenuation = true;    ///< "attenuation": a_j and mean depth, single perspective
+    bool depth = true;               ///< "depth": single-perspective depth layers
+    bool distortion = true;          ///< "distortion": multi-perspective depth + distortion layers
+    bool attenuation = true;         ///< "attenuation": a_j and mean depth, single perspective
     bool multi_attenuation = false;  ///< "multi_attenuation": the same from the distortion camera
     bool optical_depth = false;      ///< "optical_depth": tau_j as well
 };
@@ -92,9 +91,9 @@ struct InstrumentConfig {
         std::vector<ControlPoint>{{0.0, {0, 0, 1, 0}}, {1.0, {1, 0, 0, 0.5}}}, 1.0};
     std::vector<TransferFunction> training_transfer_functions;  ///< default none
     /// "layers": explicit isovalues, or "auto" (empty here) = opacity peaks, at most max_layers.
-    std::optional<std::vector<double>> layers;  ///< nullopt = "auto"
-    int max_auto_layers = 4;                    ///< "max_layers"
-    int interval_count = 16;                    ///< "intervals": {"count": ..}
+    std::optional<std::vector<double>> layers;           ///< nullopt = "auto"
+    int max_auto_layers = 4;                             ///< "max_layers"
+    int interval_count = 16;                             ///< "intervals": {"count": ..}
     IntervalMode interval_mode = IntervalMode::uniform;  ///< "intervals": {"mode": ..}
     ProxySelection proxies;
     double step_voxels = 1.0;  ///< "step": ray step in voxels
@@ -103,8 +102,8 @@ struct InstrumentConfig {
     std::vector<std::int64_t> steps;
     std::string archive = "run.cdb";  ///< "archive": directory of the proxy archive
     StoragePrecision precision = StoragePrecision::half;
-    std::string compression = "zip";  ///< "compression": none, rle, zips, zip, piz, pxr24, b44
-    int writer_queue = 4;             ///< "writer": {"queue": N}, steps held in memory at most
+    std::string compression = "zip";       ///< "compression": none, rle, zips, zip, piz, pxr24, b44
+    int writer_queue = 4;                  ///< "writer": {"queue": N}, steps held in memory at most
     WhenFull when_full = WhenFull::block;  ///< "writer": {"when_full": "block" | "drop"}
     bool keep_training_images = false;     ///< "keep_training_images"
     ColourModelConfig colour_model;        ///< "colour_model"

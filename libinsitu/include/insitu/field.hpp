@@ -6,11 +6,10 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <glm/vec3.hpp>
 #include <iosfwd>
 #include <string>
 #include <vector>
-
-#include <glm/vec3.hpp>
 
 namespace insitu {
 

@@ -20,23 +20,23 @@
 namespace insitu {
 
 enum class Status {
-    ok,           ///< proxies computed and queued (or written)
-    not_selected, ///< the cadence skipped this step
-    dropped,      ///< writer queue full with when_full = drop: this step was not stored
-    error,        ///< see last_error(); nothing already written was lost
+    ok,            ///< proxies computed and queued (or written)
+    not_selected,  ///< the cadence skipped this step
+    dropped,       ///< writer queue full with when_full = drop: this step was not stored
+    error,         ///< see last_error(); nothing already written was lost
 };
 std::string to_string(Status status);
 std::ostream& operator<<(std::ostream& out, Status status);
 
 struct InstrumentStatistics {
-    std::int64_t steps_executed = 0;   ///< execute() calls that computed proxies
+    std::int64_t steps_executed = 0;  ///< execute() calls that computed proxies
     std::int64_t steps_written = 0;
     std::int64_t steps_dropped = 0;
     std::int64_t errors = 0;
     std::uint64_t bytes_written = 0;
-    double compute_seconds = 0.0;      ///< in execute(), computing proxies
-    double blocked_seconds = 0.0;      ///< in execute(), waiting for room in the writer queue
-    double write_seconds = 0.0;        ///< on the writer thread
+    double compute_seconds = 0.0;  ///< in execute(), computing proxies
+    double blocked_seconds = 0.0;  ///< in execute(), waiting for room in the writer queue
+    double write_seconds = 0.0;    ///< on the writer thread
     /// NaN/Inf samples met in the visualised fields, summed over steps (treated as empty space).
     std::int64_t nonfinite_samples = 0;
 };

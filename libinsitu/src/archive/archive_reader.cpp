@@ -8,11 +8,10 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
 #include <utility>
-
-#include <nlohmann/json.hpp>
 
 #include "archive/archive_format.hpp"
 #include "archive/cinema_csv.hpp"
@@ -163,8 +162,7 @@ std::vector<std::string> ArchiveReader::verify() const {
         if (!inside(root, file.absolute_path)) {
             outside.insert(fs::absolute(file.absolute_path).lexically_normal());
             problems.push_back("\"" + file.absolute_path + "\" resolves to \"" +
-                               resolved(file.absolute_path).string() +
-                               "\", outside the archive");
+                               resolved(file.absolute_path).string() + "\", outside the archive");
             continue;
         }
         try {
@@ -195,8 +193,7 @@ void ArchiveReader::verify_cinema_csv(const fs::path& root, const std::set<fs::p
     for (const af::CsvRow& row : rows) {
         const std::string where = "\"" + file + "\" line " + std::to_string(row.line) + ": ";
         if (row.columns.size() != 7) {
-            problems.push_back(where + std::to_string(row.columns.size()) +
-                               " columns, expected 7");
+            problems.push_back(where + std::to_string(row.columns.size()) + " columns, expected 7");
             continue;
         }
         std::int64_t step = 0;
@@ -245,8 +242,8 @@ void ArchiveReader::verify_cinema_csv(const fs::path& root, const std::set<fs::p
             const std::string png = view_file(view, af::kPreviewKind);
             if (row->second->columns[5] != exr || row->second->columns[6] != png) {
                 problems.push_back("\"" + file + "\" line " + std::to_string(row->second->line) +
-                                   ": " + what + " names other files than the manifest (" +
-                                   exr + ", " + png + ")");
+                                   ": " + what + " names other files than the manifest (" + exr +
+                                   ", " + png + ")");
             }
         }
     }

@@ -17,11 +17,10 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
 #include <sstream>
-
-#include <nlohmann/json.hpp>
 
 #include "archive/archive_format.hpp"
 #include "archive/atomic_file.hpp"
@@ -106,8 +105,8 @@ void validate_record(const StepRecord& record, const ArchiveWriter& writer) {
         }
         for (const double angle : {view.view.orbit.azimuth_deg, view.view.orbit.elevation_deg}) {
             if (!std::isfinite(angle)) {
-                fail<InvalidArgument>(where, " view ", view.view_index, ": angle = ",
-                                      number_text(angle), " cannot be stored");
+                fail<InvalidArgument>(where, " view ", view.view_index,
+                                      ": angle = ", number_text(angle), " cannot be stored");
             }
         }
         if (view.preview.channels != 1 && view.preview.channels != 3 &&

@@ -44,9 +44,8 @@ void fsync_directory(const fs::path& directory) {
 TempFile::TempFile(fs::path final_path) : final_(std::move(final_path)) {
     // pid + counter: unique within the folder without asking the file system.
     static std::atomic<unsigned> counter{0};
-    temp_ = final_.parent_path() /
-            (std::string(kTempPrefix) + std::to_string(::getpid()) + "-" +
-             std::to_string(counter++) + "-" + final_.filename().string());
+    temp_ = final_.parent_path() / (std::string(kTempPrefix) + std::to_string(::getpid()) + "-" +
+                                    std::to_string(counter++) + "-" + final_.filename().string());
 }
 
 TempFile::~TempFile() {
@@ -144,8 +143,7 @@ std::uint64_t append_to_file(const fs::path& path, const std::string& bytes) {
         // Best effort: a cut that fails too leaves a torn last line, which readers skip.
         if (::ftruncate(fd, static_cast<off_t>(previous)) == 0) ::fsync(fd);
         ::close(fd);
-        fail<IoError>("cannot append to \"", path.string(), "\": ", what, ": ",
-                      errno_text(error));
+        fail<IoError>("cannot append to \"", path.string(), "\": ", what, ": ", errno_text(error));
     }
     if (::close(fd) != 0) {
         fail<IoError>("cannot append to \"", path.string(), "\": close: ", errno_text(errno));
@@ -187,8 +185,8 @@ FileLock::FileLock(const fs::path& path, const std::string& what) {
         fd_ = -1;
         if (error == EWOULDBLOCK) {
             fail<IoError>(what, " is locked by another writer (pid ",
-                          holder.empty() ? std::string("unknown") : holder,
-                          ", lock file \"", path.string(), "\"): one writer at a time");
+                          holder.empty() ? std::string("unknown") : holder, ", lock file \"",
+                          path.string(), "\"): one writer at a time");
         }
         fail<IoError>(what, ": cannot lock \"", path.string(), "\": ", errno_text(error));
     }
@@ -198,8 +196,8 @@ FileLock::FileLock(const fs::path& path, const std::string& what) {
         const int error = errno;
         ::close(fd_);
         fd_ = -1;
-        fail<IoError>(what, ": cannot write lock file \"", path.string(), "\": ",
-                      errno_text(error));
+        fail<IoError>(what, ": cannot write lock file \"", path.string(),
+                      "\": ", errno_text(error));
     }
 }
 

@@ -4,10 +4,9 @@
 // and FILE last, naming the PNG preview (Cinema viewers read PNG, not EXR).
 #include <cstddef>
 #include <cstdint>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json_fwd.hpp>
 
 namespace insitu::archive_format {
 

@@ -26,9 +26,8 @@
 #include <cstring>
 #include <map>
 #include <memory>
-#include <optional>
-
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "archive/archive_format.hpp"
 #include "insitu/error.hpp"
@@ -82,7 +81,7 @@ struct ChannelSource {
 struct PartSource {
     std::string name;
     std::vector<ChannelSource> channels;
-    nlohmann::json training_function;  ///< train<k> parts only
+    nlohmann::json training_function;    ///< train<k> parts only
     const ColourModel* model = nullptr;  ///< model parts only
     /// Pixels made for the part (the model's table as an image); shared so that channel
     /// pointers stay valid when the part is moved.
@@ -197,8 +196,7 @@ void add_frame_attributes(Imf::Header& header, const StepRecord& record, const V
     header.insert(kTimeAttribute, Imf::DoubleAttribute(record.time));
     header.insert(kFieldAttribute, Imf::StringAttribute(record.field));
     header.insert(kViewAttribute, Imf::IntAttribute(view.view_index));
-    header.insert(kViewConfigAttribute,
-                  Imf::StringAttribute(view.view.to_json().dump()));
+    header.insert(kViewConfigAttribute, Imf::StringAttribute(view.view.to_json().dump()));
     header.insert(kPerspectiveAttribute,
                   Imf::StringAttribute(frame.multi_perspective ? "multi" : "single"));
     header.insert(kCameraAttribute, Imf::StringAttribute(frame.camera.to_json().dump()));
@@ -209,8 +207,7 @@ void add_frame_attributes(Imf::Header& header, const StepRecord& record, const V
     header.insert(kIsovaluesAttribute,
                   Imf::StringAttribute(nlohmann::json(frame.isovalues).dump()));
     if (frame.intervals) {
-        header.insert(kIntervalsAttribute,
-                      Imf::StringAttribute(frame.intervals->to_json().dump()));
+        header.insert(kIntervalsAttribute, Imf::StringAttribute(frame.intervals->to_json().dump()));
     }
     header.insert(kTransferFunctionAttribute,
                   Imf::StringAttribute(view.transfer_function.to_json().dump()));
@@ -478,8 +475,7 @@ Image channel_range(const Image& all, int first, int count) {
 /// a_j, and z-mean and tau when present, of an "attenuation" part.
 void read_attenuation(Imf::InputPart& part, ProxyFrame& frame, const PartContext& where) {
     const Imf::ChannelList& channels = part.header().channels();
-    const char* suffixes[3] = {kAttenuationChannel, kMeanDepthChannel,
-                               kOpticalDepthChannel};
+    const char* suffixes[3] = {kAttenuationChannel, kMeanDepthChannel, kOpticalDepthChannel};
     Image* targets[3] = {&frame.attenuation, &frame.mean_depth, &frame.optical_depth};
     int counts[3];
     std::vector<std::string> names;
@@ -522,13 +518,11 @@ Image read_training(Imf::InputPart& part, const PartContext& where) {
 /// The colour model of a "model" part: its table image, checked against L and K.
 ColourModel read_model(Imf::InputPart& part, const PartContext& where) {
     const Imf::Header& header = part.header();
-    const auto* intervals =
-        header.findTypedAttribute<Imf::IntAttribute>(kModelIntervalsAttribute);
-    const auto* clusters =
-        header.findTypedAttribute<Imf::IntAttribute>(kModelClustersAttribute);
+    const auto* intervals = header.findTypedAttribute<Imf::IntAttribute>(kModelIntervalsAttribute);
+    const auto* clusters = header.findTypedAttribute<Imf::IntAttribute>(kModelClustersAttribute);
     if (!intervals || !clusters) {
-        where.error(std::string("no int attributes \"") + kModelIntervalsAttribute +
-                    "\" and \"" + kModelClustersAttribute + "\"");
+        where.error(std::string("no int attributes \"") + kModelIntervalsAttribute + "\" and \"" +
+                    kModelClustersAttribute + "\"");
     }
     const std::string channel = where.part + kModelChannel;
     if (!header.channels().findChannel(channel)) where.error("no channel \"" + channel + "\"");

@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
-
-#include <nlohmann/json.hpp>
 
 #include "archive/archive_format.hpp"
 #include "archive/atomic_file.hpp"
@@ -66,8 +65,8 @@ const nlohmann::json& require(const nlohmann::json& object, const char* key, Exp
     }
     const nlohmann::json& value = object.at(key);
     if (!holds(value, expect)) {
-        fail<ParseError>("\"", file, "\": key \"", name, "\" has the wrong type: ",
-                         value_text(value));
+        fail<ParseError>("\"", file, "\": key \"", name,
+                         "\" has the wrong type: ", value_text(value));
     }
     return value;
 }
@@ -119,8 +118,8 @@ void check_step_entry(const nlohmann::json& step, const std::string& file,
         for (std::size_t f = 0; f < files.size(); ++f) {
             const std::string file_where = view_where + ".files[" + std::to_string(f) + "]";
             kinds.insert(require(files[f], "kind", Expect::string, file, file_where));
-            check_relative_path(require(files[f], "path", Expect::string, file, file_where),
-                                file, file_where);
+            check_relative_path(require(files[f], "path", Expect::string, file, file_where), file,
+                                file_where);
             require(files[f], "bytes", Expect::count, file, file_where);
             require(files[f], "crc32", Expect::crc32, file, file_where);
         }
@@ -234,8 +233,8 @@ Index read_index(const std::string& archive_path) {
                     // rename and before the journal went. Anything else is a conflict.
                     const auto same = std::find(entries.begin(), entries.end(), entry);
                     if (same == entries.end()) {
-                        fail<ParseError>("\"", journal.string(), "\": ", where, ": step ",
-                                         number, " is repeated");
+                        fail<ParseError>("\"", journal.string(), "\": ", where, ": step ", number,
+                                         " is repeated");
                     }
                 } else {
                     entries.push_back(std::move(entry));

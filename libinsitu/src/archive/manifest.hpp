@@ -18,10 +18,9 @@
 // opens the archive moves it, verbatim, to "malformed_steps" with the reason (kept for whoever
 // repairs the archive, never read as a step). A broken top level is still refused whole.
 #include <cstdint>
+#include <nlohmann/json.hpp>  // Index holds values
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>  // Index holds values
 
 #include "insitu/archive/archive_writer.hpp"
 

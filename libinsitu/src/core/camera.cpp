@@ -3,11 +3,10 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <ostream>
-
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 #include <nlohmann/json.hpp>
+#include <ostream>
 
 #include "insitu/error.hpp"
 
@@ -187,9 +186,10 @@ Camera Camera::from_json(const json& object) {
          glm::length(camera.up() - vec3(object, "up")), std::abs(camera.half_width() - half_width),
          std::abs(camera.half_height() - half_height)});
     if (!(mismatch <= tolerance)) {
-        fail<InvalidArgument>("camera JSON is inconsistent (position, forward, right, up, "
-                              "half_width and half_height differ by ",
-                              mismatch, " from its orbit parameters)");
+        fail<InvalidArgument>(
+            "camera JSON is inconsistent (position, forward, right, up, "
+            "half_width and half_height differ by ",
+            mismatch, " from its orbit parameters)");
     }
     return camera;
 }

@@ -1,16 +1,16 @@
 #include "insitu/core/image.hpp"
 
-#include <algorithm>
-#include <cmath>
-#include <limits>
-#include <ostream>
-
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <png.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <ostream>
 
 #include "insitu/error.hpp"
 
@@ -49,8 +49,7 @@ std::ostream& operator<<(std::ostream& out, const Image& image) {
 float linear_to_srgb(float linear) {
     if (!(linear > 0.0f)) return 0.0f;  // also maps NaN to 0
     if (linear >= 1.0f) return 1.0f;
-    return linear <= 0.0031308f ? 12.92f * linear
-                                : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
+    return linear <= 0.0031308f ? 12.92f * linear : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
 }
 
 namespace {
@@ -157,10 +156,11 @@ void write_exr(const std::string& path, const Image& image,
         const std::size_t y_stride = x_stride * image.width;
         for (int c = 0; c < image.channels; ++c) {
             header.channels().insert(channel_names[c], Imf::Channel(Imf::FLOAT));
-            frame.insert(channel_names[c],
-                         Imf::Slice(Imf::FLOAT,
-                                    reinterpret_cast<char*>(const_cast<float*>(image.pixels.data()) + c),
-                                    x_stride, y_stride));
+            frame.insert(
+                channel_names[c],
+                Imf::Slice(Imf::FLOAT,
+                           reinterpret_cast<char*>(const_cast<float*>(image.pixels.data()) + c),
+                           x_stride, y_stride));
         }
         Imf::OutputFile file(path.c_str(), header);
         file.setFrameBuffer(frame);

@@ -2,9 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <ostream>
-
 #include <nlohmann/json.hpp>
+#include <ostream>
 
 #include "insitu/error.hpp"
 
@@ -35,8 +34,7 @@ double between(double lo, double hi, double numerator, double denominator) {
 
 void check_count(int count) {
     if (count < 1 || count > kMaxIntervals) {
-        fail<InvalidArgument>("interval count = ", count, " (must be in [1, ", kMaxIntervals,
-                              "])");
+        fail<InvalidArgument>("interval count = ", count, " (must be in [1, ", kMaxIntervals, "])");
     }
 }
 }  // namespace
@@ -124,7 +122,9 @@ int IntervalSet::index_of(double value) const {
     return static_cast<int>(upper - (edges_.begin() + 1));
 }
 
-nlohmann::json IntervalSet::to_json() const { return nlohmann::json{{"edges", edges_}}; }
+nlohmann::json IntervalSet::to_json() const {
+    return nlohmann::json{{"edges", edges_}};
+}
 
 std::ostream& operator<<(std::ostream& out, const IntervalSet& intervals) {
     return out << "IntervalSet" << intervals.to_json().dump();

@@ -46,7 +46,8 @@ std::vector<double> opacity_peaks(const TransferFunction& tf, const ValueRange& 
         constexpr int kScan = 1024;
         float largest = 0.0f;
         for (int s = 0; s <= kScan; ++s) {
-            largest = std::max(largest, tf.evaluate(range.min + (range.max - range.min) * s / kScan).a);
+            largest =
+                std::max(largest, tf.evaluate(range.min + (range.max - range.min) * s / kScan).a);
         }
         for (int s = 0; s <= kScan && largest > 0.0f; ++s) {
             const double value = range.min + (range.max - range.min) * s / kScan;

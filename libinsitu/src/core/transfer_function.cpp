@@ -4,10 +4,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <ostream>
 #include <sstream>
-
-#include <nlohmann/json.hpp>
 
 #include "insitu/error.hpp"
 
@@ -25,8 +24,8 @@ void validate_row(const TransferRow& row, const std::string& where) {
         }
         if (i > 0 && point.value < row.points[i - 1].value) {
             fail<InvalidArgument>(where, ": points[", i, "] value = ", point.value,
-                                  " is below points[", i - 1, "] value = ",
-                                  row.points[i - 1].value, " (points must be sorted by value)");
+                                  " is below points[", i - 1, "] value = ", row.points[i - 1].value,
+                                  " (points must be sorted by value)");
         }
         for (int c = 0; c < 4; ++c) {
             const float component = point.rgba[c];
@@ -50,8 +49,9 @@ glm::vec4 evaluate_row(const TransferRow& row, double value) {
     const auto& points = row.points;
     if (!(value > points.front().value)) return points.front().rgba;
     if (!(value < points.back().value)) return points.back().rgba;
-    const auto upper = std::upper_bound(points.begin(), points.end(), value,
-                                        [](double v, const ControlPoint& p) { return v < p.value; });
+    const auto upper =
+        std::upper_bound(points.begin(), points.end(), value,
+                         [](double v, const ControlPoint& p) { return v < p.value; });
     const ControlPoint& right = *upper;
     const ControlPoint& left = *(upper - 1);
     const double span = right.value - left.value;
@@ -74,9 +74,9 @@ std::vector<ControlPoint> points_from_json(const nlohmann::json& json, const std
                                  " (expected a number)");
             }
         }
-        points.push_back({entry[0].get<double>(),
-                          glm::vec4(entry[1].get<float>(), entry[2].get<float>(),
-                                    entry[3].get<float>(), entry[4].get<float>())});
+        points.push_back(
+            {entry[0].get<double>(), glm::vec4(entry[1].get<float>(), entry[2].get<float>(),
+                                               entry[3].get<float>(), entry[4].get<float>())});
     }
     return points;
 }
@@ -135,14 +135,16 @@ TransferFunction TransferFunction::from_json(const nlohmann::json& json) {
     const bool has_points = json.contains("points");
     const bool has_rows = json.contains("gradient_rows");
     if (has_points == has_rows) {
-        fail<ParseError>("transfer function: give exactly one of \"points\" (1D) or "
-                         "\"gradient_rows\" (2D)");
+        fail<ParseError>(
+            "transfer function: give exactly one of \"points\" (1D) or "
+            "\"gradient_rows\" (2D)");
     }
     if (has_points) {
         return TransferFunction(points_from_json(json["points"], "transfer function"), unit_length);
     }
     const auto& rows_json = json["gradient_rows"];
-    if (!rows_json.is_array()) fail<ParseError>("transfer function: gradient_rows must be an array");
+    if (!rows_json.is_array())
+        fail<ParseError>("transfer function: gradient_rows must be an array");
     std::vector<TransferRow> rows;
     for (std::size_t r = 0; r < rows_json.size(); ++r) {
         const std::string where = "transfer function gradient_rows[" + std::to_string(r) + "]";
@@ -152,7 +154,8 @@ TransferFunction TransferFunction::from_json(const nlohmann::json& json) {
             fail<ParseError>(where, " = ", row.dump(),
                              " (expected {\"gradient_magnitude\": number, \"points\": [...]})");
         }
-        rows.push_back({row["gradient_magnitude"].get<double>(), points_from_json(row["points"], where)});
+        rows.push_back(
+            {row["gradient_magnitude"].get<double>(), points_from_json(row["points"], where)});
     }
     return TransferFunction(std::move(rows), unit_length);
 }
@@ -250,8 +253,8 @@ TransferTable TransferFunction::sample(int value_bins, int gradient_bins) const 
         const double gradient =
             table.gradient_bins > 1 ? table.gradient_max * g / (table.gradient_bins - 1) : 0.0;
         for (int v = 0; v < table.value_bins; ++v) {
-            const double value = table.value_min +
-                                 (table.value_max - table.value_min) * v / (table.value_bins - 1);
+            const double value =
+                table.value_min + (table.value_max - table.value_min) * v / (table.value_bins - 1);
             const glm::vec4 rgba = evaluate(value, gradient);
             float* out = &table.rgba[(static_cast<std::size_t>(g) * table.value_bins + v) * 4];
             for (int c = 0; c < 4; ++c) out[c] = rgba[c];

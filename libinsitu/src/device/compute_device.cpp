@@ -1,12 +1,12 @@
 #include "insitu/device/compute_device.hpp"
 
-#include "device/kernel_constants.hpp"
-#include "device/opencl_device.hpp"
-
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
 #include <sstream>
+
+#include "device/kernel_constants.hpp"
+#include "device/opencl_device.hpp"
 
 namespace insitu {
 namespace detail {
@@ -51,9 +51,10 @@ Choice choose_device(const std::string& selector) {
         platforms.clear();
     }
     if (platforms.empty()) {
-        fail<ComputeError>("no OpenCL platform found: install an OpenCL driver (scripts/setup "
-                           "installs PoCL, Debian package pocl-opencl-icd) or check "
-                           "/etc/OpenCL/vendors");
+        fail<ComputeError>(
+            "no OpenCL platform found: install an OpenCL driver (scripts/setup "
+            "installs PoCL, Debian package pocl-opencl-icd) or check "
+            "/etc/OpenCL/vendors");
     }
 
     std::vector<Choice> all;
@@ -109,7 +110,8 @@ Choice choose_device(const std::string& selector) {
 std::string opencl_status_name(cl_int status) {
     switch (status) {
 #define INSITU_CL_CASE(code) \
-    case code: return std::string(#code) + " (" + std::to_string(code) + ")";
+    case code:               \
+        return std::string(#code) + " (" + std::to_string(code) + ")";
         INSITU_CL_CASE(CL_SUCCESS)
         INSITU_CL_CASE(CL_DEVICE_NOT_FOUND)
         INSITU_CL_CASE(CL_OUT_OF_RESOURCES)
@@ -130,7 +132,8 @@ std::string opencl_status_name(cl_int status) {
         INSITU_CL_CASE(CL_INVALID_GLOBAL_WORK_SIZE)
         INSITU_CL_CASE(CL_PLATFORM_NOT_FOUND_KHR)
 #undef INSITU_CL_CASE
-        default: return "OpenCL status " + std::to_string(status);
+        default:
+            return "OpenCL status " + std::to_string(status);
     }
 }
 
@@ -181,8 +184,7 @@ const EmbeddedKernel& embedded(const std::string& stem) {
     const auto& sources = embedded_kernel_sources();
     const auto found = sources.find(stem);
     if (found == sources.end()) {
-        fail<ComputeError>("no embedded kernel family \"", stem, "\" (kernels/**/", stem,
-                           ".cl)");
+        fail<ComputeError>("no embedded kernel family \"", stem, "\" (kernels/**/", stem, ".cl)");
     }
     return found->second;
 }
@@ -218,8 +220,8 @@ cl::Program OpenClDevice::build_program(const std::vector<const EmbeddedKernel*>
     } catch (const cl::BuildError& error) {
         std::string log;
         for (const auto& entry : error.getBuildLog()) log += entry.second;
-        fail<ComputeError>("building ", path, " for ", description_, " failed: ",
-                           opencl_status_name(error.err()), "\nbuild log:\n", log);
+        fail<ComputeError>("building ", path, " for ", description_,
+                           " failed: ", opencl_status_name(error.err()), "\nbuild log:\n", log);
     } catch (const cl::Error& error) {
         fail<ComputeError>("building ", path, " failed: ", opencl_status_name(error.err()));
     }
@@ -264,7 +266,7 @@ void OpenClDevice::check_argument_count(cl::Kernel& kernel, std::size_t given) {
 }
 
 void OpenClDevice::enqueue(cl::Kernel& kernel, const cl::NDRange& global,
-                            const cl::NDRange& local) {
+                           const cl::NDRange& local) {
     try {
         cl::Event event;
         queue_.enqueueNDRangeKernel(kernel, cl::NullRange, global, local, nullptr, &event);
@@ -281,18 +283,18 @@ void OpenClDevice::enqueue(cl::Kernel& kernel, const cl::NDRange& global,
 }
 
 void OpenClDevice::fail_launch(cl::Kernel& kernel, const std::string& stage,
-                                const cl::Error& error) {
+                               const cl::Error& error) {
     std::string name = "?";
     try {
         name = kernel.getInfo<CL_KERNEL_FUNCTION_NAME>();
     } catch (const cl::Error&) {
     }
-    fail<ComputeError>("kernel \"", name, "\" on ", description_, ": ", stage, " failed: ",
-                       opencl_status_name(error.err()));
+    fail<ComputeError>("kernel \"", name, "\" on ", description_, ": ", stage,
+                       " failed: ", opencl_status_name(error.err()));
 }
 
-void OpenClDevice::ensure_buffer(cl::Buffer& buffer, std::size_t& capacity_bytes,
-                                  std::size_t bytes, cl_mem_flags flags) {
+void OpenClDevice::ensure_buffer(cl::Buffer& buffer, std::size_t& capacity_bytes, std::size_t bytes,
+                                 cl_mem_flags flags) {
     if (bytes == 0) bytes = 1;  // OpenCL forbids empty buffers
     if (capacity_bytes >= bytes && buffer()) return;
     try {
@@ -305,22 +307,22 @@ void OpenClDevice::ensure_buffer(cl::Buffer& buffer, std::size_t& capacity_bytes
 }
 
 void OpenClDevice::upload(cl::Buffer& buffer, const void* host, std::size_t bytes,
-                           const char* what) {
+                          const char* what) {
     try {
         queue_.enqueueWriteBuffer(buffer, CL_TRUE, 0, bytes, host);
     } catch (const cl::Error& error) {
-        fail<ComputeError>("uploading ", what, " (", bytes, " bytes): ",
-                           opencl_status_name(error.err()));
+        fail<ComputeError>("uploading ", what, " (", bytes,
+                           " bytes): ", opencl_status_name(error.err()));
     }
 }
 
 void OpenClDevice::download(const cl::Buffer& buffer, void* host, std::size_t bytes,
-                             const char* what) {
+                            const char* what) {
     try {
         queue_.enqueueReadBuffer(buffer, CL_TRUE, 0, bytes, host);
     } catch (const cl::Error& error) {
-        fail<ComputeError>("downloading ", what, " (", bytes, " bytes): ",
-                           opencl_status_name(error.err()));
+        fail<ComputeError>("downloading ", what, " (", bytes,
+                           " bytes): ", opencl_status_name(error.err()));
     }
 }
 
@@ -342,7 +344,9 @@ ComputeDevice::ComputeDevice(const std::string& selector)
 
 ComputeDevice::~ComputeDevice() = default;
 
-const std::string& ComputeDevice::description() const { return opencl_->description(); }
+const std::string& ComputeDevice::description() const {
+    return opencl_->description();
+}
 
 std::vector<std::string> ComputeDevice::embedded_families() {
     std::vector<std::string> names;

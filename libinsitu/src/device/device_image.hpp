@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "device/opencl_device.hpp"
-#include "insitu/error.hpp"
 #include "insitu/core/image.hpp"
+#include "insitu/error.hpp"
 
 namespace insitu::detail {
 

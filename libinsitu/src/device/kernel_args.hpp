@@ -4,7 +4,6 @@
 // Each returns what OpenClDevice::launch sets as that many arguments, in the order the kernels
 // declare them (e.g. kernels/render/ray_march.cl for the camera, volume and table).
 #include <cmath>
-
 #include <glm/trigonometric.hpp>
 #include <glm/vec3.hpp>
 
@@ -27,11 +26,15 @@ inline cl_float4 to_float4(double x, double y, double z, double w) {
 }
 
 /// Image extent: (width, height) in pixels, as `int2 size` of every per-pixel kernel.
-inline cl_int2 image_size(int width, int height) { return {{width, height}}; }
+inline cl_int2 image_size(int width, int height) {
+    return {{width, height}};
+}
 inline cl_int2 image_size(const Camera& camera) {
     return image_size(camera.width(), camera.height());
 }
-inline cl_int2 image_size(const Image& image) { return image_size(image.width, image.height); }
+inline cl_int2 image_size(const Image& image) {
+    return image_size(image.width, image.height);
+}
 
 /// The camera plane's extent: (half width, half height, projection: 0 orthographic /
 /// 1 perspective, tan(tilt)), half sizes in world units (orthographic) or tangents of the ray
@@ -53,8 +56,8 @@ inline auto camera_plane(const Camera& camera, double tilt_deg = 0.0) {
 /// A camera's orientation and extent: forward, right, up (unit world vectors), camera_extent.
 /// For kernels that need world directions but not the camera's position (relighting).
 inline auto camera_axes(const Camera& camera) {
-    return pack_args(to_float4(camera.forward()), to_float4(camera.right()),
-                     to_float4(camera.up()), camera_extent(camera));
+    return pack_args(to_float4(camera.forward()), to_float4(camera.right()), to_float4(camera.up()),
+                     camera_extent(camera));
 }
 
 /// A whole camera for ray marching: position (world units), then camera_axes.
@@ -66,8 +69,8 @@ inline auto camera_args(const Camera& camera) {
 /// (voxels per world unit), bounding box lower and upper corners (world units).
 inline auto volume_args(const DeviceVolume& volume) {
     const Index3& d = volume.dims;
-    const cl_int4 dims = {{static_cast<cl_int>(d[0]), static_cast<cl_int>(d[1]),
-                           static_cast<cl_int>(d[2]), 0}};
+    const cl_int4 dims = {
+        {static_cast<cl_int>(d[0]), static_cast<cl_int>(d[1]), static_cast<cl_int>(d[2]), 0}};
     return pack_args(volume.memory->buffer, dims, to_float4(volume.origin),
                      to_float4(1.0 / volume.spacing), to_float4(volume.bounds.lower),
                      to_float4(volume.bounds.upper));
@@ -87,6 +90,8 @@ inline auto transfer_args(const cl::Buffer& buffer, const TransferTable& table) 
 inline cl::NDRange image_global_range(int width, int height) {
     return cl::NDRange((width + 7) / 8 * 8, (height + 7) / 8 * 8);
 }
-inline cl::NDRange image_local_range() { return cl::NDRange(8, 8); }
+inline cl::NDRange image_local_range() {
+    return cl::NDRange(8, 8);
+}
 
 }  // namespace insitu::detail

@@ -1,6 +1,7 @@
-// The colour model of seed 000 §6.2: host fit (Eigen), device prediction (kernels/explore/colour_model.cl).
-// The fit runs in situ once per step and view, so it works on a deterministic subsample of the
-// training pixels and computes k-means distances as one matrix product per iteration.
+// The colour model of seed 000 §6.2: host fit (Eigen), device prediction
+// (kernels/explore/colour_model.cl). The fit runs in situ once per step and view, so it works on a
+// deterministic subsample of the training pixels and computes k-means distances as one matrix
+// product per iteration.
 #include "insitu/explore/colour_model.hpp"
 
 #include <Eigen/Dense>
@@ -12,8 +13,8 @@
 
 #include "device/device_image.hpp"
 #include "insitu/core/check.hpp"
-#include "insitu/error.hpp"
 #include "insitu/core/intervals.hpp"
+#include "insitu/error.hpp"
 
 namespace insitu {
 
@@ -378,8 +379,8 @@ Image ColourModel::predict(const Image& attenuation, ComputeDevice& device) cons
     const cl::Buffer table = detail::upload_read_only(device, table_, "colour model: table");
     cl::Kernel kernel = device.opencl().kernel("colour_model", "predict_colour");
     device.opencl().launch(kernel, cl::NDRange(pixels), cl::NullRange, input.buffer(),
-                  static_cast<cl_int>(intervals_), static_cast<cl_uint>(pixels), table,
-                  static_cast<cl_int>(clusters_), output.buffer());
+                           static_cast<cl_int>(intervals_), static_cast<cl_uint>(pixels), table,
+                           static_cast<cl_int>(clusters_), output.buffer());
     return output.download(device, "colour model: prediction");
 }
 
@@ -390,9 +391,8 @@ std::ostream& operator<<(std::ostream& out, const ColourModel& model) {
 std::ostream& operator<<(std::ostream& out, const ColourModelSettings& settings) {
     return out << "ColourModelSettings{K " << settings.clusters << ", iterations "
                << settings.max_iterations << ", regularisation " << settings.regularisation
-               << ", seed " << settings.seed << ", training pixels "
-               << settings.max_training_pixels << ", empty below " << settings.empty_threshold
-               << "}";
+               << ", seed " << settings.seed << ", training pixels " << settings.max_training_pixels
+               << ", empty below " << settings.empty_threshold << "}";
 }
 
 }  // namespace insitu

@@ -1,11 +1,11 @@
 #include "insitu/explore/enhancement.hpp"
 
-#include <ostream>
 #include <cmath>
+#include <ostream>
 
 #include "device/device_image.hpp"
-#include "insitu/error.hpp"
 #include "device/kernel_args.hpp"
+#include "insitu/error.hpp"
 
 namespace insitu {
 
@@ -71,9 +71,9 @@ Image enhance_depth_aware(const Image& colour, const Image& attenuation,
     const cl_int2 size = detail::image_size(colour);
     cl::Kernel kernel = device.opencl().kernel("enhancement", "enhance_depth_aware");
     device.opencl().launch(kernel, detail::image_global_range(colour.width, colour.height),
-                  detail::image_local_range(), colour_device.buffer(), attenuation_device.buffer(),
-                  static_cast<cl_int>(attenuation.channels), size, law(settings),
-                  enhanced_device.buffer());
+                           detail::image_local_range(), colour_device.buffer(),
+                           attenuation_device.buffer(), static_cast<cl_int>(attenuation.channels),
+                           size, law(settings), enhanced_device.buffer());
     return enhanced_device.download(device, "enhanced colour");
 }
 
@@ -94,7 +94,8 @@ Image enhance_image_edges(const Image& colour, const EnhancementSettings& settin
                            size, luminance_device.buffer());
     cl::Kernel enhance = device.opencl().kernel("enhancement", "enhance_image_edges");
     device.opencl().launch(enhance, global, detail::image_local_range(), colour_device.buffer(),
-                  luminance_device.buffer(), size, law(settings), enhanced_device.buffer());
+                           luminance_device.buffer(), size, law(settings),
+                           enhanced_device.buffer());
     return enhanced_device.download(device, "edge-enhanced colour");
 }
 

@@ -1,12 +1,11 @@
 #include "insitu/explore/explorer.hpp"
 
-#include <ostream>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
-
 #include <nlohmann/json.hpp>
+#include <ostream>
 
 #include "archive/archive_format.hpp"
 #include "device/device_image.hpp"
@@ -108,7 +107,8 @@ cl::NDRange pixel_range(std::size_t pixels) {
     return cl::NDRange((pixels + 63) / 64 * 64);
 }
 
-/// Per-pixel combination steps of kernels/explore/explorer.cl on one colour image kept on the device.
+/// Per-pixel combination steps of kernels/explore/explorer.cl on one colour image kept on the
+/// device.
 class Compositor {
 public:
     Compositor(ComputeDevice& device, const Image& colour) : device_(device) {
@@ -120,8 +120,8 @@ public:
         detail::DeviceImage lit;
         lit.upload(device_, lit_white, "lighting factor");
         cl::Kernel kernel = device_.opencl().kernel("explorer", "apply_lighting_factor");
-        device_.opencl().launch(kernel, pixel_range(pixels_), cl::NullRange, colour_.buffer(), lit.buffer(),
-                       static_cast<cl_uint>(pixels_));
+        device_.opencl().launch(kernel, pixel_range(pixels_), cl::NullRange, colour_.buffer(),
+                                lit.buffer(), static_cast<cl_uint>(pixels_));
     }
 
     void apply_occlusion(const Image& occlusion) {
@@ -129,7 +129,7 @@ public:
         factor.upload(device_, occlusion, "ambient occlusion");
         cl::Kernel kernel = device_.opencl().kernel("explorer", "apply_occlusion");
         device_.opencl().launch(kernel, pixel_range(pixels_), cl::NullRange, colour_.buffer(),
-                       factor.buffer(), static_cast<cl_uint>(pixels_));
+                                factor.buffer(), static_cast<cl_uint>(pixels_));
     }
 
     Image result() { return colour_.download(device_, "explored colour"); }
@@ -155,8 +155,8 @@ public:
         cl::Kernel front_kernel = device.opencl().kernel("explorer", "front_depth");
         for (const Image& depth : layers) {
             layer_.upload(device, depth, "depth layer");
-            device.opencl().launch(front_kernel, pixel_range(pixels_), cl::NullRange, front_.buffer(),
-                          layer_.buffer(), static_cast<cl_uint>(pixels_));
+            device.opencl().launch(front_kernel, pixel_range(pixels_), cl::NullRange,
+                                   front_.buffer(), layer_.buffer(), static_cast<cl_uint>(pixels_));
         }
     }
 
@@ -173,7 +173,8 @@ public:
             const cl_float4 rgb{{rgba.r, rgba.g, rgba.b, 1.0f}};
             layer_.upload(device_, layers_[l], "depth layer");
             device_.opencl().launch(paint, pixel_range(pixels_), cl::NullRange, colour.buffer(),
-                           layer_.buffer(), front_.buffer(), rgb, static_cast<cl_uint>(pixels_));
+                                    layer_.buffer(), front_.buffer(), rgb,
+                                    static_cast<cl_uint>(pixels_));
         }
         return colour.download(device_, "surface colour");
     }

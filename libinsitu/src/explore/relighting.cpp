@@ -1,15 +1,14 @@
 #include "insitu/explore/relighting.hpp"
 
-#include <ostream>
 #include <cmath>
 #include <cstddef>
+#include <glm/geometric.hpp>
+#include <ostream>
 #include <vector>
 
-#include <glm/geometric.hpp>
-
 #include "device/device_image.hpp"
-#include "insitu/error.hpp"
 #include "device/kernel_args.hpp"
+#include "insitu/error.hpp"
 
 namespace insitu {
 
@@ -43,8 +42,8 @@ void check_image(const Image& image, const char* what, int channels, const Camer
     }
 }
 
-/// Three float4 per light (kernels/explore/relighting.cl illuminate()); one zero light when there are
-/// none, because OpenCL buffers cannot be empty.
+/// Three float4 per light (kernels/explore/relighting.cl illuminate()); one zero light when there
+/// are none, because OpenCL buffers cannot be empty.
 cl::Buffer upload_lights(ComputeDevice& device, const LightingSettings& lighting) {
     std::vector<cl_float4> packed;
     for (const Light& light : lighting.lights) {
@@ -193,8 +192,8 @@ Image unsharp_mask_occlusion(const Image& depth, const Camera& camera,
     cl::Kernel kernel = device.opencl().kernel("relighting", "unsharp_mask_occlusion");
     device.opencl().launch(kernel, detail::image_global_range(depth.width, depth.height),
                            detail::image_local_range(), depth_device.buffer(),
-                           detail::image_size(depth), static_cast<cl_int>(radius),
-                           gaussian_device, occlusion, occlusion_device.buffer());
+                           detail::image_size(depth), static_cast<cl_int>(radius), gaussian_device,
+                           occlusion, occlusion_device.buffer());
     return occlusion_device.download(device, "unsharp-mask occlusion");
 }
 
@@ -234,9 +233,9 @@ Image light_volume(const Image& attenuation, const Image& mean_depth,
 std::ostream& operator<<(std::ostream& out, const Light& light) {
     const glm::dvec3& d = light.direction_world;
     const glm::dvec3& c = light.colour;
-    return out << "Light{direction (" << d.x << ", " << d.y << ", " << d.z << "), colour ("
-               << c.x << ", " << c.y << ", " << c.z << "), diffuse " << light.diffuse
-               << ", specular " << light.specular << ", shininess " << light.shininess << "}";
+    return out << "Light{direction (" << d.x << ", " << d.y << ", " << d.z << "), colour (" << c.x
+               << ", " << c.y << ", " << c.z << "), diffuse " << light.diffuse << ", specular "
+               << light.specular << ", shininess " << light.shininess << "}";
 }
 
 std::ostream& operator<<(std::ostream& out, const LightingSettings& settings) {

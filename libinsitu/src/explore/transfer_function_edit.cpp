@@ -151,8 +151,8 @@ Image recolour(const Image& attenuation, const std::vector<float>& colours, Comp
         detail::upload_read_only(device, colours, "recolour: interval colours");
     cl::Kernel kernel = device.opencl().kernel("transfer_function_edit", "recolour");
     device.opencl().launch(kernel, cl::NDRange(pixels), cl::NullRange, input.buffer(),
-                  static_cast<cl_int>(intervals), static_cast<cl_uint>(pixels), colour_buffer,
-                  output.buffer());
+                           static_cast<cl_int>(intervals), static_cast<cl_uint>(pixels),
+                           colour_buffer, output.buffer());
     return output.download(device, "recolour: colour");
 }
 
@@ -187,9 +187,10 @@ Image estimate_attenuation(const Image& attenuation, const Image& mean_depth,
         detail::upload_read_only(device, scale_values, "estimate_attenuation: scales");
     cl::Kernel kernel = device.opencl().kernel("transfer_function_edit", "estimate_attenuation");
     device.opencl().launch(kernel, cl::NDRange(pixels), cl::NullRange, a.buffer(), depth.buffer(),
-                  optical_depth ? tau.buffer() : cl::Buffer(),
-                  static_cast<cl_int>(optical_depth ? 1 : 0), static_cast<cl_int>(intervals),
-                  static_cast<cl_uint>(pixels), scale_buffer, output.buffer());
+                           optical_depth ? tau.buffer() : cl::Buffer(),
+                           static_cast<cl_int>(optical_depth ? 1 : 0),
+                           static_cast<cl_int>(intervals), static_cast<cl_uint>(pixels),
+                           scale_buffer, output.buffer());
     return output.download(device, "estimate_attenuation: edited attenuation");
 }
 

@@ -1,14 +1,14 @@
 #include "insitu/explore/view_synthesis.hpp"
 
-#include <ostream>
 #include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
+#include <ostream>
 #include <string>
 
 #include "device/device_image.hpp"
-#include "insitu/error.hpp"
 #include "device/kernel_args.hpp"
+#include "insitu/error.hpp"
 
 namespace insitu {
 
@@ -139,7 +139,7 @@ cl::Buffer empty_keys(ComputeDevice& device, std::size_t count) {
     cl::Buffer keys = device_buffer(device, count * sizeof(cl_uint));
     cl::Kernel fill = device.opencl().kernel("view_synthesis", "fill_keys");
     device.opencl().launch(fill, cl::NDRange((count + 63) / 64 * 64), cl::NDRange(64), keys,
-                  static_cast<cl_int>(count));
+                           static_cast<cl_int>(count));
     return keys;
 }
 
@@ -180,20 +180,21 @@ SynthesisedLayers synthesise_layers(const ProxyFrame& frame, const Camera& targe
     device.opencl().launch(resolve, detail::image_global_range(target.width(), target.height()),
                            detail::image_local_range(), keys, static_cast<cl_int>(layers),
                            target_plane, static_cast<cl_int>(settings.hole_fill_radius_pixels),
-                           depth, source_plane, inverse.rows[0], inverse.rows[1],
-                           inverse.rows[2], bounding_sphere_in(source, target), depth_out,
-                           confidence_out, union_out);
+                           depth, source_plane, inverse.rows[0], inverse.rows[1], inverse.rows[2],
+                           bounding_sphere_in(source, target), depth_out, confidence_out,
+                           union_out);
 
     SynthesisedLayers result;
     std::vector<float> values(target_pixels * layers);
-    device.opencl().download(depth_out, values.data(), values.size() * sizeof(float), "synthesised depth");
+    device.opencl().download(depth_out, values.data(), values.size() * sizeof(float),
+                             "synthesised depth");
     result.depth = planes(values, target.width(), target.height(), layers);
     device.opencl().download(confidence_out, values.data(), values.size() * sizeof(float),
-                    "synthesised layer confidence");
+                             "synthesised layer confidence");
     result.layer_confidence = planes(values, target.width(), target.height(), layers);
     result.confidence = Image(target.width(), target.height(), 1);
-    device.opencl().download(union_out, result.confidence.pixels.data(), target_pixels * sizeof(float),
-                    "synthesised confidence");
+    device.opencl().download(union_out, result.confidence.pixels.data(),
+                             target_pixels * sizeof(float), "synthesised confidence");
     return result;
 }
 
@@ -228,7 +229,7 @@ SynthesisedAttenuation synthesise_attenuation(const ProxyFrame& frame, const Cam
         const std::size_t count = target_pixels * intervals;
         cl::Kernel fill = device.opencl().kernel("view_synthesis", "fill_values");
         device.opencl().launch(fill, cl::NDRange((count + 63) / 64 * 64), cl::NDRange(64), values,
-                      static_cast<cl_int>(count));
+                               static_cast<cl_int>(count));
     }
     const cl::Buffer source_total = device_buffer(device, source_pixels * sizeof(float));
     const auto source_plane =
@@ -267,11 +268,11 @@ SynthesisedAttenuation synthesise_attenuation(const ProxyFrame& frame, const Cam
         inverse.rows[0], inverse.rows[1], inverse.rows[2], bounding_sphere_in(source, target),
         attenuation_out, mean_depth_out, confidence_out);
     device.opencl().download(attenuation_out, result.attenuation.pixels.data(), interval_bytes,
-                    "synthesised attenuation");
+                             "synthesised attenuation");
     device.opencl().download(mean_depth_out, result.mean_depth.pixels.data(), interval_bytes,
-                    "synthesised mean depth");
-    device.opencl().download(confidence_out, result.confidence.pixels.data(), target_pixels * sizeof(float),
-                    "synthesised confidence");
+                             "synthesised mean depth");
+    device.opencl().download(confidence_out, result.confidence.pixels.data(),
+                             target_pixels * sizeof(float), "synthesised confidence");
     return result;
 }
 
@@ -298,12 +299,12 @@ RadialityHistogram radiality_histogram(const ProxyFrame& multi_frame, int bins,
         kernel, detail::image_global_range(camera.width(), camera.height()),
         detail::image_local_range(), depth, distortion,
         static_cast<cl_int>(multi_frame.multi_perspective ? 1 : 0), static_cast<cl_int>(layers),
-        detail::camera_plane(camera, multi_frame.multi_perspective
-                                         ? multi_frame.distortion_tilt_deg
-                                         : 0.0),
+        detail::camera_plane(camera,
+                             multi_frame.multi_perspective ? multi_frame.distortion_tilt_deg : 0.0),
         angles);
     std::vector<float> angle_deg(pixels * layers);
-    device.opencl().download(angles, angle_deg.data(), angle_deg.size() * sizeof(float), "radiality angles");
+    device.opencl().download(angles, angle_deg.data(), angle_deg.size() * sizeof(float),
+                             "radiality angles");
 
     RadialityHistogram histogram;
     for (int b = 0; b <= bins; ++b) histogram.bin_edges_deg.push_back(90.0 * b / bins);

@@ -1,10 +1,9 @@
 #include "insitu/render/distortion_camera.hpp"
 
 #include <cmath>
-#include <ostream>
-
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
+#include <ostream>
 
 #include "insitu/error.hpp"
 

@@ -64,8 +64,7 @@ BlockRanges scan_blocks(const std::vector<float>& values, const Index3& dims, in
 }
 
 std::vector<std::uint8_t> skippable_blocks(const BlockRanges& blocks, const TransferTable& table,
-                                           const std::vector<double>& isovalues,
-                                           bool accumulates) {
+                                           const std::vector<double>& isovalues, bool accumulates) {
     // next_opaque[b]: the first table bin >= b with non-zero opacity, so "any opacity between
     // bins lo and hi" is one comparison. In a 2D table a bin is opaque if any gradient row is
     // (conservative: the proxies look up the row of gradient 0).

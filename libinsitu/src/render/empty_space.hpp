@@ -35,7 +35,6 @@ BlockRanges scan_blocks(const std::vector<float>& values, const Index3& dims,
 /// that range interpolates (kernels/render/ray_march.cl lookup_transfer). Every sample of such a
 /// block adds nothing and lies on one side of every isovalue.
 std::vector<std::uint8_t> skippable_blocks(const BlockRanges& blocks, const TransferTable& table,
-                                           const std::vector<double>& isovalues,
-                                           bool accumulates);
+                                           const std::vector<double>& isovalues, bool accumulates);
 
 }  // namespace insitu::detail

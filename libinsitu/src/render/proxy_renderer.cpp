@@ -1,19 +1,17 @@
 #include "insitu/render/proxy_renderer.hpp"
 
-#include <ostream>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-
 #include <glm/trigonometric.hpp>
+#include <ostream>
 
-#include "insitu/core/check.hpp"
-#include "insitu/error.hpp"
-#include "insitu/core/layers.hpp"
 #include "device/kernel_args.hpp"
 #include "device/kernel_constants.hpp"
 #include "device/opencl_device.hpp"
+#include "insitu/core/check.hpp"
+#include "insitu/core/layers.hpp"
+#include "insitu/error.hpp"
 #include "render/empty_space.hpp"
 
 namespace insitu {
@@ -73,7 +71,9 @@ ProxyRenderer::~ProxyRenderer() = default;
 ProxyRenderer::ProxyRenderer(ProxyRenderer&&) noexcept = default;
 ProxyRenderer& ProxyRenderer::operator=(ProxyRenderer&&) noexcept = default;
 
-void ProxyRenderer::upload(const Field& field) { renderer_.upload(field); }
+void ProxyRenderer::upload(const Field& field) {
+    renderer_.upload(field);
+}
 
 IntervalSet ProxyRenderer::choose_intervals(int count, IntervalMode mode) const {
     const DeviceVolume& volume = renderer_.volume();
@@ -84,8 +84,7 @@ IntervalSet ProxyRenderer::choose_intervals(int count, IntervalMode mode) const 
     return IntervalSet::histogram_equalized(volume.host_values, min, max, count);
 }
 
-std::vector<double> ProxyRenderer::choose_layers(const TransferFunction& tf,
-                                                 int max_layers) const {
+std::vector<double> ProxyRenderer::choose_layers(const TransferFunction& tf, int max_layers) const {
     return opacity_peaks(tf, renderer_.volume().range, max_layers);
 }
 
@@ -163,10 +162,9 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     // The attenuation's opacity is classified exactly as the ground truth classifies it. Without
     // accumulation a one-entry transparent table keeps the kernel's arguments valid.
     const TransferTable table =
-        want_accumulation ? step_corrected_table(*request.transfer_function, step_world,
-                                                 request.march)
-                          : TransferFunction({{0.0, glm::vec4(0.0f)}, {1.0, glm::vec4(0.0f)}})
-                                .sample(2);
+        want_accumulation
+            ? step_corrected_table(*request.transfer_function, step_world, request.march)
+            : TransferFunction({{0.0, glm::vec4(0.0f)}, {1.0, glm::vec4(0.0f)}}).sample(2);
     const cl::Buffer table_buffer =
         upload_floats(state_->table, table.rgba, "transfer-function table");
     const cl::Buffer isovalue_buffer = upload_floats(
@@ -218,11 +216,11 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     device_->opencl().launch(
         state_->kernel, detail::image_global_range(width, height), detail::image_local_range(),
         detail::volume_args(volume), detail::transfer_args(table_buffer, table),
-        detail::camera_args(camera), detail::image_size(camera), march,
-        static_cast<cl_int>(wanted), static_cast<cl_int>(layer_count), isovalue_buffer,
-        static_cast<cl_int>(interval_count), static_cast<cl_float>(uniform_scale), edge_buffer,
-        depth_out, distortion_out, attenuation_out, mean_depth_out, optical_depth_out,
-        skippable_buffer, block_counts, block_voxels);
+        detail::camera_args(camera), detail::image_size(camera), march, static_cast<cl_int>(wanted),
+        static_cast<cl_int>(layer_count), isovalue_buffer, static_cast<cl_int>(interval_count),
+        static_cast<cl_float>(uniform_scale), edge_buffer, depth_out, distortion_out,
+        attenuation_out, mean_depth_out, optical_depth_out, skippable_buffer, block_counts,
+        block_voxels);
 
     std::vector<float> planar;
     auto fetch = [&](const cl::Buffer& buffer, int planes, const char* what) {
@@ -240,8 +238,8 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     // Per-interval outputs are pixel-interleaved on the device, as Image stores channels.
     auto fetch_channels = [&](const cl::Buffer& buffer, const char* what) {
         Image image(width, height, interval_count);
-        device_->opencl().download(buffer, image.pixels.data(),
-                                   image.pixels.size() * sizeof(float), what);
+        device_->opencl().download(buffer, image.pixels.data(), image.pixels.size() * sizeof(float),
+                                   what);
         return image;
     };
     if (request.attenuation) frame.attenuation = fetch_channels(attenuation_out, "attenuation");

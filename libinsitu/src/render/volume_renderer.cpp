@@ -5,9 +5,9 @@
 #include <limits>
 #include <ostream>
 
-#include "insitu/error.hpp"
 #include "device/kernel_args.hpp"
 #include "device/opencl_device.hpp"
+#include "insitu/error.hpp"
 
 namespace insitu {
 
@@ -24,7 +24,8 @@ void validate(const RenderSettings& settings) {
     const PhongParameters& p = settings.phong;
     for (float value : {p.ambient, p.diffuse, p.specular, p.shininess}) {
         if (!(value >= 0.0f) || !std::isfinite(value)) {
-            fail<InvalidArgument>("Phong parameter ", value, " (ambient, diffuse, specular and "
+            fail<InvalidArgument>("Phong parameter ", value,
+                                  " (ambient, diffuse, specular and "
                                   "shininess must be finite and >= 0)");
         }
     }
@@ -46,7 +47,9 @@ TransferTable step_corrected_table(const TransferFunction& tf, double step_world
     return table;
 }
 
-std::size_t DeviceVolume::capacity_bytes() const { return memory ? memory->capacity : 0; }
+std::size_t DeviceVolume::capacity_bytes() const {
+    return memory ? memory->capacity : 0;
+}
 
 double DeviceVolume::step_world(double step_voxels) const {
     return step_voxels * std::min({spacing.x, spacing.y, spacing.z});
@@ -92,7 +95,9 @@ VolumeRenderer::~VolumeRenderer() = default;
 VolumeRenderer::VolumeRenderer(VolumeRenderer&&) noexcept = default;
 VolumeRenderer& VolumeRenderer::operator=(VolumeRenderer&&) noexcept = default;
 
-void VolumeRenderer::upload(const Field& field) { volume_.upload(*device_, field); }
+void VolumeRenderer::upload(const Field& field) {
+    volume_.upload(*device_, field);
+}
 
 Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& tf,
                                  const RenderSettings& settings) {
@@ -131,8 +136,8 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
     Rendering result;
     result.rgba = Image(width, height, 4);
     result.depth = Image(width, height, 1);
-    opencl.download(state_->rgba_out.buffer, result.rgba.pixels.data(),
-                    pixels * 4 * sizeof(float), "rendered RGBA");
+    opencl.download(state_->rgba_out.buffer, result.rgba.pixels.data(), pixels * 4 * sizeof(float),
+                    "rendered RGBA");
     opencl.download(state_->depth_out.buffer, result.depth.pixels.data(), pixels * sizeof(float),
                     "rendered depth");
     return result;

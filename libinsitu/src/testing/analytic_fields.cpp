@@ -1,10 +1,9 @@
 #include "insitu/testing/analytic_fields.hpp"
 
-#include <cmath>
 #include <algorithm>
-#include <random>
-
+#include <cmath>
 #include <glm/geometric.hpp>
+#include <random>
 
 #include "insitu/error.hpp"
 
@@ -46,9 +45,8 @@ glm::dvec3 centre_of(Index3 dims) {
 }  // namespace
 
 SampledVolume make_sphere_distance(Index3 dims, glm::dvec3 center_voxels, double radius_voxels) {
-    return sample(dims, [&](const glm::dvec3& p) {
-        return glm::length(p - center_voxels) - radius_voxels;
-    });
+    return sample(
+        dims, [&](const glm::dvec3& p) { return glm::length(p - center_voxels) - radius_voxels; });
 }
 
 SampledVolume make_radial_distance(Index3 dims, glm::dvec3 center_voxels) {
@@ -88,7 +86,8 @@ SampledVolume make_gaussian_blobs(Index3 dims, int count, std::uint32_t seed) {
     std::vector<Blob> blobs;
     for (int b = 0; b < count; ++b) {
         const glm::dvec3 centre = glm::dvec3(0.2 + 0.6 * unit(random), 0.2 + 0.6 * unit(random),
-                                             0.2 + 0.6 * unit(random)) * extent;
+                                             0.2 + 0.6 * unit(random)) *
+                                  extent;
         const double width = size * (0.06 + 0.1 * unit(random));
         blobs.push_back({centre, 1.0 / (width * width), 0.4 + 0.6 * unit(random)});
     }

@@ -10,12 +10,11 @@
 // smaller of the two fields of view.
 // Depth everywhere is the distance along the view direction from the camera plane (through the
 // eye for perspective), in world units.
-#include <iosfwd>
-#include <string>
-
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <iosfwd>
 #include <nlohmann/json_fwd.hpp>
+#include <string>
 
 #include "insitu/field.hpp"
 

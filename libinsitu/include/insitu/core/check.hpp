@@ -28,8 +28,7 @@ template <typename A, typename B>
 [[noreturn]] void fail_check(const char* file, int line, const char* expression, const A& a,
                              const B& b) {
     std::ostringstream out;
-    out << file << ":" << line << ": check failed: " << expression << " with " << a << " vs "
-        << b;
+    out << file << ":" << line << ": check failed: " << expression << " with " << a << " vs " << b;
     throw InvariantError(out.str());
 }
 
@@ -42,20 +41,20 @@ template <typename A, typename B>
 }  // namespace detail
 }  // namespace insitu
 
-#define INSITU_CHECK(condition)                                                   \
-    do {                                                                          \
+#define INSITU_CHECK(condition)                                                         \
+    do {                                                                                \
         if (!(condition)) ::insitu::detail::fail_check(__FILE__, __LINE__, #condition); \
     } while (false)
 
 // Both sides are evaluated once; their values are printed on failure.
-#define INSITU_CHECK_OP(a, op, b)                                                     \
-    do {                                                                              \
-        const auto& insitu_check_a = (a);                                             \
-        const auto& insitu_check_b = (b);                                             \
-        if (!(insitu_check_a op insitu_check_b)) {                                    \
-            ::insitu::detail::fail_check(__FILE__, __LINE__, #a " " #op " " #b,       \
-                                         insitu_check_a, insitu_check_b);             \
-        }                                                                             \
+#define INSITU_CHECK_OP(a, op, b)                                                               \
+    do {                                                                                        \
+        const auto& insitu_check_a = (a);                                                       \
+        const auto& insitu_check_b = (b);                                                       \
+        if (!(insitu_check_a op insitu_check_b)) {                                              \
+            ::insitu::detail::fail_check(__FILE__, __LINE__, #a " " #op " " #b, insitu_check_a, \
+                                         insitu_check_b);                                       \
+        }                                                                                       \
     } while (false)
 
 #define INSITU_CHECK_EQ(a, b) INSITU_CHECK_OP(a, ==, b)
@@ -67,13 +66,13 @@ template <typename A, typename B>
 
 #ifdef NDEBUG
 // Compiled out, but the expressions still parse (and name no unused variables).
-#define INSITU_DCHECK(condition) \
-    do {                         \
+#define INSITU_DCHECK(condition)      \
+    do {                              \
         if (false) (void)(condition); \
     } while (false)
-#define INSITU_DCHECK_OP(a, op, b)     \
-    do {                               \
-        if (false) (void)((a) op (b)); \
+#define INSITU_DCHECK_OP(a, op, b)   \
+    do {                             \
+        if (false) (void)((a)op(b)); \
     } while (false)
 #else
 #define INSITU_DCHECK(condition) INSITU_CHECK(condition)

@@ -4,10 +4,9 @@
 // [edges.front(), edges.back()] belong to the nearest end interval, so every finite sample lands
 // in exactly one interval and Σ_j a_j = 1 - T_end holds.
 #include <iosfwd>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json_fwd.hpp>
 
 namespace insitu {
 
@@ -28,8 +27,8 @@ public:
     static IntervalSet uniform(double min, double max, int count);
     /// L intervals holding about equally many of the finite `values` (quantiles of their
     /// histogram); NaN values are ignored. Falls back to uniform where quantiles coincide.
-    static IntervalSet histogram_equalized(const std::vector<float>& values, double min,
-                                           double max, int count);
+    static IntervalSet histogram_equalized(const std::vector<float>& values, double min, double max,
+                                           int count);
 
     int count() const { return static_cast<int>(edges_.size()) - 1; }
     const std::vector<double>& edges() const { return edges_; }

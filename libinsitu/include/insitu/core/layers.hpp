@@ -4,8 +4,8 @@
 // features a user made opaque are the surfaces worth keeping).
 #include <vector>
 
-#include "insitu/field.hpp"
 #include "insitu/core/transfer_function.hpp"
+#include "insitu/field.hpp"
 
 namespace insitu {
 

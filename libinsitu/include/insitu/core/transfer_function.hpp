@@ -8,12 +8,11 @@
 // clamps. JSON:
 //   1D: {"points": [[value, r, g, b, a], ...], "unit_length": 1.0}
 //   2D: {"gradient_rows": [{"gradient_magnitude": 0.0, "points": [...]}, ...], "unit_length": 1.0}
+#include <glm/vec4.hpp>
 #include <iosfwd>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
-
-#include <glm/vec4.hpp>
-#include <nlohmann/json_fwd.hpp>
 
 namespace insitu {
 

@@ -19,8 +19,8 @@
 #include <iosfwd>
 #include <vector>
 
-#include "insitu/device/compute_device.hpp"
 #include "insitu/core/image.hpp"
+#include "insitu/device/compute_device.hpp"
 
 namespace insitu {
 
@@ -67,8 +67,8 @@ public:
     const std::vector<float>& table() const { return table_; }
 
     /// Predicted RGBA (premultiplied) for every pixel of an L-channel attenuation image; alpha is
-    /// sum_j a_j (exact: 1 - T). Runs kernels/explore/colour_model.cl on `device`. InvalidArgument when
-    /// the image does not have intervals() channels.
+    /// sum_j a_j (exact: 1 - T). Runs kernels/explore/colour_model.cl on `device`. InvalidArgument
+    /// when the image does not have intervals() channels.
     Image predict(const Image& attenuation, ComputeDevice& device = *ComputeDevice::shared()) const;
     /// Host reference of predict() for one pixel (a has intervals() entries): RGB.
     void predict_pixel(const float* attenuation, float* rgb) const;

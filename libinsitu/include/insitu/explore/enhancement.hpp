@@ -9,8 +9,9 @@
 // over any background instead of turning transparent. Where every gradient is 0 (a constant
 // attenuation image) r = 0 and the colour is returned exactly.
 #include <iosfwd>
-#include "insitu/device/compute_device.hpp"
+
 #include "insitu/core/image.hpp"
+#include "insitu/device/compute_device.hpp"
 
 namespace insitu {
 

@@ -19,8 +19,8 @@
 //  7. depth-aware enhancement (Eq. 11).
 // Without attenuation proxies the front-most depth layer is drawn as a surface in the transfer
 // function's colour at its isovalue.
-#include <iosfwd>
 #include <cstdint>
+#include <iosfwd>
 #include <list>
 #include <memory>
 #include <mutex>
@@ -31,12 +31,12 @@
 
 #include "insitu/archive/archive.hpp"
 #include "insitu/core/camera.hpp"
-#include "insitu/explore/colour_model.hpp"
-#include "insitu/device/compute_device.hpp"
-#include "insitu/explore/enhancement.hpp"
 #include "insitu/core/image.hpp"
-#include "insitu/explore/relighting.hpp"
 #include "insitu/core/transfer_function.hpp"
+#include "insitu/device/compute_device.hpp"
+#include "insitu/explore/colour_model.hpp"
+#include "insitu/explore/enhancement.hpp"
+#include "insitu/explore/relighting.hpp"
 #include "insitu/explore/view_synthesis.hpp"
 
 namespace insitu {

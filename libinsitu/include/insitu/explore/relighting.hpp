@@ -16,14 +16,13 @@
 // one-sided across a silhouette: when one side's depth step exceeds twice the other side's plus
 // two pixel footprints (world units at that depth), that side is taken to be another surface
 // and the other side is used alone. An axis with no usable neighbour has no derivative.
+#include <glm/vec3.hpp>
 #include <iosfwd>
 #include <vector>
 
-#include <glm/vec3.hpp>
-
 #include "insitu/core/camera.hpp"
-#include "insitu/device/compute_device.hpp"
 #include "insitu/core/image.hpp"
+#include "insitu/device/compute_device.hpp"
 
 namespace insitu {
 

@@ -9,10 +9,10 @@
 // Both work per pixel on the compute device (kernels/explore/transfer_function_edit.cl).
 #include <vector>
 
-#include "insitu/device/compute_device.hpp"
 #include "insitu/core/image.hpp"
 #include "insitu/core/intervals.hpp"
 #include "insitu/core/transfer_function.hpp"
+#include "insitu/device/compute_device.hpp"
 
 namespace insitu {
 

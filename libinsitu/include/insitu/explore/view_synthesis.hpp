@@ -29,13 +29,13 @@
 // front to back in target depth order, a'_j = (a_j / T_j) T', T' = 1 - sum of the a' in front.
 // Hence sum_j a'_j <= 1, and an unchanged camera gives a'_j = a_j exactly. A hole surrounded by
 // data takes the composite of its nearest surrounding pixel.
-#include <iosfwd>
 #include <cstdint>
+#include <iosfwd>
 #include <vector>
 
 #include "insitu/core/camera.hpp"
-#include "insitu/device/compute_device.hpp"
 #include "insitu/core/image.hpp"
+#include "insitu/device/compute_device.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 
 namespace insitu {

@@ -8,10 +8,9 @@
 // is theta = 45 degrees. A hit at distance s along the ray has depth s cos(theta) (along v from
 // the camera plane) and distortion ds = |q_im - p_im| = s sin(theta) (Eq. 2), q_im being the
 // orthographic projection of the hit on the camera plane. Both are in world units.
-#include <iosfwd>
-
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <iosfwd>
 
 #include "insitu/core/camera.hpp"
 

@@ -22,11 +22,11 @@
 #include <vector>
 
 #include "insitu/core/camera.hpp"
-#include "insitu/explore/colour_model.hpp"
-#include "insitu/render/distortion_camera.hpp"
 #include "insitu/core/image.hpp"
 #include "insitu/core/intervals.hpp"
 #include "insitu/core/transfer_function.hpp"
+#include "insitu/explore/colour_model.hpp"
+#include "insitu/render/distortion_camera.hpp"
 #include "insitu/render/volume_renderer.hpp"
 
 namespace insitu {
@@ -62,16 +62,16 @@ std::ostream& operator<<(std::ostream& out, const ProxyRequest& request);
 /// per-interval proxies (channel j = interval j). Empty images for what was not requested.
 struct ProxyFrame {
     bool multi_perspective = false;
-    Camera camera;                                 ///< the single-perspective camera, or the base
-    double distortion_tilt_deg = 0.0;              ///< multi-perspective only
+    Camera camera;                     ///< the single-perspective camera, or the base
+    double distortion_tilt_deg = 0.0;  ///< multi-perspective only
     std::vector<double> isovalues;
     std::optional<IntervalSet> intervals;
-    std::vector<Image> depth_layers;               ///< 1 channel each
-    std::vector<Image> distortion_layers;          ///< 1 channel each, multi-perspective only
-    Image attenuation;                             ///< L channels
-    Image mean_depth;                              ///< L channels
-    Image optical_depth;                           ///< L channels
-    std::vector<Image> training;                   ///< RGBA each
+    std::vector<Image> depth_layers;       ///< 1 channel each
+    std::vector<Image> distortion_layers;  ///< 1 channel each, multi-perspective only
+    Image attenuation;                     ///< L channels
+    Image mean_depth;                      ///< L channels
+    Image optical_depth;                   ///< L channels
+    std::vector<Image> training;           ///< RGBA each
     /// Colour model fitted on the training renderings (seed 000 §6.2), single perspective only.
     std::optional<ColourModel> colour_model;
 };

@@ -1,8 +1,8 @@
 #pragma once
 // The ground-truth volume renderer (seed 002): emission-absorption ray casting.
 //
-// The definition every accuracy figure depends on, and which libinsitu/src/testing/reference_renderer.cpp
-// implements independently:
+// The definition every accuracy figure depends on, and which
+// libinsitu/src/testing/reference_renderer.cpp implements independently:
 //  * Rays come from Camera::ray at pixel centres. They are clipped to the field's world bounds;
 //    sample i (i = 0, 1, ...) lies at t = t_near + (i + 0.5) * step while t < t_far, where
 //    step = step_voxels * min(spacing) in world units.
@@ -29,10 +29,10 @@
 #include <vector>
 
 #include "insitu/core/camera.hpp"
-#include "insitu/device/compute_device.hpp"
-#include "insitu/field.hpp"
 #include "insitu/core/image.hpp"
 #include "insitu/core/transfer_function.hpp"
+#include "insitu/device/compute_device.hpp"
+#include "insitu/field.hpp"
 
 namespace insitu {
 

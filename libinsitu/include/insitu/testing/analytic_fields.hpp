@@ -3,10 +3,9 @@
 // All positions and radii are in voxel units of the grid they are sampled on (spacing 1 and
 // origin 0 unless a caller changes them on the returned volume before taking its Field view).
 #include <cstdint>
+#include <glm/vec3.hpp>
 #include <string>
 #include <vector>
-
-#include <glm/vec3.hpp>
 
 #include "insitu/field.hpp"
 

@@ -22,8 +22,8 @@
 #include <limits>
 #include <vector>
 
-#include "insitu/error.hpp"
 #include "insitu/core/image.hpp"
+#include "insitu/error.hpp"
 
 namespace insitu::evaluation {
 

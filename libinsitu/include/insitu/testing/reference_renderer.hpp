@@ -2,8 +2,8 @@
 // An independent scalar C++ implementation of the ground-truth definition written out in
 // insitu/render/volume_renderer.hpp, in double precision, reading the field through Field::value.
 #include "insitu/core/camera.hpp"
-#include "insitu/field.hpp"
 #include "insitu/core/transfer_function.hpp"
+#include "insitu/field.hpp"
 #include "insitu/render/volume_renderer.hpp"
 
 namespace insitu::reference {
