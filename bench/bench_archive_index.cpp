@@ -70,11 +70,6 @@ StepRecord tiny_step(std::int64_t step) {
     return record;
 }
 
-double median(std::vector<double> values) {
-    std::sort(values.begin(), values.end());
-    return values[values.size() / 2];
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -100,7 +95,7 @@ int main(int argc, char** argv) {
             }
         }
         const auto window_median = [&](int first) {
-            return median(
+            return bench::median(
                 std::vector<double>(step_ms.begin() + first, step_ms.begin() + first + kWindow));
         };
         const double early = window_median(kEarlyStep - kWindow / 2);

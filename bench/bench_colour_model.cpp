@@ -16,6 +16,7 @@
 #include "insitu/explore/colour_model.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
+#include "median_time.hpp"
 
 namespace {
 
@@ -73,11 +74,6 @@ double psnr(const Image& image, const Image& truth) {
         count += 3;
     }
     return count == 0 ? INFINITY : -10.0 * std::log10(std::max(sum / count, 1e-20));
-}
-
-double median(std::vector<double> values) {
-    std::sort(values.begin(), values.end());
-    return values[values.size() / 2];
 }
 
 }  // namespace
@@ -142,7 +138,7 @@ int main(int argc, char** argv) {
                     pixels == defaults.max_training_pixels ? " (def)"
                     : pixels == 0                          ? " (all)"
                                                            : "",
-                    median(milliseconds), model.clusters(),
+                    bench::median(milliseconds), model.clusters(),
                     psnr(model.predict(attenuations[0]), colours[0]),
                     psnr(model.predict(held_out_attenuation), held_out_truth));
     }
@@ -156,6 +152,6 @@ int main(int argc, char** argv) {
             std::chrono::duration<double, std::milli>(Clock::now() - start).count());
     }
     std::printf("predict (device, incl. transfers): %.1f ms at %d^2, table %d x %d floats\n",
-                median(milliseconds), options.image, model.row_floats(), model.clusters());
+                bench::median(milliseconds), options.image, model.row_floats(), model.clusters());
     return 0;
 }

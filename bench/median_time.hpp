@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <utility>
 #include <vector>
 
 namespace insitu::bench {
@@ -12,6 +13,12 @@ namespace insitu::bench {
 inline double ms_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
         .count();
+}
+
+/// The median of `values` (the upper one of an even count); `values` must not be empty.
+inline double median(std::vector<double> values) {
+    std::sort(values.begin(), values.end());
+    return values[values.size() / 2];
 }
 
 /// Median wall time (ms) of `repeats` (>= 1) runs of `run`, after one warm-up run.
@@ -23,8 +30,7 @@ inline double median_ms(int repeats, const std::function<void()>& run) {
         run();
         times.push_back(ms_since(start));
     }
-    std::sort(times.begin(), times.end());
-    return times[times.size() / 2];
+    return median(std::move(times));
 }
 
 }  // namespace insitu::bench
