@@ -1033,6 +1033,18 @@ TEST_F(Archive, HeadersDeclaringMoreThanTheViewAreRefusedBeforeAllocating) {
         return bytes;
     };
     const std::size_t max_x = window + key.size() + 4 + 8;
+    const std::string channels_key = std::string("channels") + '\0' + "chlist" + '\0';
+    const std::size_t channels = original.find(channels_key);
+    ASSERT_NE(channels, std::string::npos);
+    std::int32_t channels_size = 0;
+    std::memcpy(&channels_size, &original[channels + channels_key.size()], 4);
+    ASSERT_GT(channels_size, 18);
+    const auto with_type = [&](std::size_t attribute, const std::string& type) {
+        std::string bytes = original;
+        const std::size_t at = attribute + std::string("dataWindow").size() + 1;
+        bytes.replace(at, type.size(), type);  // same length as "box2i"
+        return bytes;
+    };
     struct Case {
         std::string what;
         std::string bytes;
@@ -1042,7 +1054,16 @@ TEST_F(Archive, HeadersDeclaringMoreThanTheViewAreRefusedBeforeAllocating) {
         {"wider than the view", with_int(max_x, 12 + 100), "data window 113x9"},
         {"66 million lines", with_int(max_x + 4, 66'000'000), "larger than 12x9 (the view)"},
         {"attribute past the end", with_int(window + key.size(), 0x7FFFFFFF),
-         "declares 2147483647 bytes, past the end of the file"}};
+         "declares 2147483647 bytes, past the end of the file"},
+        // OpenEXR reads a channel list up to its null entry, not by its size: a list declared
+        // one entry short made it read the rest as attributes (a fuzzed file asked for 1.8 GB).
+        {"channel list shorter than its entries",
+         with_int(channels + channels_key.size(), channels_size - 18),
+         "channel list does not fill its"},
+        {"a type libinsitu never writes", with_type(window, "box2f"),
+         "has type \"box2f\", which libinsitu archives do not hold"},
+        {"a fixed-size type of another size", with_int(window + key.size(), 12),
+         "of type box2i declares 12 bytes (it has 16)"}};
     for (const Case& c : cases) {
         SCOPED_TRACE(c.what);
         replace_consistently(4, 0, c.bytes);

@@ -557,6 +557,53 @@ EncodedView encode_view(const StepRecord& record, const ViewRecord& view,
 
 namespace {
 
+/// Checks that OpenEXR will read exactly `size` bytes for this attribute, so its parse stays in
+/// step with skip_header's walk: a channel list is read entry by entry up to its terminating
+/// null, not by its declared size (a fuzzed list shorter than its entries made OpenEXR read the
+/// next bytes as attributes, one of them a 1.8 GB string). Types libinsitu never writes are
+/// refused, since each has a reader of its own with sizes inside its value.
+void check_attribute_value(const std::vector<char>& bytes, std::size_t at, std::size_t name_end,
+                           std::size_t type_end, std::size_t value, std::size_t size,
+                           const PartContext& where) {
+    const std::string name(&bytes[at], name_end - at);
+    const std::string type(&bytes[name_end + 1], type_end - name_end - 1);
+    static const std::map<std::string, std::size_t> fixed_sizes = {
+        {"int", 4}, {"float", 4},       {"double", 8},   {"box2i", 16},
+        {"v2f", 8}, {"compression", 1}, {"lineOrder", 1}};
+    const auto fixed = fixed_sizes.find(type);
+    if (fixed != fixed_sizes.end()) {
+        if (size != fixed->second) {
+            where.error("attribute \"" + name + "\" of type " + type + " declares " +
+                        std::to_string(size) + " bytes (it has " + std::to_string(fixed->second) +
+                        ")");
+        }
+        return;
+    }
+    if (type == "string") return;  // read as exactly `size` bytes
+    if (type != "chlist") {
+        where.error("attribute \"" + name + "\" has type \"" + type +
+                    "\", which libinsitu archives do not hold");
+    }
+    // Entries: name\0, then pixel type (int32), pLinear + 3 reserved bytes, x and y sampling
+    // (int32 each); a null byte ends the list.
+    const std::size_t end = value + size;
+    std::size_t entry = value;
+    for (;;) {
+        const auto terminator = std::find(bytes.begin() + static_cast<std::ptrdiff_t>(entry),
+                                          bytes.begin() + static_cast<std::ptrdiff_t>(end), '\0');
+        const auto stop = static_cast<std::size_t>(terminator - bytes.begin());
+        if (stop == end) break;
+        if (stop == entry) {
+            if (entry + 1 == end) return;  // the list's null byte is its last byte
+            break;
+        }
+        entry = stop + 1 + 16;
+        if (entry > end) break;
+    }
+    where.error("attribute \"" + name + "\": channel list does not fill its " +
+                std::to_string(size) + " bytes exactly");
+}
+
 /// Walks the attribute list of one header from `at` without allocating anything: each attribute
 /// is name\0 type\0 int32 size value[size], and a size past the end of the file is refused here
 /// (OpenEXR would allocate it first). Returns where the header ends; an empty header (the
@@ -590,6 +637,7 @@ std::size_t skip_header(const std::vector<char>& bytes, std::size_t at, const Pa
                         std::to_string(size) + " bytes, past the end of the file (" +
                         std::to_string(bytes.size()) + " bytes)");
         }
+        check_attribute_value(bytes, at, name, type, value, static_cast<std::size_t>(size), where);
         at = value + static_cast<std::size_t>(size);
     }
 }
