@@ -561,15 +561,34 @@ TEST(InstrumentDeathTest, FullDiskKeepsTheSimulationRunningAndTheArchiveReadable
     fs::remove_all(archive);
 }
 
-/// Resident set size in bytes, from /proc/self/statm (second field, in pages), after handing
-/// free heap pages back to the system so that only live memory counts.
-std::int64_t resident_bytes() {
+#if defined(__SANITIZE_ADDRESS__)
+}  // namespace
+}  // namespace insitu
+// AddressSanitizer's count of the heap bytes the program holds (declared in
+// sanitizer/allocator_interface.h, which GCC does not ship; libasan exports it).
+extern "C" std::size_t __sanitizer_get_current_allocated_bytes();
+namespace insitu {
+namespace {
+#endif
+
+/// The memory the flat-memory test bounds: resident set size in bytes, from /proc/self/statm
+/// (second field, in pages), after handing free heap pages back to the system so that only live
+/// memory counts. Under AddressSanitizer resident memory is not the program's: freed blocks wait
+/// in ASan's quarantine (256 MB by default) before they are reused, so RSS climbs for hundreds of
+/// steps with no live memory behind it, and shadow pages come on top. ASan's own count of live
+/// heap bytes measures exactly what the test is about (what execute() and the writer keep from
+/// step to step) without the quarantine, so that is what is bounded there.
+std::int64_t retained_bytes() {
+#if defined(__SANITIZE_ADDRESS__)
+    return static_cast<std::int64_t>(__sanitizer_get_current_allocated_bytes());
+#else
     ::malloc_trim(0);
     std::ifstream statm("/proc/self/statm");
     std::int64_t size_pages = 0;
     std::int64_t resident_pages = 0;
     statm >> size_pages >> resident_pages;
     return resident_pages * static_cast<std::int64_t>(::sysconf(_SC_PAGESIZE));
+#endif
 }
 
 TEST_F(InstrumentTest, ThousandStepsRunWithFlatMemory) {
@@ -599,7 +618,7 @@ TEST_F(InstrumentTest, ThousandStepsRunWithFlatMemory) {
                  ++wait) {
                 std::this_thread::sleep_for(std::chrono::milliseconds(5));
             }
-            return resident_bytes();
+            return retained_bytes();
         };
         std::int64_t after_100 = 0;
         for (int step = 1; step <= 1000; ++step) {
@@ -615,10 +634,10 @@ TEST_F(InstrumentTest, ThousandStepsRunWithFlatMemory) {
         constexpr std::int64_t kBoundBytesPerStep = 512;
         const std::int64_t growth = after_1000 - after_100;
         EXPECT_LT(growth, 900 * kBoundBytesPerStep)
-            << "resident after step 100: " << after_100 << " bytes, after 1000: " << after_1000;
-        std::cout << "[ memory   ] resident after step 100: " << after_100 / 1024
-                  << " KiB, after step 1000: " << after_1000 / 1024 << " KiB (" << growth / 900
-                  << " bytes per step; manifest.json "
+            << "retained after step 100: " << after_100 << " bytes, after 1000: " << after_1000;
+        std::cout << "[ memory   ] retained (RSS; live heap under ASan) after step 100: "
+                  << after_100 / 1024 << " KiB, after step 1000: " << after_1000 / 1024 << " KiB ("
+                  << growth / 900 << " bytes per step; manifest.json "
                   << fs::file_size(path / "run.cdb" / "manifest.json") / 1024 << " KiB)\n";
     }
     fs::remove_all(path);
