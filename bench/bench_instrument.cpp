@@ -37,8 +37,7 @@ Options parse(int argc, char** argv) {
     Options options;
     for (int i = 1; i < argc; ++i) {
         const std::string flag = argv[i];
-        if (i + 1 >= argc) throw cli::UsageError(flag + " needs a value");
-        const std::string value = argv[++i];
+        const std::string value = cli::next_value(argc, argv, i);
         if (flag == "--sizes") {
             options.sizes.clear();
             std::stringstream list(value);

@@ -34,8 +34,7 @@ Options parse(int argc, char** argv) {
     Options options;
     for (int i = 1; i < argc; ++i) {
         const std::string flag = argv[i];
-        if (i + 1 >= argc) throw cli::UsageError(flag + " needs a value");
-        const int value = cli::parse_integer<int>(flag, argv[++i], 1);
+        const int value = cli::parse_integer<int>(flag, cli::next_value(argc, argv, i), 1);
         if (flag == "--size")
             options.size = value;
         else if (flag == "--image")
