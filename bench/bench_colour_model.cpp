@@ -16,6 +16,7 @@
 #include "insitu/explore/colour_model.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
+#include "insitu/testing/metrics.hpp"
 #include "median_time.hpp"
 
 namespace {
@@ -59,21 +60,6 @@ TransferFunction blob_function(float low, float middle, float high) {
                              {0.8, {0.9f, 0.7f, 0.1f, high}},
                              {1.0, {0.9f, 0.1f, 0.1f, high}}},
                             8.0);
-}
-
-/// PSNR (dB) of premultiplied RGB over the pixels either image covers.
-double psnr(const Image& image, const Image& truth) {
-    double sum = 0.0;
-    std::size_t count = 0;
-    for (std::size_t p = 0; p < truth.pixel_count(); ++p) {
-        if (!(truth.pixels[4 * p + 3] > 0.0f) && !(image.pixels[4 * p + 3] > 0.0f)) continue;
-        for (int c = 0; c < 3; ++c) {
-            const double d = double(image.pixels[4 * p + c]) - truth.pixels[4 * p + c];
-            sum += d * d;
-        }
-        count += 3;
-    }
-    return count == 0 ? INFINITY : -10.0 * std::log10(std::max(sum / count, 1e-20));
 }
 
 }  // namespace
@@ -134,13 +120,14 @@ int main(int argc, char** argv) {
             milliseconds.push_back(
                 std::chrono::duration<double, std::milli>(Clock::now() - start).count());
         }
-        std::printf("%15lld%7s %10.1f %10d %12.2f %14.2f\n", static_cast<long long>(pixels),
-                    pixels == defaults.max_training_pixels ? " (def)"
-                    : pixels == 0                          ? " (all)"
-                                                           : "",
-                    bench::median(milliseconds), model.clusters(),
-                    psnr(model.predict(attenuations[0]), colours[0]),
-                    psnr(model.predict(held_out_attenuation), held_out_truth));
+        std::printf(
+            "%15lld%7s %10.1f %10d %12.2f %14.2f\n", static_cast<long long>(pixels),
+            pixels == defaults.max_training_pixels ? " (def)"
+            : pixels == 0                          ? " (all)"
+                                                   : "",
+            bench::median(milliseconds), model.clusters(),
+            evaluation::psnr_covered_db(model.predict(attenuations[0]), colours[0]),
+            evaluation::psnr_covered_db(model.predict(held_out_attenuation), held_out_truth));
     }
 
     const ColourModel model = ColourModel::fit(attenuations, colours);

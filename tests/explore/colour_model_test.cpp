@@ -17,6 +17,7 @@
 #include "insitu/explore/transfer_function_edit.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
+#include "insitu/testing/metrics.hpp"
 #include "support/expect_error.hpp"
 
 namespace insitu {
@@ -24,21 +25,7 @@ namespace {
 
 using testing::expect_error_naming;
 
-/// PSNR in dB of premultiplied RGB against `truth`, peak 1, over the pixels either image covers
-/// (alpha > 0): empty background would otherwise inflate it.
-double psnr(const Image& image, const Image& truth) {
-    double sum = 0.0;
-    std::size_t count = 0;
-    for (std::size_t p = 0; p < truth.pixel_count(); ++p) {
-        if (!(truth.pixels[4 * p + 3] > 0.0f) && !(image.pixels[4 * p + 3] > 0.0f)) continue;
-        for (int c = 0; c < 3; ++c) {
-            const double d = double(image.pixels[4 * p + c]) - truth.pixels[4 * p + c];
-            sum += d * d;
-        }
-        count += 3;
-    }
-    return count == 0 ? INFINITY : -10.0 * std::log10(std::max(sum / count, 1e-20));
-}
+using evaluation::psnr_covered_db;
 
 bool all_finite(const Image& image) {
     return std::all_of(image.pixels.begin(), image.pixels.end(),
@@ -147,15 +134,16 @@ TEST(ColourModel, PredictsAHeldOutTransferFunction) {
     const Image estimated_tau =
         estimate_attenuation(a.attenuation, a.mean_depth, &a.optical_depth, scales);
 
-    const double fit_psnr = psnr(model.predict(a.attenuation), truth_a);
-    const double direct_psnr = psnr(model.predict(direct), truth);
-    const double estimated_psnr = psnr(model.predict(estimated), truth);
-    const double estimated_tau_psnr = psnr(model.predict(estimated_tau), truth);
+    const double fit_psnr = psnr_covered_db(model.predict(a.attenuation), truth_a);
+    const double direct_psnr = psnr_covered_db(model.predict(direct), truth);
+    const double estimated_psnr = psnr_covered_db(model.predict(estimated), truth);
+    const double estimated_tau_psnr = psnr_covered_db(model.predict(estimated_tau), truth);
     const std::vector<float> colours = interval_colours(kHeldOut, scene.intervals);
-    const double recomposed_psnr = psnr(recolour(direct, colours), truth);
-    const double model_vs_recomposed = psnr(model.predict(direct), recolour(direct, colours));
-    const double broken_psnr = psnr(without_jacobians(model).predict(direct), truth);
-    const double stored_psnr = psnr(truth_a, truth);
+    const double recomposed_psnr = psnr_covered_db(recolour(direct, colours), truth);
+    const double model_vs_recomposed =
+        psnr_covered_db(model.predict(direct), recolour(direct, colours));
+    const double broken_psnr = psnr_covered_db(without_jacobians(model).predict(direct), truth);
+    const double stored_psnr = psnr_covered_db(truth_a, truth);
     std::cout << std::fixed << std::setprecision(2) << "colour model PSNR (dB): training fit "
               << fit_psnr << ", held-out from a proxy pass " << direct_psnr
               << ", held-out from the opacity edit of stored a " << estimated_psnr << " (with tau "
@@ -354,7 +342,7 @@ TEST(ColourModel, SingleIntervalScenesFitAndPredictFinitely) {
     ASSERT_TRUE(all_finite(predicted));
     // One interval only knows how much is opaque, not which shell: colour is a function of
     // alpha alone, a poor but defined model. 15 dB checks it is not garbage.
-    const double single_psnr = psnr(model.predict(a.attenuation), truth_a);
+    const double single_psnr = psnr_covered_db(model.predict(a.attenuation), truth_a);
     std::cout << "L = 1 training fit PSNR " << single_psnr << " dB" << std::endl;
     EXPECT_GE(single_psnr, 15.0);
 }

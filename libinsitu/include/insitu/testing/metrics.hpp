@@ -64,6 +64,23 @@ inline double psnr_db(const Image& a, const Image& b) {
     return std::min(kPsnrCapDb, -10.0 * std::log10(std::max(mse, 1e-10)));
 }
 
+/// PSNR in dB of premultiplied RGB against `truth`, peak 1, over the pixels either image covers
+/// (alpha > 0): empty background would otherwise inflate it. +inf when neither covers any pixel;
+/// MSE floored at 1e-20, so it is not capped at kPsnrCapDb. Both images RGBA of one size.
+inline double psnr_covered_db(const Image& image, const Image& truth) {
+    double sum = 0.0;
+    std::size_t count = 0;
+    for (std::size_t p = 0; p < truth.pixel_count(); ++p) {
+        if (!(truth.pixels[4 * p + 3] > 0.0f) && !(image.pixels[4 * p + 3] > 0.0f)) continue;
+        for (int c = 0; c < 3; ++c) {
+            const double d = double(image.pixels[4 * p + c]) - truth.pixels[4 * p + c];
+            sum += d * d;
+        }
+        count += 3;
+    }
+    return count == 0 ? INFINITY : -10.0 * std::log10(std::max(sum / count, 1e-20));
+}
+
 inline double max_abs_error(const Image& a, const Image& b) {
     require_same_size(a, b, 1, "max_abs_error");
     if (a.channels != b.channels) {
