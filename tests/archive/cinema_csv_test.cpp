@@ -8,9 +8,12 @@
 
 #include "archive/archive_format.hpp"
 #include "archive/manifest.hpp"
+#include "archive/manifest_entries.hpp"
 
 namespace insitu::archive_format {
 namespace {
+
+using insitu::testing::insert_step;
 
 nlohmann::json view_entry(int view, double phi, double theta, const std::string& stem) {
     return {

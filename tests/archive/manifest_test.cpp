@@ -12,6 +12,7 @@
 #include <string>
 
 #include "archive/archive_format.hpp"
+#include "archive/manifest_entries.hpp"
 #include "insitu/error.hpp"
 #include "support/expect_error.hpp"
 
@@ -20,6 +21,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using insitu::testing::expect_error_naming;
+using insitu::testing::insert_step;
 using ::testing::ElementsAre;
 
 nlohmann::json step_entry(std::int64_t step) {

@@ -292,15 +292,6 @@ std::vector<std::int64_t> manifest_steps(const nlohmann::json& manifest) {
     return steps;
 }
 
-void insert_step(nlohmann::json& manifest, nlohmann::json step_entry) {
-    nlohmann::json& steps = manifest["steps"];
-    const std::int64_t step = step_entry.at("step").get<std::int64_t>();
-    const auto position = std::find_if(steps.begin(), steps.end(), [&](const auto& entry) {
-        return entry.at("step").template get<std::int64_t>() > step;
-    });
-    steps.insert(position, std::move(step_entry));
-}
-
 nlohmann::json file_entry(const WrittenFile& file, const char* kind) {
     return {
         {"kind", kind}, {"path", file.relative_path}, {"bytes", file.bytes}, {"crc32", file.crc32}};

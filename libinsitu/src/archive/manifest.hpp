@@ -62,8 +62,6 @@ void append_journal(const std::string& archive_path, const nlohmann::json& step_
 
 /// Step numbers of a validated manifest, sorted.
 std::vector<std::int64_t> manifest_steps(const nlohmann::json& manifest);
-/// Inserts a step entry, keeping the steps sorted.
-void insert_step(nlohmann::json& manifest, nlohmann::json step_entry);
 
 /// The entry of `file` in a view's "files" list.
 nlohmann::json file_entry(const WrittenFile& file, const char* kind);
