@@ -16,7 +16,7 @@ public:
     /// Copies `image` to the device.
     void upload(ComputeDevice& device, const Image& image, const char* what) {
         allocate(device, image.width, image.height, image.channels);
-        device.opencl().upload(buffer_, image.pixels.data(), bytes(), what);
+        device.opencl().upload(memory_.buffer, image.pixels.data(), bytes(), what);
     }
     /// Device storage for a width x height x channels float image (contents undefined).
     void allocate(ComputeDevice& device, int width, int height, int channels) {
@@ -26,21 +26,20 @@ public:
         width_ = width;
         height_ = height;
         channels_ = channels;
-        device.opencl().ensure_buffer(buffer_, capacity_, bytes(), CL_MEM_READ_WRITE);
+        device.opencl().ensure_buffer(memory_.buffer, memory_.capacity, bytes(), CL_MEM_READ_WRITE);
     }
     Image download(ComputeDevice& device, const char* what) const {
         Image image(width_, height_, channels_);
-        device.opencl().download(buffer_, image.pixels.data(), bytes(), what);
+        device.opencl().download(memory_.buffer, image.pixels.data(), bytes(), what);
         return image;
     }
-    cl::Buffer& buffer() { return buffer_; }
+    cl::Buffer& buffer() { return memory_.buffer; }
     std::size_t bytes() const {
         return static_cast<std::size_t>(width_) * height_ * channels_ * sizeof(float);
     }
 
 private:
-    cl::Buffer buffer_;
-    std::size_t capacity_ = 0;
+    DeviceMemory memory_;
     int width_ = 0, height_ = 0, channels_ = 0;
 };
 
