@@ -382,4 +382,83 @@ TEST(InstrumentConfig, FromFileNamesTheFile) {
 }
 
 }  // namespace
+TEST(InstrumentConfig, SuggestsTheNearestKnownKeyAtTheSameLevel) {
+    EXPECT_EQ(suggest_key("evry"), "every");
+    EXPECT_EQ(suggest_key("stpe"), "step");
+    EXPECT_EQ(suggest_key("views[0].azimut"), "azimuth");
+    EXPECT_EQ(suggest_key("fields[1].views[0].elevaton"), "elevation");
+    EXPECT_EQ(suggest_key("intervals.cout"), "count");
+    EXPECT_EQ(suggest_key("transfer_function.pionts"), "points");
+    EXPECT_EQ(suggest_key("fields[0].nmae"), "name");
+    EXPECT_EQ(suggest_key("zoom"), "");            // nothing close
+    EXPECT_EQ(suggest_key("views[0].every"), "");  // a key of another level is not offered
+    EXPECT_EQ(describe_unknown_keys({"evry", "zoom"}),
+              "unknown configuration key \"evry\" (did you mean \"every\"?); "
+              "unknown configuration key \"zoom\"");
+}
+
+TEST(InstrumentConfig, StrictAndOnExistingReadAndRoundTrip) {
+    const InstrumentConfig defaults;
+    EXPECT_TRUE(defaults.strict);
+    EXPECT_EQ(defaults.on_existing, OnExisting::append);
+    const InstrumentConfig config =
+        InstrumentConfig::from_json_text(R"({"strict": false, "on_existing": "replace"})");
+    EXPECT_FALSE(config.strict);
+    EXPECT_EQ(config.on_existing, OnExisting::replace);
+    const InstrumentConfig again = InstrumentConfig::from_json(config.to_json());
+    EXPECT_FALSE(again.strict);
+    EXPECT_EQ(again.on_existing, OnExisting::replace);
+    expect_error<InvalidArgument>(R"({"on_existing": "overwrite"})", {"on_existing"});
+}
+
+TEST(InstrumentConfig, FieldsMayCarryTheirOwnViewsTransferFunctionAndLayers) {
+    const InstrumentConfig config = InstrumentConfig::from_json_text(R"({
+        "fields": ["density",
+                   {"name": "energy", "views": [{"azimuth": 90, "size": [64, 32]},
+                                                {"azimuth": 180, "size": [64, 32]}],
+                    "transfer_function": {"points": [[0, 0, 1, 0, 0], [5, 1, 1, 0, 1]]},
+                    "layers": [2.5]}],
+        "views": [{"size": [16, 16]}], "layers": "auto"})");
+    ASSERT_EQ(config.fields.size(), 2u);
+    EXPECT_EQ(config.views_of("density").size(), 1u);
+    EXPECT_EQ(config.views_of("energy").size(), 2u);
+    EXPECT_EQ(config.views_of("energy")[1].orbit.azimuth_deg, 180.0);
+    EXPECT_FALSE(config.layers_of("density").has_value());
+    ASSERT_TRUE(config.layers_of("energy").has_value());
+    EXPECT_EQ(config.layers_of("energy")->at(0), 2.5);
+    EXPECT_TRUE(config.trains("density"));
+    EXPECT_FALSE(config.trains("energy"));
+    const std::vector<PlannedView> planned = config.planned_views();
+    ASSERT_EQ(planned.size(), 3u);
+    EXPECT_EQ(planned[0].field, "density");
+    EXPECT_EQ(planned[2].field, "energy");
+    // The estimate counts every field's pixels: 16^2 + 2 * 64 * 32.
+    InstrumentConfig single = config;
+    single.fields = {"density"};
+    single.field_styles.clear();
+    EXPECT_NEAR(config.estimated_samples_per_step() / single.estimated_samples_per_step(),
+                (256.0 + 2 * 2048.0) / 256.0, 1e-9);
+    // to_json writes a styled field as an object, a plain one as its name, and reads back.
+    const nlohmann::json json = config.to_json();
+    EXPECT_TRUE(json["fields"][0].is_string());
+    EXPECT_EQ(json["fields"][1]["name"], "energy");
+    const InstrumentConfig again = InstrumentConfig::from_json(json);
+    EXPECT_EQ(again.to_json(), json);
+}
+
+TEST(InstrumentConfig, BadFieldEntriesAreNamed) {
+    expect_error<InvalidArgument>(R"({"fields": ["v", "v"]})", {"fields[1]"});
+    expect_error<InvalidArgument>(R"({"fields": [{"views": []}]})", {"name"});
+    expect_error<InvalidArgument>(R"({"fields": [{"name": "v", "views": []}]})",
+                                  {"fields[0].views"});
+    expect_error<InvalidArgument>(
+        R"({"fields": [{"name": "v", "layers": [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15,
+                                                16, 17, 18, 19, 20, 21, 22, 23, 24, 25, 26, 27, 28,
+                                                29, 30, 31, 32, 33]}]})",
+        {"fields[0].layers"});
+    std::vector<std::string> unknown;
+    InstrumentConfig::from_json_text(R"({"fields": [{"name": "v", "colour": 1}]})", &unknown);
+    EXPECT_THAT(unknown, ElementsAre("fields[0].colour"));
+}
+
 }  // namespace insitu

@@ -474,4 +474,66 @@ TEST(Field, CoreTypesPrintThemselves) {
 }
 
 }  // namespace
+// --- Centring and blocks (issue 18) ---
+
+TEST(Field, CentringSaysWhatTheOriginIs) {
+    std::vector<float> values(4 * 4 * 4, 1.0f);
+    Field node("v", values.data(), ScalarType::float32, {4, 4, 4});
+    node.set_origin({1.0, 2.0, 3.0}).set_spacing({0.5, 0.5, 0.5});
+    EXPECT_EQ(node.centering(), Centering::node);
+    EXPECT_EQ(node.first_sample(), glm::dvec3(1.0, 2.0, 3.0));
+    EXPECT_EQ(node.bounds().upper, glm::dvec3(2.5, 3.5, 4.5));
+    Field cell = node;
+    cell.set_centering(Centering::cell);
+    // The origin is the first cell's low corner; its value sits half a spacing inside.
+    EXPECT_EQ(cell.origin(), glm::dvec3(1.0, 2.0, 3.0));
+    EXPECT_EQ(cell.first_sample(), glm::dvec3(1.25, 2.25, 3.25));
+    EXPECT_EQ(cell.bounds().lower, glm::dvec3(1.25, 2.25, 3.25));
+    EXPECT_EQ(cell.bounds().upper, glm::dvec3(2.75, 3.75, 4.75));
+    EXPECT_EQ(parse_centering("cell"), Centering::cell);
+    EXPECT_EQ(to_string(Centering::node), "node");
+    EXPECT_THROW(parse_centering("point"), InvalidArgument);
+}
+
+TEST(JoinBlocks, TilesInAnyOrderJoinIntoTheWholeField) {
+    // An 5x3x4 field of distinct values, cut into three tiles along x and z.
+    const Index3 dims{5, 3, 4};
+    std::vector<double> whole;
+    for (int k = 0; k < 4; ++k) {
+        for (int j = 0; j < 3; ++j) {
+            for (int i = 0; i < 5; ++i) whole.push_back(100 * k + 10 * j + i);
+        }
+    }
+    // Tile A: x 0..2 (shares x = 2 with B), z 0..3; B: x 2..4, z 0..1; C: x 2..4, z 2..3.
+    // Each tile views the whole array through strides and ghosts: no copies.
+    const Index3 strides{1, 5, 15};
+    Field a("v", whole.data(), ScalarType::float64, dims);
+    a.set_ghost_layers({0, 0, 0}, {2, 0, 0});
+    Field b("v", whole.data(), ScalarType::float64, dims);
+    b.set_ghost_layers({2, 0, 0}, {0, 0, 2}).set_origin({2.0, 0.0, 0.0});
+    Field c("v", whole.data(), ScalarType::float64, dims);
+    c.set_ghost_layers({2, 0, 2}, {0, 0, 0}).set_origin({2.0, 0.0, 2.0});
+    for (Field* tile : {&a, &b, &c}) tile->set_strides(strides);
+
+    std::vector<float> storage;
+    const Field joined = join_blocks({&c, &a, &b}, storage);
+    EXPECT_EQ(joined.dims(), dims);
+    EXPECT_EQ(joined.origin(), glm::dvec3(0.0));
+    for (int k = 0; k < 4; ++k) {
+        for (int j = 0; j < 3; ++j) {
+            for (int i = 0; i < 5; ++i) {
+                EXPECT_EQ(joined.value(i, j, k), 100 * k + 10 * j + i) << i << j << k;
+            }
+        }
+    }
+    // Without C the box has a hole.
+    try {
+        join_blocks({&a, &b}, storage);
+        FAIL() << "a gap was accepted";
+    } catch (const InvalidArgument& error) {
+        EXPECT_THAT(error.what(), ::testing::HasSubstr("gap"));
+        EXPECT_THAT(error.what(), ::testing::HasSubstr("(3, 0, 2)"));  // the first hole, world
+    }
+}
+
 }  // namespace insitu

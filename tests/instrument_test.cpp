@@ -322,20 +322,137 @@ TEST_F(InstrumentTest, AFieldBeyondFloat32IsRefusedNamingTheFieldAndItsRange) {
     EXPECT_THAT(ArchiveReader(archive().string()).steps(), ElementsAre(0));
 }
 
-TEST_F(InstrumentTest, ARestartContinuesTheArchiveAndRefusesStepsItHolds) {
+TEST_F(InstrumentTest, ARestartContinuesTheArchiveAndSkipsTheStepsItHolds) {
+    std::uint64_t step_one_bytes = 0;
     {
         Instrument first(small_config(archive(), 16), quiet());
         ASSERT_EQ(first.execute(0, 0.0, {volume_.field()}), Status::ok);
         ASSERT_EQ(first.execute(1, 1.0, {volume_.field()}), Status::ok);
     }  // the destructor finalizes
-    Instrument second(small_config(archive(), 16), quiet());
-    EXPECT_EQ(second.execute(1, 1.0, {volume_.field()}), Status::error);
-    EXPECT_THAT(second.last_error(), HasSubstr("step 1"));
-    EXPECT_EQ(second.execute(2, 2.0, {volume_.field()}), Status::ok) << second.last_error();
-    ASSERT_EQ(second.finalize(), Status::ok) << second.last_error();
+    step_one_bytes = fs::file_size(archive() / "proxies" / "step000001_view0.exr");
+    InstrumentOptions logged;
+    ::testing::internal::CaptureStderr();
+    {
+        Instrument second(small_config(archive(), 16), logged);
+        EXPECT_FALSE(second.selects(0));
+        // The replayed steps are skipped (even with another field: nothing is computed).
+        SampledVolume changed = small_volume(12);
+        EXPECT_EQ(second.execute(0, 0.0, {changed.field()}), Status::not_selected);
+        EXPECT_EQ(second.execute(1, 1.0, {changed.field()}), Status::not_selected);
+        EXPECT_TRUE(second.selects(2));
+        EXPECT_EQ(second.execute(2, 2.0, {volume_.field()}), Status::ok) << second.last_error();
+        ASSERT_EQ(second.finalize(), Status::ok) << second.last_error();
+        EXPECT_EQ(second.statistics().steps_replayed, 2);
+        EXPECT_EQ(second.statistics().errors, 0);
+    }
+    const std::string log = ::testing::internal::GetCapturedStderr();
+    // One notice for the replay, not one per step.
+    EXPECT_EQ(log.find("already in archive"), log.rfind("already in archive")) << log;
+    EXPECT_THAT(log, HasSubstr("step 0 is already in archive")) << log;
     const ArchiveReader reader(archive().string());
     EXPECT_THAT(reader.steps(), ElementsAre(0, 1, 2));
     EXPECT_THAT(reader.verify(), ElementsAre());
+    EXPECT_EQ(fs::file_size(archive() / "proxies" / "step000001_view0.exr"), step_one_bytes);
+}
+
+TEST_F(InstrumentTest, OnExistingReplaceStartsTheArchiveAnewAndKeepsOtherFiles) {
+    {
+        Instrument first(small_config(archive(), 16), quiet());
+        ASSERT_EQ(first.execute(0, 0.0, {volume_.field()}), Status::ok);
+        ASSERT_EQ(first.execute(1, 1.0, {volume_.field()}), Status::ok);
+    }
+    { std::ofstream(archive() / "notes.txt") << "the user's own file\n"; }
+    InstrumentConfig config = small_config(archive(), 16);
+    config.on_existing = OnExisting::replace;
+    {
+        Instrument second(config, quiet());
+        EXPECT_TRUE(second.selects(0));
+        ASSERT_EQ(second.execute(0, 0.5, {volume_.field()}), Status::ok) << second.last_error();
+    }
+    const ArchiveReader reader(archive().string());
+    EXPECT_THAT(reader.steps(), ElementsAre(0));
+    EXPECT_DOUBLE_EQ(reader.entry(0, 0).time, 0.5);
+    EXPECT_FALSE(fs::exists(archive() / "proxies" / "step000001_view0.exr"));
+    EXPECT_FALSE(fs::exists(archive() / "previews" / "step000001_view0.png"));
+    EXPECT_TRUE(fs::exists(archive() / "notes.txt"));
+    EXPECT_THAT(reader.verify(), ElementsAre());
+}
+
+TEST_F(InstrumentTest, OnExistingFailRefusesAnExistingArchiveAndLeavesItAlone) {
+    {
+        Instrument first(small_config(archive(), 16), quiet());
+        ASSERT_EQ(first.execute(0, 0.0, {volume_.field()}), Status::ok);
+    }
+    InstrumentConfig config = small_config(archive(), 16);
+    config.on_existing = OnExisting::fail;
+    try {
+        Instrument second(config, quiet());
+        FAIL() << "an existing archive was accepted with on_existing = fail";
+    } catch (const IoError& error) {
+        EXPECT_THAT(error.what(), HasSubstr("on_existing"));
+        EXPECT_THAT(error.what(), HasSubstr(archive().string()));
+    }
+    EXPECT_THAT(ArchiveReader(archive().string()).steps(), ElementsAre(0));
+    // A fresh directory is fine with "fail".
+    config.archive = (directory_ / "fresh.cdb").string();
+    EXPECT_NO_THROW(Instrument(config, quiet()));
+}
+
+TEST_F(InstrumentTest, SeveralFieldsGoIntoOneArchiveEachWithItsViews) {
+    InstrumentConfig config = small_config(archive(), 16);
+    SampledVolume energy = make_gaussian_blobs({20, 20, 20}, 2, /*seed=*/3);
+    energy.name = "energy";
+    FieldStyle style;
+    ViewConfig side;
+    side.orbit = OrbitView{90.0, 0.0};
+    side.orbit.width = 24;
+    side.orbit.height = 12;
+    style.views = std::vector<ViewConfig>{side, side};
+    style.views->at(1).orbit.azimuth_deg = 180.0;
+    style.transfer_function = TransferFunction({{0.0, {0, 1, 0, 0}}, {1.0, {1, 1, 0, 0.8}}}, 1.0);
+    config.fields = {"f", "energy"};
+    config.field_styles["energy"] = style;
+    Instrument instrument(config, quiet());
+    // Both are needed on a selected step.
+    EXPECT_EQ(instrument.execute(0, 0.0, {volume_.field()}), Status::error);
+    EXPECT_THAT(instrument.last_error(), HasSubstr("\"energy\" missing"));
+    ASSERT_EQ(instrument.execute(1, 1.0, {energy.field(), volume_.field()}), Status::ok)
+        << instrument.last_error();
+    ASSERT_EQ(instrument.finalize(), Status::ok) << instrument.last_error();
+
+    const ArchiveReader reader(archive().string());
+    ASSERT_EQ(reader.view_count(), 3);
+    EXPECT_EQ(reader.entry(1, 0).field, "f");
+    EXPECT_EQ(reader.entry(1, 1).field, "energy");
+    EXPECT_EQ(reader.entry(1, 2).field, "energy");
+    EXPECT_EQ(reader.load_preview(1, 0).width, 16);
+    EXPECT_EQ(reader.load_preview(1, 1).width, 24);
+    EXPECT_EQ(reader.load_preview(1, 2).height, 12);
+    EXPECT_THAT(reader.verify(), ElementsAre());
+    // The configuration reads back with the field's own settings.
+    const InstrumentConfig stored = reader.configuration();
+    EXPECT_EQ(stored.views_of("energy").size(), 2u);
+    EXPECT_EQ(stored.views_of("f").size(), 1u);
+    EXPECT_EQ(stored.transfer_function_of("energy").to_json(), style.transfer_function->to_json());
+}
+
+TEST_F(InstrumentTest, FinalizeStatesTheInSituShareOfWallTime) {
+    InstrumentOptions logged;
+    ::testing::internal::CaptureStderr();
+    {
+        Instrument instrument(small_config(archive(), 16), logged);
+        ASSERT_EQ(instrument.execute(0, 0.0, {volume_.field()}), Status::ok);
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the "simulation"
+        ASSERT_EQ(instrument.execute(1, 1.0, {volume_.field()}), Status::ok);
+        ASSERT_EQ(instrument.finalize(), Status::ok);
+        const InstrumentStatistics statistics = instrument.statistics();
+        EXPECT_GE(statistics.simulation_seconds, 0.045);
+        EXPECT_GE(statistics.execute_seconds, statistics.compute_seconds);
+    }
+    const std::string log = ::testing::internal::GetCapturedStderr();
+    EXPECT_THAT(log, HasSubstr("inside execute"));
+    EXPECT_THAT(log, HasSubstr("% of"));
+    EXPECT_THAT(log, HasSubstr("between calls"));
 }
 
 TEST_F(InstrumentTest, MissingFieldIsAnErrorNamingIt) {
@@ -402,10 +519,26 @@ TEST_F(InstrumentTest, NonfiniteSamplesAreCountedAndWarnedAboutOnce) {
     EXPECT_THAT(log, HasSubstr("2 NaN/Inf"));
 }
 
-TEST_F(InstrumentTest, UnknownConfigurationKeysAreReportedByName) {
+TEST_F(InstrumentTest, UnknownConfigurationKeysAreErrorsNamingTheNearestKey) {
+    const nlohmann::json json = {{"fields", {"f"}},
+                                 {"views", {{{"size", {8, 8}}}}},
+                                 {"evry", 10},
+                                 {"archive", archive().string()}};
+    try {
+        Instrument::from_json_text(json.dump(), quiet());
+        FAIL() << "an unknown key was accepted";
+    } catch (const ParseError& error) {
+        EXPECT_THAT(error.what(), HasSubstr("\"evry\" (did you mean \"every\"?)"));
+        EXPECT_THAT(error.what(), HasSubstr("\"strict\": false"));
+    }
+    EXPECT_FALSE(fs::exists(archive()));  // refused before anything was written
+}
+
+TEST_F(InstrumentTest, UnknownConfigurationKeysAreReportedByNameWhenNotStrict) {
     const nlohmann::json json = {{"fields", {"f"}},
                                  {"views", {{{"size", {8, 8}}, {"zoom", 2}}}},
                                  {"writer", {{"speed", "fast"}}},
+                                 {"strict", false},
                                  {"archive", archive().string()}};
     InstrumentOptions options;
     ::testing::internal::CaptureStderr();

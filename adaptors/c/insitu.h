@@ -46,10 +46,19 @@ enum {
     INSITU_FLOAT64 = 4
 };
 
+/* Centring of a field's samples (insitu::Centering). Node: sample (i, j, k) of the interior lies
+ * at origin + (i, j, k) * spacing, so origin is the first interior sample. Cell: sample (i, j, k)
+ * is the cell [origin + (i, j, k) * spacing, origin + (i + 1, j + 1, k + 1) * spacing], so origin
+ * is the low corner of the first interior cell and the value sits at the cell's centre. */
+enum { INSITU_NODE = 0, INSITU_CELL = 1 };
+
 /* Create an instrument from a JSON configuration file or text (see insitu/config.hpp). *out is
- * set to NULL on failure: INSITU_ERROR_PARSE (malformed JSON), INSITU_ERROR_INVALID_ARGUMENT (a
- * bad value, named), INSITU_ERROR_IO (unreadable file, archive that cannot be opened),
- * INSITU_ERROR_COMPUTE (no OpenCL device). Unknown keys are logged to stderr, not errors. */
+ * set to NULL on failure: INSITU_ERROR_PARSE (malformed JSON, or an unknown key while "strict"
+ * is true, the default), INSITU_ERROR_INVALID_ARGUMENT (a bad value, named), INSITU_ERROR_IO
+ * (unreadable file, archive that cannot be opened), INSITU_ERROR_COMPUTE (no OpenCL device).
+ * A failed start-up is printed once to stderr; every later call given the NULL instrument is a
+ * silent no-op returning INSITU_NOT_SELECTED, so a run whose visualisation could not start goes
+ * on without a message per step. (Before any create failed, a NULL instrument is an error.) */
 int insitu_create_from_file(const char* path, insitu_instrument** out);
 int insitu_create_from_json(const char* json_text, insitu_instrument** out);
 
@@ -73,14 +82,40 @@ int insitu_set_field_strided(insitu_instrument* instrument, const char* name, co
                              const double spacing[3], const int64_t ghosts[3],
                              const int64_t strides_samples[3]);
 
+/* The general form: adds one block of a field for the next insitu_execute. Several blocks of one
+ * field (the tiles a rank owns) are joined on the grid they share: same spacing and centring,
+ * origins a whole number of samples apart, and their interiors together covering a box (a gap,
+ * or blocks that disagree, is INSITU_ERROR_INVALID_ARGUMENT naming the blocks). Blocks may share
+ * samples (node-centred tiles that share a face); the later block's value is used.
+ * ghosts_low, ghosts_high: layers skipped on the low and high side of each axis (NULL = none;
+ * ghosts_high NULL = the same as ghosts_low). strides_samples: as insitu_set_field_strided.
+ * centering: INSITU_NODE or INSITU_CELL. insitu_set_field(_strided) is this with node centring,
+ * after dropping the field's earlier blocks. */
+int insitu_add_block(insitu_instrument* instrument, const char* name, const void* data,
+                     int scalar_type, const int64_t dims[3], const double origin[3],
+                     const double spacing[3], const int64_t ghosts_low[3],
+                     const int64_t ghosts_high[3], const int64_t strides_samples[3], int centering);
+
+/* Whether insitu_execute would compute this step: INSITU_OK when the cadence selects it and the
+ * archive does not hold it yet, INSITU_NOT_SELECTED otherwise (the cadence skips it, or a
+ * restarted run replays a step an earlier run archived), or an error (INSITU_ERROR_STATE after
+ * insitu_finalize). Fields need only be set on steps for which it returns INSITU_OK. */
+int insitu_selects(insitu_instrument* instrument, int64_t step);
+
+/* For language bindings (the Fortran module): the entry name the next failing call on this
+ * thread reports in insitu_last_error() ("insitu_set_field" for the Fortran generic) instead of
+ * the C function's. Applies to the next call only. NULL restores the C names. */
+void insitu_name_next_call(const char* entry_name);
+
 /* Compute and queue the proxies of the fields set since the last execute, then forget those
  * fields (their pointers are not used again). step: in [0, 2^53 - 1] and increasing; time:
  * simulation time, finite (the archive's JSON manifest holds neither NaN nor Inf).
- * Returns INSITU_OK (queued), INSITU_NOT_SELECTED (the cadence skipped the step; nothing is
- * computed), INSITU_DROPPED, or an error, after which the run may go on:
- *   INSITU_ERROR_INVALID_ARGUMENT  duplicate, decreasing or out-of-range step; non-finite
- *                                  time; the first configured field not set (on steps the
- *                                  cadence skips too); values beyond float32
+ * Returns INSITU_OK (queued), INSITU_NOT_SELECTED (the cadence skipped the step, or the archive
+ * already holds it from an earlier run: nothing is computed, fields need not be set),
+ * INSITU_DROPPED, or an error, after which the run may go on:
+ *   INSITU_ERROR_INVALID_ARGUMENT  decreasing or out-of-range step; non-finite time; a
+ *                                  configured field not set on a selected step; values beyond
+ *                                  float32; blocks of a field that do not join
  *   INSITU_ERROR_COMPUTE           OpenCL failure while computing the proxies
  *   INSITU_ERROR_STATE             called after insitu_finalize
  * A step the writer thread fails to store is reported by insitu_finalize. */

@@ -4,8 +4,10 @@
 // row): every extern "C" function runs its body through guarded(), which catches everything and
 // records the message in a thread_local string for insitu_last_error(). No exception may cross
 // into C or Fortran: unwinding through frames compiled without exception tables is undefined.
+#include <atomic>
 #include <cstdint>
 #include <exception>
+#include <iostream>
 #include <map>
 #include <memory>
 #include <string>
@@ -20,9 +22,10 @@
 // The opaque handle of insitu.h.
 struct insitu_instrument {
     std::unique_ptr<insitu::Instrument> instrument;
-    // Views handed over by insitu_set_field since the last execute, by field name, so that
-    // setting a field twice before one execute replaces it instead of passing it twice.
-    std::map<std::string, insitu::Field> pending_fields;
+    // Blocks handed over since the last execute, by field name: insitu_set_field replaces a
+    // field's blocks (setting it twice before one execute does not pass it twice),
+    // insitu_add_block appends one (the tiles of a rank).
+    std::map<std::string, std::vector<insitu::Field>> pending_fields;
     // Set by insitu_finalize: later set_field/execute calls are a caller bug (INSITU_ERROR_STATE),
     // caught here before a stale field pointer is stored.
     bool finalized = false;
@@ -32,6 +35,19 @@ namespace {
 
 // Per thread, so that two threads driving two instruments do not overwrite each other's message.
 thread_local std::string last_error_message;
+// insitu_name_next_call: the entry name a language binding's user called, for the next call.
+thread_local std::string next_call_name;
+// Set once a create failed in this process: later calls given the NULL instrument that create
+// left are silent no-ops (insitu.h), instead of one "instrument is NULL" per step.
+std::atomic<bool> startup_failed{false};
+
+// The name the current call reports: the binding's entry name when one was given, else the C
+// function's. Consumed, so it applies to one call.
+std::string call_name(const char* function) {
+    std::string name = next_call_name.empty() ? std::string(function) : next_call_name;
+    next_call_name.clear();
+    return name;
+}
 
 using insitu::StateError;
 
@@ -101,15 +117,26 @@ int code_for_kind(insitu::ErrorKind kind) {
 // (insitu::classify; other insitu::Error, std::bad_alloc, ... are INSITU_ERROR_UNKNOWN) and a
 // message prefixed with the C function's name.
 template <typename Body>
-int guarded(const char* function, Body&& body) noexcept {
+int guarded(const char* c_function, Body&& body) noexcept {
+    std::string function;
+    try {
+        function = call_name(c_function);
+    } catch (...) {
+        function.clear();  // no memory for a name: report under none rather than throw
+    }
     try {
         return body();
     } catch (const std::exception& error) {
         const int code = code_for_kind(insitu::classify(std::current_exception()));
-        return fail_with(code, function, error.what());
+        return fail_with(code, function.c_str(), error.what());
     } catch (...) {
-        return fail_with(INSITU_ERROR_UNKNOWN, function, "unknown exception");
+        return fail_with(INSITU_ERROR_UNKNOWN, function.c_str(), "unknown exception");
     }
+}
+
+// True when `instrument` is the NULL a failed create left: the call is then a silent no-op.
+bool after_failed_startup(const insitu_instrument* instrument) {
+    return instrument == nullptr && startup_failed.load();
 }
 
 enum class Call { execute, finalize };
@@ -144,16 +171,28 @@ int create(const char* function, insitu_instrument** out,
         // The constructor still throws for a bad configuration; guarded() turns that into a code.
         options.rethrow_errors = false;
         auto handle = std::make_unique<insitu_instrument>();
-        handle->instrument = make(argument, options);
+        try {
+            handle->instrument = make(argument, options);
+        } catch (const std::exception& error) {
+            // Said once, here; every later call on the NULL handle is a silent no-op.
+            startup_failed = true;
+            std::cerr << "insitu: " << function << ": start-up failed, in-situ visualisation is "
+                      << "off for this run: " << insitu::one_line(error.what()) << std::endl;
+            throw;
+        }
         *out = handle.release();
         return INSITU_OK;
     });
 }
 
-int set_field(const char* function, insitu_instrument* instrument, const char* name,
+enum class Blocks { replace, append };
+
+int add_block(const char* function, insitu_instrument* instrument, const char* name,
               const void* data, int scalar_type, const int64_t dims[3], const double origin[3],
-              const double spacing[3], const int64_t ghosts[3], const int64_t strides[3]) {
-    return guarded(function, [&]() -> int {
+              const double spacing[3], const int64_t ghosts_low[3], const int64_t ghosts_high[3],
+              const int64_t strides[3], int centering, Blocks blocks) {
+    if (after_failed_startup(instrument)) return INSITU_NOT_SELECTED;
+    const int status = guarded(function, [&]() -> int {
         require_not_null(instrument, "instrument");
         require_not_null(name, "name");
         require_not_null(data, "data");
@@ -174,19 +213,46 @@ int set_field(const char* function, insitu_instrument* instrument, const char* n
             insitu::fail<insitu::InvalidArgument>(
                 "field \"", name, "\" is not in the configuration's fields (", names, ")");
         }
+        if (centering != INSITU_NODE && centering != INSITU_CELL) {
+            insitu::fail<insitu::InvalidArgument>("centering = ", centering,
+                                                  " is not INSITU_NODE (0) or INSITU_CELL (1)");
+        }
 
         const insitu::ScalarType type = scalar_type_from_c(scalar_type);
         insitu::Field field(name, data, type, {dims[0], dims[1], dims[2]});
+        field.set_centering(centering == INSITU_CELL ? insitu::Centering::cell
+                                                     : insitu::Centering::node);
         if (origin != nullptr) field.set_origin({origin[0], origin[1], origin[2]});
         if (spacing != nullptr) field.set_spacing({spacing[0], spacing[1], spacing[2]});
         if (strides != nullptr) field.set_strides({strides[0], strides[1], strides[2]});
-        if (ghosts != nullptr) {
-            const insitu::Index3 layers{ghosts[0], ghosts[1], ghosts[2]};
-            field.set_ghost_layers(layers, layers);
+        if (ghosts_low != nullptr) {
+            const insitu::Index3 low{ghosts_low[0], ghosts_low[1], ghosts_low[2]};
+            const insitu::Index3 high =
+                ghosts_high == nullptr
+                    ? low
+                    : insitu::Index3{ghosts_high[0], ghosts_high[1], ghosts_high[2]};
+            field.set_ghost_layers(low, high);
+        } else if (ghosts_high != nullptr) {
+            field.set_ghost_layers({0, 0, 0}, {ghosts_high[0], ghosts_high[1], ghosts_high[2]});
         }
-        instrument->pending_fields.insert_or_assign(name, std::move(field));
+        std::vector<insitu::Field>& pending = instrument->pending_fields[name];
+        if (blocks == Blocks::replace) pending.clear();
+        pending.push_back(std::move(field));
         return INSITU_OK;
     });
+    // A failed hand-over is an error of the run: counted, and kept as the root cause should the
+    // step then fail for want of the field.
+    if (status < 0 && instrument != nullptr && instrument->instrument) {
+        try {
+            instrument->instrument->report_error(last_error_message,
+                                                 status == INSITU_ERROR_STATE
+                                                     ? insitu::ErrorKind::state
+                                                     : insitu::ErrorKind::invalid_argument);
+        } catch (...) {
+            // Counting must not turn a reported failure into a crash.
+        }
+    }
+    return status;
 }
 
 }  // namespace
@@ -206,37 +272,69 @@ int insitu_create_from_json(const char* json_text, insitu_instrument** out) {
 int insitu_set_field(insitu_instrument* instrument, const char* name, const void* data,
                      int scalar_type, const int64_t dims[3], const double origin[3],
                      const double spacing[3], const int64_t ghosts[3]) {
-    return set_field("insitu_set_field", instrument, name, data, scalar_type, dims, origin, spacing,
-                     ghosts, nullptr);
+    return add_block("insitu_set_field", instrument, name, data, scalar_type, dims, origin, spacing,
+                     ghosts, nullptr, nullptr, INSITU_NODE, Blocks::replace);
 }
 
 int insitu_set_field_strided(insitu_instrument* instrument, const char* name, const void* data,
                              int scalar_type, const int64_t dims[3], const double origin[3],
                              const double spacing[3], const int64_t ghosts[3],
                              const int64_t strides_samples[3]) {
-    return set_field("insitu_set_field_strided", instrument, name, data, scalar_type, dims, origin,
-                     spacing, ghosts, strides_samples);
+    return add_block("insitu_set_field_strided", instrument, name, data, scalar_type, dims, origin,
+                     spacing, ghosts, nullptr, strides_samples, INSITU_NODE, Blocks::replace);
+}
+
+int insitu_add_block(insitu_instrument* instrument, const char* name, const void* data,
+                     int scalar_type, const int64_t dims[3], const double origin[3],
+                     const double spacing[3], const int64_t ghosts_low[3],
+                     const int64_t ghosts_high[3], const int64_t strides_samples[3],
+                     int centering) {
+    return add_block("insitu_add_block", instrument, name, data, scalar_type, dims, origin, spacing,
+                     ghosts_low, ghosts_high, strides_samples, centering, Blocks::append);
+}
+
+int insitu_selects(insitu_instrument* instrument, int64_t step) {
+    if (after_failed_startup(instrument)) return INSITU_NOT_SELECTED;
+    return guarded("insitu_selects", [&]() -> int {
+        require_not_null(instrument, "instrument");
+        if (instrument->finalized) {
+            throw StateError("insitu_selects(step " + std::to_string(step) +
+                             ") after insitu_finalize");
+        }
+        return instrument->instrument->selects(step) ? INSITU_OK : INSITU_NOT_SELECTED;
+    });
+}
+
+void insitu_name_next_call(const char* entry_name) {
+    try {
+        next_call_name = entry_name == nullptr ? std::string() : std::string(entry_name);
+    } catch (...) {
+        next_call_name.clear();
+    }
 }
 
 int insitu_execute(insitu_instrument* instrument, int64_t step, double time) {
+    if (after_failed_startup(instrument)) return INSITU_NOT_SELECTED;
     return guarded("insitu_execute", [&]() -> int {
         require_not_null(instrument, "instrument");
         // The views are only promised valid until this call returns: forget them whatever
         // happens, so a later execute cannot read memory the simulation has since freed.
-        std::map<std::string, insitu::Field> pending;
+        std::map<std::string, std::vector<insitu::Field>> pending;
         pending.swap(instrument->pending_fields);
         if (instrument->finalized) {
             throw StateError("step " + std::to_string(step) + " executed after insitu_finalize");
         }
         std::vector<insitu::Field> fields;
-        fields.reserve(pending.size());
-        for (auto& entry : pending) fields.push_back(std::move(entry.second));
+        for (auto& entry : pending) {
+            for (insitu::Field& block : entry.second) fields.push_back(std::move(block));
+        }
         const insitu::Status status = instrument->instrument->execute(step, time, fields);
         return code_for_status(status, *instrument->instrument, Call::execute);
     });
 }
 
 int insitu_finalize(insitu_instrument* instrument) {
+    if (after_failed_startup(instrument)) return INSITU_NOT_SELECTED;
     return guarded("insitu_finalize", [&]() -> int {
         require_not_null(instrument, "instrument");
         instrument->pending_fields.clear();

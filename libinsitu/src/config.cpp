@@ -7,6 +7,7 @@
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "insitu/core/layers.hpp"
@@ -310,27 +311,118 @@ const Key<ColourModelConfig> kColourModelKeys[] = {
      [](const ColourModelConfig& model) { return json(model.enabled); }},
 };
 
+std::vector<ViewConfig> parse_views(const json& value, const std::string& key, Unknown& unknown) {
+    require_array(value, key);
+    std::vector<ViewConfig> views;
+    for (std::size_t i = 0; i < value.size(); ++i) {
+        ViewConfig view;
+        parse_object(value[i], element_key(key, i), kViewKeys, view, unknown);
+        views.push_back(view);
+    }
+    return views;
+}
+
+json write_views(const std::vector<ViewConfig>& views) {
+    json list = json::array();
+    for (const ViewConfig& view : views) list.push_back(write_object(view, kViewKeys));
+    return list;
+}
+
+/// "layers": "auto" (nullopt) or a list of isovalues.
+std::optional<std::vector<double>> parse_layers(const json& value, const std::string& key) {
+    if (value.is_string()) {
+        if (value.get<std::string>() != "auto") {
+            out_of_range(key, value.dump(), "expected \"auto\" or a list of isovalues");
+        }
+        return std::nullopt;
+    }
+    if (!value.is_array()) wrong_type(key, value, "\"auto\" or a list of isovalues");
+    return list_of(value, key, number);
+}
+
+json write_layers(const std::optional<std::vector<double>>& layers) {
+    return layers ? json(*layers) : json("auto");
+}
+
+// A field written as an object in "fields" (FieldStyle).
+struct FieldEntry {
+    std::string name;
+    FieldStyle style;
+};
+
+const Key<FieldEntry> kFieldKeys[] = {
+    {"name",
+     [](const json& value, const std::string& key, FieldEntry& field, Unknown&) {
+         field.name = text(value, key);
+     },
+     [](const FieldEntry& field) { return json(field.name); }},
+    {"views",
+     [](const json& value, const std::string& key, FieldEntry& field, Unknown& unknown) {
+         field.style.views = parse_views(value, key, unknown);
+     },
+     [](const FieldEntry& field) {
+         return field.style.views ? write_views(*field.style.views) : json();
+     }},
+    {"transfer_function",
+     [](const json& value, const std::string& key, FieldEntry& field, Unknown& unknown) {
+         field.style.transfer_function = parse_transfer_function(value, key, unknown);
+     },
+     [](const FieldEntry& field) {
+         return field.style.transfer_function ? field.style.transfer_function->to_json() : json();
+     }},
+    {"layers",
+     [](const json& value, const std::string& key, FieldEntry& field, Unknown&) {
+         field.style.has_layers = true;
+         field.style.layers = parse_layers(value, key);
+     },
+     [](const FieldEntry& field) {
+         return field.style.has_layers ? write_layers(field.style.layers) : json();
+     }},
+};
+
+constexpr Choice<OnExisting> kOnExisting[] = {
+    {"append", OnExisting::append}, {"replace", OnExisting::replace}, {"fail", OnExisting::fail}};
+
 const Key<InstrumentConfig> kTopLevelKeys[] = {
     {"fields",
-     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
-         config.fields = list_of(value, key, text);
-     },
-     [](const InstrumentConfig& config) { return json(config.fields); }},
-    {"views",
      [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
          require_array(value, key);
-         config.views.clear();
+         config.fields.clear();
+         config.field_styles.clear();
          for (std::size_t i = 0; i < value.size(); ++i) {
-             ViewConfig view;
-             parse_object(value[i], element_key(key, i), kViewKeys, view, unknown);
-             config.views.push_back(view);
+             if (value[i].is_string()) {
+                 config.fields.push_back(value[i].get<std::string>());
+                 continue;
+             }
+             if (!value[i].is_object()) {
+                 wrong_type(element_key(key, i), value[i], "a field name or an object");
+             }
+             FieldEntry field;
+             parse_object(value[i], element_key(key, i), kFieldKeys, field, unknown);
+             if (!value[i].contains("name")) {
+                 out_of_range(element_key(key, i), value[i].dump(), "give the field's \"name\"");
+             }
+             config.fields.push_back(field.name);
+             config.field_styles[field.name] = field.style;
          }
      },
      [](const InstrumentConfig& config) {
-         json views = json::array();
-         for (const ViewConfig& view : config.views) views.push_back(view.to_json());
-         return views;
+         json list = json::array();
+         for (const std::string& name : config.fields) {
+             const auto style = config.field_styles.find(name);
+             if (style == config.field_styles.end()) {
+                 list.push_back(name);
+             } else {
+                 list.push_back(write_object(FieldEntry{name, style->second}, kFieldKeys));
+             }
+         }
+         return list;
      }},
+    {"views",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
+         config.views = parse_views(value, key, unknown);
+     },
+     [](const InstrumentConfig& config) { return write_views(config.views); }},
     {"transfer_function",
      [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
          config.transfer_function = parse_transfer_function(value, key, unknown);
@@ -353,20 +445,9 @@ const Key<InstrumentConfig> kTopLevelKeys[] = {
      }},
     {"layers",
      [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
-         if (value.is_string()) {
-             if (value.get<std::string>() != "auto") {
-                 out_of_range(key, value.dump(), "expected \"auto\" or a list of isovalues");
-             }
-             config.layers.reset();
-         } else if (value.is_array()) {
-             config.layers = list_of(value, key, number);
-         } else {
-             wrong_type(key, value, "\"auto\" or a list of isovalues");
-         }
+         config.layers = parse_layers(value, key);
      },
-     [](const InstrumentConfig& config) {
-         return config.layers ? json(*config.layers) : json("auto");
-     }},
+     [](const InstrumentConfig& config) { return write_layers(config.layers); }},
     {"max_layers",
      [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
          config.max_auto_layers = small_integer(value, key);
@@ -445,7 +526,57 @@ const Key<InstrumentConfig> kTopLevelKeys[] = {
      [](const InstrumentConfig& config) {
          return write_object(config.colour_model, kColourModelKeys);
      }},
+    {"strict",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.strict = boolean(value, key);
+     },
+     [](const InstrumentConfig& config) { return json(config.strict); }},
+    {"on_existing",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.on_existing = choose(value, key, kOnExisting);
+     },
+     [](const InstrumentConfig& config) { return json(name_of(config.on_existing, kOnExisting)); }},
 };
+
+// The key names of each object of the configuration, by the name of the key that holds the
+// object ("" for the top level), for suggest_key.
+template <typename Target, std::size_t N>
+std::vector<std::string> names_of(const Key<Target> (&keys)[N]) {
+    std::vector<std::string> names;
+    for (const Key<Target>& key : keys) names.push_back(key.name);
+    return names;
+}
+
+std::vector<std::string> known_keys_under(const std::string& parent) {
+    if (parent.empty()) return names_of(kTopLevelKeys);
+    if (parent == "views") return names_of(kViewKeys);
+    if (parent == "fields") return names_of(kFieldKeys);
+    if (parent == "intervals") return names_of(kIntervalKeys);
+    if (parent == "writer") return names_of(kWriterKeys);
+    if (parent == "colour_model") return names_of(kColourModelKeys);
+    if (parent == "transfer_function" || parent == "training_transfer_functions") {
+        return {kTransferFunctionKeys.begin(), kTransferFunctionKeys.end()};
+    }
+    return {};
+}
+
+// Optimal string alignment distance (Levenshtein plus adjacent transpositions): "evry" is one
+// edit from "every", "stpe" one from "step".
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+    std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
+    for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+    for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            const std::size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
+            d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) {
+                d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+            }
+        }
+    }
+    return d[a.size()][b.size()];
+}
 
 std::string join(const std::vector<std::string>& names) {
     std::string joined;
@@ -454,6 +585,41 @@ std::string join(const std::vector<std::string>& names) {
 }
 
 }  // namespace
+
+std::string suggest_key(const std::string& unknown_path) {
+    const std::size_t dot = unknown_path.rfind('.');
+    const std::string key = dot == std::string::npos ? unknown_path : unknown_path.substr(dot + 1);
+    // The parent's own name, without its path and its [index]: "fields[1].views[0]" -> "views".
+    std::string parent = dot == std::string::npos ? "" : unknown_path.substr(0, dot);
+    const std::size_t parent_dot = parent.rfind('.');
+    if (parent_dot != std::string::npos) parent = parent.substr(parent_dot + 1);
+    parent = parent.substr(0, parent.find('['));
+
+    std::string best;
+    std::size_t best_distance = std::numeric_limits<std::size_t>::max();
+    for (const std::string& known : known_keys_under(parent)) {
+        const std::size_t distance = edit_distance(key, known);
+        if (distance < best_distance) {
+            best_distance = distance;
+            best = known;
+        }
+    }
+    // Close means at most a third of the letters differ (at least one edit): "evry" -> "every",
+    // but "colour" is not offered for "zoom".
+    const std::size_t allowed = std::max<std::size_t>(1, key.size() / 3);
+    return best_distance <= allowed ? best : std::string();
+}
+
+std::string describe_unknown_keys(const std::vector<std::string>& unknown_paths) {
+    std::string text;
+    for (const std::string& path : unknown_paths) {
+        text +=
+            (text.empty() ? "" : "; ") + std::string("unknown configuration key \"") + path + "\"";
+        const std::string nearest = suggest_key(path);
+        if (!nearest.empty()) text += " (did you mean \"" + nearest + "\"?)";
+    }
+    return text;
+}
 
 nlohmann::json ViewConfig::to_json() const {
     return write_object(*this, kViewKeys);
@@ -512,14 +678,12 @@ InstrumentConfig InstrumentConfig::from_json_file(const std::string& path,
     }
 }
 
-void InstrumentConfig::validate() const {
-    if (fields.empty()) out_of_range("fields", "[]", "name at least one field");
-    for (std::size_t i = 0; i < fields.size(); ++i) {
-        if (fields[i].empty()) out_of_range(element_key("fields", i), "\"\"", "empty name");
-    }
-    if (views.empty()) out_of_range("views", "[]", "give at least one view");
+namespace {
+// The checks of one "views" list (the top level's, or a field's own), naming `views_key`.
+void validate_views(const std::vector<ViewConfig>& views, const std::string& views_key) {
+    if (views.empty()) out_of_range(views_key, "[]", "give at least one view");
     for (std::size_t i = 0; i < views.size(); ++i) {
-        const std::string key = element_key("views", i);
+        const std::string key = element_key(views_key, i);
         const OrbitView& orbit = views[i].orbit;
         checked(child_key(key, "azimuth"), text_of(orbit.azimuth_deg),
                 [&] { check_orbit_azimuth(orbit.azimuth_deg); });
@@ -538,6 +702,36 @@ void InstrumentConfig::validate() const {
         if (!(tilt >= 0.0 && tilt < 90.0)) {
             out_of_range(child_key(key, "distortion_tilt"), text_of(tilt),
                          "degrees, must be in [0, 90)");
+        }
+    }
+}
+}  // namespace
+
+void InstrumentConfig::validate() const {
+    if (fields.empty()) out_of_range("fields", "[]", "name at least one field");
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+        if (fields[i].empty()) out_of_range(element_key("fields", i), "\"\"", "empty name");
+    }
+    validate_views(views, "views");
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+        const auto first = std::find(fields.begin(), fields.begin() + i, fields[i]);
+        if (first != fields.begin() + i) {
+            out_of_range(element_key("fields", i), "\"" + fields[i] + "\"", "repeats ",
+                         element_key("fields", static_cast<std::size_t>(first - fields.begin())),
+                         "; give each field once");
+        }
+    }
+    for (const auto& [name, style] : field_styles) {
+        const auto at = std::find(fields.begin(), fields.end(), name);
+        if (at == fields.end()) {
+            out_of_range("fields", "\"" + name + "\"", "has settings but is not listed");
+        }
+        const std::string key =
+            element_key("fields", static_cast<std::size_t>(at - fields.begin()));
+        if (style.views) validate_views(*style.views, child_key(key, "views"));
+        if (style.layers) {
+            checked(child_key(key, "layers"), list_text(*style.layers),
+                    [&] { validate_isovalues(*style.layers); });
         }
     }
     if (layers) checked("layers", list_text(*layers), [&] { validate_isovalues(*layers); });
@@ -582,14 +776,17 @@ void InstrumentConfig::validate() const {
     const double samples = estimated_samples_per_step();
     if (samples > kMaxSamplesPerStep) {
         double pixels = 0.0;
-        for (const ViewConfig& view : views) {
-            pixels += static_cast<double>(view.orbit.width) * view.orbit.height;
+        const std::vector<PlannedView> planned = planned_views();
+        for (const PlannedView& planned_view : planned) {
+            pixels +=
+                static_cast<double>(planned_view.view.orbit.width) * planned_view.view.orbit.height;
         }
         fail<InvalidArgument>(
             "configuration: about ", samples, " samples per step, above the ceiling of ",
             kMaxSamplesPerStep, " (", kWorstDiagonalVoxels,
-            "-voxel rays at \"step\" = ", step_voxels, " over \"views\": ", views.size(),
-            " views, ", pixels, " pixels in all, ", passes_per_view(),
+            "-voxel rays at \"step\" = ", step_voxels, " over \"views\": ", planned.size(),
+            " views of ", fields.size(), " field(s), ", pixels, " pixels in all, ",
+            passes_per_view(),
             " passes each from \"proxies\" and \"training_transfer_functions\"); raise \"step\" "
             "or reduce the others");
     }
@@ -608,11 +805,50 @@ int InstrumentConfig::passes_per_view() const {
 }
 
 double InstrumentConfig::estimated_samples_per_step() const {
+    // passes_per_view() counts the training passes, which only fields using the top-level
+    // transfer function make: an upper bound, as the ceiling needs.
     double pixels = 0.0;
-    for (const ViewConfig& view : views) {
-        pixels += static_cast<double>(view.orbit.width) * view.orbit.height;
+    for (const PlannedView& planned : planned_views()) {
+        pixels += static_cast<double>(planned.view.orbit.width) * planned.view.orbit.height;
     }
     return pixels * passes_per_view() * (kWorstDiagonalVoxels / step_voxels);
+}
+
+namespace {
+const FieldStyle* style_of(const InstrumentConfig& config, const std::string& field) {
+    const auto found = config.field_styles.find(field);
+    return found == config.field_styles.end() ? nullptr : &found->second;
+}
+}  // namespace
+
+const std::vector<ViewConfig>& InstrumentConfig::views_of(const std::string& field) const {
+    const FieldStyle* style = style_of(*this, field);
+    return style != nullptr && style->views ? *style->views : views;
+}
+
+const TransferFunction& InstrumentConfig::transfer_function_of(const std::string& field) const {
+    const FieldStyle* style = style_of(*this, field);
+    return style != nullptr && style->transfer_function ? *style->transfer_function
+                                                        : transfer_function;
+}
+
+const std::optional<std::vector<double>>& InstrumentConfig::layers_of(
+    const std::string& field) const {
+    const FieldStyle* style = style_of(*this, field);
+    return style != nullptr && style->has_layers ? style->layers : layers;
+}
+
+bool InstrumentConfig::trains(const std::string& field) const {
+    const FieldStyle* style = style_of(*this, field);
+    return style == nullptr || !style->transfer_function;
+}
+
+std::vector<PlannedView> InstrumentConfig::planned_views() const {
+    std::vector<PlannedView> planned;
+    for (const std::string& field : fields) {
+        for (const ViewConfig& view : views_of(field)) planned.push_back({field, view});
+    }
+    return planned;
 }
 
 nlohmann::json InstrumentConfig::to_json() const {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <limits>
 #include <ostream>
@@ -50,6 +51,16 @@ ScalarType parse_scalar_type(const std::string& text) {
     }
     fail<InvalidArgument>("unsupported scalar type \"", text,
                           "\" (expected uint8, uint16, int16, float32 or float64)");
+}
+
+std::string to_string(Centering centering) {
+    return centering == Centering::cell ? "cell" : "node";
+}
+
+Centering parse_centering(const std::string& text) {
+    if (text == "node") return Centering::node;
+    if (text == "cell") return Centering::cell;
+    fail<InvalidArgument>("unknown centring \"", text, "\" (expected \"node\" or \"cell\")");
 }
 
 std::ostream& operator<<(std::ostream& out, const ValueRange& range) {
@@ -136,6 +147,16 @@ Field& Field::set_origin(glm::dvec3 origin_world) {
     return *this;
 }
 
+Field& Field::set_centering(Centering centering) {
+    centering_ = centering;
+    return *this;
+}
+
+glm::dvec3 Field::first_sample() const {
+    // A cell's value is taken at its centre, half a spacing inside its low corner.
+    return centering_ == Centering::cell ? origin_ + 0.5 * spacing_ : origin_;
+}
+
 Field& Field::set_spacing(glm::dvec3 spacing_world) {
     for (int axis = 0; axis < 3; ++axis) {
         if (!(spacing_world[axis] > 0.0) || !std::isfinite(spacing_world[axis])) {
@@ -201,7 +222,7 @@ Bounds Field::bounds() const {
     const Index3 d = dims();
     const glm::dvec3 extent(static_cast<double>(d[0] - 1), static_cast<double>(d[1] - 1),
                             static_cast<double>(d[2] - 1));
-    return Bounds{origin_, origin_ + extent * spacing_};
+    return Bounds{first_sample(), first_sample() + extent * spacing_};
 }
 
 std::int64_t Field::offset_of(std::int64_t i, std::int64_t j, std::int64_t k) const {
@@ -325,13 +346,100 @@ ValueRange Field::copy_interior_as_float(std::vector<float>& out) const {
     return accumulator.result();
 }
 
+Field join_blocks(const std::vector<const Field*>& blocks, std::vector<float>& storage) {
+    if (blocks.empty()) fail<InvalidArgument>("join_blocks: no blocks");
+    const Field& first = *blocks.front();
+    const std::string& name = first.name();
+    const auto where = [&](std::size_t b) {
+        return "field \"" + name + "\" block " + std::to_string(b);
+    };
+    // Each block's offset on the shared grid, in samples from the lowest first sample.
+    glm::dvec3 lower = first.first_sample();
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+        const Field& block = *blocks[b];
+        if (block.name() != name) {
+            fail<InvalidArgument>(where(b), " is named \"", block.name(), "\"");
+        }
+        if (block.centering() != first.centering()) {
+            fail<InvalidArgument>(where(b), " is ", to_string(block.centering()),
+                                  "-centred, block 0 ", to_string(first.centering()),
+                                  "-centred (blocks of a field share their centring)");
+        }
+        for (int axis = 0; axis < 3; ++axis) {
+            const double a = block.spacing()[axis];
+            const double b0 = first.spacing()[axis];
+            if (std::abs(a - b0) > 1e-9 * std::max(std::abs(a), std::abs(b0))) {
+                fail<InvalidArgument>(where(b), ": spacing.", axis_name(axis), " = ", a,
+                                      ", block 0 has ", b0, " (blocks of a field share a grid)");
+            }
+        }
+        lower = glm::min(lower, block.first_sample());
+    }
+    const glm::dvec3 spacing = first.spacing();
+    std::vector<Index3> offsets;
+    Index3 dims{0, 0, 0};
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+        const Field& block = *blocks[b];
+        Index3 offset{};
+        for (int axis = 0; axis < 3; ++axis) {
+            const double samples = (block.first_sample()[axis] - lower[axis]) / spacing[axis];
+            const double whole = std::round(samples);
+            if (std::abs(samples - whole) > 1e-6) {
+                fail<InvalidArgument>(where(b), ": origin.", axis_name(axis), " = ",
+                                      block.origin()[axis], " is ", samples,
+                                      " samples from the lowest block's, not a whole number "
+                                      "(blocks of a field share a grid)");
+            }
+            offset[axis] = static_cast<std::int64_t>(whole);
+            dims[axis] = std::max(
+                dims[axis], checked_add(offset[axis], block.dims()[axis], where(b) + ": extent"));
+        }
+        offsets.push_back(offset);
+    }
+    const std::int64_t count = checked_multiply(checked_multiply(dims[0], dims[1], "joined blocks"),
+                                                dims[2], "joined blocks of field \"" + name + "\"");
+    storage.assign(static_cast<std::size_t>(count), std::numeric_limits<float>::quiet_NaN());
+    std::vector<bool> covered(static_cast<std::size_t>(count), false);
+    std::vector<float> interior;
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+        blocks[b]->copy_interior_as_float(interior);
+        const Index3 d = blocks[b]->dims();
+        const Index3& o = offsets[b];
+        const float* source = interior.data();
+        for (std::int64_t k = 0; k < d[2]; ++k) {
+            for (std::int64_t j = 0; j < d[1]; ++j) {
+                const std::size_t row =
+                    static_cast<std::size_t>(((k + o[2]) * dims[1] + (j + o[1])) * dims[0] + o[0]);
+                std::copy(source, source + d[0],
+                          storage.begin() + static_cast<std::ptrdiff_t>(row));
+                std::fill(covered.begin() + static_cast<std::ptrdiff_t>(row),
+                          covered.begin() + static_cast<std::ptrdiff_t>(row) + d[0], true);
+                source += d[0];
+            }
+        }
+    }
+    const auto gap = std::find(covered.begin(), covered.end(), false);
+    if (gap != covered.end()) {
+        const auto index = static_cast<std::int64_t>(gap - covered.begin());
+        const Index3 at{index % dims[0], (index / dims[0]) % dims[1], index / (dims[0] * dims[1])};
+        const glm::dvec3 world = lower + glm::dvec3(at[0], at[1], at[2]) * spacing;
+        fail<InvalidArgument>("field \"", name, "\": its ", blocks.size(),
+                              " blocks leave a gap: no block holds the sample at (", world.x, ", ",
+                              world.y, ", ", world.z, ") (sample (", at[0], ", ", at[1], ", ",
+                              at[2], ") of the box around them); blocks must cover a box");
+    }
+    Field joined(name, storage.data(), ScalarType::float32, dims);
+    joined.set_origin(lower).set_spacing(spacing);
+    return joined;
+}
+
 std::ostream& operator<<(std::ostream& out, const Field& field) {
     const Index3 d = field.dims();
     return out << "Field{\"" << field.name() << "\", " << to_string(field.type()) << ", dims=("
                << d[0] << ", " << d[1] << ", " << d[2] << "), origin=(" << field.origin().x << ", "
                << field.origin().y << ", " << field.origin().z << "), spacing=("
                << field.spacing().x << ", " << field.spacing().y << ", " << field.spacing().z
-               << ")}";
+               << "), " << to_string(field.centering()) << "}";
 }
 
 }  // namespace insitu

@@ -53,6 +53,7 @@ std::ostream& operator<<(std::ostream& out, const InstrumentStatistics& s) {
          << s.steps_written << ", dropped " << s.steps_dropped << ", errors " << s.errors << ", "
          << s.bytes_written << " bytes, compute " << s.compute_seconds << " s, blocked "
          << s.blocked_seconds << " s, writing " << s.write_seconds << " s";
+    if (s.steps_replayed > 0) line << ", replayed " << s.steps_replayed << " (skipped)";
     if (s.nonfinite_samples > 0) line << ", " << s.nonfinite_samples << " NaN/Inf samples";
     return out << line.str();
 }
@@ -88,6 +89,10 @@ struct Instrument::Impl {
     std::optional<std::int64_t> last_step;  ///< the last step execute() accepted
     bool finalized = false;
     bool nonfinite_reported = false;
+    bool replay_reported = false;
+    std::vector<float> joined_blocks;  ///< storage of a field joined from several blocks
+    /// When the last execute() returned: the simulation's own time runs from there.
+    std::optional<Clock::time_point> last_return;
 
     // Touched by the writer thread only (after construction).
     std::unique_ptr<ArchiveWriter> archive;
@@ -101,6 +106,7 @@ struct Instrument::Impl {
     bool stopping = false;
     InstrumentStatistics statistics;
     std::string last_error;
+    std::string first_error;
     ErrorKind last_error_kind = ErrorKind::none;
     std::exception_ptr write_failure;  ///< the latest failed write, rethrown by finalize()
     bool execute_error_logged = false;
@@ -117,6 +123,7 @@ struct Instrument::Impl {
     void record_error(const std::string& message, ErrorKind kind, bool from_writer) {
         std::lock_guard<std::mutex> lock(mutex);
         ++statistics.errors;
+        if (first_error.empty()) first_error = message;
         last_error = message;
         last_error_kind = kind;
         bool& logged = from_writer ? write_error_logged : execute_error_logged;
@@ -127,17 +134,24 @@ struct Instrument::Impl {
         }
     }
 
-    /// Keeps the configuration's unknown keys and warns about them (they are ignored).
+    /// Keeps the configuration's unknown keys ("strict": false) and warns about them.
     void adopt_unknown_keys(std::vector<std::string> keys, const std::string& source) {
         unknown_keys = std::move(keys);
         if (unknown_keys.empty()) return;
-        std::string names;
-        for (const std::string& key : unknown_keys) names += (names.empty() ? "" : ", ") + key;
-        log("warning: " + source + "unknown configuration keys ignored: " + names);
+        log("warning: " + source + describe_unknown_keys(unknown_keys) +
+            ": ignored (\"strict\": false)");
+    }
+
+    bool selects(std::int64_t step) const {
+        return !finalized && (!last_step || step > *last_step) && config.selects(step) &&
+               archived_steps.count(step) == 0;
     }
 
     Status execute(std::int64_t step, double time, const std::vector<Field>& fields);
-    StepRecord compute(std::int64_t step, double time, const Field& field);
+    StepRecord compute(std::int64_t step, double time, const std::vector<Field>& fields);
+    /// Renders the views of one configured field into `record`, numbering them from
+    /// record.views.size().
+    void compute_field(const Field& field, StepRecord& record);
     Status enqueue(StepRecord record, double compute_seconds);
     void writer_loop();
     Status finalize();
@@ -163,32 +177,67 @@ Status Instrument::Impl::execute(std::int64_t step, double time, const std::vect
         fail<InvalidArgument>("step ", step, ": not after the previous step ", *last_step,
                               " (step numbers must increase)");
     }
-    // A restarted simulation may replay steps an earlier run already archived.
+    // A restarted simulation replays steps an earlier run already archived: those are kept as
+    // they are ("on_existing": "append") and skipped, with one notice.
     if (archived_steps.count(step) != 0) {
-        fail<InvalidArgument>("step ", step, ": duplicate step, already in archive \"",
-                              config.archive, "\"");
-    }
-    const std::string& name = config.fields.front();
-    const auto field = std::find_if(fields.begin(), fields.end(),
-                                    [&](const Field& f) { return f.name() == name; });
-    if (field == fields.end()) {
-        fail<InvalidArgument>("step ", step, ": field \"", name, "\" missing (got ",
-                              joined_names(fields), ")");
+        last_step = step;
+        {
+            std::lock_guard<std::mutex> lock(mutex);
+            ++statistics.steps_replayed;
+        }
+        if (!replay_reported) {
+            replay_reported = true;
+            log("notice: step " + std::to_string(step) + " is already in archive \"" +
+                config.archive +
+                "\" (a restarted run replaying it): archived steps are skipped, counted in "
+                "statistics (\"on_existing\": \"replace\" starts the archive anew)");
+        }
+        return Status::not_selected;
     }
     if (!config.selects(step)) {
         last_step = step;
         return Status::not_selected;
     }
+    for (const std::string& name : config.fields) {
+        const bool present = std::any_of(fields.begin(), fields.end(),
+                                         [&](const Field& f) { return f.name() == name; });
+        if (!present) {
+            fail<InvalidArgument>("step ", step, ": field \"", name, "\" missing (got ",
+                                  joined_names(fields), ")");
+        }
+    }
 
     const auto start = Clock::now();
-    StepRecord record = compute(step, time, *field);
+    StepRecord record = compute(step, time, fields);
     const double compute_seconds = seconds_since(start);
     // From here the step number is used, even if the queue drops the step.
     last_step = step;
     return enqueue(std::move(record), compute_seconds);
 }
 
-StepRecord Instrument::Impl::compute(std::int64_t step, double time, const Field& field) {
+StepRecord Instrument::Impl::compute(std::int64_t step, double time,
+                                     const std::vector<Field>& fields) {
+    StepRecord record;
+    record.step = step;
+    record.time = time;
+    record.field = config.fields.front();
+    for (const std::string& name : config.fields) {
+        std::vector<const Field*> blocks;
+        for (const Field& field : fields) {
+            if (field.name() == name) blocks.push_back(&field);
+        }
+        // One block is marched where it lies (zero-copy up to the upload); tiles are joined.
+        if (blocks.size() == 1) {
+            compute_field(*blocks.front(), record);
+        } else {
+            compute_field(join_blocks(blocks, joined_blocks), record);
+        }
+    }
+    return record;
+}
+
+void Instrument::Impl::compute_field(const Field& field, StepRecord& record) {
+    const std::int64_t step = record.step;
     // The one read of the simulation's memory: the upload packs the interior into the renderer's
     // host staging vector and the device buffer; everything below reads those copies.
     renderer->upload(field);
@@ -217,16 +266,17 @@ StepRecord Instrument::Impl::compute(std::int64_t step, double time, const Field
     }
 
     // Layers and intervals come from this step's data: "model no more than a scene needs".
+    const TransferFunction& transfer_function = config.transfer_function_of(field.name());
+    const std::optional<std::vector<double>>& layers = config.layers_of(field.name());
     const std::vector<double> isovalues =
-        config.layers ? *config.layers
-                      : renderer->choose_layers(config.transfer_function, config.max_auto_layers);
+        layers ? *layers : renderer->choose_layers(transfer_function, config.max_auto_layers);
     const IntervalSet intervals =
         renderer->choose_intervals(config.interval_count, config.interval_mode);
 
     ProxyRequest base;
     base.isovalues = isovalues;
     base.intervals = intervals;
-    base.transfer_function = config.transfer_function;
+    base.transfer_function = transfer_function;
     base.march.step_voxels = config.step_voxels;
 
     ProxyRequest single = base;
@@ -237,10 +287,10 @@ StepRecord Instrument::Impl::compute(std::int64_t step, double time, const Field
     // The colour model maps the stored attenuation to colour, so it is fitted only where that
     // attenuation is stored. Training renderings are rendered when the model or the archive
     // needs them, and stored only on request ("keep_training_images").
-    const bool fits_model = config.colour_model.enabled &&
-                            !config.training_transfer_functions.empty() &&
-                            config.proxies.attenuation;
-    if (config.keep_training_images || fits_model) {
+    // Training functions are in the top-level function's units: only its fields train.
+    const bool trains = config.trains(field.name()) && !config.training_transfer_functions.empty();
+    const bool fits_model = trains && config.colour_model.enabled && config.proxies.attenuation;
+    if (trains && (config.keep_training_images || fits_model)) {
         single.training_transfer_functions = config.training_transfer_functions;
     }
     const bool wants_single = single.depth_layers || single.attenuation || single.optical_depth ||
@@ -265,16 +315,12 @@ StepRecord Instrument::Impl::compute(std::int64_t step, double time, const Field
     RenderSettings preview_settings;
     preview_settings.step_voxels = config.step_voxels;
 
-    StepRecord record;
-    record.step = step;
-    record.time = time;
-    record.field = field.name();
-    for (std::size_t v = 0; v < config.views.size(); ++v) {
-        const ViewConfig& view = config.views[v];
+    for (const ViewConfig& view : config.views_of(field.name())) {
         ViewRecord out;
-        out.view_index = static_cast<int>(v);
+        out.view_index = static_cast<int>(record.views.size());
+        out.field = field.name();
         out.view = view;
-        out.transfer_function = config.transfer_function;
+        out.transfer_function = transfer_function;
         out.training_transfer_functions = single.training_transfer_functions;
         const Camera camera = Camera::orbit(view.orbit, volume.bounds);
         if (wants_single) out.single = renderer->render(camera, single);
@@ -294,10 +340,9 @@ StepRecord Instrument::Impl::compute(std::int64_t step, double time, const Field
                 multi);
         }
         out.preview =
-            renderer->render_ground_truth(camera, config.transfer_function, preview_settings).rgba;
+            renderer->render_ground_truth(camera, transfer_function, preview_settings).rgba;
         record.views.push_back(std::move(out));
     }
-    return record;
 }
 
 Status Instrument::Impl::enqueue(StepRecord record, double compute_seconds) {
@@ -385,7 +430,21 @@ Status Instrument::Impl::finalize() {
         failure = write_failure;
         std::ostringstream summary;
         summary << "finalized \"" << config.archive << "\": " << statistics;
-        if (!last_error.empty()) summary << "; last error: " << last_error;
+        // The cost a user can see and bound (issue 18): the share of the run's wall time the
+        // simulation spent waiting in execute(), beside its own time between the calls.
+        const double wall = statistics.execute_seconds + statistics.simulation_seconds;
+        if (wall > 0.0) {
+            summary << std::fixed << std::setprecision(3) << "; in situ "
+                    << statistics.execute_seconds << " s inside execute, " << std::setprecision(1)
+                    << 100.0 * statistics.execute_seconds / wall << " % of " << std::setprecision(3)
+                    << wall << " s wall since the first call (simulation "
+                    << statistics.simulation_seconds << " s between calls; writer "
+                    << statistics.write_seconds << " s on its own thread)";
+        }
+        if (!first_error.empty()) summary << "; first error: " << first_error;
+        if (!last_error.empty() && last_error != first_error) {
+            summary << "; last error: " << last_error;
+        }
         log(summary.str());
     }
     if (!failure) return Status::ok;
@@ -419,10 +478,22 @@ Instrument::Instrument(InstrumentConfig config, InstrumentOptions options)
     impl.writer = std::thread(&Impl::writer_loop, &impl);
 }
 
+namespace {
+// "strict" (the default): an unknown key is most often a typo ("evry") that would otherwise
+// change what the run costs without a word, so it stops the start-up, naming the nearest key.
+void refuse_unknown_keys(const InstrumentConfig& config, const std::vector<std::string>& unknown,
+                         const std::string& source) {
+    if (!config.strict || unknown.empty()) return;
+    fail<ParseError>(source, describe_unknown_keys(unknown),
+                     " (set \"strict\": false to warn and ignore unknown keys)");
+}
+}  // namespace
+
 std::unique_ptr<Instrument> Instrument::from_json_file(const std::string& path,
                                                        InstrumentOptions options) {
     std::vector<std::string> unknown;
     InstrumentConfig config = InstrumentConfig::from_json_file(path, &unknown);
+    refuse_unknown_keys(config, unknown, path + ": ");
     auto instrument = std::make_unique<Instrument>(std::move(config), options);
     instrument->impl_->adopt_unknown_keys(std::move(unknown), path + ": ");
     return instrument;
@@ -432,6 +503,7 @@ std::unique_ptr<Instrument> Instrument::from_json_text(const std::string& text,
                                                        InstrumentOptions options) {
     std::vector<std::string> unknown;
     InstrumentConfig config = InstrumentConfig::from_json_text(text, &unknown);
+    refuse_unknown_keys(config, unknown, "configuration: ");
     auto instrument = std::make_unique<Instrument>(std::move(config), options);
     instrument->impl_->adopt_unknown_keys(std::move(unknown), "");
     return instrument;
@@ -446,6 +518,21 @@ Instrument::~Instrument() {
 }
 
 Status Instrument::execute(std::int64_t step, double time, const std::vector<Field>& fields) {
+    // Times the call, whatever it returns, and the simulation's own time since the last one.
+    struct CallTimer {
+        Impl& impl;
+        Clock::time_point start = Clock::now();
+        ~CallTimer() {
+            const Clock::time_point end = Clock::now();
+            std::lock_guard<std::mutex> lock(impl.mutex);
+            impl.statistics.execute_seconds += std::chrono::duration<double>(end - start).count();
+            if (impl.last_return) {
+                impl.statistics.simulation_seconds +=
+                    std::chrono::duration<double>(start - *impl.last_return).count();
+            }
+            impl.last_return = end;
+        }
+    } timer{*impl_};
     try {
         return impl_->execute(step, time, fields);
     } catch (const std::exception& error) {
@@ -471,6 +558,14 @@ Status Instrument::finalize() {
     return Status::error;
 }
 
+bool Instrument::selects(std::int64_t step) const {
+    return impl_->selects(step);
+}
+
+void Instrument::report_error(const std::string& message, ErrorKind kind) {
+    impl_->record_error(message, kind, /*from_writer=*/false);
+}
+
 InstrumentStatistics Instrument::statistics() const {
     std::lock_guard<std::mutex> lock(impl_->mutex);
     return impl_->statistics;
@@ -479,6 +574,11 @@ InstrumentStatistics Instrument::statistics() const {
 std::string Instrument::last_error() const {
     std::lock_guard<std::mutex> lock(impl_->mutex);
     return impl_->last_error;
+}
+
+std::string Instrument::first_error() const {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    return impl_->first_error;
 }
 
 ErrorKind Instrument::last_error_kind() const {

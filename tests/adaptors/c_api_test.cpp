@@ -9,7 +9,10 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <thread>
 #include <utility>
@@ -121,22 +124,53 @@ TEST(CApiCreate, NullTextOrPathIsNamedAndOutIsNulled) {
     EXPECT_EQ(out, nullptr);
 }
 
+// A NULL instrument is an error only until a create has failed in the process (after that,
+// calls on the NULL it left are silent no-ops): these checks run in a process of their own, the
+// "threadsafe" death-test style re-executing the test binary, so that the creates other tests
+// make fail cannot change what they see. Each failed check prints a line; none may.
+template <typename Checks>
+void expect_in_fresh_process(Checks checks) {
+    GTEST_FLAG_SET(death_test_style, "threadsafe");
+    EXPECT_EXIT(
+        {
+            checks();
+            std::exit(0);
+        },
+        ::testing::ExitedWithCode(0), "^$");
+}
+
+void check(bool condition, const std::string& what) {
+    if (!condition) std::fprintf(stderr, "failed: %s (%s)\n", what.c_str(), insitu_last_error());
+}
+
 TEST(CApiNullInstrument, EveryFunctionNamesIt) {
-    BallField ball;
-    EXPECT_EQ(insitu_set_field(nullptr, "v", ball.samples.data(), INSITU_FLOAT32, ball.dims,
-                               nullptr, nullptr, nullptr),
-              INSITU_ERROR_INVALID_ARGUMENT);
-    EXPECT_TRUE(contains(insitu_last_error(), "instrument is NULL")) << insitu_last_error();
-    EXPECT_EQ(insitu_set_field_strided(nullptr, "v", ball.samples.data(), INSITU_FLOAT32, ball.dims,
-                                       nullptr, nullptr, nullptr, nullptr),
-              INSITU_ERROR_INVALID_ARGUMENT);
-    EXPECT_TRUE(contains(insitu_last_error(), "instrument is NULL")) << insitu_last_error();
-    EXPECT_EQ(insitu_execute(nullptr, 0, 0.0), INSITU_ERROR_INVALID_ARGUMENT);
-    EXPECT_TRUE(contains(insitu_last_error(), "insitu_execute: instrument is NULL"))
-        << insitu_last_error();
-    EXPECT_EQ(insitu_finalize(nullptr), INSITU_ERROR_INVALID_ARGUMENT);
-    EXPECT_TRUE(contains(insitu_last_error(), "insitu_finalize: instrument is NULL"))
-        << insitu_last_error();
+    expect_in_fresh_process([] {
+        BallField ball;
+        check(insitu_set_field(nullptr, "v", ball.samples.data(), INSITU_FLOAT32, ball.dims,
+                               nullptr, nullptr, nullptr) == INSITU_ERROR_INVALID_ARGUMENT,
+              "set_field code");
+        check(contains(insitu_last_error(), "instrument is NULL"), "set_field message");
+        check(insitu_set_field_strided(nullptr, "v", ball.samples.data(), INSITU_FLOAT32, ball.dims,
+                                       nullptr, nullptr, nullptr,
+                                       nullptr) == INSITU_ERROR_INVALID_ARGUMENT,
+              "set_field_strided code");
+        check(contains(insitu_last_error(), "instrument is NULL"), "set_field_strided message");
+        check(insitu_add_block(nullptr, "v", ball.samples.data(), INSITU_FLOAT32, ball.dims,
+                               nullptr, nullptr, nullptr, nullptr, nullptr,
+                               INSITU_NODE) == INSITU_ERROR_INVALID_ARGUMENT,
+              "add_block code");
+        check(contains(insitu_last_error(), "insitu_add_block: instrument is NULL"),
+              "add_block message");
+        check(insitu_selects(nullptr, 0) == INSITU_ERROR_INVALID_ARGUMENT, "selects code");
+        check(contains(insitu_last_error(), "insitu_selects: instrument is NULL"),
+              "selects message");
+        check(insitu_execute(nullptr, 0, 0.0) == INSITU_ERROR_INVALID_ARGUMENT, "execute code");
+        check(contains(insitu_last_error(), "insitu_execute: instrument is NULL"),
+              "execute message");
+        check(insitu_finalize(nullptr) == INSITU_ERROR_INVALID_ARGUMENT, "finalize code");
+        check(contains(insitu_last_error(), "insitu_finalize: instrument is NULL"),
+              "finalize message");
+    });
 }
 
 TEST(CApiDestroy, NullIsFine) {
@@ -388,8 +422,9 @@ TEST_F(CApiTest, NonFiniteTimeIsAnInvalidArgumentAndTheArchiveStillOpens) {
                                ball_.origin, ball_.spacing, ball_.ghosts),
               INSITU_OK)
         << insitu_last_error();
-    EXPECT_EQ(insitu_execute(again, 4, 0.4), INSITU_ERROR_INVALID_ARGUMENT);  // already there
-    EXPECT_TRUE(contains(insitu_last_error(), "already in archive")) << insitu_last_error();
+    // A restarted run replays step 4: skipped, not an error, and the archived step kept.
+    EXPECT_EQ(insitu_selects(again, 4), INSITU_NOT_SELECTED);
+    EXPECT_EQ(insitu_execute(again, 4, 0.4), INSITU_NOT_SELECTED) << insitu_last_error();
     insitu_destroy(again);
 }
 
@@ -443,14 +478,215 @@ TEST(CApiDestroy, FinalizesAnUnfinalizedInstrument) {
     fs::remove_all(directory);
 }
 
+// --- Blocks, centring, cadence queries (issue 18) ---
+
+std::string file_bytes(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// The ball's 10^3 interior as a dense array, for blocks cut out of it without ghosts.
+struct DenseBall {
+    static constexpr std::int64_t kSide = 10;
+    std::vector<float> samples;
+    DenseBall() {
+        const BallField ball;
+        const std::int64_t a = BallField::kAllocated;
+        for (std::int64_t k = 1; k <= kSide; ++k) {
+            for (std::int64_t j = 1; j <= kSide; ++j) {
+                for (std::int64_t i = 1; i <= kSide; ++i) {
+                    samples.push_back(ball.samples[i + a * (j + a * k)]);
+                }
+            }
+        }
+    }
+    // Planes [first, first + count) along z, as a block with its own origin.
+    const float* planes(std::int64_t first) const { return samples.data() + first * kSide * kSide; }
+};
+
+// Runs one selected step (2) with `hand_over` setting the fields; returns the files of view 0.
+template <typename HandOver>
+std::pair<std::string, std::string> run_one_step(const fs::path& archive, HandOver hand_over) {
+    insitu_instrument* instrument = nullptr;
+    EXPECT_EQ(insitu_create_from_json(small_config(archive).c_str(), &instrument), INSITU_OK)
+        << insitu_last_error();
+    EXPECT_EQ(hand_over(instrument), INSITU_OK) << insitu_last_error();
+    EXPECT_EQ(insitu_execute(instrument, 2, 0.2), INSITU_OK) << insitu_last_error();
+    EXPECT_EQ(insitu_finalize(instrument), INSITU_OK) << insitu_last_error();
+    insitu_destroy(instrument);
+    return {file_bytes(archive / "proxies" / "step000002_view0.exr"),
+            file_bytes(archive / "previews" / "step000002_view0.png")};
+}
+
+TEST(CApiBlocks, TilesSharingAFaceGiveTheArchiveOfTheWholeField) {
+    const fs::path directory = fresh_directory();
+    const DenseBall ball;
+    const std::int64_t whole[3] = {10, 10, 10};
+    const double spacing[3] = {0.1, 0.1, 0.1};
+    const double origin[3] = {0.0, 0.0, 0.0};
+    const auto reference = run_one_step(directory / "whole.cdb", [&](insitu_instrument* in) {
+        return insitu_set_field(in, "v", ball.samples.data(), INSITU_FLOAT32, whole, origin,
+                                spacing, nullptr);
+    });
+    ASSERT_FALSE(reference.first.empty());
+    // Planes 0..5 and 5..9: node-centred tiles share plane 5. Handed over high block first.
+    const auto tiled = run_one_step(directory / "tiles.cdb", [&](insitu_instrument* in) {
+        const std::int64_t low_dims[3] = {10, 10, 6};
+        const std::int64_t high_dims[3] = {10, 10, 5};
+        const double high_origin[3] = {0.0, 0.0, 0.5};
+        int status = insitu_add_block(in, "v", ball.planes(5), INSITU_FLOAT32, high_dims,
+                                      high_origin, spacing, nullptr, nullptr, nullptr, INSITU_NODE);
+        if (status != INSITU_OK) return status;
+        return insitu_add_block(in, "v", ball.planes(0), INSITU_FLOAT32, low_dims, origin, spacing,
+                                nullptr, nullptr, nullptr, INSITU_NODE);
+    });
+    EXPECT_TRUE(tiled.first == reference.first) << "proxy EXR differs";
+    EXPECT_TRUE(tiled.second == reference.second) << "preview PNG differs";
+    fs::remove_all(directory);
+}
+
+TEST(CApiBlocks, CellCentredOriginIsTheLowCornerOfTheFirstCell) {
+    const fs::path directory = fresh_directory();
+    const DenseBall ball;
+    const std::int64_t whole[3] = {10, 10, 10};
+    const double spacing[3] = {0.1, 0.1, 0.1};
+    const double node_origin[3] = {0.05, 0.05, 0.05};  // the first cell's centre
+    const double corner[3] = {0.0, 0.0, 0.0};
+    const auto nodes = run_one_step(directory / "node.cdb", [&](insitu_instrument* in) {
+        return insitu_set_field(in, "v", ball.samples.data(), INSITU_FLOAT32, whole, node_origin,
+                                spacing, nullptr);
+    });
+    const auto cells = run_one_step(directory / "cell.cdb", [&](insitu_instrument* in) {
+        return insitu_add_block(in, "v", ball.samples.data(), INSITU_FLOAT32, whole, corner,
+                                spacing, nullptr, nullptr, nullptr, INSITU_CELL);
+    });
+    ASSERT_FALSE(nodes.first.empty());
+    EXPECT_TRUE(cells.first == nodes.first) << "proxy EXR differs";
+    EXPECT_TRUE(cells.second == nodes.second) << "preview PNG differs";
+    fs::remove_all(directory);
+}
+
+TEST_F(CApiTest, BlocksWithAGapAreRefusedNamingTheGap) {
+    const DenseBall ball;
+    const std::int64_t dims[3] = {10, 10, 4};
+    const double spacing[3] = {0.1, 0.1, 0.1};
+    const double low[3] = {0.0, 0.0, 0.0};
+    const double high[3] = {0.0, 0.0, 0.5};  // planes 0..3 and 5..8: plane 4 is missing
+    ASSERT_EQ(insitu_add_block(instrument_, "v", ball.planes(0), INSITU_FLOAT32, dims, low, spacing,
+                               nullptr, nullptr, nullptr, INSITU_NODE),
+              INSITU_OK);
+    ASSERT_EQ(insitu_add_block(instrument_, "v", ball.planes(5), INSITU_FLOAT32, dims, high,
+                               spacing, nullptr, nullptr, nullptr, INSITU_NODE),
+              INSITU_OK);
+    EXPECT_EQ(insitu_execute(instrument_, 2, 0.2), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "gap")) << insitu_last_error();
+    EXPECT_TRUE(contains(insitu_last_error(), "0.4")) << insitu_last_error();  // where
+}
+
+TEST_F(CApiTest, BlocksOnDifferentGridsAreRefused) {
+    const DenseBall ball;
+    const std::int64_t dims[3] = {10, 10, 5};
+    const double spacing[3] = {0.1, 0.1, 0.1};
+    const double coarse[3] = {0.2, 0.2, 0.2};
+    const double origin[3] = {0.0, 0.0, 0.0};
+    const double shifted[3] = {0.0, 0.0, 0.53};  // 5.3 samples up: not on the grid
+    ASSERT_EQ(insitu_add_block(instrument_, "v", ball.planes(0), INSITU_FLOAT32, dims, origin,
+                               spacing, nullptr, nullptr, nullptr, INSITU_NODE),
+              INSITU_OK);
+    ASSERT_EQ(insitu_add_block(instrument_, "v", ball.planes(5), INSITU_FLOAT32, dims, shifted,
+                               spacing, nullptr, nullptr, nullptr, INSITU_NODE),
+              INSITU_OK);
+    EXPECT_EQ(insitu_execute(instrument_, 2, 0.2), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "block 1: origin.z")) << insitu_last_error();
+
+    ASSERT_EQ(insitu_add_block(instrument_, "v", ball.planes(0), INSITU_FLOAT32, dims, origin,
+                               spacing, nullptr, nullptr, nullptr, INSITU_NODE),
+              INSITU_OK);
+    ASSERT_EQ(insitu_add_block(instrument_, "v", ball.planes(5), INSITU_FLOAT32, dims, origin,
+                               coarse, nullptr, nullptr, nullptr, INSITU_CELL),
+              INSITU_OK);
+    EXPECT_EQ(insitu_execute(instrument_, 4, 0.4), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "centred")) << insitu_last_error();
+    EXPECT_EQ(insitu_add_block(instrument_, "v", ball.planes(0), INSITU_FLOAT32, dims, origin,
+                               spacing, nullptr, nullptr, nullptr, 7),
+              INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "centering = 7")) << insitu_last_error();
+}
+
+TEST_F(CApiTest, SelectsAnswersTheCadenceAndUnselectedStepsNeedNoField) {
+    // small_config: every 2nd step.
+    EXPECT_EQ(insitu_selects(instrument_, 1), INSITU_NOT_SELECTED);
+    EXPECT_EQ(insitu_selects(instrument_, 2), INSITU_OK);
+    EXPECT_EQ(insitu_execute(instrument_, 1, 0.1), INSITU_NOT_SELECTED) << insitu_last_error();
+    EXPECT_EQ(insitu_execute(instrument_, 3, 0.3), INSITU_NOT_SELECTED) << insitu_last_error();
+    EXPECT_EQ(insitu_selects(instrument_, 3), INSITU_NOT_SELECTED);  // not after the last step
+    EXPECT_EQ(insitu_selects(instrument_, 4), INSITU_OK);
+    EXPECT_EQ(insitu_execute(instrument_, 4, 0.4), INSITU_ERROR_INVALID_ARGUMENT);  // no field
+    EXPECT_TRUE(contains(insitu_last_error(), "field \"v\" missing")) << insitu_last_error();
+    ASSERT_EQ(insitu_finalize(instrument_), INSITU_OK);
+    EXPECT_EQ(insitu_selects(instrument_, 6), INSITU_ERROR_STATE);
+}
+
+TEST(CApiStartup, AFailedStartUpIsSaidOnceAndLaterCallsAreSilentNoOps) {
+    insitu_instrument* instrument = nullptr;
+    ::testing::internal::CaptureStderr();
+    EXPECT_EQ(insitu_create_from_json(R"({"evry": 2})", &instrument), INSITU_ERROR_PARSE);
+    const std::string said = ::testing::internal::GetCapturedStderr();
+    const std::string message = insitu_last_error();
+    EXPECT_TRUE(contains(message, "did you mean \"every\"")) << message;
+    EXPECT_TRUE(contains(said, "start-up failed")) << said;
+    ASSERT_EQ(instrument, nullptr);
+
+    BallField ball;
+    ::testing::internal::CaptureStderr();
+    for (int step = 0; step < 3; ++step) {
+        EXPECT_EQ(insitu_selects(instrument, step), INSITU_NOT_SELECTED);
+        EXPECT_EQ(insitu_set_field(instrument, "v", ball.samples.data(), INSITU_FLOAT32, ball.dims,
+                                   nullptr, nullptr, nullptr),
+                  INSITU_NOT_SELECTED);
+        EXPECT_EQ(insitu_execute(instrument, step, 0.0), INSITU_NOT_SELECTED);
+    }
+    EXPECT_EQ(insitu_finalize(instrument), INSITU_NOT_SELECTED);
+    EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+    EXPECT_EQ(std::string(insitu_last_error()), message);  // the start-up failure, unchanged
+}
+
+TEST_F(CApiTest, ALanguageBindingNamesItsOwnEntryForOneCall) {
+    insitu_name_next_call("insitu_set_field");
+    EXPECT_EQ(
+        insitu_set_field_strided(instrument_, "pressure", ball_.samples.data(), INSITU_FLOAT32,
+                                 ball_.dims, nullptr, nullptr, nullptr, nullptr),
+        INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "insitu_set_field: ")) << insitu_last_error();
+    EXPECT_FALSE(contains(insitu_last_error(), "strided")) << insitu_last_error();
+    // Once only: the next failure names the C function again.
+    EXPECT_EQ(
+        insitu_set_field_strided(instrument_, "pressure", ball_.samples.data(), INSITU_FLOAT32,
+                                 ball_.dims, nullptr, nullptr, nullptr, nullptr),
+        INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_TRUE(contains(insitu_last_error(), "insitu_set_field_strided: ")) << insitu_last_error();
+}
+
+TEST_F(CApiTest, FailedHandOversAreCountedAndTheRootCauseReportedAtFinalize) {
+    EXPECT_EQ(set_ball("pressure"), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_EQ(insitu_execute(instrument_, 2, 0.2), INSITU_ERROR_INVALID_ARGUMENT);  // no "v"
+    ::testing::internal::CaptureStderr();
+    EXPECT_EQ(insitu_finalize(instrument_), INSITU_OK);
+    const std::string summary = ::testing::internal::GetCapturedStderr();
+    EXPECT_TRUE(contains(summary, "errors 2")) << summary;
+    EXPECT_TRUE(contains(summary, "first error: insitu_set_field: field \"pressure\"")) << summary;
+}
+
 // --- insitu_last_error and insitu_status_name ---
 
 TEST(CApiLastError, IsPerThread) {
-    EXPECT_EQ(insitu_execute(nullptr, 0, 0.0), INSITU_ERROR_INVALID_ARGUMENT);
-    std::string other_thread_message = "unset";
-    std::thread([&] { other_thread_message = insitu_last_error(); }).join();
-    EXPECT_EQ(other_thread_message, "");
-    EXPECT_TRUE(contains(insitu_last_error(), "instrument is NULL"));
+    expect_in_fresh_process([] {
+        check(insitu_execute(nullptr, 0, 0.0) == INSITU_ERROR_INVALID_ARGUMENT, "execute code");
+        std::string other_thread_message = "unset";
+        std::thread([&] { other_thread_message = insitu_last_error(); }).join();
+        check(other_thread_message.empty(), "other thread's message: " + other_thread_message);
+        check(contains(insitu_last_error(), "instrument is NULL"), "this thread's message");
+    });
 }
 
 TEST(CApiStatusName, NamesEveryCode) {

@@ -14,8 +14,10 @@
 //  "colour_model": {"clusters": 24, "enabled": true}}
 //
 // Every key is optional; defaults are listed on the members below. Unknown keys (at any level)
-// are collected by name, not silently ignored; invalid values raise InvalidArgument/ParseError
-// naming the key and the value. Cadence: "every": N (N >= 1) or "steps": [s0, s1, ...] (distinct,
+// are collected by name, not silently ignored: an Instrument refuses them unless "strict" is
+// false, naming the nearest known key (suggest_key); invalid values raise
+// InvalidArgument/ParseError naming the key and the value. Cadence: "every": N (N >= 1) or "steps":
+// [s0, s1, ...] (distinct,
 // >= 0), not both. "step" is at least kMinStepVoxels, and the estimated cost of a step at most
 // kMaxSamplesPerStep samples.
 // A view's keys: "azimuth", "elevation" (degrees), "camera" ("ortho" | "orthographic" |
@@ -26,6 +28,7 @@
 // function gets a ground-truth rendering and attenuation proxies of its own, the model is fitted
 // on those pairs and stored in the archive (the renderings only with "keep_training_images").
 #include <cstdint>
+#include <map>
 #include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <string>
@@ -82,8 +85,44 @@ constexpr double kWorstDiagonalVoxels = 2815.0;
 /// configuration is orders of magnitude off rather than tuned, so it is refused at start-up.
 constexpr double kMaxSamplesPerStep = 4398046511104.0;
 
+/// "on_existing": what a run does when its archive directory already holds an archive.
+enum class OnExisting {
+    append,   ///< continue it (the default): a restarted run's replayed steps are skipped
+    replace,  ///< remove the archive's own files (nothing else in the directory) and start anew
+    fail,     ///< refuse to start (IoError naming the archive)
+};
+
+/// A field's own settings, for a field written as an object in "fields":
+/// {"name": "energy", "views": [...], "transfer_function": {...}, "layers": [...] | "auto"}.
+/// What it leaves out comes from the top level. Training transfer functions (and the colour
+/// model) are in the top-level transfer function's units, so they apply only to the fields
+/// that use it.
+struct FieldStyle {
+    std::optional<std::vector<ViewConfig>> views;
+    std::optional<TransferFunction> transfer_function;
+    bool has_layers = false;                    ///< "layers" given for this field
+    std::optional<std::vector<double>> layers;  ///< nullopt = "auto" (when has_layers)
+};
+
+/// One view of one field as the archive numbers it: views are indexed field by field, in the
+/// order of "fields", then in the order of that field's views.
+struct PlannedView {
+    std::string field;
+    ViewConfig view;
+};
+
+/// The known key nearest to the last component of an unknown key's dotted path, at the same
+/// level of the configuration ("evry" -> "every", "views[0].azimut" -> "azimuth"); empty when
+/// none is close (at most a third of the key's letters differ).
+std::string suggest_key(const std::string& unknown_path);
+/// "unknown configuration key "evry" (did you mean "every"?)", for each key, joined by "; ".
+std::string describe_unknown_keys(const std::vector<std::string>& unknown_paths);
+
 struct InstrumentConfig {
-    std::vector<std::string> fields{"v"};  ///< "fields": names of the fields to visualise
+    /// "fields": the names of the fields to visualise, each with the top-level views, transfer
+    /// function and layers unless field_styles gives it its own; all in one archive.
+    std::vector<std::string> fields{"v"};
+    std::map<std::string, FieldStyle> field_styles;  ///< by field name; none by default
     std::vector<ViewConfig> views{ViewConfig{}};
     /// "transfer_function"; default: a blue-to-red ramp, transparent at the range's minimum,
     /// over [0, 1] (set it to the data's units).
@@ -107,6 +146,19 @@ struct InstrumentConfig {
     WhenFull when_full = WhenFull::block;  ///< "writer": {"when_full": "block" | "drop"}
     bool keep_training_images = false;     ///< "keep_training_images"
     ColourModelConfig colour_model;        ///< "colour_model"
+    /// "strict": unknown keys are errors (default), naming the nearest known key; false makes
+    /// them warnings.
+    bool strict = true;
+    OnExisting on_existing = OnExisting::append;  ///< "on_existing"
+
+    /// The views of `field` (its own, or the top-level ones), its transfer function, its layers,
+    /// and whether the training transfer functions apply to it (it uses the top-level function).
+    const std::vector<ViewConfig>& views_of(const std::string& field) const;
+    const TransferFunction& transfer_function_of(const std::string& field) const;
+    const std::optional<std::vector<double>>& layers_of(const std::string& field) const;
+    bool trains(const std::string& field) const;
+    /// Every archived view, in archive order (see PlannedView).
+    std::vector<PlannedView> planned_views() const;
 
     /// Parses `json`; unknown keys are appended to `unknown_keys` as dotted paths
     /// ("views[0].zoom"). Throws ParseError (wrong JSON type) or InvalidArgument (value out of

@@ -1,8 +1,15 @@
 #pragma once
 // Field: a non-owning view of one scalar array of a simulation on a uniform grid.
 // Nothing is copied when a Field is made; the simulation keeps ownership of its memory and
-// the view must not outlive it. Sample (i, j, k) of the interior lives at world position
-// origin + (i, j, k) * spacing (node-centred samples, x fastest).
+// the view must not outlive it. Samples are x fastest. What the origin means depends on the
+// centring (set_centering), the one place it is defined:
+//  - node (default): sample (i, j, k) of the interior is the value at the grid node
+//    origin + (i, j, k) * spacing, so the origin is the first interior sample;
+//  - cell: sample (i, j, k) is the value of the cell [origin + (i, j, k) * spacing,
+//    origin + (i + 1, j + 1, k + 1) * spacing], taken at its centre; the origin is the low corner
+//    of the first interior cell (the corner of the simulation's domain, or of its block).
+// Either way the renderers sample at first_sample() + (i, j, k) * spacing and march the box
+// through the samples, bounds(); trilinear interpolation needs no value beyond it.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -50,6 +57,13 @@ struct Bounds {
 };
 std::ostream& operator<<(std::ostream& out, const Bounds& bounds);
 
+/// Where a field's values sit on its grid (see the comment at the top of this file).
+enum class Centering { node, cell };
+/// "node", "cell".
+std::string to_string(Centering centering);
+/// Inverse of to_string; throws InvalidArgument naming the unknown text.
+Centering parse_centering(const std::string& text);
+
 class Field {
 public:
     /// A view of a contiguous x-fastest array of `allocated_dims` samples.
@@ -57,8 +71,11 @@ public:
     /// in bytes does not fit in 64-bit integers.
     Field(std::string name, const void* data, ScalarType type, Index3 allocated_dims);
 
-    /// World position of the first interior sample (world units). Default (0, 0, 0).
+    /// World position of the first interior node (node centring) or of the low corner of the
+    /// first interior cell (cell centring), world units, finite. Default (0, 0, 0).
     Field& set_origin(glm::dvec3 origin_world);
+    /// Node (default) or cell centring: what the origin means.
+    Field& set_centering(Centering centering);
     /// Distance between samples along each axis (world units, > 0 and finite). Default (1, 1, 1).
     Field& set_spacing(glm::dvec3 spacing_world);
     /// Ghost layers to skip on the low and high side of each axis (samples, >= 0).
@@ -79,12 +96,17 @@ public:
     /// Samples per axis after the ghost layers are skipped.
     Index3 dims() const;
     std::int64_t sample_count() const;
+    /// As set: the first node or the first cell's low corner (see centering()).
     glm::dvec3 origin() const { return origin_; }
     glm::dvec3 spacing() const { return spacing_; }
+    Centering centering() const { return centering_; }
+    /// World position of interior sample (0, 0, 0): the origin, or the first cell's centre.
+    glm::dvec3 first_sample() const;
     Index3 ghost_low() const { return ghost_low_; }
     Index3 ghost_high() const { return ghost_high_; }
     Index3 strides() const { return strides_; }
-    /// World box spanned by the interior samples.
+    /// World box spanned by the interior samples (through the cell centres for cell centring):
+    /// the box the renderers march.
     Bounds bounds() const;
 
     /// Interior sample (i, j, k) as double, read through the type, ghosts and strides.
@@ -110,11 +132,21 @@ private:
     Index3 allocated_dims_;
     glm::dvec3 origin_{0.0};
     glm::dvec3 spacing_{1.0};
+    Centering centering_ = Centering::node;
     Index3 ghost_low_{0, 0, 0};
     Index3 ghost_high_{0, 0, 0};
     Index3 strides_;
 };
 
 std::ostream& operator<<(std::ostream& out, const Field& field);
+
+/// Joins the blocks (tiles) of one field that a rank owns into one node-centred float32 Field
+/// viewing `storage` (resized), on the grid the blocks share. They must have the same name,
+/// spacing (to 1e-9 relative) and centring, first samples a whole number of samples apart (to
+/// 1e-6 samples), and their interiors must together cover the box around them; samples two
+/// blocks share (node-centred tiles meeting at a face) take the later block's value. Otherwise
+/// InvalidArgument naming the blocks by their position in `blocks` and the offending value.
+/// A single block is copied too: callers that can use it directly should.
+Field join_blocks(const std::vector<const Field*>& blocks, std::vector<float>& storage);
 
 }  // namespace insitu

@@ -32,11 +32,19 @@ struct InstrumentStatistics {
     std::int64_t steps_executed = 0;  ///< execute() calls that computed proxies
     std::int64_t steps_written = 0;
     std::int64_t steps_dropped = 0;
+    /// Steps skipped because the archive held them already (a restarted run replaying them).
+    std::int64_t steps_replayed = 0;
+    /// Failures of execute(), of the writer, and those a boundary reports (report_error).
     std::int64_t errors = 0;
     std::uint64_t bytes_written = 0;
     double compute_seconds = 0.0;  ///< in execute(), computing proxies
     double blocked_seconds = 0.0;  ///< in execute(), waiting for room in the writer queue
     double write_seconds = 0.0;    ///< on the writer thread
+    /// Wall time inside execute() (every call, whatever its status): what the simulation waited.
+    double execute_seconds = 0.0;
+    /// Wall time between one execute() returning and the next being called: the simulation's
+    /// own work, against which the in-situ share is stated.
+    double simulation_seconds = 0.0;
     /// NaN/Inf samples met in the visualised fields, summed over steps (treated as empty space).
     std::int64_t nonfinite_samples = 0;
 };
@@ -64,17 +72,25 @@ public:
     Instrument(const Instrument&) = delete;
     Instrument& operator=(const Instrument&) = delete;
 
-    /// One timestep: fields are matched by name against the configuration's "fields". Only the
-    /// first configured field is visualised (and must be present); several fields per step are
-    /// future work. Checks, in order: not finalized; `step` in [0, 2^53 - 1] (what the JSON
-    /// manifest holds exactly), `time` finite (JSON has no NaN/Inf), `step` greater than every
-    /// step executed before and not already in the archive (else error naming it, nothing
-    /// written); the first configured field present (else error naming it); the cadence (else
-    /// not_selected, nothing computed); the field's values within float32, which the renderers
+    /// One timestep: fields are matched by name against the configuration's "fields"; every
+    /// configured field is visualised, each with its views, into one archive. Several Fields of
+    /// one name are the blocks (tiles) of that field and are joined (join_blocks). Checks, in
+    /// order: not finalized; `step` in [0, 2^53 - 1] (what the JSON manifest holds exactly),
+    /// `time` finite (JSON has no NaN/Inf), `step` greater than every step executed before
+    /// (else error naming it, nothing written); a step the archive already holds (a restarted
+    /// run replaying it) is skipped, not_selected, with one notice per run; the cadence (else
+    /// not_selected, nothing computed, no field needed); every configured field present (else
+    /// error naming it); the blocks join; the values within float32, which the renderers
     /// sample. Then computes the proxies and preview of every view and queues them; with the
     /// queue full it waits (when_full = block, timed in blocked_seconds) or returns dropped.
     /// The Fields are not referenced after execute() returns.
     Status execute(std::int64_t step, double time, const std::vector<Field>& fields);
+    /// Whether execute(step, ...) would compute proxies: not finalized, after the last step,
+    /// selected by the cadence and not already archived. Fields need only be made then.
+    bool selects(std::int64_t step) const;
+    /// Counts a failure met at a boundary before execute() (a C API set_field, say) as an error
+    /// of the run: logged like execute()'s first error, kept as the first root cause.
+    void report_error(const std::string& message, ErrorKind kind);
     /// Drains the writer queue and stops the writer; later execute() calls return error.
     /// Returns error when a write failed during the run (last_error() says which); calling it
     /// again does nothing and returns ok.
@@ -83,6 +99,8 @@ public:
     InstrumentStatistics statistics() const;
     /// The most recent error message (empty if none).
     std::string last_error() const;
+    /// The first error of the run (empty if none): the root cause the later ones often follow.
+    std::string first_error() const;
     /// The kind of that error (ErrorKind::none if none), so boundaries such as the C API can map
     /// it to a code without reading the message.
     ErrorKind last_error_kind() const;

@@ -2,7 +2,8 @@
 //
 // Everything read is validated: the manifest's shape (manifest.cpp), each file's size and CRC-32
 // against the manifest before it is parsed, and every EXR part, channel and attribute the frame
-// needs (exr_frame.cpp).
+// needs (exr_frame.cpp). open_damaged() is the one tolerant way in: it keeps what a damaged index
+// still holds, for the tools that report damage.
 #include "insitu/archive/archive_reader.hpp"
 
 #include <algorithm>
@@ -14,6 +15,7 @@
 #include <utility>
 
 #include "archive/archive_format.hpp"
+#include "archive/atomic_file.hpp"
 #include "archive/cinema_csv.hpp"
 #include "archive/exr_frame.hpp"
 #include "archive/manifest.hpp"
@@ -67,8 +69,130 @@ ArchiveReader::ArchiveReader(const std::string& path) : path_(path) {
     diagnostics_ = std::move(index.diagnostics);
 }
 
+ArchiveReader::ArchiveReader(std::string path, std::vector<std::string> diagnostics,
+                             std::shared_ptr<const nlohmann::json> manifest, bool manifest_readable)
+    : path_(std::move(path)),
+      diagnostics_(std::move(diagnostics)),
+      manifest_readable_(manifest_readable),
+      manifest_(std::move(manifest)) {}
+
+namespace {
+
+/// The journal's step entries appended to `manifest`'s, as read_index() replays them, except
+/// that nothing refuses the whole index: an unreadable journal, a line that is no valid step
+/// entry and a step repeated with other content each become a line of `diagnostics`. Returns
+/// how many steps the journal added; `journal_problem` says why it added none.
+std::size_t replay_journal_tolerantly(const std::string& archive, nlohmann::json& manifest,
+                                      std::vector<std::string>& diagnostics,
+                                      std::string& journal_problem) {
+    const std::string journal = (fs::path(archive) / af::kJournalFile).string();
+    std::error_code error;
+    if (!fs::exists(journal, error)) {
+        journal_problem = "\"" + journal + "\" does not exist";
+        return 0;
+    }
+    std::vector<char> bytes;
+    try {
+        bytes = af::read_whole_file(journal);
+    } catch (const IoError& unreadable) {
+        journal_problem = unreadable.what();
+        diagnostics.push_back(journal_problem);
+        return 0;
+    }
+    nlohmann::json& entries = manifest["steps"];
+    std::set<std::int64_t> steps;
+    for (const nlohmann::json& step : entries) steps.insert(step.at("step").get<std::int64_t>());
+    std::size_t added = 0;
+    std::size_t line_number = 0;
+    for (auto begin = bytes.begin(); begin != bytes.end();) {
+        const auto end = std::find(begin, bytes.end(), '\n');
+        // A last line without its newline is an append a crash cut short, ignored as
+        // read_index() ignores it: that step never completed.
+        if (end == bytes.end()) break;
+        ++line_number;
+        const std::string where = "line " + std::to_string(line_number);
+        try {
+            nlohmann::json entry;
+            try {
+                entry = nlohmann::json::parse(begin, end);
+            } catch (const nlohmann::json::exception&) {
+                fail<ParseError>("\"", journal, "\": ", where, ": not valid JSON");
+            }
+            af::check_step_entry(entry, journal, where);
+            const auto number = entry.at("step").get<std::int64_t>();
+            if (!steps.insert(number).second) {
+                // The same entry twice is what a compaction killed before it removed the
+                // journal leaves; other content under the same step is a conflict.
+                if (std::find(entries.begin(), entries.end(), entry) == entries.end()) {
+                    fail<ParseError>("\"", journal, "\": ", where, ": step ", number,
+                                     " is repeated with other content");
+                }
+            } else {
+                entries.push_back(std::move(entry));
+                ++added;
+            }
+        } catch (const ParseError& problem) {
+            diagnostics.push_back(std::string("step entry skipped: ") + problem.what());
+        }
+        begin = end + 1;
+    }
+    std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
+        return a.at("step").template get<std::int64_t>() <
+               b.at("step").template get<std::int64_t>();
+    });
+    if (added == 0) journal_problem = "\"" + journal + "\" holds no usable step entry";
+    return added;
+}
+
+}  // namespace
+
+ArchiveReader ArchiveReader::open_damaged(const std::string& path) {
+    std::error_code error;
+    if (!fs::is_directory(path, error)) fail<IoError>("archive \"", path, "\" is not a directory");
+    try {
+        return ArchiveReader(path);
+    } catch (const Error&) {
+        // The strict index refused: read it again part by part, keeping every usable part.
+    }
+    std::vector<std::string> diagnostics;
+    nlohmann::json skipped = nlohmann::json::array();
+    nlohmann::json manifest;
+    bool manifest_readable = true;
+    std::string manifest_problem;
+    try {
+        manifest = af::read_manifest(path, &skipped);
+    } catch (const Error& unusable) {
+        manifest_readable = false;
+        manifest_problem = unusable.what();
+        diagnostics.push_back(manifest_problem);
+        manifest = af::empty_manifest();
+        manifest["producer"] = "";
+        manifest["configuration"] = nlohmann::json::object();
+    }
+    std::string journal_problem;
+    const std::size_t journal_steps =
+        replay_journal_tolerantly(path, manifest, diagnostics, journal_problem);
+    if (!manifest_readable && journal_steps == 0) {
+        fail<IoError>("archive \"", path, "\" has no readable index: ", manifest_problem, "; ",
+                      journal_problem);
+    }
+    for (const nlohmann::json& set_aside : manifest.value(af::kMalformedKey, nlohmann::json())) {
+        diagnostics.push_back("set aside by an earlier writer: " +
+                              set_aside.value("problem", std::string("(no reason given)")));
+    }
+    for (const nlohmann::json& entry : skipped) {
+        diagnostics.push_back("step entry skipped: " + entry.at("problem").get<std::string>());
+    }
+    return ArchiveReader(path, std::move(diagnostics),
+                         std::make_shared<const nlohmann::json>(std::move(manifest)),
+                         manifest_readable);
+}
+
 InstrumentConfig ArchiveReader::configuration() const {
     const std::string file = (fs::path(path_) / af::kManifestFile).string();
+    if (!manifest_readable_) {
+        fail<ParseError>("\"", file, "\" could not be read: the configuration is unknown");
+    }
     try {
         return InstrumentConfig::from_json(manifest_->at("configuration"));
     } catch (const std::exception& error) {
@@ -98,6 +222,8 @@ ArchivedView ArchiveReader::entry(std::int64_t step, int view) const {
     result.step = step;
     result.time = found.step->at("time").get<double>();
     result.view_index = view;
+    // Each view names its field since several fields share an archive; older ones, the step's.
+    result.field = found.view->value("field", found.step->at("field").get<std::string>());
     const std::string root = fs::absolute(path_).string();
     result.exr_path = af::listed_file(root, *found.view, af::kProxyKind).absolute_path;
     result.preview_path = af::listed_file(root, *found.view, af::kPreviewKind).absolute_path;
@@ -153,7 +279,28 @@ bool inside(const fs::path& root, const fs::path& path) {
 }  // namespace
 
 std::vector<std::string> ArchiveReader::verify() const {
-    std::vector<std::string> problems = diagnostics_;
+    return check().problems;
+}
+
+ArchiveCheck ArchiveReader::check() const {
+    ArchiveCheck result;
+    result.problems = diagnostics_;
+    // Which (step, view) each proxy EXR serves, so that a file found unusable marks its entry.
+    std::multimap<std::string, std::pair<std::int64_t, int>> proxy_owners;
+    for (const nlohmann::json& step : manifest_->at("steps")) {
+        for (const nlohmann::json& view : step.at("views")) {
+            proxy_owners.emplace(
+                af::listed_file(path_, view, af::kProxyKind).absolute_path,
+                std::pair{step.at("step").get<std::int64_t>(), view.at("view").get<int>()});
+        }
+    }
+    const auto unusable = [&](const af::ListedFile& file, std::string problem) {
+        result.problems.push_back(std::move(problem));
+        const auto [first, last] = proxy_owners.equal_range(file.absolute_path);
+        for (auto owner = first; owner != last; ++owner) {
+            result.unreadable_proxies.insert(owner->second);
+        }
+    };
     const fs::path root = resolved(fs::absolute(path_));
     std::set<fs::path> outside;
     for (const af::ListedFile& file : af::listed_files(path_, *manifest_)) {
@@ -161,18 +308,35 @@ std::vector<std::string> ArchiveReader::verify() const {
         // check the bytes a link points at elsewhere.
         if (!inside(root, file.absolute_path)) {
             outside.insert(fs::absolute(file.absolute_path).lexically_normal());
-            problems.push_back("\"" + file.absolute_path + "\" resolves to \"" +
+            unusable(file, "\"" + file.absolute_path + "\" resolves to \"" +
                                resolved(file.absolute_path).string() + "\", outside the archive");
             continue;
         }
         try {
             af::read_listed_file(file);
         } catch (const IoError& error) {
-            problems.push_back(error.what());
+            unusable(file, error.what());
         }
     }
-    verify_cinema_csv(root, outside, problems);
-    return problems;
+    verify_cinema_csv(root, outside, result.problems);
+    return result;
+}
+
+ArchiveReader ArchiveReader::without_views(
+    const std::set<std::pair<std::int64_t, int>>& views) const {
+    auto manifest = std::make_shared<nlohmann::json>(*manifest_);
+    nlohmann::json& steps = (*manifest)["steps"];
+    for (auto step = steps.begin(); step != steps.end();) {
+        const auto number = step->at("step").get<std::int64_t>();
+        nlohmann::json& entries = (*step)["views"];
+        const auto kept_before = entries.size();
+        for (auto view = entries.begin(); view != entries.end();) {
+            view =
+                views.count({number, view->at("view").get<int>()}) ? entries.erase(view) : view + 1;
+        }
+        step = entries.empty() && kept_before > 0 ? steps.erase(step) : step + 1;
+    }
+    return ArchiveReader(path_, diagnostics_, std::move(manifest), manifest_readable_);
 }
 
 void ArchiveReader::verify_cinema_csv(const fs::path& root, const std::set<fs::path>& outside,

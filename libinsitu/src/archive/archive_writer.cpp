@@ -119,6 +119,33 @@ void validate_record(const StepRecord& record, const ArchiveWriter& writer) {
 
 }  // namespace
 
+namespace {
+// "on_existing": "replace": removes what an archive consists of — its indexes, then every file
+// in its own proxies/ and previews/ folders — and nothing else the directory holds. The indexes
+// go first: should the run die half-way, what is left is unindexed files, not an index naming
+// missing ones.
+void remove_archive_files(const fs::path& archive) {
+    for (const char* index : {af::kJournalFile, af::kManifestFile, af::kCsvFile}) {
+        std::error_code error;
+        fs::remove(archive / index, error);
+        if (error) {
+            fail<IoError>("cannot replace archive \"", archive.string(), "\": removing ", index,
+                          ": ", error.message());
+        }
+    }
+    for (const char* folder : {af::kProxyFolder, af::kPreviewFolder}) {
+        std::error_code error;
+        for (const fs::directory_entry& entry : fs::directory_iterator(archive / folder, error)) {
+            if (entry.is_regular_file()) fs::remove(entry.path(), error);
+            if (error) {
+                fail<IoError>("cannot replace archive \"", archive.string(), "\": removing ",
+                              entry.path().string(), ": ", error.message());
+            }
+        }
+    }
+}
+}  // namespace
+
 ArchiveWriter::ArchiveWriter(const InstrumentConfig& config)
     : path_(config.archive), config_(config) {
     af::check_compression(config_.compression);  // fail early, before touching the disk
@@ -139,6 +166,16 @@ ArchiveWriter::ArchiveWriter(const InstrumentConfig& config)
                                                    "archive \"" + path_ + "\"");
         }
     }
+
+    // "on_existing" (issue 18), decided under the lock so that no other writer is mid-step.
+    const bool exists =
+        fs::exists(archive / af::kManifestFile) || fs::exists(archive / af::kJournalFile);
+    if (exists && config_.on_existing == OnExisting::fail) {
+        fail<IoError>("archive \"", path_,
+                      "\" already exists and \"on_existing\" is \"fail\" (use \"append\" to "
+                      "continue it, \"replace\" to start anew, or another \"archive\")");
+    }
+    if (exists && config_.on_existing == OnExisting::replace) remove_archive_files(archive);
 
     nlohmann::json configuration = config_.to_json();
     nlohmann::json manifest;
@@ -219,6 +256,7 @@ StepWriteResult ArchiveWriter::write(const StepRecord& record) {
                 archive, af::preview_relative_path(record.step, view.view_index), view.preview));
             step_entry["views"].push_back(
                 {{"view", view.view_index},
+                 {"field", view.field.empty() ? record.field : view.field},
                  {"phi", view.view.orbit.azimuth_deg},
                  {"theta", view.view.orbit.elevation_deg},
                  {"parts", exr.parts},

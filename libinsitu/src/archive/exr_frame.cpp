@@ -194,7 +194,8 @@ void add_frame_attributes(Imf::Header& header, const StepRecord& record, const V
     // Steps are 64-bit; EXR has no 64-bit integer attribute, and a decimal string is exact.
     header.insert(kStepAttribute, Imf::StringAttribute(std::to_string(record.step)));
     header.insert(kTimeAttribute, Imf::DoubleAttribute(record.time));
-    header.insert(kFieldAttribute, Imf::StringAttribute(record.field));
+    header.insert(kFieldAttribute,
+                  Imf::StringAttribute(view.field.empty() ? record.field : view.field));
     header.insert(kViewAttribute, Imf::IntAttribute(view.view_index));
     header.insert(kViewConfigAttribute, Imf::StringAttribute(view.view.to_json().dump()));
     header.insert(kPerspectiveAttribute,

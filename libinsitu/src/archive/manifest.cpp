@@ -107,6 +107,8 @@ void check_step_entry(const nlohmann::json& step, const std::string& file,
         }
         require(view, "phi", Expect::number, file, view_where);
         require(view, "theta", Expect::number, file, view_where);
+        // Optional: archives written before several fields per run name only the step's field.
+        if (view.contains("field")) require(view, "field", Expect::string, file, view_where);
         for (const auto& part : require(view, "parts", Expect::array, file, view_where)) {
             if (!part.is_string()) {
                 fail<ParseError>("\"", file, "\": ", view_where, ".parts: ", part.dump(),

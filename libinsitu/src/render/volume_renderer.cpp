@@ -74,7 +74,7 @@ void DeviceVolume::upload(ComputeDevice& device, const Field& field) {
     device.opencl().ensure_buffer(memory->buffer, memory->capacity, bytes, CL_MEM_READ_ONLY);
     device.opencl().upload(memory->buffer, host_values.data(), bytes, "volume");
     dims = field_dims;
-    origin = field.origin();
+    origin = field.first_sample();  // the renderers sample nodes: a cell's is its centre
     spacing = field.spacing();
     bounds = field.bounds();
     ++generation;

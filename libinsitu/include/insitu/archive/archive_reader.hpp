@@ -7,6 +7,7 @@
 #include <nlohmann/json_fwd.hpp>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "insitu/config.hpp"
@@ -20,8 +21,19 @@ struct ArchivedView {
     std::int64_t step = 0;
     double time = 0.0;
     int view_index = 0;
+    std::string field;         ///< the field the view shows
     std::string exr_path;      ///< absolute
     std::string preview_path;  ///< absolute
+};
+
+/// What ArchiveReader::check() found.
+struct ArchiveCheck {
+    /// One line per problem, each naming its file (verify()'s list).
+    std::vector<std::string> problems;
+    /// (step, view) of the entries whose proxy EXR cannot be used: missing, outside the archive,
+    /// or not the size and CRC-32 the index records.
+    std::set<std::pair<std::int64_t, int>> unreadable_proxies;
+    bool clean() const { return problems.empty(); }
 };
 
 class ArchiveReader {
@@ -31,10 +43,27 @@ public:
     /// skipped and reported in diagnostics(); a manifest whose top level is broken is refused.
     explicit ArchiveReader(const std::string& path);
 
-    /// One line per step entry the index held but could not use (empty for a sound archive).
+    /// Opens what can be read of a damaged archive, for tools that report damage rather than
+    /// refuse it (insitu-view info and verify); other readers keep the strict constructor. As the
+    /// constructor, except that a broken index costs only its broken part, reported in
+    /// diagnostics(): a manifest.json that is missing, unreadable or not a valid manifest leaves
+    /// the steps of manifest.journal (manifest_readable() is then false: the configuration and
+    /// the steps compacted into manifest.json are lost), an unreadable journal leaves the
+    /// manifest's steps, and a journal step that conflicts with another is skipped. IoError when
+    /// `path` is not a directory or has no readable index at all (neither a usable manifest.json
+    /// nor a journal with a usable step entry), naming both.
+    static ArchiveReader open_damaged(const std::string& path);
+
+    /// One line per problem of the index: a step entry it held but could not use and, for
+    /// open_damaged, a manifest.json or journal that could not be read (empty for a sound index).
     const std::vector<std::string>& diagnostics() const { return diagnostics_; }
+    /// False only for open_damaged on an archive whose manifest.json could not be used: then
+    /// manifest() holds the journal's steps and an empty configuration.
+    bool manifest_readable() const { return manifest_readable_; }
 
     const nlohmann::json& manifest() const { return *manifest_; }
+    /// The configuration manifest.json recorded; ParseError when it is unreadable
+    /// (manifest_readable() false).
     InstrumentConfig configuration() const;
     std::vector<std::int64_t> steps() const;
     int view_count() const;
@@ -55,14 +84,25 @@ public:
     /// the manifest's files and that each of its rows names files inside the archive that exist.
     /// Returns one line per problem, diagnostics() first (empty when the archive is intact).
     std::vector<std::string> verify() const;
+    /// verify()'s checks, with the (step, view) entries whose proxies they found unusable.
+    ArchiveCheck check() const;
+
+    /// The same archive with the (step, view) entries in `views` left out of the index (a step
+    /// left without views goes too): what stays readable of a damaged archive, for tools that
+    /// show it (`views` from check()).
+    ArchiveReader without_views(const std::set<std::pair<std::int64_t, int>>& views) const;
 
 private:
+    ArchiveReader(std::string path, std::vector<std::string> diagnostics,
+                  std::shared_ptr<const nlohmann::json> manifest, bool manifest_readable);
+
     void verify_cinema_csv(const std::filesystem::path& root,
                            const std::set<std::filesystem::path>& outside,
                            std::vector<std::string>& problems) const;
 
     std::string path_;
     std::vector<std::string> diagnostics_;
+    bool manifest_readable_ = true;
     // Shared rather than held by value, so this header needs only json_fwd.hpp; the manifest
     // never changes once read, so copies of a reader may share it.
     std::shared_ptr<const nlohmann::json> manifest_;

@@ -17,6 +17,8 @@ constexpr int kArchiveSchemaVersion = 1;
 /// Everything of one view at one timestep, copied off the simulation's memory.
 struct ViewRecord {
     int view_index = 0;
+    /// The field this view shows (archives with several fields); empty = StepRecord::field.
+    std::string field;
     ViewConfig view;
     std::optional<ProxyFrame> single;  ///< depth layers, attenuation, training images
     std::optional<ProxyFrame> multi;   ///< distortion-camera depth and distortion layers
@@ -28,7 +30,7 @@ struct ViewRecord {
 struct StepRecord {
     std::int64_t step = 0;
     double time = 0.0;
-    std::string field;  ///< name of the field the proxies came from
+    std::string field;  ///< the first field's name (each view names its own, ViewRecord::field)
     std::vector<ViewRecord> views;
 };
 
