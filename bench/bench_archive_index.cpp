@@ -79,6 +79,7 @@ int main(int argc, char** argv) {
         fs::remove_all(root);
         fs::create_directories(root);
         InstrumentConfig config;
+        config.every = 1;  // every step is emitted (the default is every 10th)
         config.archive = (root / "run.cdb").string();
         config.views[0].orbit.width = config.views[0].orbit.height = kImageSize;
         config.compression = "none";

@@ -65,6 +65,7 @@ Options parse(int argc, char** argv) {
 InstrumentConfig make_config(const std::string& archive, int image, StoragePrecision precision,
                              const std::string& compression, int queue, WhenFull when_full) {
     InstrumentConfig config;
+    config.every = 1;  // every step is emitted (the default is every 10th)
     config.fields = {"f"};
     config.views[0].orbit.width = image;
     config.views[0].orbit.height = image;

@@ -44,8 +44,8 @@ TEST(InstrumentConfig, EmptyObjectGivesTheDocumentedDefaults) {
     EXPECT_EQ(orbit.azimuth_deg, 30.0);
     EXPECT_EQ(orbit.elevation_deg, 20.0);
     EXPECT_EQ(orbit.projection, Projection::orthographic);
-    EXPECT_EQ(orbit.width, 512);
-    EXPECT_EQ(orbit.height, 512);
+    EXPECT_EQ(orbit.width, 256);
+    EXPECT_EQ(orbit.height, 256);
     EXPECT_EQ(config.views[0].distortion_tilt_deg, 45.0);
     EXPECT_EQ(config.transfer_function.value_min(), 0.0);
     EXPECT_EQ(config.transfer_function.value_max(), 1.0);
@@ -60,7 +60,7 @@ TEST(InstrumentConfig, EmptyObjectGivesTheDocumentedDefaults) {
     EXPECT_FALSE(config.proxies.multi_attenuation);
     EXPECT_FALSE(config.proxies.optical_depth);
     EXPECT_EQ(config.step_voxels, 1.0);
-    EXPECT_EQ(config.every, 1);
+    EXPECT_EQ(config.every, 10);
     EXPECT_TRUE(config.steps.empty());
     EXPECT_EQ(config.archive, "run.cdb");
     EXPECT_EQ(config.precision, StoragePrecision::half);
@@ -318,7 +318,8 @@ TEST(InstrumentConfig, StepBelowTheFloorIsRefusedNamingTheBound) {
 }
 
 TEST(InstrumentConfig, EstimatedSamplesPerStepFollowTheCostModel) {
-    InstrumentConfig config;  // one 512^2 view; depth, distortion, attenuation; step 1
+    InstrumentConfig config;  // one view; depth, distortion, attenuation; step 1
+    config.views[0].orbit.width = config.views[0].orbit.height = 512;
     EXPECT_EQ(config.passes_per_view(), 3);  // single, multi-perspective, preview
     EXPECT_DOUBLE_EQ(config.estimated_samples_per_step(), 512.0 * 512.0 * 3 * kWorstDiagonalVoxels);
     config.step_voxels = 0.5;

@@ -53,6 +53,7 @@ InstrumentConfig small_config(const fs::path& archive, int image = 32) {
         TransferFunction({{0.0, {0, 0, 1, 0}}, {0.2, {0, 0, 1, 0}}, {1.0, {1, 0, 0, 0.5}}}, 1.0);
     config.layers = std::vector<double>{0.3, 0.6};
     config.interval_count = 4;
+    config.every = 1;  // every step: the tests count steps one by one
     config.archive = archive.string();
     return config;
 }
@@ -410,7 +411,9 @@ TEST_F(InstrumentTest, SeveralFieldsGoIntoOneArchiveEachWithItsViews) {
     style.views = std::vector<ViewConfig>{side, side};
     style.views->at(1).orbit.azimuth_deg = 180.0;
     style.transfer_function = TransferFunction({{0.0, {0, 1, 0, 0}}, {1.0, {1, 1, 0, 0.8}}}, 1.0);
-    config.fields = {"f", "energy"};
+    // "energy" first: its own (larger) views are the archive's views 0 and 1, so a reader that
+    // took sizes from the top-level "views" by index would refuse to decode them.
+    config.fields = {"energy", "f"};
     config.field_styles["energy"] = style;
     Instrument instrument(config, quiet());
     // Both are needed on a selected step.
@@ -422,12 +425,14 @@ TEST_F(InstrumentTest, SeveralFieldsGoIntoOneArchiveEachWithItsViews) {
 
     const ArchiveReader reader(archive().string());
     ASSERT_EQ(reader.view_count(), 3);
-    EXPECT_EQ(reader.entry(1, 0).field, "f");
+    EXPECT_EQ(reader.entry(1, 0).field, "energy");
     EXPECT_EQ(reader.entry(1, 1).field, "energy");
-    EXPECT_EQ(reader.entry(1, 2).field, "energy");
-    EXPECT_EQ(reader.load_preview(1, 0).width, 16);
-    EXPECT_EQ(reader.load_preview(1, 1).width, 24);
-    EXPECT_EQ(reader.load_preview(1, 2).height, 12);
+    EXPECT_EQ(reader.entry(1, 2).field, "f");
+    EXPECT_EQ(reader.load_preview(1, 0).width, 24);
+    EXPECT_EQ(reader.load_preview(1, 1).height, 12);
+    EXPECT_EQ(reader.load_preview(1, 2).width, 16);
+    EXPECT_EQ(reader.load(1, 0).camera.width(), 24);
+    EXPECT_EQ(reader.load(1, 2).camera.width(), 16);
     EXPECT_THAT(reader.verify(), ElementsAre());
     // The configuration reads back with the field's own settings.
     const InstrumentConfig stored = reader.configuration();

@@ -9,24 +9,37 @@
 //               [--fill PIXELS] [--mask OUT.png] --out OUT.png|exr
 //   insitu-view verify ARCHIVE
 //   insitu-view serve ARCHIVE [--port P] [--bind ADDR]
+//   insitu-view COMMAND --help      (or -h, anywhere among the arguments; or: help COMMAND)
 //
-// Exit status: 0 on success; 1 when verify finds problems or on failures that are not the
-// user's input (no OpenCL platform, a failed kernel); 2 for bad arguments and bad input (unknown
-// flag, malformed value, missing archive, step or view). Every failure is one line on stderr
-// naming the offending flag or value.
+// info and verify read damaged archives too: info shows what can be read and lists the damage
+// under "damage:", verify lists every problem; only a directory with no readable index at all is
+// refused.
+//
+// Exit status (tools/cli.hpp): 0 on success (and for --help); 3 when info or verify found damage
+// (what could be read was shown, every problem listed on stdout, one line on stderr says so); 2
+// for bad arguments and bad input (unknown flag, malformed value, missing archive, step or view,
+// an archive with no readable index); 1 on failures that are not the user's input (no OpenCL
+// platform, a failed kernel). Every failure is one line on stderr naming the offending flag or
+// value.
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <exception>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "archive_inspection.hpp"
+#include "arguments.hpp"
 #include "cli.hpp"
 #include "explore_options.hpp"
+#include "insitu/archive/archive_reader.hpp"
 #include "insitu/core/image.hpp"
 #include "insitu/error.hpp"
 #include "insitu/explore/explorer.hpp"
@@ -35,21 +48,94 @@
 namespace {
 
 constexpr const char* kProgram = "insitu-view";
-/// verify's status when it finds problems (as for runtime failures).
-constexpr int kExitProblems = insitu::cli::kExitRuntimeError;
+using insitu::cli::CommandHelp;
+using insitu::cli::default_text;
+using insitu::cli::OptionHelp;
 using insitu::cli::UsageError;
 
-void print_help(std::ostream& out) {
-    out << "usage:\n"
-           "  insitu-view info ARCHIVE [--json]\n"
-           "  insitu-view render ARCHIVE --step N [--view V] [--azimuth DEG --elevation DEG]\n"
-           "      [--tf TF.json | --opacity-scale J=S,...] [--colour auto|model|recompose]\n"
-           "      [--source auto|single|multi]\n"
-           "      [--light AZ,EL[,DIFFUSE[,SPECULAR]] | --light camera]... [--ambient A]\n"
-           "      [--ao] [--ao-radius PIXELS] [--ao-strength S] [--enhance LAMBDA,GAMMA]\n"
-           "      [--fill PIXELS] [--mask OUT.png] --out OUT.png|exr\n"
-           "  insitu-view verify ARCHIVE\n"
-           "  insitu-view serve ARCHIVE [--port P] [--bind ADDR]\n";
+const CommandHelp& info_help() {
+    static const CommandHelp help{
+        "insitu-view info ARCHIVE [--json]",
+        "Describes ARCHIVE: its steps, views, proxies and configuration. Every file is checked "
+        "against the index (size, CRC-32); of a damaged archive it shows what can be read and "
+        "lists each problem, one line each naming the file, under \"damage:\".",
+        {{"--json", "",
+          "print the description as JSON (as the web viewer's /api/archive), with "
+          "\"damage\" and \"unreadable\" (step, view) lists",
+          "text"}},
+        "Exit status: 0 for a sound archive, 3 when damage was found (what can be read is still "
+        "shown), 2 for bad arguments or a directory with no readable index."};
+    return help;
+}
+
+const CommandHelp& verify_help() {
+    static const CommandHelp help{
+        "insitu-view verify ARCHIVE",
+        "Checks every file the index names (present, inside the archive, size and CRC-32 as "
+        "recorded), the index itself (manifest.json, manifest.journal, malformed step entries) "
+        "and data.csv against it, and lists every problem, one line each.",
+        {},
+        "Exit status: 0 when the archive is intact, 3 when problems were found, 2 for bad "
+        "arguments or a directory with no readable index."};
+    return help;
+}
+
+/// render's flags. Each one with a value is the explore option of its name
+/// (explore_options.hpp) except --out, --mask, --tf (a file, read here), --light (repeatable)
+/// and --ao-radius/--ao-strength (folded into the "ao" option).
+const std::vector<OptionHelp>& render_options() {
+    static const std::vector<OptionHelp> options{
+        {"--step", "N", "the step to show", "", true},
+        {"--view", "V", "the stored view to start from", "0"},
+        {"--azimuth", "DEG", "orbit azimuth of a new view, in degrees", "the stored view's"},
+        {"--elevation", "DEG", "orbit elevation of a new view, in degrees in [-90, 90]",
+         "the stored view's"},
+        {"--tf", "TF.json",
+         "an edited transfer function (DESIGN.md TF JSON) over the stored one's value range",
+         "the stored one"},
+        {"--opacity-scale", "J=S,...", "scale interval J's opacity by S >= 0", "none"},
+        {"--colour", "auto|model|recompose",
+         "colour by the fitted colour model or by exact recomposition; auto takes the model when "
+         "the archive has one and the colours are unchanged",
+         "auto"},
+        {"--source", "auto|single|multi",
+         "the stored proxies a new view is synthesised from; auto takes the single-perspective "
+         "ones when stored",
+         "auto"},
+        {"--light", "AZ,EL[,DIFFUSE[,SPECULAR]]|camera",
+         "a directional light toward orbit angles AZ, EL in degrees (world space), DIFFUSE " +
+             default_text(insitu::Light{}.diffuse) + " and SPECULAR " +
+             default_text(insitu::Light{}.specular) +
+             " unless given, or camera: a headlight; repeat for more lights",
+         "unlit"},
+        {"--ambient", "A", "ambient term of the lighting, >= 0",
+         default_text(insitu::LightingSettings{}.ambient)},
+        {"--ao", "", "proxy ambient occlusion (Eq. 5)", ""},
+        {"--ao-radius", "PIXELS", "ambient occlusion radius in pixels, 1..64; implies --ao",
+         default_text(insitu::AmbientOcclusionSettings{}.radius_pixels)},
+        {"--ao-strength", "S", "ambient occlusion strength, >= 0; implies --ao",
+         default_text(insitu::AmbientOcclusionSettings{}.strength)},
+        {"--enhance", "LAMBDA,GAMMA", "depth-aware enhancement (Eq. 11), LAMBDA >= 0, GAMMA > 0",
+         "off"},
+        {"--fill", "PIXELS", "hole-filling radius of view synthesis in pixels, 0..16",
+         default_text(insitu::SynthesisSettings{}.hole_fill_radius_pixels)},
+        {"--mask", "OUT.png",
+         "also write the confidence mask (1: stored or well supported, 0: a hole)", "none"},
+        {"--out", "OUT.png|exr", "the image: 8-bit sRGB PNG or linear premultiplied EXR", "", true},
+    };
+    return options;
+}
+
+const CommandHelp& render_help() {
+    static const CommandHelp help{
+        "insitu-view render ARCHIVE --step N --out OUT.png|exr [options]",
+        "Renders one frame from the stored proxies of a step, without the volume: the stored "
+        "view or a new one, with an edited transfer function, lighting, ambient occlusion and "
+        "enhancement (the pixels the web viewer shows for the same options).",
+        render_options(),
+        "Exit status: 0 success, 2 bad arguments or input (unknown flag, malformed value, "
+        "missing archive, step or view), 1 other failures (no OpenCL device)."};
+    return help;
 }
 
 std::string read_text_file(const std::string& flag, const std::string& path) {
@@ -58,6 +144,24 @@ std::string read_text_file(const std::string& flag, const std::string& path) {
     std::ostringstream text;
     text << in.rdbuf();
     return text.str();
+}
+
+/// info's and verify's last word on a damaged archive: one line on stderr, the damage status.
+int report_damage(const std::string& archive, std::size_t problems, const char* where) {
+    return insitu::cli::report(kProgram,
+                               "\"" + archive + "\" is damaged: " + std::to_string(problems) +
+                                   " problem" + (problems == 1 ? "" : "s") + " " + where,
+                               insitu::cli::kExitDamagedInput);
+}
+
+/// The (step, view) entries left out, "step 8 view 0, step 12 view 1".
+std::string entries_text(const std::set<std::pair<std::int64_t, int>>& entries) {
+    std::string text;
+    for (const auto& [step, view] : entries) {
+        text += (text.empty() ? "" : ", ") + std::string("step ") + std::to_string(step) +
+                " view " + std::to_string(view);
+    }
+    return text;
 }
 
 int run_info(const std::vector<std::string>& args) {
@@ -75,11 +179,19 @@ int run_info(const std::vector<std::string>& args) {
         }
     }
     if (archive.empty()) throw UsageError("info: missing ARCHIVE");
-    const insitu::ArchiveReader reader(archive);
-    const nlohmann::json description = insitu::describe_archive(reader);
+    const insitu::viewer::ArchiveInspection inspection = insitu::viewer::inspect_archive(archive);
+    const nlohmann::json& description = inspection.description;
+    const std::vector<std::string>& damage = inspection.damage;
     if (json) {
-        std::cout << description.dump(2) << "\n";
-        return 0;
+        nlohmann::json output = description;
+        output["damage"] = damage;
+        output["unreadable"] = nlohmann::json::array();
+        for (const auto& [step, view] : inspection.unreadable) {
+            output["unreadable"].push_back({{"step", step}, {"view", view}});
+        }
+        output["manifest_readable"] = inspection.manifest_readable;
+        std::cout << output.dump(2) << "\n";
+        return damage.empty() ? 0 : report_damage(archive, damage.size(), "(\"damage\")");
     }
     const auto& steps = description.at("steps");
     std::cout << "archive       " << archive << "\n"
@@ -112,8 +224,32 @@ int run_info(const std::vector<std::string>& args) {
             std::cout << "\n";
         }
     }
-    std::cout << "configuration " << description.at("configuration").dump() << "\n";
-    return 0;
+    if (inspection.manifest_readable) {
+        std::cout << "configuration " << description.at("configuration").dump() << "\n";
+    } else {
+        std::cout << "configuration unknown (manifest.json is unusable; steps from "
+                     "manifest.journal)\n";
+    }
+    if (!inspection.unreadable.empty()) {
+        std::cout << "unreadable    " << entries_text(inspection.unreadable) << "\n";
+    }
+    if (damage.empty()) {
+        std::cout << "damage        none\n";
+        return 0;
+    }
+    std::cout << "damage:\n";
+    for (const std::string& problem : damage)
+        std::cout << "  " << insitu::one_line(problem) << "\n";
+    return report_damage(archive, damage.size(), "(listed under \"damage:\")");
+}
+
+/// Refuses (UsageError) a flag that render does not list.
+void require_render_flag(const std::string& flag) {
+    const auto& options = render_options();
+    if (std::none_of(options.begin(), options.end(),
+                     [&](const OptionHelp& option) { return option.flag == flag; })) {
+        throw UsageError("render: unknown flag " + flag);
+    }
 }
 
 int run_render(const std::vector<std::string>& args) {
@@ -128,6 +264,7 @@ int run_render(const std::vector<std::string>& args) {
             archive = arg;
             continue;
         }
+        require_render_flag(arg);
         if (arg == "--ao") {
             ao = true;
             continue;
@@ -150,10 +287,6 @@ int run_render(const std::vector<std::string>& args) {
         } else if (key == "ao-strength") {
             ao_strength = value;
         } else {
-            const auto& known = insitu::viewer::explore_option_keys();
-            if (std::find(known.begin(), known.end(), key) == known.end() || key == "ao") {
-                throw UsageError("render: unknown flag " + arg);
-            }
             options[key] = value;
         }
     }
@@ -162,7 +295,9 @@ int run_render(const std::vector<std::string>& args) {
     if (out_path.empty()) throw UsageError("render: missing --out OUT.png|exr");
     if (ao || !ao_radius.empty() || !ao_strength.empty()) {
         options["ao"] =
-            (ao_radius.empty() ? "8" : ao_radius) + (ao_strength.empty() ? "" : "," + ao_strength);
+            (ao_radius.empty() ? default_text(insitu::AmbientOcclusionSettings{}.radius_pixels)
+                               : ao_radius) +
+            (ao_strength.empty() ? "" : "," + ao_strength);
     }
     const insitu::ExploreRequest request = insitu::viewer::request_from_options(options);
     insitu::Explorer explorer(archive);
@@ -177,42 +312,88 @@ int run_render(const std::vector<std::string>& args) {
 }
 
 int run_verify(const std::vector<std::string>& args) {
-    if (args.size() != 1 || args[0].rfind("--", 0) == 0) {
-        throw UsageError("verify: expected exactly one ARCHIVE");
+    for (const std::string& arg : args) {
+        if (arg.rfind("--", 0) == 0) throw UsageError("verify: unknown flag " + arg);
     }
-    const insitu::ArchiveReader reader(args[0]);
-    const std::vector<std::string> problems = reader.verify();
-    for (const std::string& problem : problems) std::cout << problem << "\n";
+    if (args.size() != 1) throw UsageError("verify: expected exactly one ARCHIVE");
+    const insitu::ArchiveReader reader = insitu::ArchiveReader::open_damaged(args[0]);
+    const std::vector<std::string> problems = reader.check().problems;
+    for (const std::string& problem : problems) std::cout << insitu::one_line(problem) << "\n";
     std::size_t files = 0;
     for (const auto& step : reader.manifest().at("steps")) {
         for (const auto& view : step.at("views")) files += view.at("files").size();
     }
     std::cout << args[0] << ": " << files << " files checked, " << problems.size() << " problem"
               << (problems.size() == 1 ? "" : "s") << "\n";
-    return problems.empty() ? 0 : kExitProblems;
+    return problems.empty() ? 0 : report_damage(args[0], problems.size(), "(listed on stdout)");
+}
+
+struct Command {
+    const char* name;
+    const CommandHelp& (*help)();
+    int (*run)(const std::vector<std::string>& args);
+};
+
+const std::vector<Command>& commands() {
+    static const std::vector<Command> table{
+        {"info", info_help, run_info},
+        {"render", render_help, run_render},
+        {"verify", verify_help, run_verify},
+        {"serve", insitu::viewer::serve_help, insitu::viewer::serve_main}};
+    return table;
+}
+
+const Command* find_command(const std::string& name) {
+    for (const Command& command : commands()) {
+        if (name == command.name) return &command;
+    }
+    return nullptr;
+}
+
+UsageError unknown_command(const std::string& name) {
+    return UsageError("unknown command \"" + name + "\" (expected info, render, verify or serve)");
+}
+
+void print_help(std::ostream& out) {
+    out << "usage: insitu-view COMMAND ARCHIVE [options]\n\n"
+           "Explores a proxy archive without the volume.\n\n"
+           "commands:\n";
+    for (const Command& command : commands()) out << "  " << command.help().usage << "\n";
+    out << "\n'insitu-view COMMAND --help' (or 'insitu-view help COMMAND') lists a command's\n"
+           "options and their defaults.\n"
+           "Exit status: 0 success, 2 bad arguments or input, 3 damage found by info or verify,\n"
+           "1 other failures.\n";
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-    const std::vector<std::string> all(argv + 1, argv + argc);
+    const std::vector<std::string> all = insitu::cli::program_arguments(argc, argv);
     if (all.empty()) {
         return insitu::cli::report(
             kProgram, "missing command (info, render, verify or serve; --help for usage)",
             insitu::cli::kExitBadInput);
     }
-    if (all[0] == "--help" || all[0] == "-h" || all[0] == "help") {
-        print_help(std::cout);
+    // "help [COMMAND]", "--help [COMMAND]": the overview, or the command's own help.
+    if (all[0] == "help" || insitu::cli::is_help_flag(all[0])) {
+        if (all.size() == 1) {
+            print_help(std::cout);
+            return 0;
+        }
+        const Command* command = find_command(all[1]);
+        if (!command) {
+            return insitu::cli::report(kProgram, unknown_command(all[1]).what(),
+                                       insitu::cli::kExitBadInput);
+        }
+        insitu::cli::write_help(std::cout, command->help());
         return 0;
     }
-    const std::string command = all[0];
+    const Command* command = find_command(all[0]);
+    if (!command) {
+        return insitu::cli::report(kProgram, unknown_command(all[0]).what(),
+                                   insitu::cli::kExitBadInput);
+    }
     const std::vector<std::string> args(all.begin() + 1, all.end());
-    return insitu::cli::run_reporting(kProgram, [&] {
-        if (command == "info") return run_info(args);
-        if (command == "render") return run_render(args);
-        if (command == "verify") return run_verify(args);
-        if (command == "serve") return insitu::viewer::serve_main(args);
-        throw UsageError("unknown command \"" + command +
-                         "\" (expected info, render, verify or serve)");
-    });
+    return insitu::cli::run_command(kProgram, args, command->help(),
+                                    [&] { return command->run(args); });
 }

@@ -459,7 +459,9 @@ private:
                 const IntervalSet& intervals = *frame.intervals;
                 info["intervals"] = intervals.edges();
                 info["interval_colours"] =
-                    interval_colours(reader.configuration().transfer_function, intervals);
+                    interval_colours(reader.configuration().transfer_function_of(
+                                         reader.entry(key.step, key.view).field),
+                                     intervals);
                 if (frame.attenuation.channels == intervals.count()) {
                     // A summary for the editor, not per-pixel synthesis: a_j summed over the
                     // stored image (Eq. 7), as the mean per pixel.
@@ -820,6 +822,23 @@ private:
 };
 
 }  // namespace
+
+const cli::CommandHelp& serve_help() {
+    static const cli::CommandHelp help{
+        "insitu-view serve ARCHIVE [--port P] [--bind ADDR]",
+        "Serves the web viewer of ARCHIVE (the page is built in: no files, no network needed) "
+        "until Ctrl-C. Frames come from the same renderer as insitu-view render; steps a "
+        "running simulation adds appear without a restart.",
+        {{"--port", "P", "TCP port to listen on, 0..65535; 0 picks a free one",
+          std::to_string(kDefaultPort)},
+         {"--bind", "ADDR",
+          "address to listen on; anything but a loopback address lets anyone who can reach it "
+          "view the archive",
+          ServeArguments{}.bind}},
+        "Exit status: 0 after Ctrl-C or SIGTERM, 1 when it cannot listen or serve, 2 for bad "
+        "arguments or an archive that does not open."};
+    return help;
+}
 
 int serve_main(const std::vector<std::string>& args) {
     // Bad arguments and the library's typed errors propagate to insitu-view's main, which reports

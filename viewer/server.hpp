@@ -28,7 +28,12 @@
 #include <string>
 #include <vector>
 
+#include "arguments.hpp"
+
 namespace insitu::viewer {
+
+/// What `insitu-view serve --help` prints: its options and their defaults.
+const cli::CommandHelp& serve_help();
 
 /// Runs `insitu-view serve ARCHIVE [--port P] [--bind ADDR]` (args after "serve") until SIGINT
 /// or SIGTERM; returns the exit status (0 after a signal, 1 when it cannot serve, 2 for bad

@@ -56,9 +56,10 @@ enum { INSITU_NODE = 0, INSITU_CELL = 1 };
  * set to NULL on failure: INSITU_ERROR_PARSE (malformed JSON, or an unknown key while "strict"
  * is true, the default), INSITU_ERROR_INVALID_ARGUMENT (a bad value, named), INSITU_ERROR_IO
  * (unreadable file, archive that cannot be opened), INSITU_ERROR_COMPUTE (no OpenCL device).
- * A failed start-up is printed once to stderr; every later call given the NULL instrument is a
- * silent no-op returning INSITU_NOT_SELECTED, so a run whose visualisation could not start goes
- * on without a message per step. (Before any create failed, a NULL instrument is an error.) */
+ * After a failed start-up (report insitu_last_error() once), every later call given the NULL
+ * instrument it left is a silent no-op returning INSITU_NOT_SELECTED, so a run whose
+ * visualisation could not start goes on without a message per step. (Before any create failed
+ * in the process, a NULL instrument is an error.) */
 int insitu_create_from_file(const char* path, insitu_instrument** out);
 int insitu_create_from_json(const char* json_text, insitu_instrument** out);
 

@@ -7,7 +7,6 @@
 #include <atomic>
 #include <cstdint>
 #include <exception>
-#include <iostream>
 #include <map>
 #include <memory>
 #include <string>
@@ -173,11 +172,10 @@ int create(const char* function, insitu_instrument** out,
         auto handle = std::make_unique<insitu_instrument>();
         try {
             handle->instrument = make(argument, options);
-        } catch (const std::exception& error) {
-            // Said once, here; every later call on the NULL handle is a silent no-op.
+        } catch (...) {
+            // The caller says it once, from insitu_last_error() (the library prints nothing, so
+            // the message is not doubled); every later call on the NULL handle is a silent no-op.
             startup_failed = true;
-            std::cerr << "insitu: " << function << ": start-up failed, in-situ visualisation is "
-                      << "off for this run: " << insitu::one_line(error.what()) << std::endl;
             throw;
         }
         *out = handle.release();

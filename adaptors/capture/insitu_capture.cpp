@@ -17,11 +17,13 @@
 #include <cstdint>
 #include <cstdio>
 #include <exception>
+#include <fstream>
 #include <functional>
 #include <iomanip>
 #include <iostream>
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -64,7 +66,6 @@ struct Arguments {
     OnError on_error = OnError::stop;
     std::int64_t first_step = 0;
     std::vector<std::string> inputs;
-    bool help = false;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -96,6 +97,7 @@ struct Option {
     const char* value_name;  ///< nullptr for switches
     bool required;
     const char* help;
+    const char* default_value;  ///< as --help shows it; "" when there is none
     std::function<void(Arguments&, const std::string& flag, const std::string& value)> apply;
 };
 
@@ -103,19 +105,18 @@ const std::vector<Option>& options() {
     using V = const std::string&;
     static const std::vector<Option> table = {
         {"--config", "CONFIG.json", true,
-         "libinsitu JSON configuration (views, fields, transfer function, proxies)",
+         "libinsitu JSON configuration (views, fields, transfer function, proxies)", "",
          [](Arguments& a, V, V v) { a.config_path = v; }},
         {"--out", "ARCHIVE", true,
          "archive directory (overrides the configuration's \"archive\"; an existing archive is "
          "continued)",
-         [](Arguments& a, V, V v) { a.out_path = v; }},
-        {"--field", "NAME", false,
-         "array (.vti) or grid (.vdb) to read (default: the configuration's first field)",
-         [](Arguments& a, V, V v) { a.field = v; }},
-        {"--raw-dims", "NX,NY,NZ", false, "samples per axis of raw inputs",
+         "", [](Arguments& a, V, V v) { a.out_path = v; }},
+        {"--field", "NAME", false, "array (.vti) or grid (.vdb) to read",
+         "the configuration's first field", [](Arguments& a, V, V v) { a.field = v; }},
+        {"--raw-dims", "NX,NY,NZ", false, "samples per axis of raw inputs", "",
          [](Arguments& a, V f, V v) { a.raw_dims = parse_dims(f, v); }},
         {"--raw-type", "TYPE", false,
-         "raw sample type: uint8 int8 uint16 int16 uint32 int32 uint64 int64 float32 float64",
+         "raw sample type: uint8 int8 uint16 int16 uint32 int32 uint64 int64 float32 float64", "",
          [](Arguments& a, V f, V v) {
              try {
                  a.raw_type = insitu::capture::parse_raw_type(v);
@@ -123,46 +124,47 @@ const std::vector<Option>& options() {
                  throw UsageError(f + ": " + error.what());
              }
          }},
-        {"--raw-spacing", "SX,SY,SZ", false, "raw sample spacing in world units (default 1,1,1)",
+        {"--raw-spacing", "SX,SY,SZ", false, "raw sample spacing in world units", "1,1,1",
          [](Arguments& a, V f, V v) { a.raw_spacing = parse_spacing(f, v); }},
-        {"--raw-big-endian", nullptr, false, "raw inputs are big-endian (default little-endian)",
+        {"--raw-big-endian", nullptr, false, "raw inputs are big-endian", "little-endian",
          [](Arguments& a, V, V) { a.raw_big_endian = true; }},
         {"--on-error", "stop|skip", false,
-         "an input that cannot be read stops the capture (default) or is skipped",
+         "an input that cannot be read stops the capture or is skipped", "stop",
          [](Arguments& a, V f, V v) {
              if (v != "stop" && v != "skip") {
                  throw UsageError(f + ": expected stop or skip, got \"" + v + "\"");
              }
              a.on_error = v == "stop" ? OnError::stop : OnError::skip;
          }},
-        {"--first-step", "N", false, "step number of the first input (default 0)",
+        {"--first-step", "N", false, "step number of the first input", "0",
          [](Arguments& a, V f, V v) { a.first_step = parse_integer<std::int64_t>(f, v, 0); }},
-        {"--help", nullptr, false, "print this help and exit",
-         [](Arguments& a, V, V) { a.help = true; }},
     };
     return table;
 }
 
-void print_help(std::ostream& out) {
-    out << "usage: " << kProgram << " --config CONFIG.json --out ARCHIVE [options] INPUT...\n\n"
-        << "Writes a timestep proxy archive from files on disk, one timestep per input, with the\n"
-           "configuration an Instrument uses in situ. The input type follows from the name:\n"
-           "  .vti  VTK image data (point or cell array; cell values sit at cell centres)\n"
-           "  .pvd  VTK collection of .vti files (time from each data set's timestep)\n"
-           "  .vdb  OpenVDB float/double grid (active bounding box densified; level sets get a\n"
-           "        layer at the zero crossing unless the configuration names its layers)\n"
-           "  other raw samples, x fastest, described by --raw-dims and --raw-type\n\n";
-    for (const Option& option : options()) {
-        std::string left = std::string("  ") + option.name;
-        if (option.value_name) left += std::string(" ") + option.value_name;
-        constexpr std::size_t kHelpColumn = 28;
-        out << left
-            << (left.size() < kHelpColumn ? std::string(kHelpColumn - left.size(), ' ')
-                                          : std::string("\n") + std::string(kHelpColumn, ' '))
-            << option.help << (option.required ? " [required]" : "") << "\n";
-    }
-    out << "\nA progress bar (steps, rate, ETA) is drawn on stderr when it is a terminal.\n"
-        << "Exit status: 0 success, 2 bad arguments or input, 1 other failures.\n";
+const insitu::cli::CommandHelp& command_help() {
+    static const insitu::cli::CommandHelp help = [] {
+        insitu::cli::CommandHelp h;
+        h.usage = std::string(kProgram) + " --config CONFIG.json --out ARCHIVE [options] INPUT...";
+        h.description =
+            "Writes a timestep proxy archive from files on disk, one timestep per input, with the\n"
+            "configuration an Instrument uses in situ. The input type follows from the name:\n"
+            "  .vti  VTK image data (point or cell array; cell values sit at cell centres)\n"
+            "  .pvd  VTK collection of .vti files (time from each data set's timestep)\n"
+            "  .vdb  OpenVDB float/double grid (active bounding box densified; level sets get a\n"
+            "        layer at the zero crossing unless the configuration names its layers)\n"
+            "  other raw samples, x fastest, described by --raw-dims and --raw-type\n"
+            "After \"--\" every argument is an INPUT.";
+        for (const Option& option : options()) {
+            h.options.push_back({option.name, option.value_name ? option.value_name : "",
+                                 option.help, option.default_value, option.required});
+        }
+        h.notes =
+            "A progress bar (steps, rate, ETA) is drawn on stderr when it is a terminal.\n"
+            "Exit status: 0 success, 2 bad arguments or input, 1 other failures.";
+        return h;
+    }();
+    return help;
 }
 
 Arguments parse_arguments(int argc, char** argv) {
@@ -202,7 +204,6 @@ Arguments parse_arguments(int argc, char** argv) {
         }
         option->apply(arguments, token, value);
     }
-    if (arguments.help) return arguments;
     for (const Option& option : options()) {
         if (option.required && !seen[option.name]) {
             throw UsageError(std::string("missing required option ") + option.name + " " +
@@ -266,10 +267,11 @@ private:
     Clock::time_point start_;
 };
 
-std::string joined(const std::vector<std::string>& names) {
-    std::string text;
-    for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
-    return text;
+// Whether the configuration file names "every" or "steps" (it has parsed already: it is JSON).
+bool configuration_sets_cadence(const std::string& path) {
+    std::ifstream in(path);
+    const nlohmann::json json = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    return json.is_object() && (json.contains("every") || json.contains("steps"));
 }
 
 int run(const Arguments& arguments) {
@@ -280,10 +282,18 @@ int run(const Arguments& arguments) {
         insitu::InstrumentConfig::from_json_file(arguments.config_path, &unknown_keys);
     config.archive = arguments.out_path;
     if (!unknown_keys.empty()) {
-        std::cerr << kProgram
-                  << ": warning: unknown configuration keys ignored: " << joined(unknown_keys)
-                  << "\n";
+        // As an Instrument does: a typo is an error unless the configuration says "strict": false.
+        if (config.strict) {
+            throw UsageError(arguments.config_path + ": " +
+                             insitu::describe_unknown_keys(unknown_keys) +
+                             " (set \"strict\": false to warn and ignore unknown keys)");
+        }
+        std::cerr << kProgram << ": warning: " << insitu::describe_unknown_keys(unknown_keys)
+                  << ": ignored (\"strict\": false)\n";
     }
+    // Each input is a step the user chose to capture: the simulation's default cadence (every
+    // 10th step) applies only when the configuration asks for a cadence itself.
+    if (!configuration_sets_cadence(arguments.config_path)) config.every = 1;
 
     capture::InputOptions input_options;
     input_options.field_name = config.fields.front();
@@ -419,12 +429,7 @@ int run(const Arguments& arguments) {
 
 int main(int argc, char** argv) {
     // A RuntimeFailure is not the user's input: exit 1, like every non-input error.
-    return insitu::cli::run_reporting(kProgram, [&] {
-        const Arguments arguments = parse_arguments(argc, argv);
-        if (arguments.help) {
-            print_help(std::cout);
-            return 0;
-        }
-        return run(arguments);
-    });
+    return insitu::cli::run_command(kProgram, insitu::cli::program_arguments(argc, argv),
+                                    command_help(),
+                                    [&] { return run(parse_arguments(argc, argv)); });
 }

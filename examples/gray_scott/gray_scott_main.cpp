@@ -37,36 +37,8 @@
 
 namespace {
 
-constexpr const char* kUsage = R"(usage: gray-scott [options]
-
-Simulates 3D Gray-Scott reaction-diffusion (explicit Euler, 7-point Laplacian, periodic box,
-dt = 1) and instruments itself with libinsitu: after every step it hands the fields u and v to an
-insitu::Instrument, which writes proxies and ground-truth previews of the selected steps to a
-timestep proxy archive (ARCHIVE/previews/stepNNNNNN_view0.png are the pictures).
-
-  --size N          interior samples per axis (default 64; 4..1024)
-  --steps S         steps to simulate (default 200); steps are numbered 1..S
-  --config FILE     libinsitu JSON configuration (see insitu/config.hpp); without it: field v,
-                    one orthographic view, gray-scott's transfer function, every 50 steps
-  --out ARCHIVE     archive directory (default gray-scott.cdb, or the configuration's
-                    "archive"); an existing archive is continued, so it must not hold these
-                    steps already
-  --every N         archive every N steps (overrides the configuration's cadence)
-  --image-size WxH  image size in pixels of every view (default 256x256)
-  --azimuth DEG     orbit camera azimuth in degrees of every view (default 30)
-  --elevation DEG   orbit camera elevation in degrees of every view, -90..90 (default 20)
-  --F f             feed rate per time unit (default 0.025; 0..0.25)
-  --k k             kill rate per time unit (default 0.055; 0..0.25)
-  --Du d            diffusion of u in voxels^2 per time unit (default 0.12; <= 0.125)
-  --Dv d            diffusion of v in voxels^2 per time unit (default 0.06; <= 0.125)
-  --seed n          random seed of the initial cubes (default 1)
-  --help            this text
-
-Bad arguments or configuration: one line on stderr, exit status 2. Runtime failures, including
-steps that could not be archived: one line, exit status 1.
-)";
-
 /// A command-line mistake; main reports it in one line and exits with status 2.
+using insitu::cli::default_text;
 using insitu::cli::UsageError;
 
 struct Options {
@@ -80,7 +52,6 @@ struct Options {
     std::optional<int> image_height;
     std::optional<double> azimuth_deg;
     std::optional<double> elevation_deg;
-    bool help = false;
 };
 
 // The shared strict rules (arguments.hpp) in gray-scott's wording: "FLAG VALUE: problem".
@@ -169,10 +140,6 @@ Options parse_arguments(int argc, char** argv) {
 
     for (int i = 1; i < argc; ++i) {
         const std::string flag = argv[i];
-        if (flag == "--help" || flag == "-h") {
-            options.help = true;
-            continue;
-        }
         const auto setter = setters.find(flag);
         if (setter == setters.end()) {
             throw UsageError(flag.rfind('-', 0) == 0 ? "unknown option " + flag
@@ -227,6 +194,55 @@ insitu::InstrumentConfig default_config() {
     config.every = 50;
     config.archive = "gray-scott.cdb";
     return config;
+}
+
+/// --help, its defaults taken from the code that applies them.
+const insitu::cli::CommandHelp& command_help() {
+    static const insitu::cli::CommandHelp help = [] {
+        const gray_scott::Parameters defaults;
+        const Options options;
+        const insitu::InstrumentConfig config = default_config();
+        const insitu::OrbitView& orbit = config.views[0].orbit;
+        return insitu::cli::CommandHelp{
+            "gray-scott [options]",
+            "Simulates 3D Gray-Scott reaction-diffusion (explicit Euler, 7-point Laplacian, "
+            "periodic "
+            "box, dt = 1) and instruments itself with libinsitu: after every step it hands the "
+            "fields u and v to an insitu::Instrument, which writes proxies and ground-truth "
+            "previews "
+            "of the selected steps to a timestep proxy archive "
+            "(ARCHIVE/previews/stepNNNNNN_view0.png "
+            "are the pictures).",
+            {{"--size", "N", "interior samples per axis, 4..1024", default_text(defaults.size)},
+             {"--steps", "S", "steps to simulate; steps are numbered 1..S",
+              default_text(options.steps)},
+             {"--config", "FILE", "libinsitu JSON configuration (see insitu/config.hpp)",
+              "field v, one orthographic view, gray-scott's transfer function, every " +
+                  default_text(config.every) + " steps"},
+             {"--out", "ARCHIVE",
+              "archive directory; an existing archive is continued, so it must not hold these "
+              "steps "
+              "already",
+              config.archive + ", or the configuration's \"archive\""},
+             {"--every", "N", "archive every N steps (overrides the configuration's cadence)",
+              "the configuration's, else " + default_text(config.every)},
+             {"--image-size", "WxH", "image size in pixels of every view",
+              default_text(orbit.width) + "x" + default_text(orbit.height)},
+             {"--azimuth", "DEG", "orbit camera azimuth in degrees of every view",
+              default_text(orbit.azimuth_deg)},
+             {"--elevation", "DEG", "orbit camera elevation in degrees of every view, -90..90",
+              default_text(orbit.elevation_deg)},
+             {"--F", "f", "feed rate per time unit, 0..0.25", default_text(defaults.feed)},
+             {"--k", "k", "kill rate per time unit, 0..0.25", default_text(defaults.kill)},
+             {"--Du", "d", "diffusion of u in voxels^2 per time unit, <= 0.125",
+              default_text(defaults.diffusion_u)},
+             {"--Dv", "d", "diffusion of v in voxels^2 per time unit, <= 0.125",
+              default_text(defaults.diffusion_v)},
+             {"--seed", "n", "random seed of the initial cubes", default_text(defaults.seed)}},
+            "Bad arguments or configuration: one line on stderr, exit status 2. Runtime failures, "
+            "including steps that could not be archived: one line, exit status 1."};
+    }();
+    return help;
 }
 
 /// The configuration file (or the defaults) with the command line's overrides applied. Throws
@@ -334,6 +350,17 @@ int run(const Options& options, const insitu::InstrumentConfig& config) {
               << " bytes (proxies " << 1e3 * statistics.compute_seconds / executed
               << " ms/step, blocked " << 1e3 * statistics.blocked_seconds / executed
               << " ms/step, finalize " << finalize_ms << " ms)";
+    if (statistics.steps_replayed > 0) {
+        std::cout << "; " << statistics.steps_replayed
+                  << " steps already in the archive skipped (a rerun continues it)";
+    }
+    // The in-situ share of the run: the time the simulation waited in execute() against its
+    // own time between the calls (issue 18: a cost the user can see).
+    const double wall = statistics.execute_seconds + statistics.simulation_seconds;
+    if (wall > 0.0) {
+        std::cout << "; in situ " << 100.0 * statistics.execute_seconds / wall << " % of " << wall
+                  << " s";
+    }
     if (statistics.nonfinite_samples > 0) {
         std::cout << "; " << statistics.nonfinite_samples << " NaN/Inf samples seen as empty";
     }
@@ -353,12 +380,12 @@ int run(const Options& options, const insitu::InstrumentConfig& config) {
 int main(int argc, char** argv) {
     Options options;
     insitu::InstrumentConfig config;
+    // --help anywhere, before any value is parsed.
+    if (insitu::cli::answer_help(insitu::cli::program_arguments(argc, argv), command_help())) {
+        return 0;
+    }
     try {
         options = parse_arguments(argc, argv);
-        if (options.help) {
-            std::cout << kUsage;
-            return 0;
-        }
         config = make_config(options);
     } catch (const UsageError& error) {
         std::cerr << "gray-scott: " << one_line(error.what()) << " (see --help)" << std::endl;

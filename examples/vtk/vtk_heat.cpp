@@ -42,8 +42,8 @@
 
 namespace {
 
-constexpr const char* kUsage =
-    "usage: vtk-heat ARCHIVE [--size N] [--steps S] [--every K] [--config CONFIG.json] "
+constexpr const char* kSynopsis =
+    "vtk-heat ARCHIVE [--size N] [--steps S] [--every K] [--config CONFIG.json] "
     "[--write-vti DIR]";
 
 using insitu::cli::UsageError;
@@ -56,6 +56,31 @@ struct Options {
     std::string config_path;
     std::string vti_folder;
 };
+
+/// --help, its defaults those of Options.
+const insitu::cli::CommandHelp& command_help() {
+    static const insitu::cli::CommandHelp help = [] {
+        const Options defaults;
+        return insitu::cli::CommandHelp{
+            kSynopsis,
+            "Simulates heat diffusion in a vtkImageData (a source circling the box) and archives "
+            "its \"temperature\" array through libinsitu's VTK adaptor into ARCHIVE, without a "
+            "copy.",
+            {{"--size", "N", "interior points per axis, >= 4", std::to_string(defaults.size)},
+             {"--steps", "S", "steps to simulate, >= 1", std::to_string(defaults.steps)},
+             {"--every", "K", "archive every K steps (overrides the configuration's cadence)",
+              std::to_string(defaults.every)},
+             {"--config", "CONFIG.json", "libinsitu JSON configuration",
+              "field temperature, one view, a ramp over the temperatures reached"},
+             {"--write-vti", "DIR",
+              "also write every archived step as DIR/heat_NNNNNN.vti and DIR/heat.pvd, for "
+              "insitu-capture",
+              "none"}},
+            "Exit status: 0 done, 2 bad arguments or configuration, 1 a runtime failure; one line "
+            "on stderr."};
+    }();
+    return help;
+}
 
 Options parse(int argc, char** argv) {
     Options options;
@@ -82,7 +107,7 @@ Options parse(int argc, char** argv) {
             throw UsageError("unknown option " + token);
         }
     }
-    if (options.archive.empty()) throw UsageError(kUsage);
+    if (options.archive.empty()) throw UsageError(std::string("usage: ") + kSynopsis);
     return options;
 }
 
@@ -224,6 +249,10 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    // --help anywhere, before any value is parsed.
+    if (insitu::cli::answer_help(insitu::cli::program_arguments(argc, argv), command_help())) {
+        return 0;
+    }
     Options options;
     try {
         options = parse(argc, argv);

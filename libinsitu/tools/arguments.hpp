@@ -4,14 +4,24 @@
 // (atoi, stod and strtol take a prefix and run on with a number nobody wrote). The parse_*
 // functions throw cli::UsageError (exit 2) naming the flag and the value; the convert_*
 // functions are the same rules for programs that word their messages themselves.
+//
+// --help: every program and sub-command answers --help (or -h) wherever it stands among its
+// arguments, before any value is parsed (so "render --step --help" is a question, not a missing
+// value), with its usage and its options and their defaults on stdout and exit status 0
+// (CommandHelp, answer_help, run_command).
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <iostream>
 #include <limits>
+#include <ostream>
+#include <sstream>
 #include <string>
 #include <system_error>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "cli.hpp"
@@ -146,6 +156,161 @@ inline PixelSize parse_pixel_size(const std::string& flag, const std::string& te
 inline std::string next_value(int argc, char** argv, int& index) {
     if (index + 1 >= argc) throw UsageError(std::string(argv[index]) + ": missing value");
     return argv[++index];
+}
+
+// ---------------------------------------------------------------------------------------------
+// --help
+
+/// One option as --help lists it.
+struct OptionHelp {
+    std::string flag;           ///< "--step"
+    std::string value_name;     ///< "N"; empty for a switch
+    std::string description;    ///< what it does, units included
+    std::string default_value;  ///< listed as "(default X)"; empty when there is none
+    bool required = false;      ///< listed as "[required]"
+};
+
+/// A default as --help lists it: `value` as a stream writes it ("0.2", where std::to_string
+/// writes "0.200000").
+template <typename Value>
+std::string default_text(const Value& value) {
+    std::ostringstream text;
+    text << value;
+    return text.str();
+}
+
+/// What --help prints for one program or sub-command.
+struct CommandHelp {
+    std::string usage;                ///< the synopsis after "usage: " (may span lines)
+    std::string description;          ///< what it does, a paragraph (may be empty)
+    std::vector<OptionHelp> options;  ///< in the order listed; "-h, --help" is added last
+    std::string notes;                ///< after the options: formats, exit statuses (may be empty)
+};
+
+/// Whether `token` asks for help.
+inline bool is_help_flag(const std::string& token) {
+    return token == "--help" || token == "-h";
+}
+
+/// Whether --help or -h is among `args` (up to a "--" that ends the options: after it "-h" is
+/// an operand, such as a file name).
+inline bool help_requested(const std::vector<std::string>& args) {
+    for (const std::string& arg : args) {
+        if (arg == "--") return false;
+        if (is_help_flag(arg)) return true;
+    }
+    return false;
+}
+
+/// main's arguments after the program's name (none when argv holds not even that).
+inline std::vector<std::string> program_arguments(int argc, char** argv) {
+    return argc > 1 ? std::vector<std::string>(argv + 1, argv + argc) : std::vector<std::string>();
+}
+
+namespace detail {
+
+/// `text` cut into lines of at most `width` columns at spaces (a longer word stays whole).
+inline std::vector<std::string> wrap_words(const std::string& text, std::size_t width) {
+    std::vector<std::string> lines(1);
+    std::string::size_type begin = 0;
+    while (begin < text.size()) {
+        const auto end = std::min(text.find(' ', begin), text.size());
+        const std::string word = text.substr(begin, end - begin);
+        begin = end + 1;
+        if (word.empty()) continue;
+        if (!lines.back().empty() && lines.back().size() + 1 + word.size() > width) {
+            lines.emplace_back();
+        }
+        lines.back() += (lines.back().empty() ? "" : " ") + word;
+    }
+    return lines;
+}
+
+/// `text` on `out`, each of its lines as written when it fits in `width` columns (so that
+/// indented tables keep their layout), wrapped at spaces otherwise.
+inline void write_wrapped(std::ostream& out, const std::string& text, std::size_t width) {
+    std::string::size_type begin = 0;
+    while (begin <= text.size()) {
+        const auto end = std::min(text.find('\n', begin), text.size());
+        const std::string line = text.substr(begin, end - begin);
+        if (line.size() <= width) {
+            out << line << "\n";
+        } else {
+            for (const std::string& part : wrap_words(line, width)) out << part << "\n";
+        }
+        begin = end + 1;
+    }
+}
+
+}  // namespace detail
+
+/// Writes `help`: usage, description, one entry per option (flag and value, then what it does,
+/// its default and whether it is required), then the notes; wrapped to 100 columns.
+inline void write_help(std::ostream& out, const CommandHelp& help) {
+    constexpr std::size_t kLineColumns = 100;
+    constexpr std::size_t kMaxHelpColumn = 32;
+    std::vector<OptionHelp> options = help.options;
+    options.push_back({"-h, --help", "", "print this help and exit", "", false});
+    const auto left_of = [](const OptionHelp& option) {
+        return "  " + option.flag + (option.value_name.empty() ? "" : " " + option.value_name);
+    };
+    std::size_t help_column = 0;
+    for (const OptionHelp& option : options) {
+        const std::size_t width = left_of(option).size() + 2;
+        if (width <= kMaxHelpColumn) help_column = std::max(help_column, width);
+    }
+    if (help_column == 0) help_column = kMaxHelpColumn;
+
+    out << "usage: " << help.usage << "\n";
+    if (!help.description.empty()) {
+        out << "\n";
+        detail::write_wrapped(out, help.description, kLineColumns);
+    }
+    out << "\noptions:\n";
+    for (const OptionHelp& option : options) {
+        // "(default" is kept on the line of the default's first word.
+        constexpr char kUnbreakableSpace = '\x1f';
+        std::string text = option.description;
+        if (!option.default_value.empty()) {
+            text += std::string(" (default") + kUnbreakableSpace + option.default_value + ")";
+        }
+        if (option.required) text += " [required]";
+        const std::string left = left_of(option);
+        out << left;
+        std::size_t column = left.size();
+        if (column + 2 > help_column) {
+            out << "\n";
+            column = 0;
+        }
+        for (std::string line : detail::wrap_words(text, kLineColumns - help_column)) {
+            std::replace(line.begin(), line.end(), kUnbreakableSpace, ' ');
+            out << std::string(help_column - column, ' ') << line << "\n";
+            column = 0;
+        }
+    }
+    if (!help.notes.empty()) {
+        out << "\n";
+        detail::write_wrapped(out, help.notes, kLineColumns);
+    }
+}
+
+/// When --help or -h is among `args`, writes `help` on `out` (stdout) and returns true: the
+/// caller then exits 0 without parsing anything.
+inline bool answer_help(const std::vector<std::string>& args, const CommandHelp& help,
+                        std::ostream& out = std::cout) {
+    if (!help_requested(args)) return false;
+    write_help(out, help);
+    return true;
+}
+
+/// A program's main: --help or -h among `args` prints `help` and returns 0 before anything is
+/// parsed; otherwise `body()` under run_reporting (cli.hpp), which turns what it throws into the
+/// exit statuses and one line on stderr.
+template <typename Body>
+int run_command(const char* program, const std::vector<std::string>& args, const CommandHelp& help,
+                Body&& body) {
+    if (answer_help(args, help)) return 0;
+    return run_reporting(program, std::forward<Body>(body));
 }
 
 /// `parse()` (a command-line parse), or one line "program: message" on stderr and exit 2 for a

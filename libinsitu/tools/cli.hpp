@@ -5,7 +5,10 @@
 //
 // Exit status: 0 on success; 2 for bad arguments and bad input (a UsageError, or the library's
 // InvalidArgument, ParseError, IoError); 1 for anything else (no OpenCL platform, a failed
-// kernel, out of memory: not the user's input).
+// kernel, out of memory: not the user's input); 3 when a damaged input was read in part: the
+// program did what it could with the readable rest, listed the damage, and says so in one line
+// on stderr (insitu-view info and verify on an archive with missing or corrupt files). --help
+// and -h answer on stdout with 0 (arguments.hpp).
 #include <exception>
 #include <iostream>
 #include <string>
@@ -16,6 +19,7 @@ namespace insitu::cli {
 
 constexpr int kExitRuntimeError = 1;
 constexpr int kExitBadInput = 2;
+constexpr int kExitDamagedInput = 3;
 
 /// A command line or input that cannot be acted on (exit 2); the message names the flag and
 /// the value. An invalid argument of the program, so every boundary classifies it as one.

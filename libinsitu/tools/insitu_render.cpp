@@ -53,7 +53,6 @@ struct Arguments {
     insitu::RenderSettings settings;
     std::string out_path;
     std::string depth_out_path;
-    bool help = false;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -115,78 +114,80 @@ struct Option {
     const char* value_name;  ///< nullptr for switches that take no value
     bool required;
     const char* help;
+    const char* default_value;  ///< as --help shows it; "" when there is none
     std::function<void(Arguments&, const std::string& flag, const std::string& value)> apply;
 };
 
 const std::vector<Option>& options() {
     using V = const std::string&;
     static const std::vector<Option> table = {
-        {"--raw", "FILE", true, "raw volume, x fastest, little-endian",
+        {"--raw", "FILE", true, "raw volume, x fastest, little-endian", "",
          [](Arguments& a, V, V v) { a.raw_path = v; }},
-        {"--dims", "NX,NY,NZ", true, "samples per axis",
+        {"--dims", "NX,NY,NZ", true, "samples per axis", "",
          [](Arguments& a, V f, V v) { a.dims = parse_dims(f, v); }},
-        {"--type", "TYPE", true, "float32, float64, uint8, uint16 or int16",
+        {"--type", "TYPE", true, "float32, float64, uint8, uint16 or int16", "",
          [](Arguments& a, V f, V v) {
              a.type = parse_with_library(f, v, insitu::parse_scalar_type);
          }},
-        {"--spacing", "SX,SY,SZ", false, "distance between samples in world units (default 1,1,1)",
+        {"--spacing", "SX,SY,SZ", false, "distance between samples in world units", "1,1,1",
          [](Arguments& a, V f, V v) { a.spacing_world = parse_vec3(f, v, "SX,SY,SZ"); }},
-        {"--origin", "OX,OY,OZ", false, "world position of the first sample (default 0,0,0)",
+        {"--origin", "OX,OY,OZ", false, "world position of the first sample", "0,0,0",
          [](Arguments& a, V f, V v) { a.origin_world = parse_vec3(f, v, "OX,OY,OZ"); }},
-        {"--tf", "TF.json", true, "transfer function JSON (see below)",
+        {"--tf", "TF.json", true, "transfer function JSON (see below)", "",
          [](Arguments& a, V, V v) { a.tf_path = v; }},
-        {"--camera", "ortho|perspective", false, "projection (default ortho)",
+        {"--camera", "ortho|perspective", false, "projection", "ortho",
          [](Arguments& a, V f, V v) {
              a.view.projection = parse_with_library(f, v, insitu::parse_projection);
          }},
-        {"--azimuth", "DEG", false, "orbit azimuth in degrees (default 0: looking down -z)",
+        {"--azimuth", "DEG", false, "orbit azimuth in degrees", "0: looking down -z",
          [](Arguments& a, V f, V v) { a.view.azimuth_deg = parse_finite(f, v); }},
-        {"--elevation", "DEG", false, "orbit elevation in degrees, [-90, 90] (default 0)",
+        {"--elevation", "DEG", false, "orbit elevation in degrees, [-90, 90]", "0",
          [](Arguments& a, V f, V v) { a.view.elevation_deg = parse_finite(f, v); }},
-        {"--fov", "DEG", false, "vertical field of view in degrees, perspective (default 30)",
+        {"--fov", "DEG", false, "vertical field of view in degrees, perspective", "30",
          [](Arguments& a, V f, V v) { a.view.fov_y_deg = parse_finite(f, v); }},
-        {"--size", "WxH", false, "image size in pixels (default 512x512)",
+        {"--size", "WxH", false, "image size in pixels", "512x512",
          [](Arguments& a, V f, V v) { parse_size(f, v, a.view); }},
-        {"--step", "VOXELS", false, "ray step in units of the smallest spacing (default 1)",
+        {"--step", "VOXELS", false, "ray step in units of the smallest spacing", "1",
          [](Arguments& a, V f, V v) { a.settings.step_voxels = parse_finite(f, v); }},
-        {"--early-termination", "OPACITY", false,
-         "stop a ray at this opacity (default 0.99; > 1: never)",
+        {"--early-termination", "OPACITY", false, "stop a ray at this opacity (> 1: never)", "0.99",
          [](Arguments& a, V f, V v) { a.settings.early_termination_opacity = parse_finite(f, v); }},
-        {"--shade", nullptr, false, "Phong shading with a headlight",
+        {"--shade", nullptr, false, "Phong shading with a headlight", "",
          [](Arguments& a, V, V) { a.settings.shading = true; }},
-        {"--out", "OUT.png|OUT.exr", true, "image: 8-bit sRGB PNG or linear premultiplied EXR",
+        {"--out", "OUT.png|OUT.exr", true, "image: 8-bit sRGB PNG or linear premultiplied EXR", "",
          [](Arguments& a, V f, V v) {
              require_extension(f, v, {".png", ".exr"});
              a.out_path = v;
          }},
         {"--depth-out", "DEPTH.exr", false, "first-hit depth (world units, +inf: no hit) as EXR Z",
+         "none",
          [](Arguments& a, V f, V v) {
              require_extension(f, v, {".exr"});
              a.depth_out_path = v;
          }},
-        {"--help", nullptr, false, "print this help and exit",
-         [](Arguments& a, V, V) { a.help = true; }},
     };
     return table;
 }
 
-void print_help(std::ostream& out) {
-    out << "usage: " << kProgram << " --raw FILE --dims NX,NY,NZ --type TYPE --tf TF.json "
-        << "--out OUT.png|OUT.exr [options]\n\n"
-        << "Renders a raw scalar volume by emission-absorption ray casting (libinsitu's ground "
-           "truth).\n\n";
-    for (const Option& option : options()) {
-        std::string left = std::string("  ") + option.name;
-        if (option.value_name) left += std::string(" ") + option.value_name;
-        out << left;
-        constexpr std::size_t kHelpColumn = 34;
-        out << (left.size() < kHelpColumn ? std::string(kHelpColumn - left.size(), ' ')
-                                          : std::string("\n") + std::string(kHelpColumn, ' '))
-            << option.help << (option.required ? " [required]" : "") << "\n";
-    }
-    out << "\nTF.json: {\"points\": [[value, r, g, b, a], ...], \"unit_length\": 1.0}, a = "
-           "opacity per unit_length world units.\n"
-        << "Exit status: 0 success, 2 bad arguments or input, 1 other failures.\n";
+const insitu::cli::CommandHelp& command_help() {
+    static const insitu::cli::CommandHelp help = [] {
+        insitu::cli::CommandHelp h;
+        h.usage = std::string(kProgram) +
+                  " --raw FILE --dims NX,NY,NZ --type TYPE --tf TF.json --out OUT.png|OUT.exr "
+                  "[options]";
+        h.description =
+            "Renders a raw scalar volume by emission-absorption ray casting (libinsitu's ground "
+            "truth).";
+        for (const Option& option : options()) {
+            h.options.push_back({option.name, option.value_name ? option.value_name : "",
+                                 option.help, option.default_value, option.required});
+        }
+        h.notes =
+            "TF.json: {\"points\": [[value, r, g, b, a], ...], \"unit_length\": 1.0}, a = "
+            "opacity per unit_length world units.\n"
+            "Exit status: 0 success, 2 bad arguments or input, 1 other failures.";
+        return h;
+    }();
+    return help;
 }
 
 Arguments parse_arguments(int argc, char** argv) {
@@ -225,7 +226,6 @@ Arguments parse_arguments(int argc, char** argv) {
         }
         option->apply(arguments, token, value);
     }
-    if (arguments.help) return arguments;
     for (const Option& option : options()) {
         if (option.required && !seen[option.name]) {
             throw UsageError(std::string("missing required option ") + option.name + " " +
@@ -331,12 +331,7 @@ int run(const Arguments& arguments) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    return insitu::cli::run_reporting(kProgram, [&] {
-        const Arguments arguments = parse_arguments(argc, argv);
-        if (arguments.help) {
-            print_help(std::cout);
-            return 0;
-        }
-        return run(arguments);
-    });
+    return insitu::cli::run_command(kProgram, insitu::cli::program_arguments(argc, argv),
+                                    command_help(),
+                                    [&] { return run(parse_arguments(argc, argv)); });
 }

@@ -73,6 +73,7 @@ TEST(ArchiveCrash, KilledWriterLeavesAnArchiveWithEveryCompletedStep) {
                                             ("insitu_archive_crash_" + std::to_string(::getpid()));
     std::filesystem::remove_all(directory);
     InstrumentConfig config;
+    config.every = 1;  // every step is emitted (the default is every 10th)
     config.archive = (directory / "run.cdb").string();
     config.precision = StoragePrecision::half;
 
@@ -150,6 +151,7 @@ TEST(ArchiveCrash, LockOfAKilledWriterIsReleased) {
                                             ("insitu_archive_lock_" + std::to_string(::getpid()));
     std::filesystem::remove_all(directory);
     InstrumentConfig config;
+    config.every = 1;  // every step is emitted (the default is every 10th)
     config.archive = (directory / "run.cdb").string();
 
     int pipe_fds[2];

@@ -108,7 +108,7 @@ set_tests_properties(gray_scott.steps_already_archived_setup PROPERTIES
 set_tests_properties(gray_scott.steps_already_archived_first PROPERTIES
                      FIXTURES_REQUIRED gray_scott_twice_clean FIXTURES_SETUP gray_scott_twice)
 # A rerun in the same directory replays archived steps: skipped with one notice, exit 0.
-gray_scott_cli_case(steps_already_archived 0 STDERR "already in archive.*skipped" --size 8 --steps 2
+gray_scott_cli_case(steps_already_archived 0 STDOUT "2 steps already in the archive skipped" --size 8 --steps 2
                     --every 1 --image-size 8x8 --out ${gray_scott_twice})
 set_tests_properties(gray_scott.steps_already_archived PROPERTIES
                      FIXTURES_REQUIRED gray_scott_twice)

@@ -58,6 +58,7 @@ TransferFunction piecewise_constant_tf(double lowest, double highest) {
 InstrumentConfig explorer_config(const fs::path& archive, const SampledVolume& volume) {
     const auto [lowest, highest] = std::minmax_element(volume.values.begin(), volume.values.end());
     InstrumentConfig config;
+    config.every = 1;  // every step is emitted (the default is every 10th)
     config.fields = {"f"};
     config.views[0].orbit = OrbitView{20.0, 15.0, Projection::orthographic, 30.0, kImage, kImage};
     config.views[0].distortion_tilt_deg = 30.0;

@@ -223,6 +223,7 @@ protected:
     /// Archives step 1 of `volume` (signed distance: inside < 0) seen from (20, 15) degrees.
     std::string write_archive(const SampledVolume& volume) {
         InstrumentConfig config;
+        config.every = 1;  // every step is emitted (the default is every 10th)
         config.fields = {"f"};
         config.views[0].orbit = OrbitView{20.0, 15.0, Projection::orthographic, 30.0, 40, 40};
         // Opaque inside the surface, transparent outside.

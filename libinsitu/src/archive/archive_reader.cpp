@@ -45,7 +45,18 @@ af::FrameLimits frame_limits(const nlohmann::json& manifest, int view) {
     }
     af::FrameLimits limits{0, 0};
     for (const nlohmann::json* configuration : configurations) {
-        const nlohmann::json views = configuration->value("views", nlohmann::json());
+        // The archive numbers views field by field (InstrumentConfig::planned_views): a field
+        // written as an object may have views of its own, the others take the top level's.
+        const nlohmann::json top_views = configuration->value("views", nlohmann::json());
+        nlohmann::json views = nlohmann::json::array();
+        const nlohmann::json fields = configuration->value("fields", nlohmann::json());
+        for (const nlohmann::json& field : fields.is_array() ? fields : nlohmann::json::array()) {
+            const nlohmann::json& own =
+                field.is_object() && field.contains("views") ? field.at("views") : top_views;
+            if (!own.is_array()) return af::FrameLimits{};
+            for (const nlohmann::json& entry : own) views.push_back(entry);
+        }
+        if (!fields.is_array()) views = top_views;
         const nlohmann::json size =
             views.is_array() && static_cast<std::size_t>(view) < views.size() &&
                     views[static_cast<std::size_t>(view)].is_object()
@@ -294,20 +305,21 @@ ArchiveCheck ArchiveReader::check() const {
                 std::pair{step.at("step").get<std::int64_t>(), view.at("view").get<int>()});
         }
     }
+    // Files found unusable here are not reported again for data.csv's rows that name them.
+    std::set<fs::path> reported;
     const auto unusable = [&](const af::ListedFile& file, std::string problem) {
         result.problems.push_back(std::move(problem));
+        reported.insert(fs::absolute(file.absolute_path).lexically_normal());
         const auto [first, last] = proxy_owners.equal_range(file.absolute_path);
         for (auto owner = first; owner != last; ++owner) {
             result.unreadable_proxies.insert(owner->second);
         }
     };
     const fs::path root = resolved(fs::absolute(path_));
-    std::set<fs::path> outside;
     for (const af::ListedFile& file : af::listed_files(path_, *manifest_)) {
         // The viewer's server refuses files outside the archive; so does verify, rather than
         // check the bytes a link points at elsewhere.
         if (!inside(root, file.absolute_path)) {
-            outside.insert(fs::absolute(file.absolute_path).lexically_normal());
             unusable(file, "\"" + file.absolute_path + "\" resolves to \"" +
                                resolved(file.absolute_path).string() + "\", outside the archive");
             continue;
@@ -318,7 +330,7 @@ ArchiveCheck ArchiveReader::check() const {
             unusable(file, error.what());
         }
     }
-    verify_cinema_csv(root, outside, result.problems);
+    verify_cinema_csv(root, reported, result.problems);
     return result;
 }
 
@@ -339,7 +351,7 @@ ArchiveReader ArchiveReader::without_views(
     return ArchiveReader(path_, diagnostics_, std::move(manifest), manifest_readable_);
 }
 
-void ArchiveReader::verify_cinema_csv(const fs::path& root, const std::set<fs::path>& outside,
+void ArchiveReader::verify_cinema_csv(const fs::path& root, const std::set<fs::path>& reported,
                                       std::vector<std::string>& problems) const {
     // data.csv must have a row per manifest step x view naming the manifest's files, and every
     // row must name files inside the archive that exist. A row for a step the manifest lacks is
@@ -380,8 +392,9 @@ void ArchiveReader::verify_cinema_csv(const fs::path& root, const std::set<fs::p
         for (const std::size_t column : {std::size_t{5}, std::size_t{6}}) {
             const fs::path named = fs::path(path_) / row.columns[column];
             std::error_code error;
-            // A file the manifest lists and that resolves elsewhere is reported once, above.
-            if (outside.count(fs::absolute(named).lexically_normal())) continue;
+            // A file the manifest lists and that is missing, damaged or resolves elsewhere is
+            // reported once, above.
+            if (reported.count(fs::absolute(named).lexically_normal())) continue;
             if (row.columns[column].empty() || fs::path(row.columns[column]).is_absolute() ||
                 !inside(root, fs::absolute(named))) {
                 problems.push_back(where + "\"" + row.columns[column] +

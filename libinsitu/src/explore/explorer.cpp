@@ -347,7 +347,9 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
         }
     }
 
-    const TransferFunction stored_tf = archive_->configuration().transfer_function;
+    // The run's function for the field this view shows (fields may carry their own).
+    const TransferFunction stored_tf = archive_->configuration().transfer_function_of(
+        archive_->entry(request.step, request.view).field);
     const TransferFunction& shown_tf =
         request.transfer_function ? *request.transfer_function : stored_tf;
 

@@ -82,7 +82,8 @@ public:
     /// Checks every file the manifest names: present, inside the archive once symbolic links
     /// are resolved, size and CRC-32 as recorded; that data.csv has a row per step x view naming
     /// the manifest's files and that each of its rows names files inside the archive that exist.
-    /// Returns one line per problem, diagnostics() first (empty when the archive is intact).
+    /// Returns one line per problem, each naming its file, diagnostics() first (empty when the
+    /// archive is intact); a damaged file is reported once, not again for data.csv.
     std::vector<std::string> verify() const;
     /// verify()'s checks, with the (step, view) entries whose proxies they found unusable.
     ArchiveCheck check() const;
@@ -97,7 +98,7 @@ private:
                   std::shared_ptr<const nlohmann::json> manifest, bool manifest_readable);
 
     void verify_cinema_csv(const std::filesystem::path& root,
-                           const std::set<std::filesystem::path>& outside,
+                           const std::set<std::filesystem::path>& reported,
                            std::vector<std::string>& problems) const;
 
     std::string path_;
