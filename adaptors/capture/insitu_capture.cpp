@@ -281,15 +281,13 @@ int run(const Arguments& arguments) {
     insitu::InstrumentConfig config =
         insitu::InstrumentConfig::from_json_file(arguments.config_path, &unknown_keys);
     config.archive = arguments.out_path;
-    if (!unknown_keys.empty()) {
-        // As an Instrument does: a typo is an error unless the configuration says "strict": false.
-        if (config.strict) {
-            throw UsageError(arguments.config_path + ": " +
-                             insitu::describe_unknown_keys(unknown_keys) +
-                             " (set \"strict\": false to warn and ignore unknown keys)");
-        }
-        std::cerr << kProgram << ": warning: " << insitu::describe_unknown_keys(unknown_keys)
-                  << ": ignored (\"strict\": false)\n";
+    // As an Instrument does: a typo is an error unless the configuration says "strict": false.
+    try {
+        const std::string warning =
+            insitu::refuse_unknown_keys(config, unknown_keys, arguments.config_path + ": ");
+        if (!warning.empty()) std::cerr << kProgram << ": warning: " << warning << "\n";
+    } catch (const insitu::ParseError& error) {
+        throw UsageError(error.what());
     }
     // Each input is a step the user chose to capture: the simulation's default cadence (every
     // 10th step) applies only when the configuration asks for a cadence itself.

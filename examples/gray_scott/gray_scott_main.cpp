@@ -251,15 +251,15 @@ insitu::InstrumentConfig make_config(const Options& options) {
     insitu::InstrumentConfig config;
     if (options.config_path) {
         std::vector<std::string> unknown;
+        std::string warning;
         try {
             config = insitu::InstrumentConfig::from_json_file(*options.config_path, &unknown);
+            // A typo is an error unless the configuration says "strict": false.
+            warning = insitu::refuse_unknown_keys(config, unknown, *options.config_path + ": ");
         } catch (const insitu::Error& error) {
             throw UsageError(std::string("--config: ") + error.what());  // names the file
         }
-        for (const std::string& key : unknown) {
-            std::cerr << "gray-scott: warning: " << *options.config_path
-                      << ": unknown configuration key " << key << " ignored" << std::endl;
-        }
+        if (!warning.empty()) std::cerr << "gray-scott: warning: " << warning << std::endl;
     } else {
         config = default_config();
     }

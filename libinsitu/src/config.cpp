@@ -621,6 +621,19 @@ std::string describe_unknown_keys(const std::vector<std::string>& unknown_paths)
     return text;
 }
 
+std::string refuse_unknown_keys(const InstrumentConfig& config,
+                                const std::vector<std::string>& unknown_paths,
+                                const std::string& source) {
+    if (unknown_paths.empty()) return {};
+    // An unknown key is most often a typo ("evry") that would otherwise change what the run
+    // costs without a word, so by default it stops the start-up, naming the nearest key.
+    if (config.strict) {
+        fail<ParseError>(source, describe_unknown_keys(unknown_paths),
+                         " (set \"strict\": false to warn and ignore unknown keys)");
+    }
+    return source + describe_unknown_keys(unknown_paths) + ": ignored (\"strict\": false)";
+}
+
 nlohmann::json ViewConfig::to_json() const {
     return write_object(*this, kViewKeys);
 }
@@ -721,7 +734,10 @@ void InstrumentConfig::validate() const {
                          "; give each field once");
         }
     }
-    for (const auto& [name, style] : field_styles) {
+    for (const auto& entry : field_styles) {
+        // Not a structured binding: C++17 lambdas (below) cannot capture those.
+        const std::string& name = entry.first;
+        const FieldStyle& style = entry.second;
         const auto at = std::find(fields.begin(), fields.end(), name);
         if (at == fields.end()) {
             out_of_range("fields", "\"" + name + "\"", "has settings but is not listed");

@@ -15,6 +15,7 @@
 #include <sstream>
 #include <thread>
 
+#include "archive/writer_thread.hpp"
 #include "insitu/archive/archive.hpp"
 #include "insitu/core/camera.hpp"
 #include "insitu/error.hpp"
@@ -134,12 +135,11 @@ struct Instrument::Impl {
         }
     }
 
-    /// Keeps the configuration's unknown keys ("strict": false) and warns about them.
-    void adopt_unknown_keys(std::vector<std::string> keys, const std::string& source) {
+    /// Keeps the configuration's unknown keys ("strict": false) and logs refuse_unknown_keys's
+    /// warning about them.
+    void adopt_unknown_keys(std::vector<std::string> keys, const std::string& warning) {
         unknown_keys = std::move(keys);
-        if (unknown_keys.empty()) return;
-        log("warning: " + source + describe_unknown_keys(unknown_keys) +
-            ": ignored (\"strict\": false)");
+        if (!warning.empty()) log("warning: " + warning);
     }
 
     bool selects(std::int64_t step) const {
@@ -369,6 +369,9 @@ Status Instrument::Impl::enqueue(StepRecord record, double compute_seconds) {
 }
 
 void Instrument::Impl::writer_loop() {
+    // Encoding and writing only when the simulation's core has nothing else to do (see
+    // writer_thread.hpp); refused, the writer keeps the simulation's priority and loses nothing.
+    archive_format::lower_writer_thread_priority();
     for (;;) {
         std::int64_t step = 0;
         std::uint64_t bytes = 0;
@@ -401,15 +404,19 @@ void Instrument::Impl::writer_loop() {
         if (!failure.empty())
             record_error("writing step " + std::to_string(step) + ": " + failure,
                          classify(failure_exception), /*from_writer=*/true);
-        std::lock_guard<std::mutex> lock(mutex);
-        --writing;
-        statistics.write_seconds += seconds;
-        if (failure.empty()) {
-            ++statistics.steps_written;
-            statistics.bytes_written += bytes;
-        } else {
-            write_failure = failure_exception;
+        {
+            std::lock_guard<std::mutex> lock(mutex);
+            --writing;
+            statistics.write_seconds += seconds;
+            if (failure.empty()) {
+                ++statistics.steps_written;
+                statistics.bytes_written += bytes;
+            } else {
+                write_failure = failure_exception;
+            }
         }
+        // After the unlock: the waiting simulation wakes and preempts this low-priority thread
+        // at once, and must not then find the mutex still held by it.
         room.notify_all();
     }
 }
@@ -478,24 +485,13 @@ Instrument::Instrument(InstrumentConfig config, InstrumentOptions options)
     impl.writer = std::thread(&Impl::writer_loop, &impl);
 }
 
-namespace {
-// "strict" (the default): an unknown key is most often a typo ("evry") that would otherwise
-// change what the run costs without a word, so it stops the start-up, naming the nearest key.
-void refuse_unknown_keys(const InstrumentConfig& config, const std::vector<std::string>& unknown,
-                         const std::string& source) {
-    if (!config.strict || unknown.empty()) return;
-    fail<ParseError>(source, describe_unknown_keys(unknown),
-                     " (set \"strict\": false to warn and ignore unknown keys)");
-}
-}  // namespace
-
 std::unique_ptr<Instrument> Instrument::from_json_file(const std::string& path,
                                                        InstrumentOptions options) {
     std::vector<std::string> unknown;
     InstrumentConfig config = InstrumentConfig::from_json_file(path, &unknown);
-    refuse_unknown_keys(config, unknown, path + ": ");
+    const std::string warning = refuse_unknown_keys(config, unknown, path + ": ");
     auto instrument = std::make_unique<Instrument>(std::move(config), options);
-    instrument->impl_->adopt_unknown_keys(std::move(unknown), path + ": ");
+    instrument->impl_->adopt_unknown_keys(std::move(unknown), warning);
     return instrument;
 }
 
@@ -503,9 +499,9 @@ std::unique_ptr<Instrument> Instrument::from_json_text(const std::string& text,
                                                        InstrumentOptions options) {
     std::vector<std::string> unknown;
     InstrumentConfig config = InstrumentConfig::from_json_text(text, &unknown);
-    refuse_unknown_keys(config, unknown, "configuration: ");
+    const std::string warning = refuse_unknown_keys(config, unknown, "configuration: ");
     auto instrument = std::make_unique<Instrument>(std::move(config), options);
-    instrument->impl_->adopt_unknown_keys(std::move(unknown), "");
+    instrument->impl_->adopt_unknown_keys(std::move(unknown), warning);
     return instrument;
 }
 

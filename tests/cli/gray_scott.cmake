@@ -80,9 +80,15 @@ file(WRITE ${gray_scott_bad_config} [=[{"every": 0}]=])
 gray_scott_cli_case(config_invalid 2 STDERR "every" --config ${gray_scott_bad_config})
 gray_scott_cli_case(config_missing 2 STDERR "cannot open configuration file"
                     --config ${CMAKE_CURRENT_BINARY_DIR}/no_such_config.json)
-# Unknown keys do not stop the run, but are named.
+# An unknown key is a usage error naming the nearest known one ...
+set(gray_scott_typo_config ${CMAKE_CURRENT_BINARY_DIR}/gray_scott_typo_config.json)
+file(WRITE ${gray_scott_typo_config} [=[{"views": [{"size": [8, 8]}], "evry": 4}]=])
+gray_scott_cli_case(config_typo 2 STDERR "\"evry\" (did you mean \"every\"?)" --size 8
+                    --steps 4 --config ${gray_scott_typo_config})
+# ... and with "strict": false it does not stop the run, but is named.
 set(gray_scott_odd_config ${CMAKE_CURRENT_BINARY_DIR}/gray_scott_odd_config.json)
-file(WRITE ${gray_scott_odd_config} [=[{"views": [{"size": [8, 8], "zoom": 2}], "every": 4}]=])
+file(WRITE ${gray_scott_odd_config}
+     [=[{"views": [{"size": [8, 8], "zoom": 2}], "every": 4, "strict": false}]=])
 gray_scott_cli_case(config_unknown_key 0 STDERR "views[0].zoom" --size 8 --steps 4
                     --config ${gray_scott_odd_config}
                     --out ${CMAKE_CURRENT_BINARY_DIR}/gray_scott_config_unknown_key.cdb)

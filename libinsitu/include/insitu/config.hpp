@@ -113,12 +113,20 @@ struct PlannedView {
     ViewConfig view;
 };
 
+struct InstrumentConfig;
+
 /// The known key nearest to the last component of an unknown key's dotted path, at the same
 /// level of the configuration ("evry" -> "every", "views[0].azimut" -> "azimuth"); empty when
 /// none is close (at most a third of the key's letters differ).
 std::string suggest_key(const std::string& unknown_path);
 /// "unknown configuration key "evry" (did you mean "every"?)", for each key, joined by "; ".
 std::string describe_unknown_keys(const std::vector<std::string>& unknown_paths);
+/// "strict" (the default): throws ParseError "`source`unknown configuration key ..." when
+/// `unknown_paths` is not empty; with "strict": false returns the warning to print instead
+/// (empty when there is nothing to say). Every program that reads a configuration calls it.
+std::string refuse_unknown_keys(const InstrumentConfig& config,
+                                const std::vector<std::string>& unknown_paths,
+                                const std::string& source);
 
 struct InstrumentConfig {
     /// "fields": the names of the fields to visualise, each with the top-level views, transfer
