@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "arguments.hpp"
+#include "child_process.hpp"
 #include "insitu/capture_input.hpp"
 #include "insitu/config.hpp"
 #include "insitu/core/camera.hpp"
@@ -219,42 +220,6 @@ int child_capture(const fs::path& dir, bool sparse, int n, int image) {
     return 0;
 }
 
-/// Runs this program with `arguments` in a child process; returns its "key value" lines.
-std::map<std::string, std::string> run_child(const std::vector<std::string>& arguments) {
-    int pipe_ends[2];
-    if (pipe(pipe_ends) != 0) throw std::runtime_error("pipe failed");
-    const pid_t pid = fork();
-    if (pid < 0) throw std::runtime_error("fork failed");
-    if (pid == 0) {
-        dup2(pipe_ends[1], STDOUT_FILENO);
-        close(pipe_ends[0]);
-        close(pipe_ends[1]);
-        std::vector<char*> argv;
-        for (const std::string& a : arguments) argv.push_back(const_cast<char*>(a.c_str()));
-        argv.push_back(nullptr);
-        execv("/proc/self/exe", argv.data());
-        std::perror("execv");
-        _exit(127);
-    }
-    close(pipe_ends[1]);
-    std::string output;
-    char buffer[4096];
-    for (ssize_t got; (got = read(pipe_ends[0], buffer, sizeof(buffer))) > 0;) {
-        output.append(buffer, static_cast<std::size_t>(got));
-    }
-    close(pipe_ends[0]);
-    int status = 0;
-    waitpid(pid, &status, 0);
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-        throw std::runtime_error("child " + arguments.at(2) + " failed (status " +
-                                 std::to_string(status) + ")");
-    }
-    std::map<std::string, std::string> values;
-    std::istringstream lines(output);
-    for (std::string key, value; lines >> key >> value;) values[key] = value;
-    return values;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -293,8 +258,9 @@ int main(int argc, char** argv) {
         fs::create_directories(dir);
         const std::string self = argv[0];
         const auto child = [&](const char* mode) {
-            return run_child(
-                {self, "--child", mode, dir.string(), std::to_string(n), std::to_string(image)});
+            return insitu::bench::run_self_as_child(
+                {self, "--child", mode, dir.string(), std::to_string(n), std::to_string(image)},
+                std::string("child ") + mode);
         };
         std::cout << "bench_capture: procedural smoke in a " << n << "^3 box, one " << image << "x"
                   << image << " orthographic view, depth + distortion + attenuation proxies\n";

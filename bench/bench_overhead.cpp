@@ -46,6 +46,7 @@
 #include <vector>
 
 #include "arguments.hpp"
+#include "child_process.hpp"
 #include "gray_scott_simulation.hpp"
 #include "insitu/config.hpp"
 #include "insitu/core/transfer_function.hpp"
@@ -271,7 +272,7 @@ int run_child(const Options& options) {
 
 // --- the parent -----------------------------------------------------------------------------
 
-using Figures = std::map<std::string, std::string>;
+using Figures = bench::ChildFigures;
 
 /// Re-executes this program as `--child mode` (pinned to `cpu` when cpu >= 0); its "key value"
 /// lines (the value is the rest of the line).
@@ -289,51 +290,8 @@ Figures run_configuration(const Options& options, const std::string& mode, int c
                                           std::to_string(options.image),
                                           "--archive",
                                           options.archive};
-    std::fflush(stdout);
-    int pipe_ends[2];
-    if (pipe(pipe_ends) != 0) throw std::runtime_error("pipe failed");
-    const pid_t pid = fork();
-    if (pid < 0) throw std::runtime_error("fork failed");
-    if (pid == 0) {
-        dup2(pipe_ends[1], STDOUT_FILENO);
-        close(pipe_ends[0]);
-        close(pipe_ends[1]);
-        if (cpu >= 0) {
-            cpu_set_t set;
-            CPU_ZERO(&set);
-            CPU_SET(cpu, &set);
-            if (sched_setaffinity(0, sizeof(set), &set) != 0) {
-                std::perror("bench_overhead: sched_setaffinity");
-                _exit(127);
-            }
-        }
-        std::vector<char*> argv;
-        for (std::string& argument : arguments) argv.push_back(argument.data());
-        argv.push_back(nullptr);
-        execv("/proc/self/exe", argv.data());
-        std::perror("bench_overhead: execv");
-        _exit(127);
-    }
-    close(pipe_ends[1]);
-    std::string output;
-    char buffer[4096];
-    for (ssize_t got; (got = read(pipe_ends[0], buffer, sizeof(buffer))) > 0;) {
-        output.append(buffer, static_cast<std::size_t>(got));
-    }
-    close(pipe_ends[0]);
-    int status = 0;
-    waitpid(pid, &status, 0);
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-        throw std::runtime_error("configuration " + mode + (cpu >= 0 ? " (pinned)" : "") +
-                                 " failed (wait status " + std::to_string(status) + ")");
-    }
-    Figures figures;
-    std::istringstream lines(output);
-    for (std::string line; std::getline(lines, line);) {
-        const auto space = line.find(' ');
-        if (space != std::string::npos) figures[line.substr(0, space)] = line.substr(space + 1);
-    }
-    return figures;
+    return bench::run_self_as_child(arguments,
+                                    "configuration " + mode + (cpu >= 0 ? " (pinned)" : ""), cpu);
 }
 
 double number(const Figures& figures, const std::string& key) {
