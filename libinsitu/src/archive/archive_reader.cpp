@@ -89,11 +89,12 @@ ArchiveReader::ArchiveReader(std::string path, std::vector<std::string> diagnost
 
 namespace {
 
-/// The journal's step entries appended to `manifest`'s, as read_index() replays them, except
-/// that nothing refuses the whole index: an unreadable journal, a line that is no valid step
-/// entry and a step repeated with other content each become a line of `diagnostics`. Returns
-/// how many steps the journal added; `journal_problem` says why it added none.
+/// The journal's step entries appended to `manifest`'s as read_index() replays them
+/// (af::replay_journal; bad lines to `skipped`), except that an unreadable journal does not
+/// refuse the whole index: it becomes a line of `diagnostics`. Returns how many steps the
+/// journal added; `journal_problem` says why it added none.
 std::size_t replay_journal_tolerantly(const std::string& archive, nlohmann::json& manifest,
+                                      nlohmann::json& skipped,
                                       std::vector<std::string>& diagnostics,
                                       std::string& journal_problem) {
     const std::string journal = (fs::path(archive) / af::kJournalFile).string();
@@ -110,47 +111,7 @@ std::size_t replay_journal_tolerantly(const std::string& archive, nlohmann::json
         diagnostics.push_back(journal_problem);
         return 0;
     }
-    nlohmann::json& entries = manifest["steps"];
-    std::set<std::int64_t> steps;
-    for (const nlohmann::json& step : entries) steps.insert(step.at("step").get<std::int64_t>());
-    std::size_t added = 0;
-    std::size_t line_number = 0;
-    for (auto begin = bytes.begin(); begin != bytes.end();) {
-        const auto end = std::find(begin, bytes.end(), '\n');
-        // A last line without its newline is an append a crash cut short, ignored as
-        // read_index() ignores it: that step never completed.
-        if (end == bytes.end()) break;
-        ++line_number;
-        const std::string where = "line " + std::to_string(line_number);
-        try {
-            nlohmann::json entry;
-            try {
-                entry = nlohmann::json::parse(begin, end);
-            } catch (const nlohmann::json::exception&) {
-                fail<ParseError>("\"", journal, "\": ", where, ": not valid JSON");
-            }
-            af::check_step_entry(entry, journal, where);
-            const auto number = entry.at("step").get<std::int64_t>();
-            if (!steps.insert(number).second) {
-                // The same entry twice is what a compaction killed before it removed the
-                // journal leaves; other content under the same step is a conflict.
-                if (std::find(entries.begin(), entries.end(), entry) == entries.end()) {
-                    fail<ParseError>("\"", journal, "\": ", where, ": step ", number,
-                                     " is repeated with other content");
-                }
-            } else {
-                entries.push_back(std::move(entry));
-                ++added;
-            }
-        } catch (const ParseError& problem) {
-            diagnostics.push_back(std::string("step entry skipped: ") + problem.what());
-        }
-        begin = end + 1;
-    }
-    std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
-        return a.at("step").template get<std::int64_t>() <
-               b.at("step").template get<std::int64_t>();
-    });
+    const std::size_t added = af::replay_journal(bytes, journal, manifest, skipped);
     if (added == 0) journal_problem = "\"" + journal + "\" holds no usable step entry";
     return added;
 }
@@ -182,18 +143,12 @@ ArchiveReader ArchiveReader::open_damaged(const std::string& path) {
     }
     std::string journal_problem;
     const std::size_t journal_steps =
-        replay_journal_tolerantly(path, manifest, diagnostics, journal_problem);
+        replay_journal_tolerantly(path, manifest, skipped, diagnostics, journal_problem);
     if (!manifest_readable && journal_steps == 0) {
         fail<IoError>("archive \"", path, "\" has no readable index: ", manifest_problem, "; ",
                       journal_problem);
     }
-    for (const nlohmann::json& set_aside : manifest.value(af::kMalformedKey, nlohmann::json())) {
-        diagnostics.push_back("set aside by an earlier writer: " +
-                              set_aside.value("problem", std::string("(no reason given)")));
-    }
-    for (const nlohmann::json& entry : skipped) {
-        diagnostics.push_back("step entry skipped: " + entry.at("problem").get<std::string>());
-    }
+    af::describe_skipped(manifest, skipped, diagnostics);
     return ArchiveReader(path, std::move(diagnostics),
                          std::make_shared<const nlohmann::json>(std::move(manifest)),
                          manifest_readable);

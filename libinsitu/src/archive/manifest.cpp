@@ -194,6 +194,68 @@ nlohmann::json read_manifest(const std::string& archive_path, nlohmann::json* sk
     return manifest;
 }
 
+std::size_t replay_journal(const std::vector<char>& bytes, const std::string& journal,
+                           nlohmann::json& manifest, nlohmann::json& skipped) {
+    std::set<std::int64_t> steps;
+    for (const nlohmann::json& step : manifest.at("steps")) {
+        steps.insert(step.at("step").get<std::int64_t>());
+    }
+    nlohmann::json& entries = manifest["steps"];
+    std::size_t added = 0;
+    std::size_t line_number = 0;
+    for (auto begin = bytes.begin(); begin != bytes.end();) {
+        const auto end = std::find(begin, bytes.end(), '\n');
+        // A last line without its newline is an append a crash cut short: that step never
+        // completed (write() had not returned), so it is ignored, silently.
+        if (end == bytes.end()) break;
+        ++line_number;
+        const std::string where = "line " + std::to_string(line_number);
+        nlohmann::json entry;
+        try {
+            entry = nlohmann::json::parse(begin, end);
+            check_step_entry(entry, journal, where);
+            const auto number = entry.at("step").get<std::int64_t>();
+            if (!steps.insert(number).second) {
+                // The same entry in manifest.json too: a compaction was killed after its
+                // rename and before the journal went. Anything else is a conflict.
+                const auto same = std::find(entries.begin(), entries.end(), entry);
+                if (same == entries.end()) {
+                    fail<ParseError>("\"", journal, "\": ", where, ": step ", number,
+                                     " is repeated with other content");
+                }
+            } else {
+                entries.push_back(std::move(entry));
+                ++added;
+            }
+        } catch (const std::exception& problem) {
+            const std::string text = dynamic_cast<const ParseError*>(&problem)
+                                         ? std::string(problem.what())
+                                         : "\"" + journal + "\": " + where + ": not valid JSON";
+            skipped.push_back(
+                {{"entry", entry.is_null() ? nlohmann::json(std::string(begin, end)) : entry},
+                 {"problem", text}});
+        }
+        begin = end + 1;
+    }
+    // Journal lines arrive in write order; keep the steps sorted as manifest.json has them.
+    std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
+        return a.at("step").template get<std::int64_t>() <
+               b.at("step").template get<std::int64_t>();
+    });
+    return added;
+}
+
+void describe_skipped(const nlohmann::json& manifest, const nlohmann::json& skipped,
+                      std::vector<std::string>& diagnostics) {
+    for (const nlohmann::json& set_aside : manifest.value(kMalformedKey, nlohmann::json())) {
+        diagnostics.push_back("set aside by an earlier writer: " +
+                              set_aside.value("problem", std::string("(no reason given)")));
+    }
+    for (const nlohmann::json& entry : skipped) {
+        diagnostics.push_back("step entry skipped: " + entry.at("problem").get<std::string>());
+    }
+}
+
 Index read_index(const std::string& archive_path) {
     Index index;
     nlohmann::json skipped = nlohmann::json::array();
@@ -211,62 +273,10 @@ Index read_index(const std::string& archive_path) {
     }
     index.manifest = read_manifest(archive_path, &skipped);
     if (journal_bytes) {
-        const std::vector<char>& bytes = *journal_bytes;
-        std::set<std::int64_t> steps;
-        for (const nlohmann::json& step : index.manifest.at("steps")) {
-            steps.insert(step.at("step").get<std::int64_t>());
-        }
-        nlohmann::json& entries = index.manifest["steps"];
-        std::size_t line_number = 0;
-        for (auto begin = bytes.begin(); begin != bytes.end();) {
-            const auto end = std::find(begin, bytes.end(), '\n');
-            // A last line without its newline is an append a crash cut short: that step never
-            // completed (write() had not returned), so it is ignored, silently.
-            if (end == bytes.end()) break;
-            ++line_number;
-            const std::string where = "line " + std::to_string(line_number);
-            nlohmann::json entry;
-            try {
-                entry = nlohmann::json::parse(begin, end);
-                check_step_entry(entry, journal.string(), where);
-                const auto number = entry.at("step").get<std::int64_t>();
-                if (!steps.insert(number).second) {
-                    // The same entry in manifest.json too: a compaction was killed after its
-                    // rename and before the journal went. Anything else is a conflict.
-                    const auto same = std::find(entries.begin(), entries.end(), entry);
-                    if (same == entries.end()) {
-                        fail<ParseError>("\"", journal.string(), "\": ", where, ": step ", number,
-                                         " is repeated");
-                    }
-                } else {
-                    entries.push_back(std::move(entry));
-                    ++index.journal_steps;
-                }
-            } catch (const std::exception& problem) {
-                const std::string text =
-                    dynamic_cast<const ParseError*>(&problem)
-                        ? std::string(problem.what())
-                        : "\"" + journal.string() + "\": " + where + ": not valid JSON";
-                skipped.push_back(
-                    {{"entry", entry.is_null() ? nlohmann::json(std::string(begin, end)) : entry},
-                     {"problem", text}});
-            }
-            begin = end + 1;
-        }
-        // Journal lines arrive in write order; keep the steps sorted as manifest.json has them.
-        std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
-            return a.at("step").template get<std::int64_t>() <
-                   b.at("step").template get<std::int64_t>();
-        });
+        index.journal_steps =
+            replay_journal(*journal_bytes, journal.string(), index.manifest, skipped);
     }
-    for (const nlohmann::json& set_aside : index.manifest.value(kMalformedKey, nlohmann::json())) {
-        index.diagnostics.push_back("set aside by an earlier writer: " +
-                                    set_aside.value("problem", std::string("(no reason given)")));
-    }
-    for (const nlohmann::json& entry : skipped) {
-        index.diagnostics.push_back("step entry skipped: " +
-                                    entry.at("problem").get<std::string>());
-    }
+    describe_skipped(index.manifest, skipped, index.diagnostics);
     index.skipped = std::move(skipped);
     return index;
 }

@@ -52,6 +52,17 @@ struct Index {
 };
 /// Reads the index as the reader and the writer see it; errors as read_manifest().
 Index read_index(const std::string& archive_path);
+/// Appends the step entries of the journal's `bytes` (read from `journal`, named in messages)
+/// to `manifest`'s steps, which stay sorted: entries that are no valid step entry, or repeat a
+/// step with other content, go to `skipped` as {"entry", "problem"}; an entry manifest.json
+/// already holds (a compaction killed before it removed the journal) is left out silently, as
+/// is a last line without its newline (an append a crash cut short). Returns the steps added.
+std::size_t replay_journal(const std::vector<char>& bytes, const std::string& journal,
+                           nlohmann::json& manifest, nlohmann::json& skipped);
+/// One diagnostic line per entry an earlier writer set aside in `manifest` and per `skipped`
+/// entry, appended to `diagnostics` (Index::diagnostics).
+void describe_skipped(const nlohmann::json& manifest, const nlohmann::json& skipped,
+                      std::vector<std::string>& diagnostics);
 
 /// Replaces ARCHIVE/manifest.json atomically, after checking it as strictly as read_manifest()
 /// would (ParseError naming the key; nothing written then).
