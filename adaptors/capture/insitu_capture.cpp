@@ -92,14 +92,7 @@ glm::dvec3 parse_spacing(const std::string& flag, const std::string& text) {
 // ---------------------------------------------------------------------------------------------
 // The option table: one row per flag; help and parsing both come from it.
 
-struct Option {
-    const char* name;
-    const char* value_name;  ///< nullptr for switches
-    bool required;
-    const char* help;
-    const char* default_value;  ///< as --help shows it; "" when there is none
-    std::function<void(Arguments&, const std::string& flag, const std::string& value)> apply;
-};
+using Option = insitu::cli::TableOption<Arguments>;
 
 const std::vector<Option>& options() {
     using V = const std::string&;
@@ -155,10 +148,7 @@ const insitu::cli::CommandHelp& command_help() {
             "        layer at the zero crossing unless the configuration names its layers)\n"
             "  other raw samples, x fastest, described by --raw-dims and --raw-type\n"
             "After \"--\" every argument is an INPUT.";
-        for (const Option& option : options()) {
-            h.options.push_back({option.name, option.value_name ? option.value_name : "",
-                                 option.help, option.default_value, option.required});
-        }
+        h.options = insitu::cli::help_rows(options());
         h.notes =
             "A progress bar (steps, rate, ETA) is drawn on stderr when it is a terminal.\n"
             "Exit status: 0 success, 2 bad arguments or input, 1 other failures.";
@@ -169,47 +159,7 @@ const insitu::cli::CommandHelp& command_help() {
 
 Arguments parse_arguments(int argc, char** argv) {
     Arguments arguments;
-    std::map<std::string, bool> seen;
-    bool options_ended = false;
-    for (int i = 1; i < argc; ++i) {
-        std::string token = argv[i];
-        if (options_ended || token.rfind("-", 0) != 0 || token == "-") {
-            arguments.inputs.push_back(token);
-            continue;
-        }
-        if (token == "--") {
-            options_ended = true;
-            continue;
-        }
-        std::string value;
-        bool has_inline_value = false;
-        if (const auto equals = token.find('='); equals != token.npos) {
-            value = token.substr(equals + 1);
-            token.resize(equals);
-            has_inline_value = true;
-        }
-        const auto& table = options();
-        const auto option = std::find_if(table.begin(), table.end(),
-                                         [&](const Option& o) { return token == o.name; });
-        if (option == table.end()) throw UsageError("unknown option \"" + token + "\"");
-        if (seen[token]) throw UsageError(token + ": given more than once");
-        seen[token] = true;
-        if (!option->value_name) {
-            if (has_inline_value) throw UsageError(token + ": takes no value");
-        } else if (!has_inline_value) {
-            if (i + 1 >= argc || std::string(argv[i + 1]).rfind("--", 0) == 0) {
-                throw UsageError(token + ": missing value " + option->value_name);
-            }
-            value = argv[++i];
-        }
-        option->apply(arguments, token, value);
-    }
-    for (const Option& option : options()) {
-        if (option.required && !seen[option.name]) {
-            throw UsageError(std::string("missing required option ") + option.name + " " +
-                             option.value_name + " (see --help)");
-        }
-    }
+    insitu::cli::parse_table(argc, argv, options(), arguments, &arguments.inputs);
     if (arguments.inputs.empty()) throw UsageError("no INPUT files given (see --help)");
     if (arguments.raw_dims.has_value() != arguments.raw_type.has_value()) {
         throw UsageError(arguments.raw_dims ? "--raw-dims needs --raw-type"

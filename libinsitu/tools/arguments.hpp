@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
 #include <limits>
 #include <ostream>
@@ -311,6 +312,87 @@ int run_command(const char* program, const std::vector<std::string>& args, const
                 Body&& body) {
     if (answer_help(args, help)) return 0;
     return run_reporting(program, std::forward<Body>(body));
+}
+
+/// One row of a command's option table: its help line and its parsing both come from it.
+template <typename Arguments>
+struct TableOption {
+    const char* name;
+    const char* value_name;  ///< nullptr for switches that take no value
+    bool required;
+    const char* help;
+    const char* default_value;  ///< as --help shows it; "" when there is none
+    std::function<void(Arguments&, const std::string& flag, const std::string& value)> apply;
+};
+
+/// The --help lines of an option table, in its order.
+template <typename Arguments>
+std::vector<OptionHelp> help_rows(const std::vector<TableOption<Arguments>>& table) {
+    std::vector<OptionHelp> rows;
+    for (const TableOption<Arguments>& option : table) {
+        rows.push_back({option.name, option.value_name ? option.value_name : "", option.help,
+                        option.default_value, option.required});
+    }
+    return rows;
+}
+
+/// Parses argv[1..] against `table` into `arguments`: "--flag value" or "--flag=value", each flag
+/// at most once, every required flag present; a value is never taken from a following "--" token
+/// ("--out --shade" forgot a value; "--elevation -30" is a value). With `positional` non-null,
+/// tokens that do not start with "-" (and "-" itself, and every token after "--") are collected
+/// there; without, they are "unexpected argument" errors. Throws UsageError naming the token.
+template <typename Arguments>
+void parse_table(int argc, char** argv, const std::vector<TableOption<Arguments>>& table,
+                 Arguments& arguments, std::vector<std::string>* positional = nullptr) {
+    std::vector<std::string> seen;
+    bool options_ended = false;
+    for (int i = 1; i < argc; ++i) {
+        std::string token = argv[i];
+        if (positional != nullptr) {
+            if (options_ended || token.rfind('-', 0) != 0 || token == "-") {
+                positional->push_back(token);
+                continue;
+            }
+            if (token == "--") {
+                options_ended = true;
+                continue;
+            }
+        }
+        std::string value;
+        bool has_inline_value = false;
+        if (const auto equals = token.find('=');
+            token.rfind("--", 0) == 0 && equals != std::string::npos) {
+            value = token.substr(equals + 1);
+            token.resize(equals);
+            has_inline_value = true;
+        }
+        const auto option =
+            std::find_if(table.begin(), table.end(),
+                         [&](const TableOption<Arguments>& o) { return token == o.name; });
+        if (option == table.end()) {
+            throw UsageError(token.rfind('-', 0) == 0 ? "unknown option \"" + token + "\""
+                                                      : "unexpected argument \"" + token + "\"");
+        }
+        if (std::find(seen.begin(), seen.end(), token) != seen.end()) {
+            throw UsageError(token + ": given more than once");
+        }
+        seen.push_back(token);
+        if (!option->value_name) {
+            if (has_inline_value) throw UsageError(token + ": takes no value");
+        } else if (!has_inline_value) {
+            if (i + 1 >= argc || std::string(argv[i + 1]).rfind("--", 0) == 0) {
+                throw UsageError(token + ": missing value " + option->value_name);
+            }
+            value = argv[++i];
+        }
+        option->apply(arguments, token, value);
+    }
+    for (const TableOption<Arguments>& option : table) {
+        if (option.required && std::find(seen.begin(), seen.end(), option.name) == seen.end()) {
+            throw UsageError(std::string("missing required option ") + option.name + " " +
+                             option.value_name + " (see --help)");
+        }
+    }
 }
 
 /// `parse()` (a command-line parse), or one line "program: message" on stderr and exit 2 for a

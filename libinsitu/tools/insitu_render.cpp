@@ -109,14 +109,7 @@ void require_extension(const std::string& flag, const std::string& path,
 // ---------------------------------------------------------------------------------------------
 // The option table: one row per flag; help text and parsing both come from it.
 
-struct Option {
-    const char* name;
-    const char* value_name;  ///< nullptr for switches that take no value
-    bool required;
-    const char* help;
-    const char* default_value;  ///< as --help shows it; "" when there is none
-    std::function<void(Arguments&, const std::string& flag, const std::string& value)> apply;
-};
+using Option = insitu::cli::TableOption<Arguments>;
 
 const std::vector<Option>& options() {
     using V = const std::string&;
@@ -177,10 +170,7 @@ const insitu::cli::CommandHelp& command_help() {
         h.description =
             "Renders a raw scalar volume by emission-absorption ray casting (libinsitu's ground "
             "truth).";
-        for (const Option& option : options()) {
-            h.options.push_back({option.name, option.value_name ? option.value_name : "",
-                                 option.help, option.default_value, option.required});
-        }
+        h.options = insitu::cli::help_rows(options());
         h.notes =
             "TF.json: {\"points\": [[value, r, g, b, a], ...], \"unit_length\": 1.0}, a = "
             "opacity per unit_length world units.\n"
@@ -192,46 +182,7 @@ const insitu::cli::CommandHelp& command_help() {
 
 Arguments parse_arguments(int argc, char** argv) {
     Arguments arguments;
-    std::map<std::string, bool> seen;
-    for (int i = 1; i < argc; ++i) {
-        std::string token = argv[i];
-        std::string value;
-        bool has_inline_value = false;
-        // Both "--flag value" and "--flag=value".
-        if (const auto equals = token.find('=');
-            token.rfind("--", 0) == 0 && equals != token.npos) {
-            value = token.substr(equals + 1);
-            token.resize(equals);
-            has_inline_value = true;
-        }
-        const auto& table = options();
-        const auto option = std::find_if(table.begin(), table.end(),
-                                         [&](const Option& o) { return token == o.name; });
-        if (option == table.end()) {
-            throw UsageError(token.rfind('-', 0) == 0 ? "unknown option \"" + token + "\""
-                                                      : "unexpected argument \"" + token + "\"");
-        }
-        if (seen[token]) throw UsageError(token + ": given more than once");
-        seen[token] = true;
-        if (!option->value_name) {
-            if (has_inline_value) throw UsageError(token + ": takes no value");
-        } else if (!has_inline_value) {
-            // A following flag is not a value: "--out --shade" means the value was forgotten.
-            // Negative numbers ("--elevation -30") are values.
-            const bool next_is_flag = i + 1 < argc && std::string(argv[i + 1]).rfind("--", 0) == 0;
-            if (i + 1 >= argc || next_is_flag) {
-                throw UsageError(token + ": missing value " + option->value_name);
-            }
-            value = argv[++i];
-        }
-        option->apply(arguments, token, value);
-    }
-    for (const Option& option : options()) {
-        if (option.required && !seen[option.name]) {
-            throw UsageError(std::string("missing required option ") + option.name + " " +
-                             option.value_name + " (see --help)");
-        }
-    }
+    insitu::cli::parse_table(argc, argv, options(), arguments);
     return arguments;
 }
 
