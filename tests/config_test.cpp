@@ -382,6 +382,49 @@ TEST(InstrumentConfig, FromFileNamesTheFile) {
     EXPECT_THROW(InstrumentConfig::from_json_file(path.parent_path().string()), IoError);
 }
 
+TEST(InstrumentConfig, LightFieldReadsRoundTripsAndCountsItsPixels) {
+    std::vector<std::string> unknown;
+    const InstrumentConfig config = InstrumentConfig::from_json_text(
+        R"({"fields": ["a", "b"], "light_field": {"cameras": 42, "size": 128,
+            "segments": [0.3, 0.7], "attenuation": false, "depth_bits": 16,
+            "depth_threshold": 0.2, "zoom": 2}})",
+        &unknown);
+    EXPECT_THAT(unknown, ElementsAre("light_field.zoom"));
+    ASSERT_TRUE(config.light_field.has_value());
+    EXPECT_EQ(config.light_field->cameras, 42);
+    EXPECT_EQ(config.light_field->size, 128);
+    EXPECT_EQ(config.light_field->segments, SegmentRule::opacity);
+    EXPECT_THAT(config.light_field->opacity_thresholds, ElementsAre(0.3, 0.7));
+    EXPECT_FALSE(config.light_field->attenuation);
+    EXPECT_EQ(config.light_field->depth_bits, 16);
+    EXPECT_EQ(config.light_field->depth_threshold, 0.2);
+    // Two fields, 42 cameras of 128^2 each.
+    EXPECT_EQ(config.light_field_pixels_per_step(), 2.0 * 42 * 128 * 128);
+    const InstrumentConfig again = InstrumentConfig::from_json(config.to_json());
+    EXPECT_EQ(again.to_json(), config.to_json());
+    // Absent: no light field, and none written back.
+    const InstrumentConfig plain = InstrumentConfig::from_json_text("{}", &unknown);
+    EXPECT_FALSE(plain.light_field.has_value());
+    EXPECT_FALSE(plain.to_json().contains("light_field"));
+    EXPECT_EQ(plain.light_field_pixels_per_step(), 0.0);
+}
+
+TEST(InstrumentConfig, BadLightFieldValuesAreNamedByTheirKeys) {
+    expect_error<InvalidArgument>(R"({"light_field": {"cameras": 40}})",
+                                  {"light_field.cameras", "40", "642"});
+    expect_error<InvalidArgument>(R"({"light_field": {"size": 3}})", {"light_field.size", "3"});
+    expect_error<InvalidArgument>(R"({"light_field": {"depth_bits": 12}})",
+                                  {"light_field.depth_bits", "12"});
+    expect_error<InvalidArgument>(R"({"light_field": {"segments": [0.7, 0.3]}})",
+                                  {"light_field.segments"});
+    expect_error<InvalidArgument>(R"({"light_field": {"segments": "lots"}})",
+                                  {"light_field.segments", "lots"});
+    expect_error<ParseError>(R"({"light_field": 42})", {"light_field"});
+    // The cost ceiling counts the light field's pixels.
+    expect_error<InvalidArgument>(
+        R"({"step": 0.001, "light_field": {"cameras": 642, "size": 4096}})", {"samples per step"});
+}
+
 }  // namespace
 TEST(InstrumentConfig, SuggestsTheNearestKnownKeyAtTheSameLevel) {
     EXPECT_EQ(suggest_key("evry"), "every");
@@ -391,6 +434,7 @@ TEST(InstrumentConfig, SuggestsTheNearestKnownKeyAtTheSameLevel) {
     EXPECT_EQ(suggest_key("intervals.cout"), "count");
     EXPECT_EQ(suggest_key("transfer_function.pionts"), "points");
     EXPECT_EQ(suggest_key("fields[0].nmae"), "name");
+    EXPECT_EQ(suggest_key("light_field.camras"), "cameras");
     EXPECT_EQ(suggest_key("zoom"), "");            // nothing close
     EXPECT_EQ(suggest_key("views[0].every"), "");  // a key of another level is not offered
     EXPECT_EQ(describe_unknown_keys({"evry", "zoom"}),

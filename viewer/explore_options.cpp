@@ -90,8 +90,8 @@ Light parse_light(const std::string& key, const std::string& text) {
 
 const std::vector<std::string>& explore_option_keys() {
     static const std::vector<std::string> keys{
-        "step",   "view",  "azimuth", "elevation", "tf",      "opacity-scale", "colour",
-        "source", "light", "ambient", "ao",        "enhance", "fill"};
+        "step",   "view",   "azimuth", "elevation", "tf", "opacity-scale", "segment-opacity",
+        "colour", "source", "light",   "ambient",   "ao", "enhance",       "fill"};
     return keys;
 }
 
@@ -126,6 +126,9 @@ ExploreRequest request_from_options(const Options& options) {
     }
     if (const auto* text = get("opacity-scale")) {
         request.opacity_scales = parse_scales("opacity-scale", *text);
+    }
+    if (const auto* text = get("segment-opacity")) {
+        request.segment_opacity_scales = parse_scales("segment-opacity", *text);
     }
     if (const auto* text = get("colour")) request.colour = parse_colour_source(*text);
     if (const auto* text = get("source")) request.source = parse_proxy_source(*text);

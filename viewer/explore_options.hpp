@@ -6,8 +6,9 @@
 //   step=N  view=V  azimuth=DEG  elevation=DEG
 //   tf=JSON-TEXT                     an edited transfer function (DESIGN.md TF JSON)
 //   opacity-scale=J=S[,J=S...]       interval J's opacity scaled by S (>= 0)
+//   segment-opacity=S=F[,S=F...]     light-field segment S's opacity scaled by F (>= 0)
 //   colour=auto|model|recompose
-//   source=auto|single|multi         which stored proxies a new view is synthesised from
+//   source=auto|single|multi|lightfield   which stored proxies a new view is made from
 //   light=AZ,EL[,DIFFUSE[,SPECULAR]][;AZ,EL...]   directional lights, orbit angles in degrees of
 //                                    the direction toward the light, in world space; "camera" =
 //                                    a headlight

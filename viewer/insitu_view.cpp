@@ -3,7 +3,7 @@
 //   insitu-view info ARCHIVE [--json]
 //   insitu-view render ARCHIVE --step N [--view V] [--azimuth DEG --elevation DEG]
 //               [--tf TF.json | --opacity-scale J=S,...] [--colour auto|model|recompose]
-//               [--source auto|single|multi]
+//               [--segment-opacity S=F,...] [--source auto|single|multi|lightfield]
 //               [--light AZ,EL[,DIFFUSE[,SPECULAR]] | --light camera]... [--ambient A]
 //               [--ao] [--ao-radius PIXELS] [--ao-strength S] [--enhance LAMBDA,GAMMA]
 //               [--fill PIXELS] [--mask OUT.png] --out OUT.png|exr
@@ -98,9 +98,12 @@ const std::vector<OptionHelp>& render_options() {
          "colour by the fitted colour model or by exact recomposition; auto takes the model when "
          "the archive has one and the colours are unchanged",
          "auto"},
-        {"--source", "auto|single|multi",
-         "the stored proxies a new view is synthesised from; auto takes the single-perspective "
-         "ones when stored",
+        {"--segment-opacity", "S=F,...",
+         "scale light-field segment S's opacity by F >= 0 (seed 001's per-layer fades)", "none"},
+        {"--source", "auto|single|multi|lightfield",
+         "the stored proxies a new view is made from; auto: the stored view's proxies at the "
+         "stored view, elsewhere the light field and the view's proxies fused per pixel by "
+         "confidence where the step has a light field, else the single-perspective proxies",
          "auto"},
         {"--light", "AZ,EL[,DIFFUSE[,SPECULAR]]|camera",
          "a directional light toward orbit angles AZ, EL in degrees (world space), DIFFUSE " +
@@ -224,6 +227,13 @@ int run_info(const std::vector<std::string>& args) {
             std::cout << "\n";
         }
     }
+    for (const auto& light_field : description.at("light_fields")) {
+        std::cout << "light field   " << light_field.at("field").get<std::string>() << ": "
+                  << light_field.at("cameras") << " cameras, " << light_field.at("map_size")
+                  << "^2 maps, " << light_field.at("segments") << " segment(s), attenuation "
+                  << (light_field.at("attenuation").get<bool>() ? "yes" : "no") << ", depth "
+                  << light_field.at("depth_bits") << " bits\n";
+    }
     if (inspection.manifest_readable) {
         std::cout << "configuration " << description.at("configuration").dump() << "\n";
     } else {
@@ -306,8 +316,8 @@ int run_render(const std::vector<std::string>& args) {
     if (!mask_path.empty()) insitu::write_image(mask_path, frame.confidence);
     std::cerr << kProgram << ": " << out_path << " (" << frame.camera.width() << "x"
               << frame.camera.height() << ", " << (frame.synthesised_view ? "new" : "stored")
-              << " view, colour by " << insitu::to_string(frame.colour_source) << ", "
-              << frame.milliseconds << " ms)\n";
+              << " view from " << insitu::to_string(frame.proxy_source) << ", colour by "
+              << insitu::to_string(frame.colour_source) << ", " << frame.milliseconds << " ms)\n";
     return 0;
 }
 

@@ -341,8 +341,12 @@ private:
     /// Every file Explorer or ArchiveReader would read for (step, view) must lie inside.
     void require_files_inside(std::int64_t step, int view) const {
         const ArchivedView entry = explorer_->archive().entry(step, view);
-        require_inside(entry.exr_path);
+        // A view of a light-field-only run has no proxy file: only its preview.
+        if (!entry.exr_path.empty()) require_inside(entry.exr_path);
         require_inside(entry.preview_path);
+        for (const ArchivedLightField& light_field : explorer_->archive().light_fields(step)) {
+            require_inside(light_field.exr_path);
+        }
     }
 
     static std::pair<std::int64_t, std::uintmax_t> stamp_of(const fs::path& path) {

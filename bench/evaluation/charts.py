@@ -19,7 +19,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-CHARTS = ["pareto", "rotation", "radiality", "clusters", "opacity_edits", "storage", "failures"]
+CHARTS = ["pareto", "rotation", "radiality", "clusters", "opacity_edits", "storage", "failures",
+          "light_fields"]
 DPI = 80
 SOURCES = {"multi45": "multi-perspective, tilt 45°", "multi20": "multi-perspective, tilt 20°",
            "single": "single perspective"}
@@ -84,6 +85,62 @@ def chart_pareto(d, rows, primary):
     fig.suptitle("Speed and size against accuracy (%s; one parameter varied at a time)" % primary)
     fig.tight_layout()
     fig.savefig(os.path.join(d, "pareto.png"), dpi=DPI)
+    plt.close(fig)
+
+
+def chart_light_fields(d, rows):
+    """Light fields (seed 001 Table 1 on our scenes) beside the single-view proxies and their
+    per-pixel fusion, all from the same random views: accuracy against bytes, error against
+    cameras, capture cost per camera against one single-perspective proxy pass."""
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
+    scenes = sorted({r["scene"] for r in rows})
+    markers = {"lightfield": "o", "single": "s", "fused": "D"}
+    for k, scene in enumerate(scenes):
+        colour = "C%d" % k
+        mine = [r for r in rows if r["scene"] == scene and r["edit"] == "0"]
+        for r in mine:
+            x, y = num(r, "stored_bytes") * 1e-6, num(r, "psnr")
+            axes[0].scatter([x], [y], s=22, marker=markers[r["source"]], color=colour)
+            label = r["source"] if r["source"] != "lightfield" else "%s@%s%s" % (
+                r["cameras"], r["map"], "" if r["depth_bits"] == "8" else " d16")
+            axes[0].annotate(label, (x, y), fontsize=6, xytext=(3, 2), textcoords="offset points")
+        front = pareto_front([(num(r, "stored_bytes") * 1e-6, num(r, "psnr")) for r in mine])
+        axes[0].step([p[0] for p in front], [p[1] for p in front], where="post", color=colour,
+                     label="%s Pareto front" % scene)
+        for size in sorted({r["map"] for r in mine if r["source"] == "lightfield"}, key=int):
+            pts = sorted((int(r["cameras"]), num(r, "mean_abs_percent")) for r in mine
+                         if r["source"] == "lightfield" and r["map"] == size
+                         and r["depth_bits"] == "8" and r["attenuation"] == "0")
+            axes[1].plot([p[0] for p in pts], [p[1] for p in pts], marker="o", color=colour,
+                         linestyle="-" if size == "512" else "--",
+                         label="%s, %s² maps" % (scene, size))
+            cost = sorted((int(r["cameras"]), num(r, "capture_ms_per_camera"),
+                           num(r, "proxy_pass_ms_per_camera")) for r in mine
+                          if r["source"] == "lightfield" and r["map"] == size
+                          and r["depth_bits"] == "8" and r["attenuation"] == "0")
+            axes[2].plot([p[0] for p in cost], [p[1] for p in cost], marker="o", color=colour,
+                         linestyle="-" if size == "512" else "--",
+                         label="%s capture, %s²" % (scene, size))
+            axes[2].plot([p[0] for p in cost], [p[2] for p in cost], marker="x", color=colour,
+                         linestyle=":", label="%s proxy pass, %s²" % (scene, size))
+    axes[0].set_xscale("log")
+    axes[0].set_xlabel("MB per step as stored")
+    axes[0].set_ylabel("PSNR dB, mean of random views")
+    axes[0].set_title("accuracy per byte (o light field, s single view, D fused)", fontsize=10)
+    axes[0].legend(fontsize=7, loc="lower right")
+    axes[1].axhline(2.0, color="grey", linestyle=":", label="goal 2 %")
+    axes[1].set_xscale("log")
+    axes[1].set_xlabel("cameras")
+    axes[1].set_ylabel("mean abs error per component, %")
+    axes[1].set_title("seed 001 Table 1 on our scenes", fontsize=10)
+    axes[1].legend(fontsize=7)
+    axes[2].set_xscale("log")
+    axes[2].set_xlabel("cameras")
+    axes[2].set_ylabel("ms per camera")
+    axes[2].set_title("capture cost per camera", fontsize=10)
+    axes[2].legend(fontsize=6)
+    fig.tight_layout()
+    fig.savefig(os.path.join(d, "light_fields.png"), dpi=DPI)
     plt.close(fig)
 
 
@@ -350,6 +407,33 @@ def write_markdown(d, path, prefix, elapsed):
                      "%.4f" % num(r, "depth_corr_30")])
     lines += [table(header, body), ""]
 
+    light = read(d, "light_fields")
+    if light:
+        lines += ["## Light fields (seed 001 Table 1 on our scenes)", "",
+                  "![light fields](%slight_fields.png)" % prefix, "",
+                  "Mean over %s random views (uniform over the sphere of directions) against the "
+                  "ground truth; mean abs error per colour component is premultiplied linear RGB "
+                  "x 255 over every pixel (the seed's measure) and over the pixels either image "
+                  "covers; coverage: share of the truth's hit pixels (alpha > 0.01) within 0.1; "
+                  "flagged: confidence < 0.5, among the covered pixels with error > 0.1 (wrong) "
+                  "and <= 0.1 (good). 'single' and 'fused' are the stored view's single-perspective "
+                  "proxies and the per-pixel fusion of both (Explorer source auto) from the same "
+                  "views." % light[0]["views"], ""]
+        header = ["scene", "source", "cameras", "map", "depth bits", "attenuation", "edit",
+                  "capture ms/camera", "proxy pass ms", "raw MB", "stored MB", "mean abs (0-255)",
+                  "mean abs %", "covered mean abs", "PSNR", "SSIM", "coverage", "wrong flagged",
+                  "good flagged", "ms/frame"]
+        body = [[r["scene"], r["source"], r["cameras"], r["map"], r["depth_bits"],
+                 r["attenuation"], r["edit"], "%.2f" % num(r, "capture_ms_per_camera"),
+                 "%.2f" % num(r, "proxy_pass_ms_per_camera"), "%.1f" % (num(r, "raw_bytes") / 1e6),
+                 "%.2f" % (num(r, "stored_bytes") / 1e6), "%.2f" % num(r, "mean_abs_255"),
+                 "%.2f" % num(r, "mean_abs_percent"), "%.2f" % num(r, "mean_abs_covered_255"),
+                 "%.1f" % num(r, "psnr"), "%.4f" % num(r, "ssim"), "%.3f" % num(r, "coverage"),
+                 "%.0f%%" % (100 * num(r, "flagged_fraction")),
+                 "%.0f%%" % (100 * num(r, "good_flagged_fraction")),
+                 "%.0f" % num(r, "reconstruct_ms")] for r in light]
+        lines += [table(header, body), ""]
+
     lines += ["## View synthesis against rotation (Fig. 6)", "", "![rotation](%srotation.png)" % prefix, "",
               "![radiality](%sradiality.png)" % prefix, ""]
     body = [[r["scene"], "%.1f" % num(r, "mean_radiality_deg"), "%.4f" % num(r, "corr_15"),
@@ -500,6 +584,7 @@ def main():
     chart_opacity_edits(d, read(d, "opacity_edits"))
     chart_storage(d, read(d, "storage"))
     chart_failures(d, read(d, "opacity_scale"), read(d, "intervals"), read(d, "occlusion"), read(d, "clusters"))
+    chart_light_fields(d, read(d, "light_fields"))
     chart_peer(d)
     write_markdown(d, args.markdown, args.image_prefix, args.elapsed)
     if args.check:

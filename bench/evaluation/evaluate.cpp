@@ -6,7 +6,7 @@
 // CSV files; bench/evaluation/charts.py draws them. Measures and prints; asserts nothing.
 //
 //   insitu_evaluate --out DIR [--smoke] [--sections a,b,...] [--raw PATH:NXxNYxNZ:TYPE ...]
-// Sections: rotation, curvature, colour, configurations, storage (default: all).
+// Sections: rotation, curvature, colour, configurations, storage, light_fields (default: all).
 #include <unistd.h>
 
 #include <algorithm>
@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <glm/trigonometric.hpp>
 #include <set>
 #include <sstream>
 #include <string>
@@ -31,6 +32,7 @@
 #include "insitu/explore/transfer_function_edit.hpp"
 #include "insitu/explore/view_synthesis.hpp"
 #include "insitu/instrument.hpp"
+#include "insitu/render/light_field_capture.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/metrics.hpp"
@@ -54,14 +56,15 @@ struct RawInput {
 struct Options {
     std::string out;
     bool smoke = false;
-    std::set<std::string> sections{"rotation", "curvature", "colour", "configurations", "storage"};
+    std::set<std::string> sections{"rotation",       "curvature", "colour",
+                                   "configurations", "storage",   "light_fields"};
     std::vector<RawInput> raw;
 };
 
 [[noreturn]] void usage_error(const std::string& message) {
     std::fprintf(stderr,
                  "insitu_evaluate: %s\nusage: insitu_evaluate --out DIR [--smoke] "
-                 "[--sections rotation,curvature,colour,configurations,storage] "
+                 "[--sections rotation,curvature,colour,configurations,storage,light_fields] "
                  "[--raw PATH:NXxNYxNZ:TYPE ...]\n",
                  message.c_str());
     std::exit(2);
@@ -797,6 +800,248 @@ void section_storage(const Options& options, const fs::path& scratch) {
     }
 }
 
+// ---------------------------------------------------------------------------------------------
+// Light fields (seed 001 Table 1 redone on our scenes): cameras x map size against error from
+// random views, bytes and cost; attenuation light fields under held-out opacity edits; and what
+// the single-view proxies and the per-pixel fusion of both give from the same views.
+
+struct LightFieldCase {
+    int cameras = 42;
+    int map = 256;
+    int depth_bits = 8;
+    bool attenuation = false;
+};
+
+std::vector<LightFieldCase> light_field_cases(bool smoke) {
+    if (smoke) return {{12, 64, 8, false}, {42, 64, 8, false}, {12, 64, 16, true}};
+    std::vector<LightFieldCase> cases;
+    for (int map : {256, 512}) {
+        for (int cameras : {12, 42, 162}) cases.push_back({cameras, map, 8, false});
+    }
+    cases.push_back({42, 256, 16, false});
+    cases.push_back({42, 512, 16, false});
+    cases.push_back({42, 256, 8, true});
+    return cases;
+}
+
+/// Error of one reconstructed frame against the ground truth, in the seed's measure (mean
+/// absolute error per colour component, premultiplied linear RGB x 255, over every pixel and
+/// over the pixels either image covers) and ours, with how its confidence flags the wrong pixels.
+struct FrameScore {
+    double mean_abs_255 = 0.0;          ///< all pixels
+    double mean_abs_covered_255 = 0.0;  ///< pixels where either alpha > 0.01
+    double psnr = 0.0, ssim = 0.0;
+    std::int64_t covered = 0, wrong = 0, wrong_flagged = 0, good_flagged = 0;
+    std::int64_t truth_hits = 0, truth_hits_right = 0;
+};
+
+FrameScore score_frame(const Image& truth, const ExploreFrame& frame) {
+    constexpr double kFlag = 0.5;  // the "flagged": confidence below one half
+    FrameScore score;
+    score.psnr = psnr_db(truth, frame.colour);
+    score.ssim = ssim_luminance(truth, frame.colour);
+    const std::vector<double> errors = pixel_errors_rgb(truth, frame.colour);
+    double sum = 0.0, covered_sum = 0.0;
+    for (std::size_t p = 0; p < errors.size(); ++p) {
+        double component_sum = 0.0;
+        for (int c = 0; c < 3; ++c) {
+            component_sum +=
+                std::abs(double(truth.pixels[4 * p + c]) - frame.colour.pixels[4 * p + c]);
+        }
+        sum += component_sum;
+        const bool truth_hit = truth.pixels[4 * p + 3] > 0.01f;
+        const bool covered = truth_hit || frame.colour.pixels[4 * p + 3] > 0.01f;
+        if (truth_hit) {
+            ++score.truth_hits;
+            if (errors[p] <= kColourErrorThreshold) ++score.truth_hits_right;
+        }
+        if (!covered) continue;
+        ++score.covered;
+        covered_sum += component_sum;
+        const bool flagged = frame.confidence.pixels[p] < kFlag;
+        if (errors[p] > kColourErrorThreshold) {
+            ++score.wrong;
+            if (flagged) ++score.wrong_flagged;
+        } else if (flagged) {
+            ++score.good_flagged;
+        }
+    }
+    score.mean_abs_255 = 255.0 * sum / (3.0 * errors.size());
+    score.mean_abs_covered_255 =
+        score.covered > 0 ? 255.0 * covered_sum / (3.0 * score.covered) : 0.0;
+    return score;
+}
+
+void section_light_fields(const std::vector<const Scene*>& scenes, const Options& options,
+                          const fs::path& scratch, int image) {
+    Csv csv(fs::path(options.out) / "light_fields.csv",
+            "scene,source,cameras,map,depth_bits,attenuation,edit,views,capture_ms,"
+            "capture_ms_per_camera,proxy_pass_ms_per_camera,raw_bytes,stored_bytes,"
+            "mean_abs_255,mean_abs_percent,mean_abs_covered_255,psnr,ssim,coverage,"
+            "high_error_fraction,flagged_fraction,good_flagged_fraction,light_field_share,"
+            "reconstruct_ms");
+    const int views = options.smoke ? 3 : 30;
+    const int repeats = options.smoke ? 1 : 3;
+    int archive_index = 0;
+    for (const Scene* scene : scenes) {
+        const auto start = std::chrono::steady_clock::now();
+        ProxyRenderer renderer;
+        renderer.upload(scene->volume.field());
+        const Bounds& bounds = renderer.volume().bounds;
+        const TransferFunction stored_tf = make_tf(*scene);
+        const IntervalSet intervals = scene_intervals(*scene, 16);
+        const std::vector<double> isovalues = scene_layers(*scene, 4);
+        const Camera stored = Camera::orbit(stored_view(image), bounds);
+        // The same random views for every case: uniform over the sphere of directions.
+        std::vector<std::pair<double, double>> angles;
+        std::uint32_t state = 12345u;
+        auto uniform = [&state] {
+            state = state * 1664525u + 1013904223u;
+            return (state >> 8) / double(1u << 24);
+        };
+        for (int v = 0; v < views; ++v) {
+            const double azimuth = 360.0 * uniform();
+            const double elevation = glm::degrees(std::asin(2.0 * uniform() - 1.0));
+            angles.emplace_back(azimuth, elevation);
+        }
+        std::vector<Image> truths;
+        for (const auto& [azimuth, elevation] : angles) {
+            truths.push_back(renderer
+                                 .render_ground_truth(stored.reorbit(azimuth, elevation), stored_tf,
+                                                      truth_settings())
+                                 .rgba);
+        }
+        const std::vector<TfSpec> edits = held_out_edits(views);
+
+        // The stored view's proxies, as the Instrument makes them (single perspective).
+        ProxyRequest view_request = proxy_request(*scene, stored_tf, 16, 4);
+        view_request.march.tf_value_bins = RenderSettings{}.tf_value_bins;
+        const ProxyFrame single = renderer.render(stored, view_request);
+
+        for (const LightFieldCase& c : light_field_cases(options.smoke)) {
+            LightFieldRequest request;
+            request.settings.cameras = c.cameras;
+            request.settings.size = c.map;
+            request.settings.depth_bits = c.depth_bits;
+            request.settings.attenuation = c.attenuation;
+            request.transfer_function = stored_tf;
+            request.isovalues = isovalues;
+            request.intervals = intervals;
+            const LightFieldRig rig = LightFieldRig::around(bounds, c.cameras, c.map);
+            LightField light_field;
+            const double capture_ms =
+                median_ms(1, [&] { light_field = capture_light_field(renderer, rig, request); });
+            // One single-perspective proxy pass of the same pixel count (layers, attenuation,
+            // mean depth): the bound on capture per camera.
+            const double proxy_ms =
+                median_ms(repeats, [&] { renderer.render(rig.camera(0), view_request); });
+
+            // Into an archive, as the Instrument writes a step.
+            InstrumentConfig config;
+            config.fields = {scene->volume.name};
+            config.views[0].orbit = stored_view(image);
+            config.transfer_function = stored_tf;
+            config.layers = isovalues;
+            config.proxies.distortion = false;
+            config.light_field = request.settings;
+            config.archive = (scratch / ("lightfield" + std::to_string(archive_index++))).string();
+            StepRecord record;
+            record.step = 0;
+            record.field = scene->volume.name;
+            ViewRecord view;
+            view.field = scene->volume.name;
+            view.view = config.views[0];
+            view.single = single;
+            view.preview = renderer.render_ground_truth(stored, stored_tf, truth_settings()).rgba;
+            view.transfer_function = stored_tf;
+            record.views.push_back(std::move(view));
+            record.light_fields.push_back({scene->volume.name, std::move(light_field)});
+            ArchiveWriter(config).write(record);
+            record = StepRecord{};
+            const std::vector<ArchivedLightField> stored_fields =
+                ArchiveReader(config.archive).light_fields(0);
+            const unsigned long long stored_bytes =
+                stored_fields.empty() ? 0 : fs::file_size(stored_fields.front().exr_path);
+            // The stored view's proxies (depth layers, attenuation, mean depth): what the
+            // single-view rows cost.
+            const unsigned long long view_bytes =
+                fs::file_size(ArchiveReader(config.archive).entry(0, 0).exr_path);
+            // Half RGBA, depth at its bits, half a_j and mean depth per interval.
+            const unsigned long long per_pixel =
+                8ull + c.depth_bits / 8 + (c.attenuation ? 4ull * 16 : 0ull);
+            const unsigned long long raw_bytes =
+                per_pixel * c.cameras * static_cast<unsigned long long>(c.map) * c.map;
+
+            Explorer explorer(config.archive);
+            auto run = [&](const char* source_name, ProxySource source, bool edit,
+                           unsigned long long bytes) {
+                FrameScore total;
+                double psnr = 0, ssim = 0, covered_abs = 0, share = 0, ms = 0;
+                for (int v = 0; v < views; ++v) {
+                    ExploreRequest explore;
+                    explore.azimuth_deg = angles[v].first;
+                    explore.elevation_deg = angles[v].second;
+                    explore.source = source;
+                    Image edited_truth;
+                    if (edit) {
+                        explore.transfer_function = make_tf(*scene, edits[v]);
+                        edited_truth = renderer
+                                           .render_ground_truth(
+                                               stored.reorbit(angles[v].first, angles[v].second),
+                                               *explore.transfer_function, truth_settings())
+                                           .rgba;
+                    }
+                    const ExploreFrame frame = explorer.render(explore);
+                    const FrameScore score = score_frame(edit ? edited_truth : truths[v], frame);
+                    total.mean_abs_255 += score.mean_abs_255 / views;
+                    covered_abs += score.mean_abs_covered_255 / views;
+                    psnr += score.psnr / views;
+                    ssim += score.ssim / views;
+                    share += frame.light_field_share / views;
+                    ms += frame.milliseconds / views;
+                    total.covered += score.covered;
+                    total.wrong += score.wrong;
+                    total.wrong_flagged += score.wrong_flagged;
+                    total.good_flagged += score.good_flagged;
+                    total.truth_hits += score.truth_hits;
+                    total.truth_hits_right += score.truth_hits_right;
+                }
+                const double good = double(total.covered - total.wrong);
+                csv.row(
+                    scene->name, source_name, c.cameras, c.map, c.depth_bits, c.attenuation ? 1 : 0,
+                    edit ? 1 : 0, views, capture_ms, capture_ms / c.cameras, proxy_ms, raw_bytes,
+                    bytes, total.mean_abs_255, 100.0 * total.mean_abs_255 / 255.0, covered_abs,
+                    psnr, ssim,
+                    total.truth_hits > 0 ? double(total.truth_hits_right) / total.truth_hits : 1.0,
+                    total.covered > 0 ? double(total.wrong) / total.covered : 0.0,
+                    total.wrong > 0 ? double(total.wrong_flagged) / total.wrong : 1.0,
+                    good > 0 ? total.good_flagged / good : 0.0, share, ms);
+                std::printf(
+                    "light fields: %s %s %d cameras %d^2 depth %d%s: mean error %.2f (%.2f%%), "
+                    "PSNR %.1f dB, flagged %.0f%% of wrong, %.0f%% of good, %.0f ms/frame\n",
+                    scene->name.c_str(), source_name, c.cameras, c.map, c.depth_bits,
+                    edit ? " edits" : "", total.mean_abs_255, 100.0 * total.mean_abs_255 / 255.0,
+                    psnr, total.wrong > 0 ? 100.0 * total.wrong_flagged / total.wrong : 100.0,
+                    good > 0 ? 100.0 * total.good_flagged / good : 0.0, ms);
+            };
+            run("lightfield", ProxySource::lightfield, false, stored_bytes);
+            if (c.attenuation) run("lightfield", ProxySource::lightfield, true, stored_bytes);
+            // What each kind adds: the view's own proxies, and both fused per pixel.
+            if (c.cameras == 42 && c.depth_bits == 8 && !c.attenuation) {
+                run("single", ProxySource::single, false, view_bytes);
+                run("fused", ProxySource::automatic, false, view_bytes + stored_bytes);
+            }
+            std::printf(
+                "light fields: %s %d cameras %d^2: capture %.0f ms (%.2f ms/camera, "
+                "proxy pass %.2f ms), %.2f MB stored, %.2f MB raw\n",
+                scene->name.c_str(), c.cameras, c.map, capture_ms, capture_ms / c.cameras, proxy_ms,
+                stored_bytes / 1e6, raw_bytes / 1e6);
+            fs::remove_all(config.archive);
+        }
+        std::printf("light fields: %s, %.1f s\n", scene->name.c_str(), ms_since(start) / 1e3);
+    }
+}
+
 std::string cpu_model() {
     std::ifstream in("/proc/cpuinfo");
     std::string line;
@@ -874,6 +1119,10 @@ int main(int argc, char** argv) {
             section_configurations(all, primary, options, scratch);
         }
         if (options.sections.count("storage")) section_storage(options, scratch);
+        if (options.sections.count("light_fields")) {
+            // The goal scenes: Gray-Scott and Marschner-Lobb.
+            section_light_fields({&primary, &analytic[2]}, options, scratch, image);
+        }
         fs::remove_all(scratch);
         std::printf("insitu_evaluate: done in %.1f s\n", ms_since(start) / 1e3);
     } catch (const std::exception& error) {

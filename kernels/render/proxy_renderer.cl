@@ -6,8 +6,12 @@
 // the kernel accumulates into them in place: a pixel's intervals share one or two cache lines,
 // whereas private arrays indexed by a data-dependent interval cost PoCL about 3x the whole pass.
 
-// MAX_LAYERS and the WANT_* bits of `wanted` come from the host as -D options
-// (libinsitu/src/device/kernel_constants.hpp).
+// Segment outputs (light-field capture, seed 001 §7) are planar too: segment s of pixel p at
+// s * pixel_count + p. Samples reach the segments in order, so only the segment being composited
+// lives in private memory; each is stored once, when the ray leaves it.
+
+// MAX_LAYERS, the WANT_* bits of `wanted` and the SEGMENTS_* rules come from the host as -D
+// options (libinsitu/src/device/kernel_constants.hpp).
 
 // Interval of a value: [edges[j], edges[j+1]), last closed, outside values to the end intervals.
 inline int interval_of(__global const float* edges, int count, float value) {
@@ -23,6 +27,15 @@ inline int interval_of(__global const float* edges, int count, float value) {
     return low;
 }
 
+// Stores segment s of a pixel: premultiplied colour and opacity 1 - T, and its first-hit depth.
+inline void store_segment(int wanted, __global float4* rgba_out, __global float* depth_out,
+                          int index, float3 colour, float transmittance, float depth) {
+    if ((wanted & WANT_SEGMENT_RGBA) != 0) {
+        rgba_out[index] = (float4)(colour, 1.0f - transmittance);
+    }
+    if ((wanted & WANT_SEGMENT_DEPTH) != 0) depth_out[index] = depth;
+}
+
 __kernel void render_proxies(
     __global const float* volume, int4 dims, float4 origin_world, float4 inv_spacing,
     float4 box_lower, float4 box_upper, __global const float4* tf_table, int2 tf_bins,
@@ -31,8 +44,11 @@ __kernel void render_proxies(
     __global const float* isovalues, int interval_count, float uniform_interval_scale,
     __global const float* interval_edges, __global float* depth_out, __global float* distortion_out,
     __global float* attenuation_out,  // always given when accumulating
-    __global float* mean_depth_out, __global float* optical_depth_out,
-    __global const uchar* skippable_blocks, int4 block_counts, int block_size) {
+    __global float* mean_depth_out, __global float* optical_depth_out, int segment_rule,
+    int segment_count, __global const float* segment_thresholds, float depth_threshold,
+    __global float4* segment_rgba_out, __global float* segment_depth_out,
+    __global float* first_hit_out, __global const uchar* skippable_blocks, int4 block_counts,
+    int block_size) {
     const int x = get_global_id(0);
     const int y = get_global_id(1);
     if (x >= size.x || y >= size.y) return;
@@ -54,6 +70,12 @@ __kernel void render_proxies(
     const bool want_attenuation = (wanted & WANT_ATTENUATION) != 0;
     const bool want_mean_depth = (wanted & WANT_MEAN_DEPTH) != 0;
     const bool want_optical_depth = (wanted & WANT_OPTICAL_DEPTH) != 0;
+    const bool want_segments =
+        (wanted & (WANT_SEGMENT_RGBA | WANT_SEGMENT_DEPTH | WANT_FIRST_HIT_DEPTH)) != 0;
+    // Segments split at the layers' crossings need them found even where depth layers are not
+    // stored; the host then passes the isovalues as layers all the same.
+    const bool find_crossings =
+        layer_count > 0 && (want_layers || (want_segments && segment_rule == SEGMENTS_LAYERS));
 
     float layer_t[MAX_LAYERS];
     for (int l = 0; l < layer_count; ++l) layer_t[l] = INFINITY;
@@ -71,9 +93,22 @@ __kernel void render_proxies(
         }
     }
 
+    // The segment being composited, front to back from T = 1 on its own; the whole ray's T,
+    // which the opacity thresholds split at, and its first hit.
+    int segment = 0;
+    float3 segment_colour = (float3)(0.0f);
+    float segment_transmittance = 1.0f;
+    float segment_depth = INFINITY;
+    float ray_transmittance = 1.0f;
+    float first_hit = INFINITY;
+
     if (ray_hits_box(&ray)) {
         float transmittance = 1.0f;
         bool accumulating = accumulate;
+        // Like `accumulating`, these stop at the early-termination opacity: the segment's own,
+        // and the whole ray's (which only opacity thresholds and the first hit read).
+        bool compositing_segment = want_segments;
+        bool compositing_ray = want_segments;
         float previous_value = NAN;
         float previous_t = 0.0f;
         float next_block_t = -INFINITY;  // t where the ray leaves the block looked up last
@@ -86,7 +121,7 @@ __kernel void render_proxies(
                 previous_value = NAN;
                 continue;
             }
-            if (want_layers && !isnan(previous_value)) {
+            if (find_crossings && !isnan(previous_value)) {
                 for (int l = 0; l < layer_count; ++l) {
                     const float iso = isovalues[l];
                     if (isinf(layer_t[l]) && ((previous_value >= iso) != (value >= iso))) {
@@ -100,9 +135,43 @@ __kernel void render_proxies(
             previous_value = value;
             previous_t = t;
 
-            if (accumulating) {
-                const float alpha = lookup_transfer(tf_table, tf_bins, tf_domain, value, 0.0f).w;
-                if (alpha > 0.0f) {
+            if (want_segments) {
+                // The segment of this sample (insitu/render/light_field_capture.hpp): a crossing
+                // between the previous sample and this one starts the next; so does the ray's
+                // opacity before this sample reaching the next threshold.
+                int sample_segment = segment;
+                if (segment_rule == SEGMENTS_LAYERS) {
+                    sample_segment = layers_found;
+                } else if (segment_rule == SEGMENTS_OPACITY) {
+                    while (sample_segment + 1 < segment_count &&
+                           1.0f - ray_transmittance >= segment_thresholds[sample_segment]) {
+                        ++sample_segment;
+                    }
+                }
+                if (sample_segment != segment) {
+                    store_segment(wanted, segment_rgba_out, segment_depth_out,
+                                  segment * pixel_count + pixel, segment_colour,
+                                  segment_transmittance, segment_depth);
+                    // Segments passed over at once (two crossings between two samples, or two
+                    // thresholds reached by one sample) stay empty.
+                    for (int s = segment + 1; s < sample_segment; ++s) {
+                        store_segment(wanted, segment_rgba_out, segment_depth_out,
+                                      s * pixel_count + pixel, (float3)(0.0f), 1.0f, INFINITY);
+                    }
+                    segment = sample_segment;
+                    segment_colour = (float3)(0.0f);
+                    segment_transmittance = 1.0f;
+                    segment_depth = INFINITY;
+                    compositing_segment = true;
+                }
+            }
+
+            if (accumulating || compositing_segment || compositing_ray) {
+                // Colour and step-corrected opacity, unshaded, as the ground truth classifies.
+                const float4 classified =
+                    lookup_transfer(tf_table, tf_bins, tf_domain, value, 0.0f);
+                const float alpha = classified.w;
+                if (accumulating && alpha > 0.0f) {
                     // Uniform intervals (the default) need no search: L / (max - min) > 0.
                     const int j =
                         uniform_interval_scale > 0.0f
@@ -118,8 +187,34 @@ __kernel void render_proxies(
                     }
                     if (1.0f - transmittance >= stop_opacity) accumulating = false;
                 }
+                if (alpha > 0.0f && compositing_segment) {
+                    segment_colour += absorb(&segment_transmittance, alpha) * classified.xyz;
+                    if (isinf(segment_depth) && 1.0f - segment_transmittance >= depth_threshold) {
+                        segment_depth = sample_depth(&ray, t);
+                    }
+                    if (1.0f - segment_transmittance >= stop_opacity) compositing_segment = false;
+                }
+                if (alpha > 0.0f && compositing_ray) {
+                    absorb(&ray_transmittance, alpha);
+                    if (isinf(first_hit) && 1.0f - ray_transmittance >= depth_threshold) {
+                        first_hit = sample_depth(&ray, t);
+                    }
+                    if (1.0f - ray_transmittance >= stop_opacity) compositing_ray = false;
+                }
             }
-            if (!accumulating && (!want_layers || layers_found == layer_count)) break;
+            // Once both have finished, the march still waits for the next segment where one can
+            // start: at a crossing not yet found, or at a threshold the (now fixed) ray opacity
+            // has reached.
+            bool segments_marching = compositing_segment || compositing_ray;
+            if (want_segments && !segments_marching && segment + 1 < segment_count) {
+                segments_marching = segment_rule == SEGMENTS_LAYERS ||
+                                    (segment_rule == SEGMENTS_OPACITY &&
+                                     1.0f - ray_transmittance >= segment_thresholds[segment]);
+            }
+            if (!accumulating && !segments_marching &&
+                (!want_layers || layers_found == layer_count)) {
+                break;
+            }
 
             // Empty-space skipping, exact: in a skippable block every sample has zero opacity and
             // lies on one side of every isovalue. Having evaluated this (first) sample of the
@@ -145,6 +240,15 @@ __kernel void render_proxies(
         }
     }
 
+    if (want_segments) {
+        store_segment(wanted, segment_rgba_out, segment_depth_out, segment * pixel_count + pixel,
+                      segment_colour, segment_transmittance, segment_depth);
+        for (int s = segment + 1; s < segment_count; ++s) {
+            store_segment(wanted, segment_rgba_out, segment_depth_out, s * pixel_count + pixel,
+                          (float3)(0.0f), 1.0f, INFINITY);
+        }
+        if ((wanted & WANT_FIRST_HIT_DEPTH) != 0) first_hit_out[pixel] = first_hit;
+    }
     if (want_layers) {
         for (int l = 0; l < layer_count; ++l) {
             const float t = layer_t[l];

@@ -536,6 +536,14 @@ const Key<InstrumentConfig> kTopLevelKeys[] = {
          config.on_existing = choose(value, key, kOnExisting);
      },
      [](const InstrumentConfig& config) { return json(name_of(config.on_existing, kOnExisting)); }},
+    {"light_field",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
+         require_object(value, key);
+         config.light_field = LightFieldSettings::from_json(value, &unknown);
+     },
+     [](const InstrumentConfig& config) {
+         return config.light_field ? config.light_field->to_json() : json();
+     }},
 };
 
 // The key names of each object of the configuration, by the name of the key that holds the
@@ -554,6 +562,7 @@ std::vector<std::string> known_keys_under(const std::string& parent) {
     if (parent == "intervals") return names_of(kIntervalKeys);
     if (parent == "writer") return names_of(kWriterKeys);
     if (parent == "colour_model") return names_of(kColourModelKeys);
+    if (parent == "light_field") return LightFieldSettings::keys();
     if (parent == "transfer_function" || parent == "training_transfer_functions") {
         return {kTransferFunctionKeys.begin(), kTransferFunctionKeys.end()};
     }
@@ -778,6 +787,7 @@ void InstrumentConfig::validate() const {
         }
     }
     if (archive.empty()) out_of_range("archive", "\"\"", "name the archive directory");
+    if (light_field) light_field->validate();
     if (std::find(kCompressions.begin(), kCompressions.end(), compression) == kCompressions.end()) {
         out_of_range("compression", "\"" + compression + "\"",
                      "expected none, rle, zips, zip, piz, pxr24 or b44");
@@ -827,7 +837,14 @@ double InstrumentConfig::estimated_samples_per_step() const {
     for (const PlannedView& planned : planned_views()) {
         pixels += static_cast<double>(planned.view.orbit.width) * planned.view.orbit.height;
     }
-    return pixels * passes_per_view() * (kWorstDiagonalVoxels / step_voxels);
+    return (pixels * passes_per_view() + light_field_pixels_per_step()) *
+           (kWorstDiagonalVoxels / step_voxels);
+}
+
+double InstrumentConfig::light_field_pixels_per_step() const {
+    if (!light_field) return 0.0;
+    return static_cast<double>(fields.size()) * light_field->cameras *
+           static_cast<double>(light_field->size) * light_field->size;
 }
 
 namespace {

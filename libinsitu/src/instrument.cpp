@@ -21,6 +21,7 @@
 #include "insitu/error.hpp"
 #include "insitu/explore/colour_model.hpp"
 #include "insitu/render/distortion_camera.hpp"
+#include "insitu/render/light_field_capture.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 
 namespace insitu {
@@ -342,6 +343,20 @@ void Instrument::Impl::compute_field(const Field& field, StepRecord& record) {
         out.preview =
             renderer->render_ground_truth(camera, transfer_function, preview_settings).rgba;
         record.views.push_back(std::move(out));
+    }
+
+    // The light field (seed 001) takes the proxies' samples, layers and intervals, so its
+    // segments and attenuation mean what the views' proxies mean.
+    if (config.light_field) {
+        LightFieldRequest request;
+        request.settings = *config.light_field;
+        request.transfer_function = transfer_function;
+        request.isovalues = isovalues;
+        if (request.settings.attenuation) request.intervals = intervals;
+        request.march.step_voxels = config.step_voxels;
+        const LightFieldRig rig =
+            LightFieldRig::around(volume.bounds, request.settings.cameras, request.settings.size);
+        record.light_fields.push_back({field.name(), capture_light_field(*renderer, rig, request)});
     }
 }
 

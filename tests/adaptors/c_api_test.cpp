@@ -677,6 +677,38 @@ TEST_F(CApiTest, FailedHandOversAreCountedAndTheRootCauseReportedAtFinalize) {
     EXPECT_TRUE(contains(summary, "first error: insitu_set_field: field \"pressure\"")) << summary;
 }
 
+// --- Light fields (issue 14): the C API takes them through the configuration. ---
+
+TEST(CApiLightField, TheConfigurationsLightFieldIsArchivedAndBadOnesAreNamed) {
+    const fs::path directory = fresh_directory();
+    const fs::path archive = directory / "run.cdb";
+    std::string config = small_config(archive, 1);
+    config.insert(config.size() - 1, R"(, "light_field": {"cameras": 12, "size": 16})");
+    insitu_instrument* instrument = nullptr;
+    ASSERT_EQ(insitu_create_from_json(config.c_str(), &instrument), INSITU_OK)
+        << insitu_last_error();
+    BallField ball;
+    ASSERT_EQ(insitu_set_field(instrument, "v", ball.samples.data(), INSITU_FLOAT32, ball.dims,
+                               ball.origin, ball.spacing, ball.ghosts),
+              INSITU_OK)
+        << insitu_last_error();
+    ASSERT_EQ(insitu_execute(instrument, 3, 0.3), INSITU_OK) << insitu_last_error();
+    ASSERT_EQ(insitu_finalize(instrument), INSITU_OK) << insitu_last_error();
+    insitu_destroy(instrument);
+    EXPECT_TRUE(fs::exists(archive / "proxies" / "step000003_lightfield0.exr"));
+    std::ifstream manifest(archive / "manifest.json");
+    const std::string text((std::istreambuf_iterator<char>(manifest)),
+                           std::istreambuf_iterator<char>());
+    EXPECT_TRUE(contains(text, "\"light_fields\"")) << text;
+
+    std::string bad = small_config(directory / "bad.cdb", 1);
+    bad.insert(bad.size() - 1, R"(, "light_field": {"cameras": 40})");
+    EXPECT_EQ(insitu_create_from_json(bad.c_str(), &instrument), INSITU_ERROR_INVALID_ARGUMENT);
+    EXPECT_EQ(instrument, nullptr);
+    EXPECT_TRUE(contains(insitu_last_error(), "light_field.cameras")) << insitu_last_error();
+    fs::remove_all(directory);
+}
+
 // --- insitu_last_error and insitu_status_name ---
 
 TEST(CApiLastError, IsPerThread) {

@@ -312,7 +312,7 @@ TEST_F(Archive, RenderedProxiesRoundTrip) {
     view.preview = view.single->training.at(0);
     view.transfer_function = *request.transfer_function;
     view.training_transfer_functions = {ramp(0.3f)};
-    StepRecord step{42, 4.2, "v", {view}};
+    StepRecord step{42, 4.2, "v", {view}, {}};
 
     ArchiveWriter(config_).write(step);
     const ArchiveReader reader(archive().string());

@@ -100,3 +100,61 @@ view_case(missing_tf_file 2 STDERR "--tf: cannot read" render ${view_archive} --
           --tf ${CMAKE_CURRENT_BINARY_DIR}/no_such_tf.json --out ${view_output}/never.png)
 view_case(bad_extension 2 STDERR "never.bmp" render ${view_archive} --step 4
           --out ${view_output}/never.bmp)
+
+# Light fields (issue 14): a Gray-Scott archive with a 12-camera light field split at the layer,
+# then info, verify and render from the light field (new view, segment fade, TF edit), fused with
+# the view's proxies (auto), and the errors for a segment the light field lacks.
+set(lf_archive ${CMAKE_CURRENT_BINARY_DIR}/insitu_view_lf.cdb)
+set(lf_config ${CMAKE_CURRENT_BINARY_DIR}/insitu_view_lf_config.json)
+set(lf_output ${CMAKE_CURRENT_BINARY_DIR}/insitu_view_lf_output)
+file(WRITE ${lf_config} [=[
+{"fields": ["v"],
+ "views": [{"azimuth": 30, "elevation": 20, "size": [48, 48]}],
+ "transfer_function": {"points": [[0.0, 0, 0, 1, 0], [0.1, 0, 0.5, 1, 0.2], [0.4, 1, 0.3, 0, 1]],
+                       "unit_length": 1.0},
+ "layers": [0.2], "intervals": {"count": 8}, "proxies": ["depth", "attenuation"],
+ "steps": [8],
+ "light_field": {"cameras": 12, "size": 48, "segments": "layers", "depth_bits": 8}}
+]=])
+add_test(NAME insitu_view.setup_lf_clean
+         COMMAND ${CMAKE_COMMAND} -E rm -rf ${lf_archive} ${lf_output})
+add_test(NAME insitu_view.setup_lf_output COMMAND ${CMAKE_COMMAND} -E make_directory ${lf_output})
+add_test(NAME insitu_view.setup_lf_archive
+         COMMAND gray-scott --size 24 --steps 8 --config ${lf_config} --out ${lf_archive})
+set_tests_properties(insitu_view.setup_lf_clean PROPERTIES FIXTURES_SETUP insitu_view_lf_clean)
+set_tests_properties(insitu_view.setup_lf_output PROPERTIES FIXTURES_REQUIRED insitu_view_lf_clean
+                     FIXTURES_SETUP insitu_view_lf_output)
+set_tests_properties(insitu_view.setup_lf_archive PROPERTIES
+                     FIXTURES_REQUIRED insitu_view_lf_output
+                     FIXTURES_SETUP insitu_view_lf_archive TIMEOUT 120)
+function(light_field_case name exit_status stream text)
+  string(JOIN "|" command $<TARGET_FILE:insitu-view> ${ARGN})
+  add_test(NAME insitu_view.${name}
+           COMMAND ${CMAKE_COMMAND} -DEXPECTED_EXIT=${exit_status}
+                   "-DEXPECTED_${stream}_SUBSTRING=${text}" "-DCOMMAND=${command}"
+                   -P ${view_cli_dir}/expect_exit.cmake)
+  set_tests_properties(insitu_view.${name} PROPERTIES
+                       FIXTURES_REQUIRED insitu_view_lf_archive TIMEOUT 60)
+endfunction()
+light_field_case(info_light_field 0 STDOUT
+                 "light field   v: 12 cameras, 48^2 maps, 2 segment(s), attenuation yes, depth 8"
+                 info ${lf_archive})
+light_field_case(verify_light_field 0 STDOUT "0 problems" verify ${lf_archive})
+light_field_case(render_light_field 0 STDERR "new view from lightfield" render ${lf_archive}
+                 --step 8 --azimuth 200 --elevation -30 --source lightfield
+                 --out ${lf_output}/light_field.png)
+light_field_case(render_light_field_fade 0 STDERR "new view from lightfield" render
+                 ${lf_archive} --step 8 --azimuth 200 --source lightfield --segment-opacity 1=0
+                 --out ${lf_output}/light_field_fade.png)
+light_field_case(render_light_field_edit 0 STDERR "colour by recompose" render ${lf_archive}
+                 --step 8 --azimuth 200 --source lightfield --tf ${edited_tf}
+                 --out ${lf_output}/light_field_edit.png)
+light_field_case(render_fused 0 STDERR "new view from auto" render ${lf_archive} --step 8
+                 --azimuth 120 --out ${lf_output}/fused.png)
+light_field_case(render_stored_keeps_proxies 0 STDERR "stored view from single" render
+                 ${lf_archive} --step 8 --out ${lf_output}/lf_stored.png)
+light_field_case(bad_segment 2 STDERR "segment-opacity segment 5" render ${lf_archive} --step 8
+                 --azimuth 200 --source lightfield --segment-opacity 5=0
+                 --out ${lf_output}/never.png)
+view_case(no_light_field 2 STDERR "has no light field" render ${view_archive} --step 4
+          --azimuth 200 --source lightfield --out ${lf_output}/never.png)

@@ -11,7 +11,9 @@
 //  "proxies": ["depth", "distortion", "attenuation"], "step": 1.0, "every": 10,
 //  "archive": "run.cdb", "precision": "half", "compression": "zip",
 //  "writer": {"queue": 4, "when_full": "block"},
-//  "colour_model": {"clusters": 24, "enabled": true}}
+//  "colour_model": {"clusters": 24, "enabled": true},
+//  "light_field": {"cameras": 42, "size": 256, "segments": "layers", "attenuation": true,
+//                  "depth_bits": 8, "depth_threshold": 0.1}}
 //
 // Every key is optional; defaults are listed on the members below. Unknown keys (at any level)
 // are collected by name, not silently ignored: an Instrument refuses them unless "strict" is
@@ -36,6 +38,7 @@
 
 #include "insitu/core/camera.hpp"
 #include "insitu/core/intervals.hpp"
+#include "insitu/core/light_field.hpp"
 #include "insitu/core/transfer_function.hpp"
 
 namespace insitu {
@@ -162,6 +165,9 @@ struct InstrumentConfig {
     /// them warnings.
     bool strict = true;
     OnExisting on_existing = OnExisting::append;  ///< "on_existing"
+    /// "light_field": per step and field, a light field (seed 001) from an icosphere of cameras
+    /// (insitu/core/light_field.hpp), captured in the proxy pass; none by default.
+    std::optional<LightFieldSettings> light_field;
 
     /// The views of `field` (its own, or the top-level ones), its transfer function, its layers,
     /// and whether the training transfer functions apply to it (it uses the top-level function).
@@ -195,7 +201,10 @@ struct InstrumentConfig {
     /// any is requested), the preview, and per training function its ground truth and, when the
     /// colour model is fitted, its attenuation (as Instrument::execute renders them).
     int passes_per_view() const;
-    /// Samples one step costs at most: the views' pixels x passes_per_view() x samples per ray
+    /// Pixels of one step's light fields (cameras x size^2 per field; 0 without "light_field").
+    double light_field_pixels_per_step() const;
+    /// Samples one step costs at most: the views' pixels x passes_per_view() (+ the light
+    /// fields' pixels, one pass each) x samples per ray
     /// along kWorstDiagonalVoxels at "step" (seed 002's cost model, DESIGN.md "Performance").
     double estimated_samples_per_step() const;
 };

@@ -18,9 +18,26 @@
 // libinsitu.model_intervals (L), libinsitu.model_clusters (K), libinsitu.model_layout (the row
 // layout in words) and libinsitu.model_training_transfer_functions (the functions it was
 // fitted on, JSON); it is written whenever the frame has a model, kept training images or not.
+//
+// One multi-part OpenEXR file per step and light field (seed 001), a part per camera, so that a
+// reader decodes only the cameras it asks for (k: the camera's index in the rig, s: segment):
+//   part "camera<k>"   camera<k>.R, .G, .B, .A            (one segment: the whole ray)
+//                      camera<k>.segment<s>.R, .G, .B, .A, camera<k>.segment<s>.depth (S > 1)
+//                      camera<k>.depth                    first hit
+//                      camera<k>.a00 .., camera<k>.zmean00 ..   (the attenuation light field)
+// RGBA, attenuation and mean depth (world units, as in the views) are HALF or FLOAT by
+// "precision". Depth is a secant fraction (seed 001 Eq. 3): HALF for depth_bits 16 (+inf no
+// hit); for depth_bits 8 the code round(f * 254), 255 = no hit, as UINT or as HALF code / 254
+// (+inf no hit), whichever compresses smaller under the archive's compression (UINT under b44,
+// which is lossy for HALF; light_field_exr.cpp). Every part carries libinsitu.{schema_version,
+// step, time, field, light_field, isovalues, intervals (when present), transfer_function,
+// camera_index, camera, depth_encoding}; the first part also the rig (libinsitu.rig), whose camera
+// positions grow with the camera count, so that the file's headers do not grow with its square.
 #include <cstdint>
 #include <cstdio>
 #include <string>
+
+#include "insitu/core/layers.hpp"
 
 namespace insitu::archive_format {
 
@@ -54,7 +71,8 @@ inline constexpr const char* kLayerChannel = ".layer";
 inline constexpr const char* kAttenuationChannel = ".a";
 inline constexpr const char* kMeanDepthChannel = ".zmean";
 inline constexpr const char* kOpticalDepthChannel = ".tau";
-inline constexpr const char* kTrainingChannels[4] = {".R", ".G", ".B", ".A"};
+inline constexpr const char* kRgbaChannels[4] = {".R", ".G", ".B", ".A"};
+inline constexpr const char* const (&kTrainingChannels)[4] = kRgbaChannels;
 inline constexpr const char* kModelChannel = ".table";
 
 // Header attributes of every part (StringAttribute holding JSON unless noted).
@@ -82,6 +100,32 @@ inline constexpr const char* kModelFunctionsAttribute =
 inline constexpr const char* kModelLayout =
     "one row per cluster: a0[0..L-1], c0 R G B, J row-major 3 x L (R row, G row, B row)";
 
+// Light fields (the table above).
+/// The step entry's list of light-field files in manifest.json and the journal.
+inline constexpr const char* kLightFieldsKey = "light_fields";
+inline constexpr const char* kCameraPartPrefix = "camera";
+inline constexpr const char* kSegmentChannel = ".segment";
+inline constexpr const char* kDepthChannel = ".depth";
+inline constexpr const char* kLightFieldAttribute = "libinsitu.light_field";    // settings JSON
+inline constexpr const char* kRigAttribute = "libinsitu.rig";                   // first part only
+inline constexpr const char* kCameraIndexAttribute = "libinsitu.camera_index";  // int
+/// How the part's depth channels encode the secant fraction (plain string, for people).
+inline constexpr const char* kDepthEncodingAttribute = "libinsitu.depth_encoding";
+/// Segments a light field may store: one per isovalue of the layers and one more.
+inline constexpr int kMaxLightFieldSegments = kMaxLayers + 1;
+/// 8-bit depth: codes 0..254 are round(fraction * 254), 255 is "no hit".
+inline constexpr int kDepthCodeSteps = 254;
+inline constexpr int kNoHitDepthCode = 255;
+
+/// "camera7": the part of camera 7.
+inline std::string camera_part(int camera) {
+    return kCameraPartPrefix + std::to_string(camera);
+}
+/// "camera7" + 2 -> "camera7.segment2": the prefix of segment 2's channels.
+inline std::string segment_prefix(const std::string& part, int segment) {
+    return part + kSegmentChannel + std::to_string(segment);
+}
+
 /// "depth" -> "multi.depth" for the distortion camera's proxies.
 inline std::string part_name(const char* base, bool multi_perspective) {
     return multi_perspective ? std::string(kMultiPrefix) + base : std::string(base);
@@ -105,6 +149,14 @@ inline std::string step_stem(std::int64_t step, int view) {
     char stem[64];
     std::snprintf(stem, sizeof stem, "step%06lld_view%d", static_cast<long long>(step), view);
     return stem;
+}
+/// "proxies/step000010_lightfield0.exr": the light field of the field at position `field` in
+/// the configuration's "fields" list.
+inline std::string light_field_relative_path(std::int64_t step, int field) {
+    char name[64];
+    std::snprintf(name, sizeof name, "step%06lld_lightfield%d.exr", static_cast<long long>(step),
+                  field);
+    return std::string(kProxyFolder) + "/" + name;
 }
 /// "proxies/step000010_view0.exr" and "previews/step000010_view0.png", relative to the archive.
 inline std::string proxy_relative_path(std::int64_t step, int view) {

@@ -18,6 +18,7 @@
 #include "archive/atomic_file.hpp"
 #include "archive/cinema_csv.hpp"
 #include "archive/exr_frame.hpp"
+#include "archive/light_field_exr.hpp"
 #include "archive/manifest.hpp"
 #include "archive/preview_png.hpp"
 #include "insitu/error.hpp"
@@ -191,13 +192,20 @@ ArchivedView ArchiveReader::entry(std::int64_t step, int view) const {
     // Each view names its field since several fields share an archive; older ones, the step's.
     result.field = found.view->value("field", found.step->at("field").get<std::string>());
     const std::string root = fs::absolute(path_).string();
-    result.exr_path = af::listed_file(root, *found.view, af::kProxyKind).absolute_path;
+    // Empty for a view that only a step's light field serves (manifest.hpp).
+    if (!view_file(*found.view, af::kProxyKind).empty()) {
+        result.exr_path = af::listed_file(root, *found.view, af::kProxyKind).absolute_path;
+    }
     result.preview_path = af::listed_file(root, *found.view, af::kPreviewKind).absolute_path;
     return result;
 }
 
 ProxyFrame ArchiveReader::load(std::int64_t step, int view, bool multi_perspective) const {
     const af::ViewEntry found = af::find_view(*manifest_, path_, step, view);
+    if (view_file(*found.view, af::kProxyKind).empty()) {
+        fail<InvalidArgument>("archive \"", path_, "\": step ", step, " view ", view,
+                              " has no proxies (its step's light fields stand in for them)");
+    }
     const af::ListedFile listed = af::listed_file(path_, *found.view, af::kProxyKind);
     std::vector<std::string> wanted;
     for (const nlohmann::json& part : found.view->at("parts")) {
@@ -212,6 +220,42 @@ ProxyFrame ArchiveReader::load(std::int64_t step, int view, bool multi_perspecti
     }
     return af::decode_frame(af::read_listed_file(listed), listed.absolute_path, wanted,
                             multi_perspective, frame_limits(*manifest_, view));
+}
+
+std::vector<ArchivedLightField> ArchiveReader::light_fields(std::int64_t step) const {
+    const nlohmann::json& step_entry = af::find_step(*manifest_, path_, step);
+    const std::string root = fs::absolute(path_).string();
+    std::vector<ArchivedLightField> result;
+    for (const nlohmann::json& entry : af::light_field_entries(step_entry)) {
+        result.push_back({step, step_entry.at("time").get<double>(),
+                          entry.at("field").get<std::string>(),
+                          af::listed_light_field(root, entry).absolute_path,
+                          entry.at("cameras").get<int>(), entry.at("map_size").get<int>()});
+    }
+    return result;
+}
+
+LightField ArchiveReader::load_light_field(std::int64_t step, const std::string& field,
+                                           const std::vector<int>& cameras) const {
+    const nlohmann::json& entry = af::find_light_field(*manifest_, path_, step, field);
+    const af::ListedFile listed = af::listed_light_field(path_, entry);
+    const int camera_count = entry.at("cameras").get<int>();
+    // Refused before the file is read: the manifest records the rig's camera count.
+    for (const int camera : cameras) {
+        if (camera < 0 || camera >= camera_count) {
+            fail<InvalidArgument>("archive \"", path_, "\": step ", step, " light field of \"",
+                                  field, "\": camera ", camera, " is outside the rig (",
+                                  camera_count, " cameras, 0..", camera_count - 1, ")");
+        }
+    }
+    LightField light_field =
+        af::decode_light_field(af::read_listed_file(listed), listed.absolute_path, cameras,
+                               entry.at("map_size").get<int>());
+    if (light_field.rig.camera_count() != camera_count) {
+        fail<IoError>("\"", listed.absolute_path, "\": a rig of ", light_field.rig.camera_count(),
+                      " cameras, the manifest records ", camera_count);
+    }
+    return light_field;
 }
 
 Image ArchiveReader::load_preview(std::int64_t step, int view) const {
@@ -255,9 +299,18 @@ ArchiveCheck ArchiveReader::check() const {
     std::multimap<std::string, std::pair<std::int64_t, int>> proxy_owners;
     for (const nlohmann::json& step : manifest_->at("steps")) {
         for (const nlohmann::json& view : step.at("views")) {
+            if (view_file(view, af::kProxyKind).empty()) continue;
             proxy_owners.emplace(
                 af::listed_file(path_, view, af::kProxyKind).absolute_path,
                 std::pair{step.at("step").get<std::int64_t>(), view.at("view").get<int>()});
+        }
+    }
+    std::multimap<std::string, std::pair<std::int64_t, std::string>> light_field_owners;
+    for (const nlohmann::json& step : manifest_->at("steps")) {
+        for (const nlohmann::json& entry : af::light_field_entries(step)) {
+            light_field_owners.emplace(af::listed_light_field(path_, entry).absolute_path,
+                                       std::pair{step.at("step").get<std::int64_t>(),
+                                                 entry.at("field").get<std::string>()});
         }
     }
     // Files found unusable here are not reported again for data.csv's rows that name them.
@@ -268,6 +321,10 @@ ArchiveCheck ArchiveReader::check() const {
         const auto [first, last] = proxy_owners.equal_range(file.absolute_path);
         for (auto owner = first; owner != last; ++owner) {
             result.unreadable_proxies.insert(owner->second);
+        }
+        const auto [first_field, last_field] = light_field_owners.equal_range(file.absolute_path);
+        for (auto owner = first_field; owner != last_field; ++owner) {
+            result.unreadable_light_fields.insert(owner->second);
         }
     };
     const fs::path root = resolved(fs::absolute(path_));
@@ -350,6 +407,9 @@ void ArchiveReader::verify_cinema_csv(const fs::path& root, const std::set<fs::p
             // A file the manifest lists and that is missing, damaged or resolves elsewhere is
             // reported once, above.
             if (reported.count(fs::absolute(named).lexically_normal())) continue;
+            // A view without proxies has an empty proxy_exr column; the comparison with the
+            // manifest below says whether it should have one.
+            if (column == 5 && row.columns[column].empty()) continue;
             if (row.columns[column].empty() || fs::path(row.columns[column]).is_absolute() ||
                 !inside(root, fs::absolute(named))) {
                 problems.push_back(where + "\"" + row.columns[column] +

@@ -26,6 +26,7 @@
 #include "archive/atomic_file.hpp"
 #include "archive/cinema_csv.hpp"
 #include "archive/exr_frame.hpp"
+#include "archive/light_field_exr.hpp"
 #include "archive/manifest.hpp"
 #include "insitu/error.hpp"
 
@@ -115,6 +116,25 @@ void validate_record(const StepRecord& record, const ArchiveWriter& writer) {
                                   view.preview.channels, " channels (expected 1, 3 or 4)");
         }
     }
+    std::set<std::string> light_fields;
+    for (const LightFieldRecord& light_field : record.light_fields) {
+        if (!light_fields.insert(light_field.field).second) {
+            fail<InvalidArgument>(where, ": two light fields of field \"", light_field.field, "\"");
+        }
+    }
+}
+
+/// The light field's file number: the field's position in the configuration's "fields", so
+/// that a field's light fields share one name pattern across steps and restarts whatever the
+/// other fields capture, as the views are numbered field by field (planned_views).
+int light_field_number(const InstrumentConfig& config, const std::string& field,
+                       std::int64_t step) {
+    const auto found = std::find(config.fields.begin(), config.fields.end(), field);
+    if (found == config.fields.end()) {
+        fail<InvalidArgument>("step ", step, ": light field of \"", field,
+                              "\", a field the configuration's \"fields\" does not list");
+    }
+    return static_cast<int>(found - config.fields.begin());
 }
 
 }  // namespace
@@ -248,21 +268,44 @@ StepWriteResult ArchiveWriter::write(const StepRecord& record) {
     std::optional<std::uint64_t> csv_size_before;
     try {
         for (const ViewRecord& view : record.views) {
-            const std::string exr_path = af::proxy_relative_path(record.step, view.view_index);
-            const af::EncodedView exr =
-                af::encode_view(record, view, config_.precision, config_.compression, exr_path);
-            result.files.push_back(place_file(archive, exr_path, exr.bytes));
+            nlohmann::json files = nlohmann::json::array();
+            std::vector<std::string> parts;
+            // A view of a step with light fields may hold only its preview (no "proxies"): the
+            // light field stands in for its proxies (manifest.hpp).
+            if (record.light_fields.empty() || af::holds_proxy_images(view)) {
+                const std::string exr_path = af::proxy_relative_path(record.step, view.view_index);
+                af::EncodedView exr =
+                    af::encode_view(record, view, config_.precision, config_.compression, exr_path);
+                result.files.push_back(place_file(archive, exr_path, exr.bytes));
+                files.push_back(af::file_entry(result.files.back(), af::kProxyKind));
+                parts = std::move(exr.parts);
+            }
             result.files.push_back(place_png(
                 archive, af::preview_relative_path(record.step, view.view_index), view.preview));
+            files.push_back(af::file_entry(result.files.back(), af::kPreviewKind));
             step_entry["views"].push_back(
                 {{"view", view.view_index},
                  {"field", view.field.empty() ? record.field : view.field},
                  {"phi", view.view.orbit.azimuth_deg},
                  {"theta", view.view.orbit.elevation_deg},
-                 {"parts", exr.parts},
-                 {"files",
-                  {af::file_entry(result.files[result.files.size() - 2], af::kProxyKind),
-                   af::file_entry(result.files.back(), af::kPreviewKind)}}});
+                 {"parts", parts},
+                 {"files", std::move(files)}});
+        }
+        if (!record.light_fields.empty()) {
+            const af::LightFieldEncoding encoding =
+                af::light_field_encoding(config_.precision, config_.compression);
+            nlohmann::json& entries = step_entry[af::kLightFieldsKey];
+            entries = nlohmann::json::array();
+            for (const LightFieldRecord& light_field : record.light_fields) {
+                const std::string path = af::light_field_relative_path(
+                    record.step, light_field_number(config_, light_field.field, record.step));
+                const af::EncodedLightField exr =
+                    af::encode_light_field(record, light_field, encoding, path);
+                result.files.push_back(place_file(archive, path, exr.bytes));
+                const LightFieldRig& rig = light_field.light_field.rig;
+                entries.push_back(af::light_field_entry(light_field.field, result.files.back(),
+                                                        rig.camera_count(), rig.map_size()));
+            }
         }
         // The entry must read back before anything names it (issue 19).
         try {

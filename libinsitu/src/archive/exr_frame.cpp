@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -34,37 +35,8 @@
 
 namespace insitu::archive_format {
 
-namespace {
-
 // ---------------------------------------------------------------------------------------------
 // Encoding
-
-/// Collects the encoded EXR in memory, so that the bytes are checksummed and written by the same
-/// durable path as every other file (errors such as EFBIG or ENOSPC come back with errno).
-class MemoryOutputStream : public Imf::OStream {
-public:
-    explicit MemoryOutputStream(const std::string& name) : Imf::OStream(name.c_str()) {}
-    void write(const char c[], int n) override {
-        if (position_ + n > bytes_.size()) bytes_.resize(position_ + n);
-        std::memcpy(&bytes_[position_], c, static_cast<std::size_t>(n));
-        position_ += static_cast<std::size_t>(n);
-    }
-    std::uint64_t tellp() override { return position_; }
-    void seekp(std::uint64_t position) override { position_ = position; }
-    std::string& bytes() { return bytes_; }
-
-private:
-    std::string bytes_;
-    std::size_t position_ = 0;
-};
-
-/// zlib level of "zip" and "zips" parts. The encoding runs on the simulation's core (an MPI rank
-/// is bound to one), so it is chosen for time: zlib's levels 1 to 3 share its fast deflate, and
-/// on Gray-Scott proxies (256^2, depth and distortion layers, 16 intervals) level 2 encoded as
-/// fast as 1 with 1% fewer bytes, and took 31-38% less time than OpenEXR's default 4 for 7-13%
-/// more bytes (issue 18; bench_overhead measures it in situ). The level is not stored in the
-/// file: readers need nothing.
-constexpr int kZipCompressionLevel = 2;
 
 Imf::Compression parse_compression(const std::string& name) {
     if (name == "none") return Imf::NO_COMPRESSION;
@@ -77,6 +49,8 @@ Imf::Compression parse_compression(const std::string& name) {
     fail<InvalidArgument>("compression \"", name,
                           "\" (expected none, rle, zips, zip, piz, pxr24 or b44)");
 }
+
+namespace {
 
 /// One channel of an EXR part: channel `channel` of `image`.
 struct ChannelSource {
@@ -340,35 +314,7 @@ std::string encode_parts(const StepRecord& record, const ViewRecord& view,
 // ---------------------------------------------------------------------------------------------
 // Decoding
 
-/// Lets OpenEXR parse a file already read (and checksummed) into memory.
-class MemoryInputStream : public Imf::IStream {
-public:
-    MemoryInputStream(const std::vector<char>& bytes, const std::string& name)
-        : Imf::IStream(name.c_str()), bytes_(bytes) {}
-    bool read(char c[], int n) override {
-        if (n < 0 || position_ > bytes_.size() || bytes_.size() - position_ < std::size_t(n)) {
-            throw std::runtime_error("unexpected end of file at byte " + std::to_string(position_));
-        }
-        std::memcpy(c, bytes_.data() + position_, static_cast<std::size_t>(n));
-        position_ += static_cast<std::size_t>(n);
-        return position_ < bytes_.size();
-    }
-    std::uint64_t tellg() override { return position_; }
-    void seekg(std::uint64_t position) override { position_ = position; }
-
-private:
-    const std::vector<char>& bytes_;
-    std::uint64_t position_ = 0;
-};
-
-/// Where an error happened, for messages: file and part.
-struct PartContext {
-    const std::string& file;
-    std::string part;
-    [[noreturn]] void error(const std::string& what) const {
-        fail<IoError>("\"", file, "\" part \"", part, "\": ", what);
-    }
-};
+}  // namespace
 
 const std::string& string_attribute(const Imf::Header& header, const char* name,
                                     const PartContext& where) {
@@ -385,6 +331,47 @@ nlohmann::json json_attribute(const Imf::Header& header, const char* name,
         where.error(std::string("attribute \"") + name + "\" is not valid JSON: " + error.what());
     }
 }
+
+/// Reads the channels `names` of one part into one image (channel c = names[c]).
+Image read_channels(Imf::InputPart& part, const std::vector<std::string>& names,
+                    const PartContext& where) {
+    const Imath::Box2i window = part.header().dataWindow();
+    const long long width = static_cast<long long>(window.max.x) - window.min.x + 1;
+    const long long height = static_cast<long long>(window.max.y) - window.min.y + 1;
+    // A header that passed the checksum can still be foreign; refuse absurd sizes before
+    // allocating (2^28 pixels = 16384^2).
+    if (width < 1 || height < 1 || width * height > (1ll << 28)) {
+        where.error("data window " + std::to_string(width) + "x" + std::to_string(height) +
+                    " is empty or too large");
+    }
+    Image image(static_cast<int>(width), static_cast<int>(height), static_cast<int>(names.size()));
+    Imf::FrameBuffer frame_buffer;
+    const std::size_t x_stride = sizeof(float) * image.channels;
+    const std::size_t y_stride = x_stride * image.width;
+    for (int c = 0; c < image.channels; ++c) {
+        // HALF channels convert to float on read. The base is shifted so that data-window
+        // coordinates index the zero-based buffer.
+        char* base = reinterpret_cast<char*>(image.pixels.data() + c) -
+                     static_cast<std::ptrdiff_t>(window.min.x * x_stride + window.min.y * y_stride);
+        frame_buffer.insert(names[c], Imf::Slice(Imf::FLOAT, base, x_stride, y_stride));
+    }
+    part.setFrameBuffer(frame_buffer);
+    part.readPixels(window.min.y, window.max.y);
+    return image;
+}
+
+/// Splits an interleaved image into consecutive groups of `count` channels.
+Image channel_range(const Image& all, int first, int count) {
+    Image image(all.width, all.height, count);
+    for (std::size_t p = 0; p < all.pixel_count(); ++p) {
+        for (int c = 0; c < count; ++c) {
+            image.pixels[p * count + c] = all.pixels[p * all.channels + first + c];
+        }
+    }
+    return image;
+}
+
+namespace {
 
 /// The frame-level metadata every part of a frame carries.
 void read_frame_attributes(const Imf::Header& header, ProxyFrame& frame, const PartContext& where) {
@@ -419,34 +406,6 @@ void read_frame_attributes(const Imf::Header& header, ProxyFrame& frame, const P
     }
 }
 
-/// Reads the channels `names` of one part into one image (channel c = names[c]).
-Image read_channels(Imf::InputPart& part, const std::vector<std::string>& names,
-                    const PartContext& where) {
-    const Imath::Box2i window = part.header().dataWindow();
-    const long long width = static_cast<long long>(window.max.x) - window.min.x + 1;
-    const long long height = static_cast<long long>(window.max.y) - window.min.y + 1;
-    // A header that passed the checksum can still be foreign; refuse absurd sizes before
-    // allocating (2^28 pixels = 16384^2).
-    if (width < 1 || height < 1 || width * height > (1ll << 28)) {
-        where.error("data window " + std::to_string(width) + "x" + std::to_string(height) +
-                    " is empty or too large");
-    }
-    Image image(static_cast<int>(width), static_cast<int>(height), static_cast<int>(names.size()));
-    Imf::FrameBuffer frame_buffer;
-    const std::size_t x_stride = sizeof(float) * image.channels;
-    const std::size_t y_stride = x_stride * image.width;
-    for (int c = 0; c < image.channels; ++c) {
-        // HALF channels convert to float on read. The base is shifted so that data-window
-        // coordinates index the zero-based buffer.
-        char* base = reinterpret_cast<char*>(image.pixels.data() + c) -
-                     static_cast<std::ptrdiff_t>(window.min.x * x_stride + window.min.y * y_stride);
-        frame_buffer.insert(names[c], Imf::Slice(Imf::FLOAT, base, x_stride, y_stride));
-    }
-    part.setFrameBuffer(frame_buffer);
-    part.readPixels(window.min.y, window.max.y);
-    return image;
-}
-
 /// How many channels name_of(0), name_of(1), ... the part has, in a row.
 template <typename NameOf>
 int count_channels(const Imf::ChannelList& channels, NameOf name_of) {
@@ -473,17 +432,6 @@ std::vector<Image> read_layers(Imf::InputPart& part, const PartContext& where) {
         for (int k = 0; k < count; ++k) layers[k].pixels[p] = all.pixels[p * count + k];
     }
     return layers;
-}
-
-/// Splits an interleaved image into consecutive groups of `count` channels.
-Image channel_range(const Image& all, int first, int count) {
-    Image image(all.width, all.height, count);
-    for (std::size_t p = 0; p < all.pixel_count(); ++p) {
-        for (int c = 0; c < count; ++c) {
-            image.pixels[p * count + c] = all.pixels[p * all.channels + first + c];
-        }
-    }
-    return image;
 }
 
 /// a_j, and z-mean and tau when present, of an "attenuation" part.
@@ -558,6 +506,16 @@ ColourModel read_model(Imf::InputPart& part, const PartContext& where) {
 
 void check_compression(const std::string& name) {
     parse_compression(name);
+}
+
+bool holds_proxy_images(const ViewRecord& view) {
+    for (const std::optional<ProxyFrame>* frame : {&view.single, &view.multi}) {
+        if (frame->has_value() &&
+            !frame_parts(**frame, view, StoragePrecision::single, "view").empty()) {
+            return true;
+        }
+    }
+    return false;
 }
 
 EncodedView encode_view(const StepRecord& record, const ViewRecord& view,
@@ -656,11 +614,10 @@ std::size_t skip_header(const std::vector<char>& bytes, std::size_t at, const Pa
     }
 }
 
-/// Refuses, before OpenEXR allocates what a header declares (issue 19: a 1 373-byte file asked
-/// for 531 MB), data windows larger than the view the archive was configured with, more
-/// channels than a libinsitu part has, and chunk tables the file is too small to hold.
-void check_headers(const std::vector<char>& bytes, const FrameLimits& limits,
-                   const std::string& path) {
+}  // namespace
+
+void check_headers(const std::vector<char>& bytes, const std::string& path,
+                   const std::function<PartLimits(const std::string& part)>& limits_of) {
     PartContext where{path, "(header)"};
     if (bytes.size() < 8) where.error("too short for an OpenEXR file");
     std::int32_t magic = 0;
@@ -689,24 +646,17 @@ void check_headers(const std::vector<char>& bytes, const FrameLimits& limits,
         const Imath::Box2i window = header.dataWindow();
         const long long width = static_cast<long long>(window.max.x) - window.min.x + 1;
         const long long height = static_cast<long long>(window.max.y) - window.min.y + 1;
-        const bool model = header.hasName() && header.name() == kModelPart;
-        // The model is a (4 L + 3) x K table (archive_format.hpp); every other part is an image
-        // of the view.
-        const long long max_width = model ? 4ll * kMaxIntervals + 3 : limits.max_width;
-        const long long max_height = model ? kMaxColourModelClusters : limits.max_height;
-        if (width < 1 || height < 1 || width > max_width || height > max_height) {
+        const PartLimits limits = limits_of(header.hasName() ? header.name() : std::string());
+        if (width < 1 || height < 1 || width > limits.max_width || height > limits.max_height) {
             where.error("data window " + std::to_string(width) + "x" + std::to_string(height) +
-                        " is empty or larger than " + std::to_string(max_width) + "x" +
-                        std::to_string(max_height) +
-                        (model ? " (the largest model)" : " (the view)"));
+                        " is empty or larger than " + std::to_string(limits.max_width) + "x" +
+                        std::to_string(limits.max_height) + " (" + limits.bound + ")");
         }
-        // Attenuation, mean depth and optical depth: three channels per interval.
-        constexpr long long kMaxChannels = 3ll * kMaxIntervals;
         long long channels = 0;
         for (auto it = header.channels().begin(); it != header.channels().end(); ++it) ++channels;
-        if (channels > kMaxChannels) {
-            where.error(std::to_string(channels) + " channels (a libinsitu part has at most " +
-                        std::to_string(kMaxChannels) + ")");
+        if (channels > limits.max_channels) {
+            where.error(std::to_string(channels) + " channels (a libinsitu part of this kind " +
+                        "has at most " + std::to_string(limits.max_channels) + ")");
         }
         // The chunk offset table (8 bytes a chunk, at least one chunk per 256 lines for every
         // compression) is in the file, so the file bounds it.
@@ -720,8 +670,6 @@ void check_headers(const std::vector<char>& bytes, const FrameLimits& limits,
     }
 }
 
-}  // namespace
-
 ProxyFrame decode_frame(const std::vector<char>& bytes, const std::string& path,
                         const std::vector<std::string>& parts, bool multi_perspective,
                         const FrameLimits& limits) {
@@ -729,7 +677,17 @@ ProxyFrame decode_frame(const std::vector<char>& bytes, const std::string& path,
     frame.multi_perspective = multi_perspective;
     PartContext where{path, "(header)"};
     try {
-        check_headers(bytes, limits, path);
+        check_headers(bytes, path, [&limits](const std::string& part) {
+            // The model is a (4 L + 3) x K table (archive_format.hpp); every other part is an
+            // image of the view, with at most attenuation, mean depth and optical depth: three
+            // channels per interval.
+            constexpr long long kMaxChannels = 3ll * kMaxIntervals;
+            if (part == kModelPart) {
+                return PartLimits{4ll * kMaxIntervals + 3, kMaxColourModelClusters, kMaxChannels,
+                                  "the largest model"};
+            }
+            return PartLimits{limits.max_width, limits.max_height, kMaxChannels, "the view"};
+        });
         MemoryInputStream stream(bytes, path);
         // No reconstruction of a damaged chunk offset table: damage is an error here.
         Imf::MultiPartInputFile file(stream, Imf::globalThreadCount(), false);

@@ -10,6 +10,7 @@
 #include "archive/archive_format.hpp"
 #include "archive/atomic_file.hpp"
 #include "insitu/archive/step_record.hpp"
+#include "insitu/core/light_field.hpp"
 #include "insitu/error.hpp"
 
 namespace insitu::archive_format {
@@ -72,14 +73,49 @@ const nlohmann::json& require(const nlohmann::json& object, const char* key, Exp
 }
 
 /// Paths in the manifest must stay inside the archive.
-void check_relative_path(const std::string& path, const std::string& file,
-                         const std::string& where) {
+void check_relative_path(const std::string& path, const std::string& file, const std::string& where,
+                         const char* key = "path") {
     const fs::path relative(path);
     bool escapes = path.empty() || relative.is_absolute();
     for (const fs::path& component : relative) escapes = escapes || component == "..";
     if (escapes) {
-        fail<ParseError>("\"", file, "\": ", where, ".path \"", path,
+        fail<ParseError>("\"", file, "\": ", where, ".", key, " \"", path,
                          "\" is not a relative path inside the archive");
+    }
+}
+
+/// The optional "light_fields" list of a step entry: one file per field, as views list theirs.
+void check_light_field_entries(const nlohmann::json& step, const std::string& file,
+                               const std::string& where) {
+    if (!step.contains(kLightFieldsKey)) return;  // archives without light fields
+    const auto& entries = require(step, kLightFieldsKey, Expect::array, file, where);
+    std::set<std::string> fields_seen;
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+        const std::string entry_where =
+            where + "." + kLightFieldsKey + "[" + std::to_string(i) + "]";
+        const auto& entry = entries[i];
+        const auto& field = require(entry, "field", Expect::string, file, entry_where);
+        if (!fields_seen.insert(field.get<std::string>()).second) {
+            fail<ParseError>("\"", file, "\": ", entry_where, ": field ", field.dump(),
+                             " is repeated");
+        }
+        check_relative_path(require(entry, "file", Expect::string, file, entry_where), file,
+                            entry_where, "file");
+        require(entry, "bytes", Expect::count, file, entry_where);
+        require(entry, "crc32", Expect::crc32, file, entry_where);
+        const auto& cameras = require(entry, "cameras", Expect::count, file, entry_where);
+        if (std::find(kLightFieldCameraCounts.begin(), kLightFieldCameraCounts.end(),
+                      cameras.get<std::int64_t>()) == kLightFieldCameraCounts.end()) {
+            fail<ParseError>("\"", file, "\": ", entry_where, ".cameras ", cameras.dump(),
+                             " is not a light field's camera count (12, 42, 162 or 642)");
+        }
+        const auto& map_size = require(entry, "map_size", Expect::count, file, entry_where);
+        if (map_size.get<std::int64_t>() < kMinLightFieldMapSize ||
+            map_size.get<std::int64_t>() > kMaxLightFieldMapSize) {
+            fail<ParseError>("\"", file, "\": ", entry_where, ".map_size ", map_size.dump(),
+                             " is outside [", kMinLightFieldMapSize, ", ", kMaxLightFieldMapSize,
+                             "]");
+        }
     }
 }
 
@@ -95,6 +131,9 @@ void check_step_entry(const nlohmann::json& step, const std::string& file,
     require(step, "time", Expect::number, file, where);
     require(step, "field", Expect::string, file, where);
     std::set<int> views_seen;
+    const auto light_fields = step.find(kLightFieldsKey);
+    const bool has_light_fields =
+        light_fields != step.end() && light_fields->is_array() && !light_fields->empty();
     const auto& views = require(step, "views", Expect::array, file, where);
     for (std::size_t v = 0; v < views.size(); ++v) {
         const std::string view_where = where + ".views[" + std::to_string(v) + "]";
@@ -126,11 +165,14 @@ void check_step_entry(const nlohmann::json& step, const std::string& file,
             require(files[f], "crc32", Expect::crc32, file, file_where);
         }
         for (const char* kind : {kProxyKind, kPreviewKind}) {
+            // The light fields of a step may stand in for its views' proxies.
+            if (kind == kProxyKind && has_light_fields) continue;
             if (!kinds.count(kind)) {
                 fail<ParseError>("\"", file, "\": ", view_where, " lists no ", kind, " file");
             }
         }
     }
+    check_light_field_entries(step, file, where);
 }
 
 namespace {
@@ -332,8 +374,46 @@ std::vector<ListedFile> listed_files(const std::string& archive, const nlohmann:
                 files.push_back(listed(archive, file));
             }
         }
+        for (const nlohmann::json& entry : light_field_entries(step)) {
+            files.push_back(listed_light_field(archive, entry));
+        }
     }
     return files;
+}
+
+const nlohmann::json& light_field_entries(const nlohmann::json& step) {
+    static const nlohmann::json none = nlohmann::json::array();
+    const auto found = step.find(kLightFieldsKey);
+    return found == step.end() ? none : *found;
+}
+
+nlohmann::json light_field_entry(const std::string& field, const WrittenFile& file, int cameras,
+                                 int map_size) {
+    return {{"field", field},      {"file", file.relative_path}, {"bytes", file.bytes},
+            {"crc32", file.crc32}, {"cameras", cameras},         {"map_size", map_size}};
+}
+
+ListedFile listed_light_field(const std::string& archive, const nlohmann::json& entry) {
+    return {(fs::path(archive) / entry.at("file").get<std::string>()).string(),
+            entry.at("bytes").get<std::uint64_t>(), entry.at("crc32").get<std::uint32_t>()};
+}
+
+const nlohmann::json& find_step(const nlohmann::json& manifest, const std::string& archive,
+                                std::int64_t step) {
+    for (const nlohmann::json& step_entry : manifest.at("steps")) {
+        if (step_entry.at("step").get<std::int64_t>() == step) return step_entry;
+    }
+    fail<InvalidArgument>("archive \"", archive, "\" has no step ", step);
+}
+
+const nlohmann::json& find_light_field(const nlohmann::json& manifest, const std::string& archive,
+                                       std::int64_t step, const std::string& field) {
+    const nlohmann::json& step_entry = find_step(manifest, archive, step);
+    for (const nlohmann::json& entry : light_field_entries(step_entry)) {
+        if (entry.at("field") == field) return entry;
+    }
+    fail<InvalidArgument>("archive \"", archive, "\": step ", step, " has no light field of \"",
+                          field, "\"");
 }
 
 std::vector<char> read_listed_file(const ListedFile& file) {

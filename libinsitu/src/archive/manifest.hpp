@@ -4,9 +4,12 @@
 //    "previous_configurations": [...]   (only when a restarted run changed it)
 //    "steps": [{"step", "time", "field",
 //               "views": [{"view", "phi", "theta", "parts": [...],
-//                          "files": [{"kind", "path", "bytes", "crc32"}, ...]}]}]}
+//                          "files": [{"kind", "path", "bytes", "crc32"}, ...]}],
+//               "light_fields": [{"field", "file", "bytes", "crc32", "cameras", "map_size"}]}]}
+//                   (only on steps with light fields; "cameras" and "map_size" are the rig's)
 //    "malformed_steps": [{"entry", "problem"}]   (only when a writer set entries aside)
-// Steps are kept sorted; each view lists one proxy_exr and one preview_png file.
+// Steps are kept sorted; each view lists one proxy_exr and one preview_png file (in a step with
+// light fields a view may list only its preview: "proxies" none, the light field stands in).
 //
 // ARCHIVE/manifest.journal holds the steps written since manifest.json was last compacted: one
 // step entry (the object above) a line, appended and fsync'ed per step, so a step costs O(1)
@@ -33,7 +36,8 @@ inline constexpr const char* kMalformedKey = "malformed_steps";
 nlohmann::json empty_manifest();
 
 /// Checks one step entry: required keys and their types (numbers finite), safe relative paths,
-/// no repeated views. ParseError naming `file`, `where` and the key.
+/// no repeated views; the optional light-field list likewise (no repeated field, a camera count
+/// and map size a light field can have). ParseError naming `file`, `where` and the key.
 void check_step_entry(const nlohmann::json& step, const std::string& file,
                       const std::string& where);
 
@@ -85,11 +89,26 @@ struct ListedFile {
 };
 /// The file of `kind` that `view` (an entry of a validated manifest) lists.
 ListedFile listed_file(const std::string& archive, const nlohmann::json& view, const char* kind);
-/// Every file the manifest lists.
+/// Every file the manifest lists, light fields included.
 std::vector<ListedFile> listed_files(const std::string& archive, const nlohmann::json& manifest);
 /// The file's bytes, after checking size and CRC-32 against the manifest (a file replaced,
 /// truncated or damaged since it was written is reported before anything parses it).
 std::vector<char> read_listed_file(const ListedFile& file);
+
+/// The "light_fields" list of a validated step entry (an empty one when it has none).
+const nlohmann::json& light_field_entries(const nlohmann::json& step);
+/// The manifest entry of a written light field (`cameras` and `map_size`: the rig's).
+nlohmann::json light_field_entry(const std::string& field, const WrittenFile& file, int cameras,
+                                 int map_size);
+/// The file a light-field entry (of a validated manifest) lists.
+ListedFile listed_light_field(const std::string& archive, const nlohmann::json& entry);
+/// The step entry of `step`; InvalidArgument when the manifest has none.
+const nlohmann::json& find_step(const nlohmann::json& manifest, const std::string& archive,
+                                std::int64_t step);
+/// The light-field entry of (step, field); InvalidArgument when the manifest has no such step
+/// or the step no light field of that field.
+const nlohmann::json& find_light_field(const nlohmann::json& manifest, const std::string& archive,
+                                       std::int64_t step, const std::string& field);
 
 /// The step and view entries of (step, view); InvalidArgument when the manifest has neither.
 struct ViewEntry {

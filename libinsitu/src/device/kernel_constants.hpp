@@ -6,6 +6,7 @@
 
 #include "insitu/core/intervals.hpp"
 #include "insitu/core/layers.hpp"
+#include "insitu/core/light_field.hpp"
 #include "insitu/explore/relighting.hpp"
 
 namespace insitu::detail {
@@ -17,6 +18,14 @@ constexpr int kWantDistortion = 2;
 constexpr int kWantAttenuation = 4;
 constexpr int kWantMeanDepth = 8;
 constexpr int kWantOpticalDepth = 16;
+constexpr int kWantSegmentRgba = 32;
+constexpr int kWantSegmentDepth = 64;
+constexpr int kWantFirstHitDepth = 128;
+
+/// render_proxies' `segment_rule` argument: SegmentRule as the kernel spells it.
+constexpr int kSegmentsWholeRay = static_cast<int>(SegmentRule::whole_ray);
+constexpr int kSegmentsLayers = static_cast<int>(SegmentRule::layers);
+constexpr int kSegmentsOpacity = static_cast<int>(SegmentRule::opacity);
 
 struct KernelConstant {
     const char* name;  ///< the macro the kernels use
@@ -25,7 +34,7 @@ struct KernelConstant {
 
 /// Every constant passed to the kernels. Private arrays are sized by the MAX_* limits, so they
 /// bound each work-item's private memory.
-inline constexpr std::array<KernelConstant, 8> kKernelConstants{{
+inline constexpr std::array<KernelConstant, 14> kKernelConstants{{
     {"MAX_LAYERS", kMaxLayers},        // depth layers per pass (layer_t[] in the proxy kernel)
     {"MAX_INTERVALS", kMaxIntervals},  // intensity intervals (a[] in colour model, edits)
     {"MAX_LIGHTS", kMaxLights},        // lights per relighting call (half_vectors[])
@@ -34,6 +43,12 @@ inline constexpr std::array<KernelConstant, 8> kKernelConstants{{
     {"WANT_ATTENUATION", kWantAttenuation},
     {"WANT_MEAN_DEPTH", kWantMeanDepth},
     {"WANT_OPTICAL_DEPTH", kWantOpticalDepth},
+    {"WANT_SEGMENT_RGBA", kWantSegmentRgba},
+    {"WANT_SEGMENT_DEPTH", kWantSegmentDepth},
+    {"WANT_FIRST_HIT_DEPTH", kWantFirstHitDepth},
+    {"SEGMENTS_WHOLE_RAY", kSegmentsWholeRay},
+    {"SEGMENTS_LAYERS", kSegmentsLayers},
+    {"SEGMENTS_OPACITY", kSegmentsOpacity},
 }};
 
 // Archive channel names number intervals with two digits ("attenuation.a07").
@@ -42,7 +57,11 @@ static_assert(kMaxLayers >= 1 && kMaxLayers <= 64, "layer_t[] is a private array
 static_assert(kMaxLights >= 1 && kMaxLights <= 64, "half_vectors[] is a private array per pixel");
 // The wanted bits must be distinct powers of two.
 static_assert((kWantDepth | kWantDistortion | kWantAttenuation | kWantMeanDepth |
-               kWantOpticalDepth) == 31,
-              "wanted bits are the five distinct low bits");
+               kWantOpticalDepth | kWantSegmentRgba | kWantSegmentDepth | kWantFirstHitDepth) ==
+                  255,
+              "wanted bits are the eight distinct low bits");
+static_assert(kSegmentsWholeRay != kSegmentsLayers && kSegmentsLayers != kSegmentsOpacity &&
+                  kSegmentsWholeRay != kSegmentsOpacity,
+              "the kernel tells the segment rules apart by these values");
 
 }  // namespace insitu::detail

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <glm/trigonometric.hpp>
 #include <ostream>
+#include <sstream>
+#include <string>
 
 #include "device/kernel_args.hpp"
 #include "device/kernel_constants.hpp"
@@ -24,18 +26,29 @@ bool accumulates(const ProxyRequest& request) {
     return request.attenuation || request.mean_depth || request.optical_depth;
 }
 
-// Planar device output -> one single-channel image per plane.
+bool wants_segments(const ProxyRequest& request) {
+    return request.segment_rgba || request.segment_depth || request.first_hit_depth;
+}
+
+// Planar device output -> one image of `channels` interleaved channels per plane.
 std::vector<Image> planes_to_images(const std::vector<float>& planar, int width, int height,
-                                    int planes) {
+                                    int planes, int channels = 1) {
     std::vector<Image> images;
-    const std::size_t pixels = static_cast<std::size_t>(width) * height;
+    const std::size_t plane_floats = static_cast<std::size_t>(width) * height * channels;
     for (int p = 0; p < planes; ++p) {
-        Image image(width, height, 1);
-        std::copy(planar.begin() + p * pixels, planar.begin() + (p + 1) * pixels,
+        Image image(width, height, channels);
+        std::copy(planar.begin() + p * plane_floats, planar.begin() + (p + 1) * plane_floats,
                   image.pixels.begin());
         images.push_back(std::move(image));
     }
     return images;
+}
+
+std::string list_text(const std::vector<double>& values) {
+    std::ostringstream text;
+    text << "[";
+    for (std::size_t i = 0; i < values.size(); ++i) text << (i ? ", " : "") << values[i];
+    return text.str() + "]";
 }
 
 }  // namespace
@@ -51,12 +64,54 @@ void validate(const ProxyRequest& request) {
             fail<InvalidArgument>("attenuation proxies requested without a transfer function");
         }
     }
+    if (wants_segments(request)) {
+        if (!request.transfer_function) {
+            fail<InvalidArgument>("segment proxies requested without a transfer function");
+        }
+        if (!(request.first_hit_threshold > 0.0 && request.first_hit_threshold < 1.0)) {
+            fail<InvalidArgument>("first-hit threshold = ", request.first_hit_threshold,
+                                  " (an opacity, must be in (0, 1))");
+        }
+        if (request.segments == SegmentRule::layers) validate_isovalues(request.isovalues);
+    }
+    const std::vector<double>& thresholds = request.segment_thresholds;
+    if (request.segments == SegmentRule::opacity) {
+        if (thresholds.empty()) {
+            fail<InvalidArgument>("segments split at opacity thresholds, but none are given");
+        }
+        for (std::size_t i = 0; i < thresholds.size(); ++i) {
+            if (!(thresholds[i] > 0.0 && thresholds[i] < 1.0)) {
+                fail<InvalidArgument>("segment opacity threshold[", i, "] = ", thresholds[i],
+                                      " (must be in (0, 1))");
+            }
+            if (i > 0 && !(thresholds[i] > thresholds[i - 1])) {
+                fail<InvalidArgument>("segment opacity thresholds ", list_text(thresholds),
+                                      " (must increase)");
+            }
+        }
+    } else if (!thresholds.empty()) {
+        fail<InvalidArgument>("segment opacity thresholds ", list_text(thresholds),
+                              " given, but the segments are ", to_string(request.segments));
+    }
+}
+
+int segment_count(const ProxyRequest& request) {
+    switch (request.segments) {
+        case SegmentRule::whole_ray:
+            return 1;
+        case SegmentRule::layers:
+            return static_cast<int>(request.isovalues.size()) + 1;
+        case SegmentRule::opacity:
+            return static_cast<int>(request.segment_thresholds.size()) + 1;
+    }
+    fail<Error>("segment_count: a rule without a case");  // a bug
 }
 
 struct ProxyRenderer::DeviceState {
     cl::Kernel kernel;
-    detail::DeviceMemory table, isovalues, edges, depth_out, distortion_out, attenuation_out,
-        mean_depth_out, optical_depth_out, skippable;
+    detail::DeviceMemory table, isovalues, edges, thresholds, depth_out, distortion_out,
+        attenuation_out, mean_depth_out, optical_depth_out, segment_rgba_out, segment_depth_out,
+        first_hit_out, skippable;
     /// Block ranges of the uploaded volume, rescanned when its generation changes.
     detail::BlockRanges blocks;
     std::uint64_t blocks_generation = 0;
@@ -112,13 +167,23 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     frame.distortion_tilt_deg = tilt_deg;
     const bool want_layers = request.depth_layers && !request.isovalues.empty();
     const bool want_accumulation = accumulates(request);
+    const bool want_segments = wants_segments(request);
+    // Segments split at the layers need their crossings found, depth layers stored or not.
+    const bool find_crossings =
+        want_layers ||
+        (want_segments && request.segments == SegmentRule::layers && !request.isovalues.empty());
+    // Both read the transfer function's opacity, so both decide which blocks may be skipped.
+    const bool want_opacity = want_accumulation || want_segments;
     if (want_layers) frame.isovalues = request.isovalues;
     if (want_accumulation) frame.intervals = request.intervals;
+    const std::vector<double> crossing_isovalues =
+        find_crossings ? request.isovalues : std::vector<double>{};
+    const int segments = want_segments ? segment_count(request) : 0;
 
     const int width = camera.width();
     const int height = camera.height();
     const std::size_t pixels = static_cast<std::size_t>(width) * height;
-    const int layer_count = want_layers ? static_cast<int>(request.isovalues.size()) : 0;
+    const int layer_count = static_cast<int>(crossing_isovalues.size());
     const int interval_count = want_accumulation ? request.intervals->count() : 0;
     // validate() bounded both; the kernel's private arrays are sized by these limits.
     INSITU_CHECK_LE(layer_count, kMaxLayers);
@@ -130,6 +195,9 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     if (request.attenuation) wanted |= detail::kWantAttenuation;
     if (request.mean_depth) wanted |= detail::kWantMeanDepth;
     if (request.optical_depth) wanted |= detail::kWantOpticalDepth;
+    if (request.segment_rgba) wanted |= detail::kWantSegmentRgba;
+    if (request.segment_depth) wanted |= detail::kWantSegmentDepth;
+    if (request.first_hit_depth) wanted |= detail::kWantFirstHitDepth;
 
     // Only requested outputs get device memory; the others are passed as null buffers.
     auto output = [&](detail::DeviceMemory& reused, bool needed, int planes) -> cl::Buffer {
@@ -149,6 +217,11 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
         output(state_->mean_depth_out, request.mean_depth, interval_count);
     const cl::Buffer optical_depth_out =
         output(state_->optical_depth_out, request.optical_depth, interval_count);
+    const cl::Buffer segment_rgba_out =
+        output(state_->segment_rgba_out, request.segment_rgba, 4 * segments);
+    const cl::Buffer segment_depth_out =
+        output(state_->segment_depth_out, request.segment_depth, segments);
+    const cl::Buffer first_hit_out = output(state_->first_hit_out, request.first_hit_depth, 1);
 
     auto upload_floats = [&](detail::DeviceMemory& reused, const std::vector<float>& values,
                              const char* what) -> cl::Buffer {
@@ -159,17 +232,23 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
         return reused.buffer;
     };
     const double step_world = volume.step_world(request.march.step_voxels);
-    // The attenuation's opacity is classified exactly as the ground truth classifies it. Without
-    // accumulation a one-entry transparent table keeps the kernel's arguments valid.
+    // The attenuation's opacity and the segments' colour are classified exactly as the ground
+    // truth classifies them. Without either a one-entry transparent table keeps the kernel's
+    // arguments valid.
     const TransferTable table =
-        want_accumulation
-            ? step_corrected_table(*request.transfer_function, step_world, request.march)
-            : TransferFunction({{0.0, glm::vec4(0.0f)}, {1.0, glm::vec4(0.0f)}}).sample(2);
+        want_opacity ? step_corrected_table(*request.transfer_function, step_world, request.march)
+                     : TransferFunction({{0.0, glm::vec4(0.0f)}, {1.0, glm::vec4(0.0f)}}).sample(2);
     const cl::Buffer table_buffer =
         upload_floats(state_->table, table.rgba, "transfer-function table");
     const cl::Buffer isovalue_buffer = upload_floats(
-        state_->isovalues, std::vector<float>(frame.isovalues.begin(), frame.isovalues.end()),
+        state_->isovalues, std::vector<float>(crossing_isovalues.begin(), crossing_isovalues.end()),
         "isovalues");
+    const std::vector<double>& thresholds = request.segment_thresholds;
+    const cl::Buffer threshold_buffer =
+        upload_floats(state_->thresholds,
+                      want_segments ? std::vector<float>(thresholds.begin(), thresholds.end())
+                                    : std::vector<float>{},
+                      "segment opacity thresholds");
     std::vector<float> edges;
     if (want_accumulation) {
         edges.assign(frame.intervals->edges().begin(), frame.intervals->edges().end());
@@ -192,7 +271,7 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
         }
         const detail::BlockRanges& blocks = state_->blocks;
         const std::vector<std::uint8_t> skippable =
-            detail::skippable_blocks(blocks, table, frame.isovalues, want_accumulation);
+            detail::skippable_blocks(blocks, table, crossing_isovalues, want_opacity);
         last_skippable_fraction_ =
             static_cast<double>(std::count(skippable.begin(), skippable.end(), 1)) /
             static_cast<double>(skippable.size());
@@ -219,8 +298,10 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
         detail::camera_args(camera), detail::image_size(camera), march, static_cast<cl_int>(wanted),
         static_cast<cl_int>(layer_count), isovalue_buffer, static_cast<cl_int>(interval_count),
         static_cast<cl_float>(uniform_scale), edge_buffer, depth_out, distortion_out,
-        attenuation_out, mean_depth_out, optical_depth_out, skippable_buffer, block_counts,
-        block_voxels);
+        attenuation_out, mean_depth_out, optical_depth_out, static_cast<cl_int>(request.segments),
+        static_cast<cl_int>(segments), threshold_buffer,
+        static_cast<cl_float>(request.first_hit_threshold), segment_rgba_out, segment_depth_out,
+        first_hit_out, skippable_buffer, block_counts, block_voxels);
 
     std::vector<float> planar;
     auto fetch = [&](const cl::Buffer& buffer, int planes, const char* what) {
@@ -247,6 +328,19 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     if (request.optical_depth) {
         frame.optical_depth = fetch_channels(optical_depth_out, "optical depth");
     }
+    if (request.segment_rgba) {
+        fetch(segment_rgba_out, 4 * segments, "segment RGBA");
+        frame.segment_rgba = planes_to_images(planar, width, height, segments, 4);
+    }
+    if (request.segment_depth) {
+        fetch(segment_depth_out, segments, "segment depth");
+        frame.segment_depth = planes_to_images(planar, width, height, segments);
+    }
+    if (request.first_hit_depth) {
+        frame.first_hit_depth = Image(width, height, 1);
+        device_->opencl().download(first_hit_out, frame.first_hit_depth.pixels.data(),
+                                   pixels * sizeof(float), "first-hit depth");
+    }
     return frame;
 }
 
@@ -256,6 +350,17 @@ std::ostream& operator<<(std::ostream& out, const ProxyRequest& request) {
     if (request.attenuation) out << "attenuation, ";
     if (request.mean_depth) out << "mean depth, ";
     if (request.optical_depth) out << "optical depth, ";
+    if (wants_segments(request)) {
+        out << segment_count(request) << " segments (" << to_string(request.segments);
+        if (request.segments == SegmentRule::opacity) {
+            out << " " << list_text(request.segment_thresholds);
+        }
+        out << ":";
+        if (request.segment_rgba) out << " RGBA";
+        if (request.segment_depth) out << " depth";
+        if (request.first_hit_depth) out << " first hit";
+        out << " at " << request.first_hit_threshold << "), ";
+    }
     if (request.intervals) out << *request.intervals << ", ";
     out << request.training_transfer_functions.size() << " training TFs, skip empty space "
         << (request.skip_empty_space ? "on" : "off") << ", " << request.march;
@@ -283,6 +388,9 @@ std::ostream& operator<<(std::ostream& out, const ProxyFrame& frame) {
     image("attenuation", frame.attenuation);
     image("mean depth", frame.mean_depth);
     image("optical depth", frame.optical_depth);
+    images("segment RGBA", frame.segment_rgba);
+    images("segment depth", frame.segment_depth);
+    image("first-hit depth", frame.first_hit_depth);
     images("training images", frame.training);
     if (frame.colour_model) out << ", " << *frame.colour_model;
     return out << "}";

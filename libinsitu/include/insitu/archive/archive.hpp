@@ -10,6 +10,8 @@
 //   manifest.journal                 steps since manifest.json was compacted, one JSON a line
 //   .lock                            flock()ed by the one writer, holding its pid
 //   proxies/step000010_view0.exr     multi-part EXR, self-describing parts and channels
+//   proxies/step000010_lightfield1.exr  a light field (seed 001) of field 1 of "fields": a part
+//                                    per camera, so a reader decodes only the cameras it needs
 //   previews/step000010_view0.png    ground-truth rendering of the configured transfer function
 //
 // EXR parts (channel names start with the part name; libinsitu/src/archive/archive_format.hpp):
@@ -25,6 +27,15 @@
 // perspective, camera, isovalues, intervals, transfer_function, training_transfer_functions}
 // (+ distortion_tilt on multi.* parts, training_transfer_function on train<k>); JSON text in
 // string attributes, doubles exact.
+//
+// Light-field parts camera<k> (k: the camera's index in the rig): camera<k>.R/G/B/A (or
+// camera<k>.segment<s>.R/G/B/A and .depth per segment when the rays are split), camera<k>.depth
+// (first hit, as a secant fraction: 16-bit HALF or seed 001's 8 bits, +inf / code 255 = no hit),
+// camera<k>.a00.. and .zmean00.. (the attenuation light field). Every part carries
+// libinsitu.{schema_version, step, time, field, light_field, isovalues, intervals,
+// transfer_function, camera_index, camera, depth_encoding}, the first part also libinsitu.rig.
+// The manifest lists them per step under "light_fields" (field, file, bytes, crc32, cameras,
+// map_size), a key steps without light fields do not have.
 //
 // One writer per archive at a time, enforced: a second ArchiveWriter (any process) is refused
 // while the first holds ARCHIVE/.lock; readers take no lock. A writer removes temp files

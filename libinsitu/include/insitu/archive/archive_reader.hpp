@@ -12,6 +12,7 @@
 
 #include "insitu/config.hpp"
 #include "insitu/core/image.hpp"
+#include "insitu/render/light_field_capture.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 
 namespace insitu {
@@ -22,8 +23,18 @@ struct ArchivedView {
     double time = 0.0;
     int view_index = 0;
     std::string field;         ///< the field the view shows
-    std::string exr_path;      ///< absolute
+    std::string exr_path;      ///< absolute; empty when only the step's light fields serve it
     std::string preview_path;  ///< absolute
+};
+
+/// What the reader can load of one field's light field at one step.
+struct ArchivedLightField {
+    std::int64_t step = 0;
+    double time = 0.0;
+    std::string field;
+    std::string exr_path;  ///< absolute
+    int cameras = 0;       ///< cameras of the rig
+    int map_size = 0;
 };
 
 /// What ArchiveReader::check() found.
@@ -33,6 +44,8 @@ struct ArchiveCheck {
     /// (step, view) of the entries whose proxy EXR cannot be used: missing, outside the archive,
     /// or not the size and CRC-32 the index records.
     std::set<std::pair<std::int64_t, int>> unreadable_proxies;
+    /// (step, field) of the light fields whose EXR cannot be used, for the same reasons.
+    std::set<std::pair<std::int64_t, std::string>> unreadable_light_fields;
     bool clean() const { return problems.empty(); }
 };
 
@@ -73,19 +86,33 @@ public:
     /// this file is read), the colour model (ProxyFrame::colour_model) included when stored.
     /// Corrupt, truncated or foreign files raise IoError naming file and part. The file's size and
     /// CRC-32 are checked against the manifest before it is parsed. A step, view or perspective the
-    /// manifest does not list raises InvalidArgument.
+    /// manifest does not list raises InvalidArgument, as does a view of a step with light fields
+    /// that was stored without proxies (only its preview).
     ProxyFrame load(std::int64_t step, int view, bool multi_perspective = false) const;
+    /// The light fields of a step (one per field that has one; empty when none). A step the
+    /// manifest does not list raises InvalidArgument.
+    std::vector<ArchivedLightField> light_fields(std::int64_t step) const;
+    /// Loads the light field of (step, field): the rig, settings, isovalues, intervals and
+    /// transfer function from the headers, and the images of `cameras` (all when empty), each
+    /// camera a part of its own, so only those parts are decoded. Cameras the file lacks are
+    /// left out of LightField::cameras (the reconstruction says which it missed); a camera
+    /// index outside the rig is InvalidArgument, a step or field without a light field too.
+    /// The file's size and CRC-32 are checked against the manifest as for load().
+    LightField load_light_field(std::int64_t step, const std::string& field,
+                                const std::vector<int>& cameras = {}) const;
     /// The preview as linear, premultiplied floats (the inverse of write_png, to 8-bit sRGB
     /// precision), with the PNG's channel count (1, 3 or 4).
     Image load_preview(std::int64_t step, int view) const;
 
-    /// Checks every file the manifest names: present, inside the archive once symbolic links
-    /// are resolved, size and CRC-32 as recorded; that data.csv has a row per step x view naming
-    /// the manifest's files and that each of its rows names files inside the archive that exist.
-    /// Returns one line per problem, each naming its file, diagnostics() first (empty when the
-    /// archive is intact); a damaged file is reported once, not again for data.csv.
+    /// Checks every file the manifest names, light fields included: present, inside the archive
+    /// once symbolic links are resolved, size and CRC-32 as recorded; that data.csv has a row per
+    /// step x view naming the manifest's files and that each of its rows names files inside the
+    /// archive that exist. Returns one line per problem, each naming its file, diagnostics()
+    /// first (empty when the archive is intact); a damaged file is reported once, not again for
+    /// data.csv.
     std::vector<std::string> verify() const;
-    /// verify()'s checks, with the (step, view) entries whose proxies they found unusable.
+    /// verify()'s checks, with the (step, view) entries whose proxies and the (step, field)
+    /// light fields whose files they found unusable.
     ArchiveCheck check() const;
 
     /// The same archive with the (step, view) entries in `views` left out of the index (a step

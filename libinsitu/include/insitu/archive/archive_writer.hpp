@@ -23,7 +23,8 @@ struct WrittenFile {
 };
 
 struct StepWriteResult {
-    std::vector<WrittenFile> files;  ///< the step's EXR and PNG files (not the indexes)
+    /// The step's EXR and PNG files, then its light-field EXRs (not the indexes).
+    std::vector<WrittenFile> files;
     std::uint64_t bytes() const;
 };
 
@@ -43,15 +44,18 @@ public:
     ArchiveWriter(const ArchiveWriter&) = delete;
     ArchiveWriter& operator=(const ArchiveWriter&) = delete;
 
-    /// Writes one step (EXR + PNG per view, then the indexes). A step already in the archive
-    /// raises InvalidArgument naming it. On failure (disk full, ...) throws IoError and leaves
-    /// the archive as it was: the indexes still name only complete files.
-    /// Every view needs a preview (data.csv's FILE column names a PNG for every row) and at
-    /// least one proxy image; steps must be >= 0 (they name files); time and view angles must
-    /// be finite (InvalidArgument naming the value: JSON cannot hold NaN or Inf). The index cost
-    /// is O(1) in the number of steps (manifest.hpp). Should only the periodic compaction fail
-    /// once the journal names the step, the step is stored (contains() is true) and IoError is
-    /// still thrown; the next compaction retries.
+    /// Writes one step (EXR + PNG per view, an EXR per light field, then the indexes). A step
+    /// already in the archive raises InvalidArgument naming it. On failure (disk full, ...)
+    /// throws IoError and leaves the archive as it was: the indexes still name only complete
+    /// files. Every view needs a preview (data.csv's FILE column names a PNG for every row) and
+    /// at least one proxy image (unless the step has light fields: then a view without any is
+    /// stored with its preview only); steps must be >= 0 (they name files); time and view angles
+    /// must be finite (InvalidArgument naming the value: JSON cannot hold NaN or Inf). A light
+    /// field must be of a field the configuration's "fields" lists (its position there numbers the
+    /// file), at most one per field. The index cost is O(1) in the number of steps
+    /// (manifest.hpp). Should only the periodic compaction fail once the journal names the step,
+    /// the step is stored (contains() is true) and IoError is still thrown; the next compaction
+    /// retries.
     StepWriteResult write(const StepRecord& record);
 
     bool contains(std::int64_t step) const;

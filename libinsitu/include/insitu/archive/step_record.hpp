@@ -8,6 +8,7 @@
 
 #include "insitu/config.hpp"
 #include "insitu/core/image.hpp"
+#include "insitu/render/light_field_capture.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 
 namespace insitu {
@@ -27,11 +28,18 @@ struct ViewRecord {
     std::vector<TransferFunction> training_transfer_functions;
 };
 
+/// One field's light field at one timestep (written as one multi-part EXR, a part per camera).
+struct LightFieldRecord {
+    std::string field;
+    LightField light_field;
+};
+
 struct StepRecord {
     std::int64_t step = 0;
     double time = 0.0;
     std::string field;  ///< the first field's name (each view names its own, ViewRecord::field)
     std::vector<ViewRecord> views;
+    std::vector<LightFieldRecord> light_fields;  ///< one per field, when "light_field" is set
 };
 
 }  // namespace insitu

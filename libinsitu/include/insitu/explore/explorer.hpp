@@ -36,6 +36,7 @@
 #include "insitu/device/compute_device.hpp"
 #include "insitu/explore/colour_model.hpp"
 #include "insitu/explore/enhancement.hpp"
+#include "insitu/explore/light_field_reconstruction.hpp"
 #include "insitu/explore/relighting.hpp"
 #include "insitu/explore/view_synthesis.hpp"
 
@@ -46,12 +47,17 @@ std::string to_string(ColourSource source);
 /// "auto" | "model" | "recompose"; InvalidArgument names other text.
 ColourSource parse_colour_source(const std::string& text);
 
-/// Which stored proxies a frame is made from: "auto" takes the single-perspective ones when the
-/// archive has them (measured ahead for every rotation; bench/RESULTS.md), else the
-/// multi-perspective ones.
-enum class ProxySource { automatic, single, multi };
+/// Which stored proxies a frame is made from. "auto": the stored view's single-perspective
+/// proxies at the stored view (exact); for other views, where the step also holds a light field
+/// of the view's field, the light-field reconstruction and the view's proxies fused per pixel by
+/// confidence (the light field keeps the pixels it trusts, confidence >= 1/2; the view's proxies
+/// fill in where it doubts and they are more confident); otherwise the single-perspective proxies
+/// when the archive has them (measured ahead of the multi-perspective ones for every rotation;
+/// bench/RESULTS.md), else the multi-perspective ones. "lightfield": the light field only
+/// (insitu/explore/light_field_reconstruction.hpp).
+enum class ProxySource { automatic, single, multi, lightfield };
 std::string to_string(ProxySource source);
-/// "auto" | "single" | "multi"; InvalidArgument names other text.
+/// "auto" | "single" | "multi" | "lightfield"; InvalidArgument names other text.
 ProxySource parse_proxy_source(const std::string& text);
 
 /// What to show. Everything optional: an empty request shows the stored view as stored.
@@ -65,6 +71,8 @@ struct ExploreRequest {
     std::optional<TransferFunction> transfer_function;
     /// Extra opacity scales per interval (index, factor >= 0), applied on top of the edit.
     std::vector<std::pair<int, double>> opacity_scales;
+    /// Opacity scales of light-field segments (index, factor >= 0): seed 001's per-layer fades.
+    std::vector<std::pair<int, double>> segment_opacity_scales;
     ColourSource colour = ColourSource::automatic;
     ProxySource source = ProxySource::automatic;
     /// Lights in world space; a light whose direction is (0, 0, 0) is a headlight (toward the
@@ -84,7 +92,13 @@ struct ExploreFrame {
     bool synthesised_view = false;                         ///< the view differs from the stored one
     ColourSource colour_source = ColourSource::recompose;  ///< model or recompose, as used
     std::vector<double> opacity_scales;  ///< per interval, as applied (empty: none)
-    double milliseconds = 0.0;           ///< wall time of render(), archive reads included
+    /// What the pixels came from: single, multi, lightfield, or auto when fused per pixel.
+    ProxySource proxy_source = ProxySource::single;
+    /// Share of pixels taken from the light field (fused frames; 1 for lightfield, 0 without).
+    double light_field_share = 0.0;
+    /// Light-field cameras the frame needed but the archive lacks (see LightFieldReconstruction).
+    std::vector<int> missing_cameras;
+    double milliseconds = 0.0;  ///< wall time of render(), archive reads included
 };
 
 /// A summary of an archive for `insitu-view info` and the viewer's API.
@@ -113,6 +127,17 @@ private:
         std::optional<ProxyFrame> multi;
     };
     const CachedStep& load(std::int64_t step, int view);
+    /// The light field of (step, field) holding at least `cameras` (loaded on demand: a frame
+    /// needs the cameras facing it, not all of them); null when the step has none for `field`.
+    const LightField* load_light_field(std::int64_t step, const std::string& field,
+                                       const std::vector<int>& cameras);
+    /// One light field kept (they are large: cameras x map pixels x channels).
+    struct CachedLightField {
+        std::int64_t step = 0;
+        std::string field;
+        LightField light_field;
+    };
+    std::optional<CachedLightField> light_field_cache_;
 
     std::string path_;
     std::shared_ptr<ComputeDevice> device_;

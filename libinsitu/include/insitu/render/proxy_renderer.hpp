@@ -11,9 +11,16 @@
 //  * mean depth: the attenuation-weighted mean depth of interval j, sum(w depth) / a_j; +inf
 //    where a_j = 0.
 //  * optical depth: tau_j = -sum ln(1 - alpha_i) over the samples in I_j.
+//  * segments (light-field capture, written out in insitu/render/light_field_capture.hpp): the
+//    ray split by a SegmentRule, each segment's premultiplied RGBA (unshaded transfer-function
+//    colour) composited front to back from T = 1 on its own, and the depth (world units from the
+//    camera plane) of the first sample at which the segment's own opacity reaches
+//    first_hit_threshold; first-hit depth: the same for the whole ray. +inf where none.
 // Attenuation stops, like the ground truth, once 1 - T reaches the early-termination opacity;
-// the proxies' default (1.0) stops only where T is exactly 0, so nothing is lost. Depth layers
-// keep marching until every layer is found or the ray leaves the volume.
+// the proxies' default (1.0) stops only where T is exactly 0, so nothing is lost. A segment
+// stops once its own 1 - T reaches it, the first hit once the ray's does. Depth layers keep
+// marching until every layer is found or the ray leaves the volume, and so do segments while a
+// later one can still start.
 // Training renderings are ground-truth renderings (VolumeRenderer) of the single-perspective
 // camera, one per training transfer function.
 #include <iosfwd>
@@ -24,6 +31,7 @@
 #include "insitu/core/camera.hpp"
 #include "insitu/core/image.hpp"
 #include "insitu/core/intervals.hpp"
+#include "insitu/core/light_field.hpp"
 #include "insitu/core/transfer_function.hpp"
 #include "insitu/explore/colour_model.hpp"
 #include "insitu/render/distortion_camera.hpp"
@@ -37,6 +45,19 @@ struct ProxyRequest {
     bool attenuation = true;
     bool mean_depth = true;
     bool optical_depth = false;
+    /// Per segment of each ray, RGBA (premultiplied) and first-hit depth; the whole ray's
+    /// first-hit depth. Each needs the transfer function.
+    bool segment_rgba = false;
+    bool segment_depth = false;
+    bool first_hit_depth = false;
+    /// Where the segments split each ray: at the first crossing of each of `isovalues`
+    /// (SegmentRule::layers, whether or not depth layers are requested) or where the ray's
+    /// accumulated opacity reaches each of `segment_thresholds` (SegmentRule::opacity).
+    SegmentRule segments = SegmentRule::whole_ray;
+    /// SegmentRule::opacity only: increasing, in (0, 1).
+    std::vector<double> segment_thresholds;
+    /// Opacity, in (0, 1), that the segment and first-hit depths are taken at.
+    double first_hit_threshold = 0.1;
     /// Isovalues of the depth layers (at most kMaxLayers), in field units.
     std::vector<double> isovalues;
     /// Intervals of the attenuation proxies; required when attenuation is requested.
@@ -57,6 +78,8 @@ struct ProxyRequest {
     }();
 };
 std::ostream& operator<<(std::ostream& out, const ProxyRequest& request);
+/// Segments per ray the request asks for: 1, isovalues + 1 or thresholds + 1.
+int segment_count(const ProxyRequest& request);
 
 /// Every proxy of one camera. Images are planar: one Image per layer, L-channel images for the
 /// per-interval proxies (channel j = interval j). Empty images for what was not requested.
@@ -71,6 +94,9 @@ struct ProxyFrame {
     Image attenuation;                     ///< L channels
     Image mean_depth;                      ///< L channels
     Image optical_depth;                   ///< L channels
+    std::vector<Image> segment_rgba;       ///< RGBA each, one per segment, front first
+    std::vector<Image> segment_depth;      ///< 1 channel each, one per segment
+    Image first_hit_depth;                 ///< 1 channel
     std::vector<Image> training;           ///< RGBA each
     /// Colour model fitted on the training renderings (seed 000 §6.2), single perspective only.
     std::optional<ColourModel> colour_model;

@@ -1,0 +1,165 @@
+#pragma once
+// Light-field cameras (seed 001 §3.1; DESIGN.md "Light fields").
+//
+// Cameras sit at the vertices of a subdivided icosahedron (12, 42, 162, 642 vertices) on the
+// camera sphere, centred on the field's bounding sphere (centre o, radius R) with radius
+// Rc = sqrt(2) R. Each records the opposing hemisphere of the camera sphere as a parabolic map.
+// Seed 001 works in the camera's frame with the camera sphere of unit radius, the camera at
+// c = (0, 0, -1) and the recorded hemisphere r_z >= 0:
+//     Eq. 1   (u, v) = (r_x, r_y) / (1 + r_z),              u^2 + v^2 <= 1
+//     Eq. 2   r_z = (1 - u^2 - v^2) / (1 + u^2 + v^2),  r_x = u (1 + r_z),  r_y = v (1 + r_z)
+//     Eq. 3   d = |p - c| / |r - c|   (depth as the fraction of the ray secant)
+// By Eq. 2, r - c = 2 / (1 + u^2 + v^2) * (u, v, 1): the ray of map position (u, v) is the ray
+// of a pinhole camera at c looking at o through the image-plane point (u, v, 1). So the
+// parabolic map *is* a perspective image with a 90-degree field of view (tangents u, v in
+// [-1, 1]); its inscribed disk u^2 + v^2 <= 1 is the cone of half-angle 45 degrees that exactly
+// holds the bounding sphere (sin 45 = R / Rc), which is why Rc = sqrt(2) R. A light-field camera
+// is therefore Camera::orbit(perspective, fov 90, N x N) from the vertex's direction (that orbit
+// puts the eye at R / sin 45 = Rc), and the capture is the single-perspective proxy pass of that
+// camera: the same ray set-up, the same samples as the ground truth. Pixel (x, y) has
+// u = 2 (x + 1/2) / N - 1, v = 1 - 2 (y + 1/2) / N (Camera's plane coordinates); the camera's
+// right, up and forward vectors are the frame's x, y and z axes.
+// The secant of map position (u, v) has length |r - c| = 2 Rc / sqrt(1 + u^2 + v^2) in world
+// units, and a point at Camera depth z (along forward) lies |p - c| = z sqrt(1 + u^2 + v^2) from
+// the eye, so Eq. 3 is d = z (1 + u^2 + v^2) / (2 Rc).
+#include <array>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <iosfwd>
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+#include <vector>
+
+#include "insitu/core/camera.hpp"
+#include "insitu/field.hpp"
+
+namespace insitu {
+
+/// Vertex counts of the icosahedron subdivided 0..3 times (10 * 4^k + 2).
+inline constexpr std::array<int, 4> kLightFieldCameraCounts{12, 42, 162, 642};
+/// Parabolic map sizes (pixels per side) a light field may have.
+constexpr int kMinLightFieldMapSize = 8;
+constexpr int kMaxLightFieldMapSize = 4096;
+
+/// How the ray of each map pixel is split into segments (seed 001 §7), each recorded as its own
+/// RGBA + depth so that segments can be faded independently.
+enum class SegmentRule {
+    whole_ray,  ///< one segment: the whole ray ("segments" absent or "none")
+    layers,     ///< at the first crossing of each of the run's isovalues ("layers")
+    opacity,    ///< where the ray's accumulated opacity reaches each threshold ([0.3, 0.7])
+};
+
+/// "light_field" in the configuration: what each captured light field holds.
+struct LightFieldSettings {
+    int cameras = 42;  ///< "cameras": one of kLightFieldCameraCounts
+    int size = 256;    ///< "size": map pixels per side
+    SegmentRule segments = SegmentRule::whole_ray;
+    std::vector<double> opacity_thresholds;  ///< SegmentRule::opacity: increasing, in (0, 1)
+    bool attenuation = true;       ///< "attenuation": per camera a_j and mean depth (L intervals)
+    int depth_bits = 8;            ///< "depth_bits": 8 (as seed 001) or 16 (half)
+    double depth_threshold = 0.1;  ///< "depth_threshold": opacity of the first hit, in (0, 1)
+
+    /// InvalidArgument naming the "light_field" key and value of the first bad member.
+    void validate() const;
+    /// The configuration's "light_field" object.
+    nlohmann::json to_json() const;
+    /// ParseError/InvalidArgument name the key ("light_field.cameras") and value; unknown keys
+    /// are appended to `unknown_keys` as "light_field.<key>".
+    static LightFieldSettings from_json(const nlohmann::json& json,
+                                        std::vector<std::string>* unknown_keys);
+    /// The keys from_json knows (the configuration's suggest_key offers them).
+    static std::vector<std::string> keys();
+};
+std::string to_string(SegmentRule rule);
+
+/// Throws InvalidArgument naming `cameras` unless it is one of kLightFieldCameraCounts.
+void check_light_field_cameras(int cameras);
+/// Throws InvalidArgument naming `size` unless it is in [kMin.., kMaxLightFieldMapSize].
+void check_light_field_map_size(int size);
+
+/// The icosahedron subdivided until it has `vertex_count` vertices, projected to the unit
+/// sphere. Deterministic: the 12 vertices of the icosahedron first, then each subdivision's
+/// edge midpoints in order of creation, so the 12 cameras of a coarse light field are the first
+/// 12 of every finer one.
+struct Icosphere {
+    std::vector<glm::dvec3> vertices;           ///< unit length
+    std::vector<std::array<int, 3>> triangles;  ///< counter-clockwise seen from outside
+
+    /// InvalidArgument naming `vertex_count` unless it is one of kLightFieldCameraCounts.
+    static Icosphere with_vertices(int vertex_count);
+};
+
+/// Seed 001 Eq. 1: a point of the recorded hemisphere (unit camera sphere, camera at
+/// (0, 0, -1), r_z >= 0) to parabolic coordinates; |(u, v)| <= 1.
+glm::dvec2 parabolic_from_hemisphere(const glm::dvec3& hemisphere_point);
+/// Seed 001 Eq. 2: the inverse; (u, v) must lie in the unit disk.
+glm::dvec3 hemisphere_from_parabolic(const glm::dvec2& parabolic);
+
+/// The three cameras around a direction and their blending weights (barycentric in the
+/// icosphere triangle the direction passes through; non-negative, summing to 1).
+struct CameraNeighbourhood {
+    std::array<int, 3> cameras{0, 0, 0};
+    std::array<double, 3> weights{1.0, 0.0, 0.0};
+};
+
+/// The cameras of one light field around a field's bounds.
+class LightFieldRig {
+public:
+    /// `cameras` from kLightFieldCameraCounts, `map_size` in [kMin.., kMaxLightFieldMapSize]
+    /// (InvalidArgument naming the value otherwise).
+    static LightFieldRig around(const Bounds& bounds, int cameras, int map_size);
+
+    int camera_count() const { return static_cast<int>(cameras_.size()); }
+    int map_size() const { return map_size_; }
+    glm::dvec3 center() const { return center_; }
+    /// R: radius of the field's bounding sphere.
+    double bounding_radius() const { return bounding_radius_; }
+    /// Rc = sqrt(2) R.
+    double camera_radius() const { return camera_radius_; }
+    const Icosphere& icosphere() const { return icosphere_; }
+    /// Camera k: perspective, 90-degree field of view, map_size x map_size, its eye at
+    /// center() + camera_radius() * icosphere().vertices[k] (see the top of this file).
+    const Camera& camera(int k) const;
+
+    /// Parabolic coordinates (u, v) of a map position in pixels (pixel centres at + 0.5).
+    glm::dvec2 parabolic_of_pixel(double x_pixels, double y_pixels) const;
+    /// The inverse: map position in pixels of (u, v).
+    glm::dvec2 pixel_of_parabolic(const glm::dvec2& parabolic) const;
+    /// Whether map position (x, y) lies in the map's disk u^2 + v^2 <= 1 (the rest of the square
+    /// records nothing: its rays miss the bounding sphere).
+    bool on_map(double x_pixels, double y_pixels) const;
+    /// World length |r - c| of the ray secant through map position (x, y).
+    double secant_length(double x_pixels, double y_pixels) const;
+    /// Eq. 3: Camera depth (world units along forward) of a point seen at (x, y) -> secant
+    /// fraction; +inf stays +inf (no hit).
+    double depth_fraction(double x_pixels, double y_pixels, double depth_world) const;
+    /// The inverse of depth_fraction.
+    double depth_world(double x_pixels, double y_pixels, double fraction) const;
+
+    /// The cameras whose positions surround `direction` (from center(), any length > 0).
+    CameraNeighbourhood cameras_around(const glm::dvec3& direction) const;
+
+    /// {"cameras", "map_size", "center", "bounding_radius", "camera_radius", "positions"}:
+    /// what the archive's headers record.
+    nlohmann::json to_json() const;
+    /// The rig to_json() describes, rebuilt and checked against the stored positions.
+    /// ParseError names a missing or mistyped key; InvalidArgument a value out of range or
+    /// positions that are not this library's.
+    static LightFieldRig from_json(const nlohmann::json& json);
+
+private:
+    int map_size_ = 0;
+    glm::dvec3 center_{0.0};
+    double bounding_radius_ = 1.0;
+    double camera_radius_ = 1.0;
+    Icosphere icosphere_;
+    std::vector<Camera> cameras_;
+    /// Triangles whose spherical caps overlap each cell of a cube map over directions
+    /// (cameras_around's look-up; libinsitu/src/core/light_field.cpp).
+    int cells_per_face_ = 0;
+    std::vector<std::vector<int>> cell_triangles_;
+};
+
+std::ostream& operator<<(std::ostream& out, const LightFieldRig& rig);
+
+}  // namespace insitu

@@ -1,0 +1,582 @@
+// The light-field codec (light_field_exr.hpp). It works on bytes in memory as the view codec
+// does (exr_frame.cpp, whose streams, header checks and channel reader it shares): the writer
+// checksums what it encodes and stores it through the crash-safe path, and the reader parses
+// only bytes it already checked against the manifest, and of those only the parts of the
+// cameras it was asked for.
+#include "archive/light_field_exr.hpp"
+
+#include <Imath/half.h>
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfDoubleAttribute.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputPart.h>
+#include <OpenEXR/ImfIntAttribute.h>
+#include <OpenEXR/ImfMultiPartInputFile.h>
+#include <OpenEXR/ImfMultiPartOutputFile.h>
+#include <OpenEXR/ImfOutputPart.h>
+#include <OpenEXR/ImfPartType.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfThreading.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "archive/archive_format.hpp"
+#include "archive/exr_frame.hpp"
+#include "insitu/error.hpp"
+
+namespace insitu::archive_format {
+
+namespace {
+
+/// RGBA and depth per segment, first-hit depth, a_j and mean depth per interval.
+constexpr long long kMaxCameraChannels = 5ll * kMaxLightFieldSegments + 1 + 2ll * kMaxIntervals;
+
+/// The channel names of one camera's part, grouped as its images are.
+struct CameraChannels {
+    std::vector<std::string> rgba;           ///< 4 per segment
+    std::vector<std::string> segment_depth;  ///< one per segment when there are several
+    std::string depth;
+    std::vector<std::string> attenuation;  ///< L
+    std::vector<std::string> mean_depth;   ///< L
+
+    /// Every name, in the order decode reads them (one pass over the part's chunks).
+    std::vector<std::string> all() const {
+        std::vector<std::string> names = rgba;
+        names.insert(names.end(), segment_depth.begin(), segment_depth.end());
+        names.push_back(depth);
+        names.insert(names.end(), attenuation.begin(), attenuation.end());
+        names.insert(names.end(), mean_depth.begin(), mean_depth.end());
+        return names;
+    }
+};
+
+CameraChannels camera_channels(int camera, int segments, int intervals) {
+    const std::string part = camera_part(camera);
+    CameraChannels names;
+    for (int s = 0; s < segments; ++s) {
+        // One segment is the whole ray: plain R, G, B, A, as any EXR viewer shows a layer.
+        const std::string prefix = segments == 1 ? part : segment_prefix(part, s);
+        for (const char* suffix : kRgbaChannels) names.rgba.push_back(prefix + suffix);
+        if (segments > 1) names.segment_depth.push_back(prefix + kDepthChannel);
+    }
+    names.depth = part + kDepthChannel;
+    for (int j = 0; j < intervals; ++j) {
+        names.attenuation.push_back(interval_channel(part, kAttenuationChannel, j));
+        names.mean_depth.push_back(interval_channel(part, kMeanDepthChannel, j));
+    }
+    return names;
+}
+
+Imf::PixelType depth_type(const LightFieldEncoding& encoding, int depth_bits) {
+    return depth_bits == 16 ? Imf::HALF : encoding.depth_code_type;
+}
+
+std::string depth_encoding_text(int depth_bits, Imf::PixelType type) {
+    if (depth_bits == 16) return "secant fraction (seed 001 Eq. 3) as HALF, +inf = no hit";
+    return type == Imf::UINT ? "8-bit secant fraction: code round(f * 254) as UINT, 255 = no hit"
+                             : "8-bit secant fraction: round(f * 254) / 254 as HALF, +inf = no hit";
+}
+
+/// Seed 001's 8-bit depth: the secant fraction in 254 steps, and a code of its own for "no hit".
+int depth_code(float fraction) {
+    if (fraction == std::numeric_limits<float>::infinity()) return kNoHitDepthCode;
+    return static_cast<int>(std::lround(std::clamp(fraction, 0.0f, 1.0f) * kDepthCodeSteps));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Encoding
+
+void check_image(const Image& image, int channels, int size, const std::string& where,
+                 const std::string& what) {
+    if (image.channels != channels || image.width != size || image.height != size ||
+        image.pixels.size() != image.pixel_count() * static_cast<std::size_t>(channels)) {
+        fail<InvalidArgument>(where, ": ", what, " is ", image.width, "x", image.height, "x",
+                              image.channels, ", expected ", size, "x", size, "x", channels);
+    }
+}
+
+/// Checks what one camera holds against the light field's settings.
+void check_camera(const LightFieldImages& images, const LightField& light_field,
+                  const std::string& where) {
+    const int size = light_field.rig.map_size();
+    const int segments = light_field.segment_count();
+    const std::string camera = "camera " + std::to_string(images.camera);
+    if (static_cast<int>(images.segment_rgba.size()) != segments) {
+        fail<InvalidArgument>(where, ": ", camera, " has ", images.segment_rgba.size(),
+                              " segment images, the settings make ", segments);
+    }
+    const std::size_t depths = segments > 1 ? static_cast<std::size_t>(segments) : 0;
+    if (images.segment_depth.size() != depths) {
+        fail<InvalidArgument>(where, ": ", camera, " has ", images.segment_depth.size(),
+                              " segment depth images, expected ", depths);
+    }
+    for (int s = 0; s < segments; ++s) {
+        check_image(images.segment_rgba[s], 4, size, where,
+                    camera + " segment " + std::to_string(s) + " RGBA");
+        if (segments > 1) {
+            check_image(images.segment_depth[s], 1, size, where,
+                        camera + " segment " + std::to_string(s) + " depth");
+        }
+    }
+    check_image(images.depth, 1, size, where, camera + " depth");
+    const int intervals = light_field.settings.attenuation ? light_field.intervals->count() : 0;
+    if (intervals == 0) {
+        if (!images.attenuation.pixels.empty() || !images.mean_depth.pixels.empty()) {
+            fail<InvalidArgument>(where, ": ", camera,
+                                  " has attenuation images but the settings have "
+                                  "\"attenuation\": false");
+        }
+        return;
+    }
+    check_image(images.attenuation, intervals, size, where, camera + " attenuation");
+    check_image(images.mean_depth, intervals, size, where, camera + " mean depth");
+}
+
+void check_light_field(const LightField& light_field, const std::string& where) {
+    try {
+        light_field.settings.validate();
+    } catch (const InvalidArgument& error) {
+        fail<InvalidArgument>(where, ": ", error.what());
+    }
+    const LightFieldRig& rig = light_field.rig;
+    if (rig.camera_count() != light_field.settings.cameras ||
+        rig.map_size() != light_field.settings.size) {
+        fail<InvalidArgument>(where, ": the rig has ", rig.camera_count(), " cameras of ",
+                              rig.map_size(), "^2, the settings say ", light_field.settings.cameras,
+                              " of ", light_field.settings.size, "^2");
+    }
+    const int segments = light_field.segment_count();
+    if (segments < 1 || segments > kMaxLightFieldSegments) {
+        fail<InvalidArgument>(where, ": ", segments, " segments (at most ", kMaxLightFieldSegments,
+                              ")");
+    }
+    if (light_field.settings.attenuation && !light_field.intervals) {
+        fail<InvalidArgument>(where, ": \"attenuation\" is set but there are no intervals");
+    }
+    if (light_field.cameras.empty()) fail<InvalidArgument>(where, ": no cameras to store");
+    std::set<int> seen;
+    for (const LightFieldImages& images : light_field.cameras) {
+        if (images.camera < 0 || images.camera >= rig.camera_count() ||
+            !seen.insert(images.camera).second) {
+            fail<InvalidArgument>(where, ": camera ", images.camera, " is repeated or outside ",
+                                  "the rig's ", rig.camera_count(), " cameras");
+        }
+        check_camera(images, light_field, where);
+    }
+}
+
+/// The attributes of every part (archive_format.hpp); the rig only on the first.
+Imf::Header camera_header(const StepRecord& record, const LightFieldRecord& source,
+                          const LightFieldImages& images, const LightFieldEncoding& encoding,
+                          bool first) {
+    const LightField& light_field = source.light_field;
+    const int size = light_field.rig.map_size();
+    const Imath::Box2i window(Imath::V2i(0, 0), Imath::V2i(size - 1, size - 1));
+    Imf::Header header(window, window);
+    header.setName(camera_part(images.camera));
+    header.setType(Imf::SCANLINEIMAGE);
+    header.compression() = encoding.compression;
+    header.zipCompressionLevel() = kZipCompressionLevel;
+
+    const int segments = light_field.segment_count();
+    const int intervals = light_field.settings.attenuation ? light_field.intervals->count() : 0;
+    const CameraChannels names = camera_channels(images.camera, segments, intervals);
+    const Imf::PixelType depth = depth_type(encoding, light_field.settings.depth_bits);
+    for (const std::string& name : names.rgba) header.channels().insert(name, encoding.compact);
+    for (const std::string& name : names.segment_depth) header.channels().insert(name, depth);
+    header.channels().insert(names.depth, depth);
+    for (const std::string& name : names.attenuation) {
+        header.channels().insert(name, encoding.compact);
+    }
+    for (const std::string& name : names.mean_depth) {
+        header.channels().insert(name, encoding.compact);
+    }
+
+    header.insert(kSchemaAttribute, Imf::IntAttribute(kArchiveSchemaVersion));
+    // Steps are 64-bit; EXR has no 64-bit integer attribute, and a decimal string is exact.
+    header.insert(kStepAttribute, Imf::StringAttribute(std::to_string(record.step)));
+    header.insert(kTimeAttribute, Imf::DoubleAttribute(record.time));
+    header.insert(kFieldAttribute, Imf::StringAttribute(source.field));
+    header.insert(kLightFieldAttribute,
+                  Imf::StringAttribute(light_field.settings.to_json().dump()));
+    // JSON keeps doubles exact (shortest round-trip form).
+    header.insert(kIsovaluesAttribute,
+                  Imf::StringAttribute(nlohmann::json(light_field.isovalues).dump()));
+    if (light_field.intervals) {
+        header.insert(kIntervalsAttribute,
+                      Imf::StringAttribute(light_field.intervals->to_json().dump()));
+    }
+    header.insert(kTransferFunctionAttribute,
+                  Imf::StringAttribute(light_field.transfer_function.to_json().dump()));
+    header.insert(kCameraIndexAttribute, Imf::IntAttribute(images.camera));
+    header.insert(kCameraAttribute,
+                  Imf::StringAttribute(light_field.rig.camera(images.camera).to_json().dump()));
+    header.insert(kDepthEncodingAttribute, Imf::StringAttribute(depth_encoding_text(
+                                               light_field.settings.depth_bits, depth)));
+    if (first) {
+        header.insert(kRigAttribute, Imf::StringAttribute(light_field.rig.to_json().dump()));
+    }
+    return header;
+}
+
+/// The pixels of one part as OpenEXR takes them: FLOAT channels in place, HALF and UINT ones
+/// converted (OpenEXR writes a slice only into a channel of its own type).
+class PartPixels {
+public:
+    PartPixels(const LightFieldImages& images, const LightField& light_field,
+               const LightFieldEncoding& encoding, const std::string& where)
+        : size_(light_field.rig.map_size()) {
+        const int segments = light_field.segment_count();
+        const int intervals = light_field.settings.attenuation ? light_field.intervals->count() : 0;
+        const CameraChannels names = camera_channels(images.camera, segments, intervals);
+        halves_.reserve(names.all().size());
+        codes_.reserve(names.all().size());
+        for (int s = 0; s < segments; ++s) {
+            for (int c = 0; c < 4; ++c) {
+                add(names.rgba[4 * s + c], images.segment_rgba[s], c, encoding.compact);
+            }
+        }
+        const int depth_bits = light_field.settings.depth_bits;
+        const Imf::PixelType depth = depth_type(encoding, depth_bits);
+        for (int s = 0; s < static_cast<int>(names.segment_depth.size()); ++s) {
+            add_depth(names.segment_depth[s], images.segment_depth[s], depth_bits, depth, where);
+        }
+        add_depth(names.depth, images.depth, depth_bits, depth, where);
+        for (int j = 0; j < intervals; ++j) {
+            add(names.attenuation[j], images.attenuation, j, encoding.compact);
+            add(names.mean_depth[j], images.mean_depth, j, encoding.compact);
+        }
+    }
+    const Imf::FrameBuffer& frame_buffer() const { return frame_buffer_; }
+
+private:
+    void add(const std::string& name, const Image& image, int channel, Imf::PixelType type) {
+        if (type == Imf::HALF) {
+            std::vector<half>& plane = halves_.emplace_back(image.pixel_count());
+            for (std::size_t i = 0; i < plane.size(); ++i) {
+                plane[i] = half(image.pixels[i * image.channels + channel]);
+            }
+            insert_half(name, plane);
+            return;
+        }
+        const std::size_t x_stride = sizeof(float) * image.channels;
+        char* base = reinterpret_cast<char*>(const_cast<float*>(image.pixels.data()) + channel);
+        frame_buffer_.insert(name, Imf::Slice(Imf::FLOAT, base, x_stride, x_stride * size_));
+    }
+
+    void add_depth(const std::string& name, const Image& image, int depth_bits, Imf::PixelType type,
+                   const std::string& where) {
+        for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+            const float fraction = image.pixels[i];
+            if (std::isnan(fraction) || fraction == -std::numeric_limits<float>::infinity()) {
+                fail<InvalidArgument>(where, ": channel \"", name, "\" pixel ", i, " is ", fraction,
+                                      " (a secant fraction, +inf for no hit)");
+            }
+        }
+        if (depth_bits == 16) {
+            add(name, image, 0, Imf::HALF);
+            return;
+        }
+        if (type == Imf::UINT) {
+            std::vector<std::uint32_t>& plane = codes_.emplace_back(image.pixel_count());
+            for (std::size_t i = 0; i < plane.size(); ++i) {
+                plane[i] = static_cast<std::uint32_t>(depth_code(image.pixels[i]));
+            }
+            frame_buffer_.insert(name,
+                                 Imf::Slice(Imf::UINT, reinterpret_cast<char*>(plane.data()),
+                                            sizeof(std::uint32_t), sizeof(std::uint32_t) * size_));
+            return;
+        }
+        std::vector<half>& plane = halves_.emplace_back(image.pixel_count());
+        for (std::size_t i = 0; i < plane.size(); ++i) {
+            const int code = depth_code(image.pixels[i]);
+            plane[i] = code == kNoHitDepthCode ? half(std::numeric_limits<float>::infinity())
+                                               : half(static_cast<float>(code) / kDepthCodeSteps);
+        }
+        insert_half(name, plane);
+    }
+
+    void insert_half(const std::string& name, std::vector<half>& plane) {
+        frame_buffer_.insert(name, Imf::Slice(Imf::HALF, reinterpret_cast<char*>(plane.data()),
+                                              sizeof(half), sizeof(half) * size_));
+    }
+
+    int size_;
+    // Reserved up front: slices point into these planes.
+    std::vector<std::vector<half>> halves_;
+    std::vector<std::vector<std::uint32_t>> codes_;
+    Imf::FrameBuffer frame_buffer_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Decoding
+
+template <typename Value>
+Value json_value(const Imf::Header& header, const char* name, const PartContext& where,
+                 Value (*parse)(const nlohmann::json&)) {
+    const nlohmann::json json = json_attribute(header, name, where);
+    try {
+        return parse(json);
+    } catch (const std::exception& error) {
+        where.error(std::string("attribute \"") + name + "\": " + error.what());
+    }
+}
+
+/// What the whole light field shares, from the first part's header.
+void read_light_field_attributes(const Imf::Header& header, LightField& light_field,
+                                 const PartContext& where) {
+    const auto* schema = header.findTypedAttribute<Imf::IntAttribute>(kSchemaAttribute);
+    if (!schema) where.error(std::string("no int attribute \"") + kSchemaAttribute + "\"");
+    if (schema->value() != kArchiveSchemaVersion) {
+        where.error("schema version " + std::to_string(schema->value()) +
+                    " (this libinsitu reads " + std::to_string(kArchiveSchemaVersion) + ")");
+    }
+    light_field.settings = json_value<LightFieldSettings>(
+        header, kLightFieldAttribute, where, [](const nlohmann::json& json) {
+            std::vector<std::string> unknown;
+            LightFieldSettings settings = LightFieldSettings::from_json(json, &unknown);
+            if (!unknown.empty()) fail<ParseError>("unknown key \"", unknown.front(), "\"");
+            settings.validate();
+            return settings;
+        });
+    light_field.rig = json_value<LightFieldRig>(
+        header, kRigAttribute, where,
+        [](const nlohmann::json& json) { return LightFieldRig::from_json(json); });
+    if (light_field.rig.camera_count() != light_field.settings.cameras ||
+        light_field.rig.map_size() != light_field.settings.size) {
+        where.error("the rig has " + std::to_string(light_field.rig.camera_count()) +
+                    " cameras of " + std::to_string(light_field.rig.map_size()) +
+                    "^2, attribute \"" + kLightFieldAttribute + "\" says " +
+                    std::to_string(light_field.settings.cameras) + " of " +
+                    std::to_string(light_field.settings.size) + "^2");
+    }
+    light_field.isovalues = json_value<std::vector<double>>(
+        header, kIsovaluesAttribute, where,
+        [](const nlohmann::json& json) { return json.get<std::vector<double>>(); });
+    if (header.findTypedAttribute<Imf::StringAttribute>(kIntervalsAttribute)) {
+        light_field.intervals = json_value<IntervalSet>(
+            header, kIntervalsAttribute, where, [](const nlohmann::json& json) {
+                return IntervalSet(json.at("edges").get<std::vector<double>>());
+            });
+    }
+    if (light_field.settings.attenuation && !light_field.intervals) {
+        where.error(std::string("\"attenuation\" is set but there is no attribute \"") +
+                    kIntervalsAttribute + "\"");
+    }
+    light_field.transfer_function = json_value<TransferFunction>(
+        header, kTransferFunctionAttribute, where,
+        [](const nlohmann::json& json) { return TransferFunction::from_json(json); });
+    const int segments = light_field.segment_count();
+    if (segments > kMaxLightFieldSegments) {
+        where.error(std::to_string(segments) + " segments (at most " +
+                    std::to_string(kMaxLightFieldSegments) + ")");
+    }
+}
+
+/// The secant fractions of depth channels read as floats: codes or HALF code / 254 back to
+/// fractions for 8-bit depth (the type says which), HALF fractions as they are for 16-bit.
+void decode_depth(Image& depth, const Imf::Channel& channel, int depth_bits,
+                  const std::string& name, const PartContext& where) {
+    const auto refuse = [&](const std::string& what) {
+        where.error("channel \"" + name + "\": " + what);
+    };
+    if (depth_bits == 16) {
+        if (channel.type != Imf::HALF) refuse("16-bit depth is not HALF");
+        return;
+    }
+    if (channel.type != Imf::UINT && channel.type != Imf::HALF) {
+        refuse("8-bit depth is neither UINT codes nor HALF");
+    }
+    const float no_hit = std::numeric_limits<float>::infinity();
+    for (float& value : depth.pixels) {
+        const float code = channel.type == Imf::UINT ? value : value * kDepthCodeSteps;
+        if (channel.type == Imf::HALF && value == no_hit) continue;
+        const float rounded = std::round(code);
+        // HALF holds code / 254 within 2^-12 relative, a quarter of a code at most.
+        if (!(rounded >= 0.0f && rounded <= kNoHitDepthCode && std::abs(code - rounded) < 0.25f) ||
+            (channel.type == Imf::HALF && rounded == kNoHitDepthCode)) {
+            refuse("value " + std::to_string(value) + " is not an 8-bit depth code");
+        }
+        value = rounded == kNoHitDepthCode ? no_hit : rounded / kDepthCodeSteps;
+    }
+}
+
+LightFieldImages read_camera(Imf::InputPart& part, int camera, const LightField& light_field,
+                             const PartContext& where) {
+    const int segments = light_field.segment_count();
+    const int intervals = light_field.settings.attenuation ? light_field.intervals->count() : 0;
+    const CameraChannels names = camera_channels(camera, segments, intervals);
+    const std::vector<std::string> all_names = names.all();
+    const Imf::ChannelList& channels = part.header().channels();
+    for (const std::string& name : all_names) {
+        const Imf::Channel* channel = channels.findChannel(name);
+        if (!channel) where.error("no channel \"" + name + "\"");
+        if (channel->xSampling != 1 || channel->ySampling != 1) {
+            where.error("channel \"" + name + "\" is subsampled");
+        }
+    }
+    const Image all = read_channels(part, all_names, where);
+    const int size = light_field.rig.map_size();
+    if (all.width != size || all.height != size) {
+        where.error("data window " + std::to_string(all.width) + "x" + std::to_string(all.height) +
+                    ", the rig's maps are " + std::to_string(size) + "x" + std::to_string(size));
+    }
+    LightFieldImages images;
+    images.camera = camera;
+    int first = 0;
+    for (int s = 0; s < segments; ++s, first += 4) {
+        images.segment_rgba.push_back(channel_range(all, first, 4));
+    }
+    const int depth_bits = light_field.settings.depth_bits;
+    for (const std::string& name : names.segment_depth) {
+        Image& depth = images.segment_depth.emplace_back(channel_range(all, first++, 1));
+        decode_depth(depth, *channels.findChannel(name), depth_bits, name, where);
+    }
+    images.depth = channel_range(all, first++, 1);
+    decode_depth(images.depth, *channels.findChannel(names.depth), depth_bits, names.depth, where);
+    if (intervals > 0) {
+        images.attenuation = channel_range(all, first, intervals);
+        images.mean_depth = channel_range(all, first + intervals, intervals);
+    }
+    return images;
+}
+
+}  // namespace
+
+LightFieldEncoding light_field_encoding(StoragePrecision precision,
+                                        const std::string& compression) {
+    LightFieldEncoding encoding;
+    encoding.compact = precision == StoragePrecision::half ? Imf::HALF : Imf::FLOAT;
+    encoding.compression = parse_compression(compression);
+    // Measured on volume renderings of nested shells through a 12-camera rig, 256^2 maps, S = 1,
+    // half precision, depth bytes a camera (8-bit UINT / 8-bit HALF / 16-bit HALF): zip 13.3 /
+    // 11.4 / 14.0 KB, zips 33.6 / 15.2 / 20.1 KB, piz 14.4 / 20.0 / 26.6 KB, pxr24 6.5 / 9.3 /
+    // 11.3 KB; uncompressed HALF is half of UINT, and rle gave 210 vs 104 KB a camera in all.
+    // The zip family splits pixels into two byte streams, not four, so UINT's zero bytes stay
+    // interleaved with the codes; piz and pxr24 separate them. b44 leaves UINT raw but is lossy
+    // for HALF, which would move codes: UINT. light_field_archive_test.cpp
+    // (DepthCodeTypeIsTheSmallerUnderEachCompression) checks the choice on rendered maps.
+    switch (encoding.compression) {
+        case Imf::PIZ_COMPRESSION:
+        case Imf::PXR24_COMPRESSION:
+        case Imf::B44_COMPRESSION:
+        case Imf::B44A_COMPRESSION:
+            encoding.depth_code_type = Imf::UINT;
+            break;
+        default:
+            encoding.depth_code_type = Imf::HALF;
+    }
+    return encoding;
+}
+
+EncodedLightField encode_light_field(const StepRecord& record, const LightFieldRecord& source,
+                                     const LightFieldEncoding& encoding,
+                                     const std::string& relative_path) {
+    const std::string where = "step " + std::to_string(record.step) + " light field of \"" +
+                              source.field + "\" (" + relative_path + ")";
+    const LightField& light_field = source.light_field;
+    check_light_field(light_field, where);
+
+    // Parts in camera order, whatever order the capture listed them in.
+    std::vector<const LightFieldImages*> cameras;
+    for (const LightFieldImages& images : light_field.cameras) cameras.push_back(&images);
+    std::sort(cameras.begin(), cameras.end(),
+              [](const auto* a, const auto* b) { return a->camera < b->camera; });
+    EncodedLightField encoded;
+    std::vector<Imf::Header> headers;
+    for (const LightFieldImages* images : cameras) {
+        headers.push_back(camera_header(record, source, *images, encoding, headers.empty()));
+        encoded.cameras.push_back(images->camera);
+    }
+
+    MemoryOutputStream stream(relative_path);
+    std::string current_part;
+    try {
+        // No OpenEXR worker threads, as for the views (exr_frame.cpp): the encoding stays on the
+        // writer thread and its lowered priority.
+        Imf::MultiPartOutputFile file(stream, headers.data(), static_cast<int>(headers.size()),
+                                      /*overrideSharedAttributes=*/false, /*numThreads=*/0);
+        for (std::size_t p = 0; p < cameras.size(); ++p) {
+            current_part = camera_part(cameras[p]->camera);
+            const PartPixels pixels(*cameras[p], light_field, encoding, where);
+            Imf::OutputPart part(file, static_cast<int>(p));
+            part.setFrameBuffer(pixels.frame_buffer());
+            part.writePixels(light_field.rig.map_size());
+        }
+    } catch (const Error&) {
+        throw;
+    } catch (const std::exception& error) {
+        fail<IoError>("cannot encode EXR \"", relative_path, "\" part \"", current_part,
+                      "\": ", error.what());
+    }
+    encoded.bytes = std::move(stream.bytes());
+    return encoded;
+}
+
+LightField decode_light_field(const std::vector<char>& bytes, const std::string& path,
+                              const std::vector<int>& cameras, int map_size) {
+    LightField light_field;
+    PartContext where{path, "(header)"};
+    try {
+        check_headers(bytes, path, [map_size](const std::string&) {
+            return PartLimits{map_size, map_size, kMaxCameraChannels,
+                              "the light field's map size in the manifest"};
+        });
+        MemoryInputStream stream(bytes, path);
+        // No reconstruction of a damaged chunk offset table: damage is an error here.
+        Imf::MultiPartInputFile file(stream, Imf::globalThreadCount(), false);
+        const Imf::Header& first = file.header(0);
+        where.part = first.hasName() ? first.name() : "(part 0)";
+        read_light_field_attributes(first, light_field, where);
+        if (light_field.rig.map_size() != map_size) {
+            where.error("maps of " + std::to_string(light_field.rig.map_size()) +
+                        "^2, the manifest records " + std::to_string(map_size) + "^2");
+        }
+        const int camera_count = light_field.rig.camera_count();
+        for (const int camera : cameras) {
+            if (camera < 0 || camera >= camera_count) {
+                fail<InvalidArgument>("\"", path, "\": camera ", camera, " is outside the rig (",
+                                      camera_count, " cameras, 0..", camera_count - 1, ")");
+            }
+        }
+        std::map<int, int> part_of_camera;
+        for (int p = 0; p < file.parts(); ++p) {
+            const Imf::Header& header = file.header(p);
+            where.part = header.hasName() ? header.name() : "(part " + std::to_string(p) + ")";
+            const auto* index = header.findTypedAttribute<Imf::IntAttribute>(kCameraIndexAttribute);
+            if (!index)
+                where.error(std::string("no int attribute \"") + kCameraIndexAttribute + "\"");
+            const int camera = index->value();
+            if (camera < 0 || camera >= camera_count || where.part != camera_part(camera) ||
+                !part_of_camera.emplace(camera, p).second) {
+                where.error("camera " + std::to_string(camera) +
+                            " is outside the rig, repeated, or not this part's camera");
+            }
+        }
+        std::set<int> wanted(cameras.begin(), cameras.end());
+        if (cameras.empty()) {
+            for (const auto& [camera, part] : part_of_camera) wanted.insert(camera);
+        }
+        for (const int camera : wanted) {
+            const auto found = part_of_camera.find(camera);
+            if (found == part_of_camera.end()) continue;  // the caller sees which it lacks
+            where.part = camera_part(camera);
+            Imf::InputPart part(file, found->second);
+            light_field.cameras.push_back(read_camera(part, camera, light_field, where));
+        }
+    } catch (const Error&) {
+        throw;
+    } catch (const std::exception& error) {
+        where.error(error.what());
+    }
+    return light_field;
+}
+
+}  // namespace insitu::archive_format

@@ -1,0 +1,523 @@
+#include "insitu/explore/light_field_reconstruction.hpp"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstddef>
+#include <exception>
+#include <glm/geometric.hpp>
+#include <limits>
+#include <optional>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "insitu/error.hpp"
+
+namespace insitu {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr int kMinSearchSteps = 4;
+constexpr int kMaxSearchSteps = 4096;
+// Halvings of the coarse bracket: 2^-16 of a coarse step is far below a map pixel's footprint
+// for any search_steps allowed, so the hit is as exact as the stored depth.
+constexpr int kBisections = 16;
+// Tolerances in map pixels' footprints: a depth stored per pixel is piecewise constant, and on
+// a sloped surface neighbouring pixels (and neighbouring cameras) differ by about a footprint.
+// A hit may lie this far behind the stored surface (more is an occluding edge, not a surface):
+constexpr double kSurfaceFootprints = 4.0;
+// and the cameras' hits along the ray are told to agree within:
+constexpr double kAgreementFootprints = 2.0;
+
+// Where the line origin + t direction (unit) meets a sphere: t of entry and exit, or nothing
+// when it misses (a tangent line counts as a miss: nothing to see along it).
+std::optional<std::pair<double, double>> sphere_chord(const Ray& ray, const glm::dvec3& centre,
+                                                      double radius) {
+    const glm::dvec3 oc = ray.origin - centre;
+    const double b = glm::dot(oc, ray.direction);
+    const double discriminant = b * b - (glm::dot(oc, oc) - radius * radius);
+    if (!(discriminant > 0.0)) return std::nullopt;
+    const double root = std::sqrt(discriminant);
+    return std::pair{-b - root, -b + root};
+}
+
+// Bilinear taps over pixel centres (x + 1/2), clamped at the map's edges.
+struct Taps {
+    std::array<std::size_t, 4> pixel{};
+    std::array<double, 4> weight{};
+};
+
+Taps bilinear_taps(int size, const glm::dvec2& map_position) {
+    const double fx = std::clamp(map_position.x - 0.5, 0.0, size - 1.0);
+    const double fy = std::clamp(map_position.y - 0.5, 0.0, size - 1.0);
+    const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+    const int x1 = std::min(x0 + 1, size - 1), y1 = std::min(y0 + 1, size - 1);
+    const double wx = fx - x0, wy = fy - y0;
+    const auto at = [size](int x, int y) { return static_cast<std::size_t>(y) * size + x; };
+    Taps taps;
+    taps.pixel = {at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1)};
+    taps.weight = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+    return taps;
+}
+
+// One present camera around a pixel's ray.
+struct CameraSample {
+    int camera = 0;
+    const LightFieldImages* images = nullptr;
+    double weight = 0.0;          ///< renormalised over the cameras present
+    std::optional<double> hit_t;  ///< whole-ray first hit along the target ray
+    glm::dvec3 read_point{0.0};   ///< the hit, or the ray's point nearest the centre
+    glm::dvec2 read_map{0.0};     ///< read_point in this camera's map (pixels)
+    /// No hit, yet a first hit recorded at read_map: a surface the ray passes by, none of whose
+    /// colour or attenuation is on this ray.
+    bool passes_by = false;
+};
+
+// Per-thread buffers, so that rows allocate nothing.
+struct Scratch {
+    std::vector<std::array<double, 4>> segment_rgba;
+    std::vector<char> missing;  ///< by camera index
+};
+
+void check_settings(const LightFieldReconstructionSettings& settings, int segments) {
+    if (settings.search_steps < kMinSearchSteps || settings.search_steps > kMaxSearchSteps) {
+        fail<InvalidArgument>("search_steps = ", settings.search_steps, " (must be in [",
+                              kMinSearchSteps, ", ", kMaxSearchSteps, "])");
+    }
+    const auto& scales = settings.segment_opacity_scales;
+    for (std::size_t s = 0; s < scales.size(); ++s) {
+        if (!(std::isfinite(scales[s]) && scales[s] >= 0.0)) {
+            fail<InvalidArgument>("segment_opacity_scales[", s, "] = ", scales[s],
+                                  " (must be finite and >= 0)");
+        }
+    }
+    if (scales.size() > static_cast<std::size_t>(segments)) {
+        fail<InvalidArgument>("segment_opacity_scales has ", scales.size(),
+                              " entries for a light field of ", segments, " segment(s)");
+    }
+}
+
+void check_image(const Image& image, int size, int channels, int camera, const char* what) {
+    if (image.width != size || image.height != size || image.channels != channels) {
+        fail<InvalidArgument>("light field camera ", camera, ": ", what, " is ", image.width, "x",
+                              image.height, "x", image.channels, ", expected ", size, "x", size,
+                              "x", channels);
+    }
+}
+
+// The images of each rig camera (null where the light field lacks it), after checking that
+// every image has the rig's map size and the light field's segment and interval counts.
+std::vector<const LightFieldImages*> camera_table(const LightField& light_field, int segments,
+                                                  int intervals) {
+    const LightFieldRig& rig = light_field.rig;
+    if (light_field.cameras.empty()) {
+        fail<InvalidArgument>("light field holds no camera images (rig of ", rig.camera_count(),
+                              " cameras)");
+    }
+    std::vector<const LightFieldImages*> table(static_cast<std::size_t>(rig.camera_count()),
+                                               nullptr);
+    const int n = rig.map_size();
+    for (const LightFieldImages& images : light_field.cameras) {
+        const int k = images.camera;
+        if (k < 0 || k >= rig.camera_count()) {
+            fail<InvalidArgument>("light field camera ", k, " is out of range for a rig of ",
+                                  rig.camera_count(), " cameras");
+        }
+        if (table[static_cast<std::size_t>(k)] != nullptr) {
+            fail<InvalidArgument>("light field holds camera ", k, " twice");
+        }
+        table[static_cast<std::size_t>(k)] = &images;
+        if (images.segment_rgba.size() != static_cast<std::size_t>(segments)) {
+            fail<InvalidArgument>("light field camera ", k, ": ", images.segment_rgba.size(),
+                                  " segment images, expected ", segments);
+        }
+        for (const Image& rgba : images.segment_rgba) check_image(rgba, n, 4, k, "segment_rgba");
+        check_image(images.depth, n, 1, k, "depth");
+        if (segments > 1) {
+            if (images.segment_depth.size() != static_cast<std::size_t>(segments)) {
+                fail<InvalidArgument>("light field camera ", k, ": ", images.segment_depth.size(),
+                                      " segment depth images, expected ", segments);
+            }
+            for (const Image& depth : images.segment_depth) {
+                check_image(depth, n, 1, k, "segment_depth");
+            }
+        }
+        if (intervals > 0) {
+            check_image(images.attenuation, n, intervals, k, "attenuation");
+            check_image(images.mean_depth, n, intervals, k, "mean_depth");
+        }
+    }
+    return table;
+}
+
+// Mean angle between neighbouring cameras, seen from the centre: the scale of the angular term.
+double camera_spacing_rad(const Icosphere& icosphere) {
+    double sum = 0.0;
+    for (const auto& triangle : icosphere.triangles) {
+        for (int e = 0; e < 3; ++e) {
+            const glm::dvec3& a = icosphere.vertices[static_cast<std::size_t>(triangle[e])];
+            const glm::dvec3& b =
+                icosphere.vertices[static_cast<std::size_t>(triangle[(e + 1) % 3])];
+            sum += std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));
+        }
+    }
+    return sum / (3.0 * static_cast<double>(icosphere.triangles.size()));
+}
+
+class Reconstructor {
+public:
+    Reconstructor(const LightField& light_field, const Camera& target,
+                  const LightFieldReconstructionSettings& settings)
+        : light_field_(light_field),
+          rig_(light_field.rig),
+          target_(target),
+          settings_(settings),
+          segments_(light_field.segment_count()) {
+        check_settings(settings, segments_);
+        const bool attenuation = settings.attenuation && light_field.settings.attenuation &&
+                                 light_field.intervals.has_value();
+        intervals_ = attenuation ? light_field.intervals->count() : 0;
+        table_ = camera_table(light_field, segments_, intervals_);
+        scales_.assign(static_cast<std::size_t>(segments_), 1.0);
+        std::copy(settings.segment_opacity_scales.begin(), settings.segment_opacity_scales.end(),
+                  scales_.begin());
+        spacing_rad_ = camera_spacing_rad(rig_.icosphere());
+
+        const int w = target.width(), h = target.height();
+        result_.rgba = Image(w, h, 4, 0.0f);
+        result_.confidence = Image(w, h, 1, 1.0f);
+        result_.depth = Image(w, h, 1, static_cast<float>(kInf));
+        if (intervals_ > 0) {
+            result_.attenuation = Image(w, h, intervals_, 0.0f);
+            result_.mean_depth = Image(w, h, intervals_, static_cast<float>(kInf));
+        }
+    }
+
+    LightFieldReconstruction run() {
+        const int height = target_.height();
+        const unsigned threads =
+            std::clamp(std::thread::hardware_concurrency(), 1u, static_cast<unsigned>(height));
+        std::atomic<int> next_row{0};
+        std::vector<Scratch> scratch(threads);
+        std::vector<std::exception_ptr> errors(threads);
+        std::vector<std::thread> workers;
+        workers.reserve(threads);
+        for (unsigned i = 0; i < threads; ++i) {
+            workers.emplace_back([&, i] {
+                try {
+                    Scratch& own = scratch[i];
+                    own.segment_rgba.resize(static_cast<std::size_t>(segments_));
+                    own.missing.assign(static_cast<std::size_t>(rig_.camera_count()), 0);
+                    for (int y = next_row++; y < height; y = next_row++) {
+                        for (int x = 0; x < target_.width(); ++x) pixel(x, y, own);
+                    }
+                } catch (...) {
+                    errors[i] = std::current_exception();
+                    next_row = height;  // the others stop after their row
+                }
+            });
+        }
+        for (std::thread& worker : workers) worker.join();
+        for (const std::exception_ptr& error : errors) {
+            if (error) std::rethrow_exception(error);
+        }
+        for (int k = 0; k < rig_.camera_count(); ++k) {
+            const bool missing = std::any_of(scratch.begin(), scratch.end(), [k](const Scratch& s) {
+                return s.missing[static_cast<std::size_t>(k)] != 0;
+            });
+            if (missing) result_.missing_cameras.push_back(k);
+        }
+        return std::move(result_);
+    }
+
+private:
+    // Eq. 3: the distance from camera k's eye of the surface it recorded at a map position,
+    // from the nearest map pixel: bilinear depth between a silhouette and the background (+inf)
+    // would be +inf or invent a surface between the two. +inf where it recorded none.
+    double stored_distance(const Image& depth, const glm::dvec2& map) const {
+        const int n = rig_.map_size();
+        const int px = static_cast<int>(std::clamp(std::floor(map.x), 0.0, n - 1.0));
+        const int py = static_cast<int>(std::clamp(std::floor(map.y), 0.0, n - 1.0));
+        return depth.at(px, py, 0) * rig_.secant_length(px + 0.5, py + 0.5);
+    }
+
+    // How far a point may lie behind camera k's recorded surface and still be on it: `footprints`
+    // map pixels' footprint at that distance (2 s / N) plus the stored depth's resolution
+    // (8-bit fractions of the secant, or half floats).
+    double depth_tolerance(double distance, const glm::dvec2& map, double footprints) const {
+        const double quantum = light_field_.settings.depth_bits == 8
+                                   ? rig_.secant_length(map.x, map.y) / 255.0
+                                   : distance * std::ldexp(1.0, -10);
+        return footprints * 2.0 * distance / rig_.map_size() + quantum;
+    }
+
+    // Seed 001 §3.2 depth correction against one camera's stored depth (secant fractions): the
+    // first t in [t0, t1] at which the ray's point passes from in front of the recorded surface
+    // to behind it, i.e. its distance from the eye reaches the stored distance, and there agrees
+    // with it. Where the stored depth jumps instead (the point passes behind an occluding edge
+    // seen from this camera) the camera does not see the ray there, and the search goes on; so
+    // does a ray that starts behind the recorded surface: its own surface, if this camera sees
+    // it, is where the point comes out and goes behind again.
+    std::optional<double> first_hit(const Camera& camera, const Image& depth, const Ray& ray,
+                                    double t0, double t1) const {
+        const auto behind_by = [&](double t) {
+            const glm::dvec3 point = ray.origin + t * ray.direction;
+            // Inside the bounding sphere, so in front of the eye and on the map's disk.
+            const double stored = stored_distance(depth, camera.project(point));
+            return glm::length(point - camera.position()) - stored;  // -inf, NaN: never behind
+        };
+        const int steps = settings_.search_steps;
+        const double step = (t1 - t0) / (steps - 1);
+        bool was_behind = behind_by(t0) >= 0.0;
+        for (int i = 1; i < steps; ++i) {
+            const double t = i == steps - 1 ? t1 : t0 + i * step;
+            const bool is_behind = behind_by(t) >= 0.0;
+            if (is_behind && !was_behind) {
+                double in_front = t - step, hidden = t;
+                for (int b = 0; b < kBisections; ++b) {
+                    const double middle = 0.5 * (in_front + hidden);
+                    (behind_by(middle) >= 0.0 ? hidden : in_front) = middle;
+                }
+                const glm::dvec3 point = ray.origin + hidden * ray.direction;
+                const double tolerance = depth_tolerance(glm::length(point - camera.position()),
+                                                         camera.project(point), kSurfaceFootprints);
+                if (behind_by(hidden) <= tolerance) return 0.5 * (in_front + hidden);
+            }
+            was_behind = is_behind;
+        }
+        return std::nullopt;
+    }
+
+    // Premultiplied RGBA of `image` at a map position, added to `sum` with `weight`.
+    void add_bilinear(const Image& image, const glm::dvec2& map, double weight,
+                      std::array<double, 4>& sum) const {
+        const Taps taps = bilinear_taps(rig_.map_size(), map);
+        for (int i = 0; i < 4; ++i) {
+            const float* texel = &image.pixels[taps.pixel[i] * 4];
+            for (int c = 0; c < 4; ++c) sum[c] += weight * taps.weight[i] * texel[c];
+        }
+    }
+
+    void pixel(int x, int y, Scratch& scratch) {
+        const Ray ray = target_.ray(x + 0.5, y + 0.5);
+        const auto chord = sphere_chord(ray, rig_.center(), rig_.bounding_radius());
+        if (!chord) return;  // the defaults: empty, depth +inf, confidence 1
+        const double t0 = std::max(chord->first, 0.0), t1 = chord->second;
+        if (!(t1 > t0)) return;
+        const double t_centre =
+            std::clamp(glm::dot(rig_.center() - ray.origin, ray.direction), t0, t1);
+        const auto at = [&](double t) { return ray.origin + t * ray.direction; };
+
+        // The line meets the camera sphere (Rc > R, so it does) where it enters it; for a
+        // perspective eye between R and Rc that point lies behind the eye, as it should: the
+        // cameras there see the ray's direction.
+        const double t_entry = sphere_chord(ray, rig_.center(), rig_.camera_radius())->first;
+        const CameraNeighbourhood around = rig_.cameras_around(at(t_entry) - rig_.center());
+        std::array<CameraSample, 3> samples;
+        int present = 0;
+        double present_weight = 0.0;
+        for (int i = 0; i < 3; ++i) {
+            const int k = around.cameras[static_cast<std::size_t>(i)];
+            const double weight = around.weights[static_cast<std::size_t>(i)];
+            if (!(weight > 0.0)) continue;  // not wanted, so not missing either
+            const LightFieldImages* images = table_[static_cast<std::size_t>(k)];
+            if (images == nullptr) {
+                scratch.missing[static_cast<std::size_t>(k)] = 1;
+                continue;
+            }
+            CameraSample& sample = samples[static_cast<std::size_t>(present++)];
+            sample.camera = k;
+            sample.images = images;
+            sample.weight = weight;
+            present_weight += weight;
+        }
+        const std::size_t p = static_cast<std::size_t>(y) * target_.width() + x;
+        if (present == 0) {  // nothing known about this ray
+            result_.confidence.pixels[p] = 0.0f;
+            return;
+        }
+
+        for (int i = 0; i < present; ++i) {
+            CameraSample& sample = samples[static_cast<std::size_t>(i)];
+            const Camera& camera = rig_.camera(sample.camera);
+            sample.weight /= present_weight;
+            sample.hit_t = first_hit(camera, sample.images->depth, ray, t0, t1);
+            sample.read_point = at(sample.hit_t.value_or(t_centre));
+            sample.read_map = camera.project(sample.read_point);
+            sample.passes_by = !sample.hit_t && std::isfinite(stored_distance(sample.images->depth,
+                                                                              sample.read_map));
+        }
+
+        // Segments: each camera depth-corrected against the segment's own depth, blended, then
+        // composited front to back with the segment's opacity scale.
+        for (auto& rgba : scratch.segment_rgba) rgba = {0.0, 0.0, 0.0, 0.0};
+        for (int i = 0; i < present; ++i) {
+            const CameraSample& sample = samples[static_cast<std::size_t>(i)];
+            const Camera& camera = rig_.camera(sample.camera);
+            for (int s = 0; s < segments_; ++s) {
+                const Image& depth = segments_ > 1
+                                         ? sample.images->segment_depth[static_cast<std::size_t>(s)]
+                                         : sample.images->depth;
+                const auto hit =
+                    segments_ > 1 ? first_hit(camera, depth, ray, t0, t1) : sample.hit_t;
+                const glm::dvec2 map = camera.project(at(hit.value_or(t_centre)));
+                // No hit: what the camera saw there is either faint (no first hit recorded:
+                // read it, it lies somewhere along the ray) or a surface the ray passes by
+                // (recorded, yet the ray never reached it): nothing of it is on this ray.
+                if (!hit && std::isfinite(stored_distance(depth, map))) continue;
+                add_bilinear(sample.images->segment_rgba[static_cast<std::size_t>(s)], map,
+                             sample.weight, scratch.segment_rgba[static_cast<std::size_t>(s)]);
+            }
+        }
+        std::array<double, 3> colour{0.0, 0.0, 0.0};
+        double transmittance = 1.0, unscaled_transmittance = 1.0;
+        for (int s = 0; s < segments_; ++s) {
+            const std::array<double, 4>& rgba = scratch.segment_rgba[static_cast<std::size_t>(s)];
+            const double alpha = std::clamp(rgba[3], 0.0, 1.0);
+            const double scale = scales_[static_cast<std::size_t>(s)];
+            double scaled_alpha = alpha, colour_factor = 1.0;
+            if (scale != 1.0) {
+                scaled_alpha = 1.0 - std::pow(1.0 - alpha, scale);
+                // The limit of A' / A as A -> 0 is the scale itself.
+                colour_factor = alpha > 0.0 ? scaled_alpha / alpha : scale;
+            }
+            for (int c = 0; c < 3; ++c) colour[c] += transmittance * colour_factor * rgba[c];
+            transmittance *= 1.0 - scaled_alpha;
+            unscaled_transmittance *= 1.0 - alpha;
+        }
+        for (int c = 0; c < 3; ++c) result_.rgba.pixels[4 * p + c] = static_cast<float>(colour[c]);
+        result_.rgba.pixels[4 * p + 3] = static_cast<float>(1.0 - transmittance);
+
+        // The blended first hit, over the cameras that recorded one.
+        double hit_weight = 0.0, hit_t = 0.0;
+        for (int i = 0; i < present; ++i) {
+            const CameraSample& sample = samples[static_cast<std::size_t>(i)];
+            if (!sample.hit_t) continue;
+            hit_weight += sample.weight;
+            hit_t += sample.weight * *sample.hit_t;
+        }
+        if (hit_weight > 0.0) {
+            hit_t /= hit_weight;
+            result_.depth.pixels[p] = static_cast<float>(target_.depth_of(at(hit_t)));
+        }
+
+        if (intervals_ > 0) attenuation(samples, present, p);
+
+        result_.confidence.pixels[p] =
+            static_cast<float>(confidence(samples, present, present_weight, hit_weight, hit_t,
+                                          1.0 - unscaled_transmittance, ray.direction));
+    }
+
+    // a_j of each camera at its whole-ray hit (or where the colour was read without one), blended
+    // with the cameras' weights; the mean depth carried into the target camera (the point at the
+    // stored mean depth along the source camera's ray, seen from the target) and blended with
+    // the weights w_k a_jk.
+    void attenuation(const std::array<CameraSample, 3>& samples, int present, std::size_t p) {
+        const int n = rig_.map_size();
+        for (int j = 0; j < intervals_; ++j) {
+            double a_sum = 0.0, weighted_depth = 0.0, depth_weight = 0.0;
+            for (int i = 0; i < present; ++i) {
+                const CameraSample& sample = samples[static_cast<std::size_t>(i)];
+                if (sample.passes_by) continue;
+                const Camera& camera = rig_.camera(sample.camera);
+                const Taps taps = bilinear_taps(n, sample.read_map);
+                // Mean depth is interpolated with the weights w a_j over the taps where it is
+                // defined (+inf where a_j = 0), so that empty texels do not pull it to +inf.
+                double a = 0.0, z_sum = 0.0, z_weight = 0.0;
+                for (int t = 0; t < 4; ++t) {
+                    const std::size_t texel = taps.pixel[t] * intervals_ + j;
+                    const double a_texel = sample.images->attenuation.pixels[texel];
+                    const double z_texel = sample.images->mean_depth.pixels[texel];
+                    a += taps.weight[t] * a_texel;
+                    if (a_texel > 0.0 && std::isfinite(z_texel)) {
+                        z_sum += taps.weight[t] * a_texel * z_texel;
+                        z_weight += taps.weight[t] * a_texel;
+                    }
+                }
+                a_sum += sample.weight * a;
+                if (!(z_weight > 0.0)) continue;
+                const Ray source = camera.ray(sample.read_map.x, sample.read_map.y);
+                const double along =
+                    (z_sum / z_weight) / glm::dot(source.direction, camera.forward());
+                const double z_target = target_.depth_of(source.origin + along * source.direction);
+                weighted_depth += sample.weight * a * z_target;
+                depth_weight += sample.weight * a;
+            }
+            const std::size_t out = p * intervals_ + j;
+            result_.attenuation.pixels[out] = static_cast<float>(a_sum);
+            if (a_sum > 0.0 && depth_weight > 0.0) {
+                result_.mean_depth.pixels[out] = static_cast<float>(weighted_depth / depth_weight);
+            }
+        }
+    }
+
+    // The header's confidence: present weight x consensus x depth agreement x angular closeness.
+    double confidence(const std::array<CameraSample, 3>& samples, int present,
+                      double present_weight, double hit_weight, double hit_t, double alpha,
+                      const glm::dvec3& direction) const {
+        // Consensus: where the blend shows something (alpha at least the light field's first-hit
+        // opacity), the weight of the cameras that recorded a hit; none -> 0.
+        const double consensus = alpha >= light_field_.settings.depth_threshold ? hit_weight : 1.0;
+
+        double agreement = 1.0;
+        if (hit_weight > 0.0) {
+            double spread2 = 0.0, tolerance = 0.0;
+            for (int i = 0; i < present; ++i) {
+                const CameraSample& sample = samples[static_cast<std::size_t>(i)];
+                if (!sample.hit_t) continue;
+                const double w = sample.weight / hit_weight;
+                const double distance =
+                    glm::length(sample.read_point - rig_.camera(sample.camera).position());
+                spread2 += w * (*sample.hit_t - hit_t) * (*sample.hit_t - hit_t);
+                tolerance += w * depth_tolerance(distance, sample.read_map, kAgreementFootprints);
+            }
+            agreement = std::exp(-spread2 / (tolerance * tolerance));
+        }
+
+        double angle = 0.0;
+        for (int i = 0; i < present; ++i) {
+            const CameraSample& sample = samples[static_cast<std::size_t>(i)];
+            const glm::dvec3 seen =
+                glm::normalize(sample.read_point - rig_.camera(sample.camera).position());
+            angle += sample.weight * std::acos(std::clamp(glm::dot(seen, direction), -1.0, 1.0));
+        }
+        const double relative = angle / spacing_rad_;
+        const double angular = std::exp(-0.5 * relative * relative);
+
+        return std::clamp(present_weight * consensus * agreement * angular, 0.0, 1.0);
+    }
+
+    const LightField& light_field_;
+    const LightFieldRig& rig_;
+    const Camera& target_;
+    const LightFieldReconstructionSettings& settings_;
+    int segments_ = 1;
+    int intervals_ = 0;
+    std::vector<const LightFieldImages*> table_;
+    std::vector<double> scales_;
+    double spacing_rad_ = 1.0;
+    // Rows are disjoint, so the workers write their pixels without locks.
+    LightFieldReconstruction result_;
+};
+
+}  // namespace
+
+LightFieldReconstruction reconstruct_light_field(const LightField& light_field,
+                                                 const Camera& target,
+                                                 const LightFieldReconstructionSettings& settings) {
+    if (target.projection() == Projection::perspective) {
+        const double distance = glm::length(target.position() - light_field.rig.center());
+        if (!(distance > light_field.rig.bounding_radius())) {
+            fail<InvalidArgument>("light field reconstruction: the target camera's eye lies ",
+                                  distance,
+                                  " from the bounding sphere's centre, inside its radius ",
+                                  light_field.rig.bounding_radius(),
+                                  " (a light field is seen from outside the bounding sphere)");
+        }
+    }
+    return Reconstructor(light_field, target, settings).run();
+}
+
+}  // namespace insitu
