@@ -101,8 +101,9 @@ def chart_light_fields(d, rows):
         for r in mine:
             x, y = num(r, "stored_bytes") * 1e-6, num(r, "psnr")
             axes[0].scatter([x], [y], s=22, marker=markers[r["source"]], color=colour)
-            label = r["source"] if r["source"] != "lightfield" else "%s@%s%s" % (
-                r["cameras"], r["map"], "" if r["depth_bits"] == "8" else " d16")
+            label = r["source"] if r["source"] != "lightfield" else "%s@%s%s%s" % (
+                r["cameras"], r["map"], "" if r["depth_bits"] == "8" else " d16",
+                "" if num(r, "depth_threshold") == 0.3 else " t%g" % num(r, "depth_threshold"))
             axes[0].annotate(label, (x, y), fontsize=6, xytext=(3, 2), textcoords="offset points")
         front = pareto_front([(num(r, "stored_bytes") * 1e-6, num(r, "psnr")) for r in mine])
         axes[0].step([p[0] for p in front], [p[1] for p in front], where="post", color=colour,
@@ -110,14 +111,16 @@ def chart_light_fields(d, rows):
         for size in sorted({r["map"] for r in mine if r["source"] == "lightfield"}, key=int):
             pts = sorted((int(r["cameras"]), num(r, "mean_abs_percent")) for r in mine
                          if r["source"] == "lightfield" and r["map"] == size
-                         and r["depth_bits"] == "8" and r["attenuation"] == "0")
+                         and r["depth_bits"] == "8" and r["attenuation"] == "0"
+                         and num(r, "depth_threshold") == 0.3)
             axes[1].plot([p[0] for p in pts], [p[1] for p in pts], marker="o", color=colour,
                          linestyle="-" if size == "512" else "--",
                          label="%s, %s² maps" % (scene, size))
             cost = sorted((int(r["cameras"]), num(r, "capture_ms_per_camera"),
                            num(r, "proxy_pass_ms_per_camera")) for r in mine
                           if r["source"] == "lightfield" and r["map"] == size
-                          and r["depth_bits"] == "8" and r["attenuation"] == "0")
+                          and r["depth_bits"] == "8" and r["attenuation"] == "0"
+                          and num(r, "depth_threshold") == 0.3)
             axes[2].plot([p[0] for p in cost], [p[1] for p in cost], marker="o", color=colour,
                          linestyle="-" if size == "512" else "--",
                          label="%s capture, %s²" % (scene, size))
@@ -419,12 +422,13 @@ def write_markdown(d, path, prefix, elapsed):
                   "and <= 0.1 (good). 'single' and 'fused' are the stored view's single-perspective "
                   "proxies and the per-pixel fusion of both (Explorer source auto) from the same "
                   "views." % light[0]["views"], ""]
-        header = ["scene", "source", "cameras", "map", "depth bits", "attenuation", "edit",
+        header = ["scene", "source", "cameras", "map", "depth bits", "threshold", "attenuation",
+                  "edit",
                   "capture ms/camera", "proxy pass ms", "raw MB", "stored MB", "mean abs (0-255)",
                   "mean abs %", "covered mean abs", "PSNR", "SSIM", "coverage", "wrong flagged",
                   "good flagged", "ms/frame"]
         body = [[r["scene"], r["source"], r["cameras"], r["map"], r["depth_bits"],
-                 r["attenuation"], r["edit"], "%.2f" % num(r, "capture_ms_per_camera"),
+                 r["depth_threshold"], r["attenuation"], r["edit"], "%.2f" % num(r, "capture_ms_per_camera"),
                  "%.2f" % num(r, "proxy_pass_ms_per_camera"), "%.1f" % (num(r, "raw_bytes") / 1e6),
                  "%.2f" % (num(r, "stored_bytes") / 1e6), "%.2f" % num(r, "mean_abs_255"),
                  "%.2f" % num(r, "mean_abs_percent"), "%.2f" % num(r, "mean_abs_covered_255"),

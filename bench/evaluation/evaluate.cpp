@@ -810,10 +810,12 @@ struct LightFieldCase {
     int map = 256;
     int depth_bits = 8;
     bool attenuation = false;
+    double depth_threshold = LightFieldSettings{}.depth_threshold;
 };
 
 std::vector<LightFieldCase> light_field_cases(bool smoke) {
     if (smoke) return {{12, 64, 8, false}, {42, 64, 8, false}, {12, 64, 16, true}};
+
     std::vector<LightFieldCase> cases;
     for (int map : {256, 512}) {
         for (int cameras : {12, 42, 162}) cases.push_back({cameras, map, 8, false});
@@ -821,6 +823,8 @@ std::vector<LightFieldCase> light_field_cases(bool smoke) {
     cases.push_back({42, 256, 16, false});
     cases.push_back({42, 512, 16, false});
     cases.push_back({42, 256, 8, true});
+    // The first-hit opacity the colour is read at (LightFieldSettings::depth_threshold).
+    for (double threshold : {0.1, 0.5, 0.7}) cases.push_back({42, 256, 8, false, threshold});
     return cases;
 }
 
@@ -875,7 +879,7 @@ FrameScore score_frame(const Image& truth, const ExploreFrame& frame) {
 void section_light_fields(const std::vector<const Scene*>& scenes, const Options& options,
                           const fs::path& scratch, int image) {
     Csv csv(fs::path(options.out) / "light_fields.csv",
-            "scene,source,cameras,map,depth_bits,attenuation,edit,views,capture_ms,"
+            "scene,source,cameras,map,depth_bits,depth_threshold,attenuation,edit,views,capture_ms,"
             "capture_ms_per_camera,proxy_pass_ms_per_camera,raw_bytes,stored_bytes,"
             "mean_abs_255,mean_abs_percent,mean_abs_covered_255,psnr,ssim,coverage,"
             "high_error_fraction,flagged_fraction,good_flagged_fraction,light_field_share,"
@@ -924,6 +928,7 @@ void section_light_fields(const std::vector<const Scene*>& scenes, const Options
             request.settings.size = c.map;
             request.settings.depth_bits = c.depth_bits;
             request.settings.attenuation = c.attenuation;
+            request.settings.depth_threshold = c.depth_threshold;
             request.transfer_function = stored_tf;
             request.isovalues = isovalues;
             request.intervals = intervals;
@@ -1017,17 +1022,21 @@ void section_light_fields(const std::vector<const Scene*>& scenes, const Options
                     total.wrong > 0 ? double(total.wrong_flagged) / total.wrong : 1.0,
                     good > 0 ? total.good_flagged / good : 0.0, share, ms);
                 std::printf(
-                    "light fields: %s %s %d cameras %d^2 depth %d%s: mean error %.2f (%.2f%%), "
+                    "light fields: %s %s %d cameras %d^2 depth %d threshold %.2f%s: mean error "
+                    "%.2f "
+                    "(%.2f%%), "
                     "PSNR %.1f dB, flagged %.0f%% of wrong, %.0f%% of good, %.0f ms/frame\n",
                     scene->name.c_str(), source_name, c.cameras, c.map, c.depth_bits,
-                    edit ? " edits" : "", total.mean_abs_255, 100.0 * total.mean_abs_255 / 255.0,
-                    psnr, total.wrong > 0 ? 100.0 * total.wrong_flagged / total.wrong : 100.0,
+                    c.depth_threshold, edit ? " edits" : "", total.mean_abs_255,
+                    100.0 * total.mean_abs_255 / 255.0, psnr,
+                    total.wrong > 0 ? 100.0 * total.wrong_flagged / total.wrong : 100.0,
                     good > 0 ? 100.0 * total.good_flagged / good : 0.0, ms);
             };
             run("lightfield", ProxySource::lightfield, false, stored_bytes);
             if (c.attenuation) run("lightfield", ProxySource::lightfield, true, stored_bytes);
             // What each kind adds: the view's own proxies, and both fused per pixel.
-            if (c.cameras == 42 && c.depth_bits == 8 && !c.attenuation) {
+            if (c.cameras == 42 && c.depth_bits == 8 && !c.attenuation &&
+                c.depth_threshold == LightFieldSettings{}.depth_threshold) {
                 run("single", ProxySource::single, false, view_bytes);
                 run("fused", ProxySource::automatic, false, view_bytes + stored_bytes);
             }

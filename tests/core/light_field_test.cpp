@@ -483,7 +483,7 @@ TEST(LightFieldSettings, JsonRoundTrips) {
     LightFieldSettings defaults;
     const json written = defaults.to_json();
     EXPECT_EQ(written, json::parse(R"({"cameras": 42, "size": 256, "segments": "none",
-        "attenuation": true, "depth_bits": 8, "depth_threshold": 0.1})"));
+        "attenuation": true, "depth_bits": 8, "depth_threshold": 0.3})"));
     std::vector<std::string> unknown;
     const LightFieldSettings back = LightFieldSettings::from_json(written, &unknown);
     EXPECT_TRUE(unknown.empty());

@@ -13,7 +13,7 @@
 //  "writer": {"queue": 4, "when_full": "block"},
 //  "colour_model": {"clusters": 24, "enabled": true},
 //  "light_field": {"cameras": 42, "size": 256, "segments": "layers", "attenuation": true,
-//                  "depth_bits": 8, "depth_threshold": 0.1}}
+//                  "depth_bits": 8, "depth_threshold": 0.3}}
 //
 // Every key is optional; defaults are listed on the members below. Unknown keys (at any level)
 // are collected by name, not silently ignored: an Instrument refuses them unless "strict" is
