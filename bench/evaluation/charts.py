@@ -422,6 +422,13 @@ def write_markdown(d, path, prefix, elapsed):
                   "and <= 0.1 (good). 'single' and 'fused' are the stored view's single-perspective "
                   "proxies and the per-pixel fusion of both (Explorer source auto) from the same "
                   "views." % light[0]["views"], ""]
+        # The section may come from its own run (insitu_evaluate --sections light_fields),
+        # on another machine than the rest: say which.
+        own = {r["key"]: r["value"] for r in read(d, "light_fields_machine")}
+        if own:
+            lines += ["Measured by `insitu_evaluate --sections light_fields` on %s (%s hardware "
+                      "threads; %s)." % (own.get("cpu", "?"), own.get("hardware_threads", "?"),
+                                         own.get("opencl_device", "?")), ""]
         header = ["scene", "source", "cameras", "map", "depth bits", "threshold", "attenuation",
                   "edit",
                   "capture ms/camera", "proxy pass ms", "raw MB", "stored MB", "mean abs (0-255)",

@@ -1013,10 +1013,10 @@ void section_light_fields(const std::vector<const Scene*>& scenes, const Options
                 }
                 const double good = double(total.covered - total.wrong);
                 csv.row(
-                    scene->name, source_name, c.cameras, c.map, c.depth_bits, c.attenuation ? 1 : 0,
-                    edit ? 1 : 0, views, capture_ms, capture_ms / c.cameras, proxy_ms, raw_bytes,
-                    bytes, total.mean_abs_255, 100.0 * total.mean_abs_255 / 255.0, covered_abs,
-                    psnr, ssim,
+                    scene->name, source_name, c.cameras, c.map, c.depth_bits, c.depth_threshold,
+                    c.attenuation ? 1 : 0, edit ? 1 : 0, views, capture_ms, capture_ms / c.cameras,
+                    proxy_ms, raw_bytes, bytes, total.mean_abs_255,
+                    100.0 * total.mean_abs_255 / 255.0, covered_abs, psnr, ssim,
                     total.truth_hits > 0 ? double(total.truth_hits_right) / total.truth_hits : 1.0,
                     total.covered > 0 ? double(total.wrong) / total.covered : 0.0,
                     total.wrong > 0 ? double(total.wrong_flagged) / total.wrong : 1.0,

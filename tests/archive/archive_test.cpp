@@ -36,11 +36,15 @@
 #include "insitu/render/distortion_camera.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "support/expect_error.hpp"
+#include "support/test_files.hpp"
 
 namespace insitu {
 namespace {
 
 using ::testing::AllOf;
+using insitu::testing::file_crc;
+using insitu::testing::read_text;
+using insitu::testing::write_text;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
@@ -143,15 +147,6 @@ StepRecord record(std::int64_t step, int views = 2, int width = 12, int height =
     return result;
 }
 
-std::string read_text(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void write_text(const std::filesystem::path& path, const std::string& text) {
-    std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
-}
-
 // Images equal channel by channel: exactly, or within half's rounding where `half` is set.
 void expect_images_match(const Image& expected, const Image& actual, bool half,
                          const std::string& what) {
@@ -213,20 +208,10 @@ void expect_frames_match(const ProxyFrame& expected, const ProxyFrame& actual, b
     expect_layers_match(expected.training, actual.training, half, "training");
 }
 
-std::uint32_t file_crc(const std::filesystem::path& path) {
-    const std::string bytes = read_text(path);
-    return static_cast<std::uint32_t>(
-        ::crc32(0L, reinterpret_cast<const Bytef*>(bytes.data()), static_cast<uInt>(bytes.size())));
-}
-
 class Archive : public ::testing::Test {
 protected:
     void SetUp() override {
-        directory_ = std::filesystem::temp_directory_path() /
-                     ("insitu_archive_test_" + std::to_string(::getpid()) + "_" +
-                      ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        std::filesystem::remove_all(directory_);
-        std::filesystem::create_directories(directory_);
+        directory_ = testing::fresh_test_directory("insitu_archive_test");
         config_.archive = (directory_ / "run.cdb").string();
         config_.precision = StoragePrecision::single;
     }

@@ -30,11 +30,15 @@
 #include "insitu/error.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "support/expect_error.hpp"
+#include "support/test_files.hpp"
 
 namespace insitu {
 namespace {
 
 using insitu::testing::expect_error_naming;
+using insitu::testing::file_crc;
+using insitu::testing::read_text;
+using insitu::testing::write_text;
 using ::testing::AllOf;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
@@ -222,29 +226,10 @@ std::vector<int> cameras_of(const LightField& field) {
     return cameras;
 }
 
-std::string read_text(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void write_text(const std::filesystem::path& path, const std::string& text) {
-    std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
-}
-
-std::uint32_t file_crc(const std::filesystem::path& path) {
-    const std::string bytes = read_text(path);
-    return static_cast<std::uint32_t>(
-        ::crc32(0L, reinterpret_cast<const Bytef*>(bytes.data()), static_cast<uInt>(bytes.size())));
-}
-
 class LightFieldArchive : public ::testing::Test {
 protected:
     void SetUp() override {
-        directory_ = std::filesystem::temp_directory_path() /
-                     ("insitu_light_field_archive_test_" + std::to_string(::getpid()) + "_" +
-                      ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        std::filesystem::remove_all(directory_);
-        std::filesystem::create_directories(directory_);
+        directory_ = testing::fresh_test_directory("insitu_light_field_archive_test");
         config_.archive = (directory_ / "run.cdb").string();
         config_.precision = StoragePrecision::single;
         config_.fields = {"u", "v"};  // "v" is field 1: its files are step*_lightfield1.exr

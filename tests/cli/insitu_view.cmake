@@ -40,15 +40,18 @@ set_tests_properties(insitu_view.setup_archive PROPERTIES
                      FIXTURES_REQUIRED insitu_view_output FIXTURES_SETUP insitu_view_archive
                      TIMEOUT 120)
 
-# view_case(NAME EXIT STDERR|STDOUT TEXT ARGS...): runs insitu-view ARGS on the archive fixture.
-function(view_case name exit_status stream text)
+# archive_case(FIXTURE NAME EXIT STDERR|STDOUT TEXT ARGS...): runs insitu-view ARGS once the
+# archive FIXTURE is set up; view_case(NAME ...) on the Gray-Scott archive above.
+function(archive_case fixture name exit_status stream text)
   string(JOIN "|" command $<TARGET_FILE:insitu-view> ${ARGN})
   add_test(NAME insitu_view.${name}
            COMMAND ${CMAKE_COMMAND} -DEXPECTED_EXIT=${exit_status}
                    "-DEXPECTED_${stream}_SUBSTRING=${text}" "-DCOMMAND=${command}"
                    -P ${view_cli_dir}/expect_exit.cmake)
-  set_tests_properties(insitu_view.${name} PROPERTIES
-                       FIXTURES_REQUIRED insitu_view_archive TIMEOUT 60)
+  set_tests_properties(insitu_view.${name} PROPERTIES FIXTURES_REQUIRED ${fixture} TIMEOUT 60)
+endfunction()
+function(view_case name exit_status stream text)
+  archive_case(insitu_view_archive ${name} ${exit_status} ${stream} "${text}" ${ARGN})
 endfunction()
 
 view_case(help 0 STDOUT "usage:" --help)
@@ -128,13 +131,7 @@ set_tests_properties(insitu_view.setup_lf_archive PROPERTIES
                      FIXTURES_REQUIRED insitu_view_lf_output
                      FIXTURES_SETUP insitu_view_lf_archive TIMEOUT 120)
 function(light_field_case name exit_status stream text)
-  string(JOIN "|" command $<TARGET_FILE:insitu-view> ${ARGN})
-  add_test(NAME insitu_view.${name}
-           COMMAND ${CMAKE_COMMAND} -DEXPECTED_EXIT=${exit_status}
-                   "-DEXPECTED_${stream}_SUBSTRING=${text}" "-DCOMMAND=${command}"
-                   -P ${view_cli_dir}/expect_exit.cmake)
-  set_tests_properties(insitu_view.${name} PROPERTIES
-                       FIXTURES_REQUIRED insitu_view_lf_archive TIMEOUT 60)
+  archive_case(insitu_view_lf_archive ${name} ${exit_status} ${stream} "${text}" ${ARGN})
 endfunction()
 light_field_case(info_light_field 0 STDOUT
                  "light field   v: 12 cameras, 48^2 maps, 2 segment(s), attenuation yes, depth 8"

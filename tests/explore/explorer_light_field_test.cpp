@@ -21,6 +21,7 @@
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/metrics.hpp"
 #include "support/expect_error.hpp"
+#include "support/test_files.hpp"
 
 namespace insitu {
 namespace {
@@ -32,11 +33,7 @@ constexpr int kImage = 64;
 class ExplorerLightField : public ::testing::Test {
 protected:
     void SetUp() override {
-        directory_ = fs::temp_directory_path() /
-                     ("insitu_explorer_lf_test_" + std::to_string(::getpid()) + "_" +
-                      ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(directory_);
-        fs::create_directories(directory_);
+        directory_ = testing::fresh_test_directory("insitu_explorer_lf_test");
         // A ball of high values: a near-opaque core inside a translucent shell.
         volume_ = make_sphere_distance({40, 40, 40}, glm::dvec3(19.5), 12.0);
         for (float& value : volume_.values) value = -value;
