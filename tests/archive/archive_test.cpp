@@ -41,10 +41,10 @@
 namespace insitu {
 namespace {
 
-using ::testing::AllOf;
 using insitu::testing::file_crc;
 using insitu::testing::read_text;
 using insitu::testing::write_text;
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 using ::testing::Not;
 

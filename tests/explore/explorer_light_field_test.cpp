@@ -120,6 +120,7 @@ TEST_F(ExplorerLightField, ANewViewFromTheLightFieldIsCloseToTheGroundTruth) {
         const ExploreFrame frame = explorer.render(at(azimuth, elevation, ProxySource::lightfield));
         EXPECT_EQ(frame.proxy_source, ProxySource::lightfield);
         EXPECT_EQ(frame.light_field_share, 1.0);
+        EXPECT_EQ(frame.colour_source, ColourSource::captured);
         EXPECT_TRUE(frame.synthesised_view);
         const Image expected = truth(azimuth, elevation, config_.transfer_function);
         const double psnr = evaluation::psnr_db(expected, frame.colour);
@@ -173,6 +174,7 @@ TEST_F(ExplorerLightField, OpacityEditsGoThroughTheAttenuationLightField) {
     ExploreRequest request = at(200.0, 10.0, ProxySource::lightfield);
     request.transfer_function = edited;
     const ExploreFrame frame = explorer.render(request);
+    EXPECT_EQ(frame.colour_source, ColourSource::recompose);
     const Image expected = truth(200.0, 10.0, edited);
     const Image unedited = truth(200.0, 10.0, config_.transfer_function);
     const double psnr = evaluation::psnr_db(expected, frame.colour);

@@ -26,6 +26,8 @@ std::string to_string(ColourSource source) {
             return "model";
         case ColourSource::recompose:
             return "recompose";
+        case ColourSource::captured:
+            return "captured";
     }
     return "unknown";
 }
@@ -420,6 +422,9 @@ void finish_frame(FrameBasis basis, const ExploreRequest& request,
                                   " has none");
         }
         frame.colour = std::move(basis.colour);
+        // Painted surfaces are the transfer function's colours; a light field's are captured.
+        frame.colour_source =
+            basis.colour_follows_edits ? ColourSource::recompose : ColourSource::captured;
     }
 
     // 6. Lighting and occlusion, as factors on whichever colour step 5 produced: per interval

@@ -42,7 +42,8 @@
 
 namespace insitu {
 
-enum class ColourSource { automatic, model, recompose };
+/// "captured" is never asked for: it reports a frame whose colour is the light field's own RGBA.
+enum class ColourSource { automatic, model, recompose, captured };
 std::string to_string(ColourSource source);
 /// "auto" | "model" | "recompose"; InvalidArgument names other text.
 ColourSource parse_colour_source(const std::string& text);
