@@ -317,7 +317,12 @@ int run_render(const std::vector<std::string>& args) {
     std::cerr << kProgram << ": " << out_path << " (" << frame.camera.width() << "x"
               << frame.camera.height() << ", " << (frame.synthesised_view ? "new" : "stored")
               << " view from " << insitu::to_string(frame.proxy_source) << ", colour by "
-              << insitu::to_string(frame.colour_source) << ", " << frame.milliseconds << " ms)\n";
+              << insitu::to_string(frame.colour_source) << ", "
+              << (frame.missing_cameras.empty()
+                      ? std::string()
+                      : std::to_string(frame.missing_cameras.size()) +
+                            " light-field cameras missing (reconstructed from the rest), ")
+              << frame.milliseconds << " ms)\n";
     return 0;
 }
 

@@ -576,6 +576,11 @@ private:
         response.set_header("X-Insitu-Encode-Milliseconds", std::to_string(encode_ms));
         response.set_header("X-Insitu-Synthesised", rendered->synthesised_view ? "1" : "0");
         response.set_header("X-Insitu-Colour-Source", to_string(rendered->colour_source));
+        response.set_header("X-Insitu-Proxy-Source", to_string(rendered->proxy_source));
+        // Light-field cameras the frame needed and the archive lacks: reconstructed from the
+        // rest, at lower confidence, and said so.
+        response.set_header("X-Insitu-Missing-Cameras",
+                            std::to_string(rendered->missing_cameras.size()));
         response.set_header("X-Insitu-Confidence", std::to_string(mean_confidence(*rendered)));
         send_png(response, png);
     }

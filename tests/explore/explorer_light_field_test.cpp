@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <glm/geometric.hpp>
@@ -230,6 +231,61 @@ TEST_F(ExplorerLightField, SegmentsFadeIndependently) {
     request.opacity_scales = {{1, 0.5}};
     testing::expect_error_naming<InvalidArgument>([&] { explorer.render(request); },
                                                   "needs attenuation proxies");
+}
+
+TEST_F(ExplorerLightField, MissingCamerasAreReconstructedFromTheRestAndSaidSo) {
+    write_step();
+    // Step 2: step 1 again, but its light field without the cameras that face the new view.
+    StepRecord record;
+    record.step = 2;
+    record.time = 0.2;
+    record.field = "f";
+    const Camera target =
+        Camera::orbit(OrbitView{120.0, -25.0, Projection::orthographic, 30.0, kImage, kImage},
+                      renderer_.volume().bounds);
+    std::vector<int> dropped;
+    {
+        const ArchiveReader reader(config_.archive);
+        ViewRecord view;
+        view.field = "f";
+        view.view = config_.views[0];
+        view.single = reader.load(1, 0);
+        view.preview = reader.load_preview(1, 0);
+        view.transfer_function = config_.transfer_function;
+        record.views.push_back(std::move(view));
+        LightField partial = reader.load_light_field(1, "f");
+        std::vector<LightFieldImages> kept;
+        for (LightFieldImages& images : partial.cameras) {
+            const glm::dvec3 vertex = partial.rig.icosphere().vertices[images.camera];
+            if (glm::dot(vertex, -target.forward()) > 0.8) {
+                dropped.push_back(images.camera);
+            } else {
+                kept.push_back(std::move(images));
+            }
+        }
+        partial.cameras = std::move(kept);
+        record.light_fields.push_back({"f", std::move(partial)});
+    }
+    ASSERT_FALSE(dropped.empty());
+    ArchiveWriter(config_).write(record);
+
+    Explorer explorer(config_.archive);
+    const ExploreFrame complete = explorer.render(at(120.0, -25.0, ProxySource::lightfield));
+    ExploreRequest request = at(120.0, -25.0, ProxySource::lightfield);
+    request.step = 2;
+    const ExploreFrame partial = explorer.render(request);
+    EXPECT_TRUE(complete.missing_cameras.empty());
+    ASSERT_FALSE(partial.missing_cameras.empty());
+    for (const int k : partial.missing_cameras) {
+        EXPECT_NE(std::find(dropped.begin(), dropped.end(), k), dropped.end()) << "camera " << k;
+    }
+    double complete_confidence = 0.0, partial_confidence = 0.0;
+    for (std::size_t p = 0; p < complete.confidence.pixels.size(); ++p) {
+        complete_confidence += complete.confidence.pixels[p];
+        partial_confidence += partial.confidence.pixels[p];
+    }
+    EXPECT_LT(partial_confidence, 0.9 * complete_confidence);
+    for (const float value : partial.colour.pixels) ASSERT_TRUE(std::isfinite(value));
 }
 
 TEST_F(ExplorerLightField, AskingForALightFieldTheArchiveLacksNamesIt) {
