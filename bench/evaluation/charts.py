@@ -104,6 +104,8 @@ def chart_light_fields(d, rows):
             label = r["source"] if r["source"] != "lightfield" else "%s@%s%s%s" % (
                 r["cameras"], r["map"], "" if r["depth_bits"] == "8" else " d16",
                 "" if num(r, "depth_threshold") == 0.3 else " t%g" % num(r, "depth_threshold"))
+            if r.get("segments", "none") != "none":
+                label += " seg " + r["segments"]
             axes[0].annotate(label, (x, y), fontsize=6, xytext=(3, 2), textcoords="offset points")
         front = pareto_front([(num(r, "stored_bytes") * 1e-6, num(r, "psnr")) for r in mine])
         axes[0].step([p[0] for p in front], [p[1] for p in front], where="post", color=colour,
@@ -112,7 +114,8 @@ def chart_light_fields(d, rows):
             pts = sorted((int(r["cameras"]), num(r, "mean_abs_percent")) for r in mine
                          if r["source"] == "lightfield" and r["map"] == size
                          and r["depth_bits"] == "8" and r["attenuation"] == "0"
-                         and num(r, "depth_threshold") == 0.3)
+                         and num(r, "depth_threshold") == 0.3
+                         and r.get("segments", "none") == "none")
             axes[1].plot([p[0] for p in pts], [p[1] for p in pts], marker="o", color=colour,
                          linestyle="-" if size == "512" else "--",
                          label="%s, %s² maps" % (scene, size))
@@ -120,7 +123,8 @@ def chart_light_fields(d, rows):
                            num(r, "proxy_pass_ms_per_camera")) for r in mine
                           if r["source"] == "lightfield" and r["map"] == size
                           and r["depth_bits"] == "8" and r["attenuation"] == "0"
-                          and num(r, "depth_threshold") == 0.3)
+                          and num(r, "depth_threshold") == 0.3
+                         and r.get("segments", "none") == "none")
             axes[2].plot([p[0] for p in cost], [p[1] for p in cost], marker="o", color=colour,
                          linestyle="-" if size == "512" else "--",
                          label="%s capture, %s²" % (scene, size))
@@ -429,13 +433,13 @@ def write_markdown(d, path, prefix, elapsed):
             lines += ["Measured by `insitu_evaluate --sections light_fields` on %s (%s hardware "
                       "threads; %s)." % (own.get("cpu", "?"), own.get("hardware_threads", "?"),
                                          own.get("opencl_device", "?")), ""]
-        header = ["scene", "source", "cameras", "map", "depth bits", "threshold", "attenuation",
-                  "edit",
+        header = ["scene", "source", "cameras", "map", "depth bits", "threshold", "segments",
+                  "attenuation", "edit",
                   "capture ms/camera", "proxy pass ms", "raw MB", "stored MB", "mean abs (0-255)",
                   "mean abs %", "covered mean abs", "PSNR", "SSIM", "coverage", "wrong flagged",
                   "good flagged", "ms/frame"]
         body = [[r["scene"], r["source"], r["cameras"], r["map"], r["depth_bits"],
-                 r["depth_threshold"], r["attenuation"], r["edit"], "%.2f" % num(r, "capture_ms_per_camera"),
+                 r["depth_threshold"], r.get("segments", "none"), r["attenuation"], r["edit"], "%.2f" % num(r, "capture_ms_per_camera"),
                  "%.2f" % num(r, "proxy_pass_ms_per_camera"), "%.1f" % (num(r, "raw_bytes") / 1e6),
                  "%.2f" % (num(r, "stored_bytes") / 1e6), "%.2f" % num(r, "mean_abs_255"),
                  "%.2f" % num(r, "mean_abs_percent"), "%.2f" % num(r, "mean_abs_covered_255"),

@@ -811,6 +811,8 @@ struct LightFieldCase {
     int depth_bits = 8;
     bool attenuation = false;
     double depth_threshold = LightFieldSettings{}.depth_threshold;
+    SegmentRule segments = SegmentRule::whole_ray;
+    std::vector<double> thresholds = {};  ///< SegmentRule::opacity
 };
 
 std::vector<LightFieldCase> light_field_cases(bool smoke) {
@@ -825,6 +827,10 @@ std::vector<LightFieldCase> light_field_cases(bool smoke) {
     cases.push_back({42, 256, 8, true});
     // The first-hit opacity the colour is read at (LightFieldSettings::depth_threshold).
     for (double threshold : {0.1, 0.5, 0.7}) cases.push_back({42, 256, 8, false, threshold});
+    // Multi-layer light fields (seed 001 §7): each segment is depth-corrected on its own, which
+    // is what a semi-transparent field needs (the scenes' four layers, or two opacity splits).
+    cases.push_back({42, 256, 8, false, 0.3, SegmentRule::layers});
+    cases.push_back({42, 256, 8, false, 0.3, SegmentRule::opacity, {0.3, 0.6}});
     return cases;
 }
 
@@ -879,7 +885,8 @@ FrameScore score_frame(const Image& truth, const ExploreFrame& frame) {
 void section_light_fields(const std::vector<const Scene*>& scenes, const Options& options,
                           const fs::path& scratch, int image) {
     Csv csv(fs::path(options.out) / "light_fields.csv",
-            "scene,source,cameras,map,depth_bits,depth_threshold,attenuation,edit,views,capture_ms,"
+            "scene,source,cameras,map,depth_bits,depth_threshold,segments,attenuation,edit,views,"
+            "capture_ms,"
             "capture_ms_per_camera,proxy_pass_ms_per_camera,raw_bytes,stored_bytes,"
             "mean_abs_255,mean_abs_percent,mean_abs_covered_255,psnr,ssim,coverage,"
             "high_error_fraction,flagged_fraction,good_flagged_fraction,light_field_share,"
@@ -929,6 +936,8 @@ void section_light_fields(const std::vector<const Scene*>& scenes, const Options
             request.settings.depth_bits = c.depth_bits;
             request.settings.attenuation = c.attenuation;
             request.settings.depth_threshold = c.depth_threshold;
+            request.settings.segments = c.segments;
+            request.settings.opacity_thresholds = c.thresholds;
             request.transfer_function = stored_tf;
             request.isovalues = isovalues;
             request.intervals = intervals;
@@ -971,12 +980,30 @@ void section_light_fields(const std::vector<const Scene*>& scenes, const Options
             // single-view rows cost.
             const unsigned long long view_bytes =
                 fs::file_size(ArchiveReader(config.archive).entry(0, 0).exr_path);
-            // Half RGBA, depth at its bits, half a_j and mean depth per interval.
+            // Half RGBA per segment, depth at its bits per segment (S > 1) and for the first
+            // hit, half a_j and mean depth per interval.
+            const unsigned long long segments_stored =
+                c.segments == SegmentRule::layers    ? isovalues.size() + 1
+                : c.segments == SegmentRule::opacity ? c.thresholds.size() + 1
+                                                     : 1;
+            const unsigned long long depth_bytes =
+                static_cast<unsigned long long>(c.depth_bits / 8);
             const unsigned long long per_pixel =
-                8ull + c.depth_bits / 8 + (c.attenuation ? 4ull * 16 : 0ull);
+                8ull * segments_stored + (segments_stored > 1 ? segments_stored * depth_bytes : 0) +
+                depth_bytes + (c.attenuation ? 4ull * 16 : 0ull);
             const unsigned long long raw_bytes =
                 per_pixel * c.cameras * static_cast<unsigned long long>(c.map) * c.map;
 
+            // "none", "layers" or the thresholds joined by "/", as the configuration names them.
+            std::string segments_text = c.segments == SegmentRule::layers ? "layers" : "none";
+            if (c.segments == SegmentRule::opacity) {
+                segments_text.clear();
+                for (const double t : c.thresholds) {
+                    char text[32];
+                    std::snprintf(text, sizeof text, "%g", t);
+                    segments_text += (segments_text.empty() ? "" : "/") + std::string(text);
+                }
+            }
             Explorer explorer(config.archive);
             auto run = [&](const char* source_name, ProxySource source, bool edit,
                            unsigned long long bytes) {
@@ -1014,21 +1041,20 @@ void section_light_fields(const std::vector<const Scene*>& scenes, const Options
                 const double good = double(total.covered - total.wrong);
                 csv.row(
                     scene->name, source_name, c.cameras, c.map, c.depth_bits, c.depth_threshold,
-                    c.attenuation ? 1 : 0, edit ? 1 : 0, views, capture_ms, capture_ms / c.cameras,
-                    proxy_ms, raw_bytes, bytes, total.mean_abs_255,
+                    segments_text, c.attenuation ? 1 : 0, edit ? 1 : 0, views, capture_ms,
+                    capture_ms / c.cameras, proxy_ms, raw_bytes, bytes, total.mean_abs_255,
                     100.0 * total.mean_abs_255 / 255.0, covered_abs, psnr, ssim,
                     total.truth_hits > 0 ? double(total.truth_hits_right) / total.truth_hits : 1.0,
                     total.covered > 0 ? double(total.wrong) / total.covered : 0.0,
                     total.wrong > 0 ? double(total.wrong_flagged) / total.wrong : 1.0,
                     good > 0 ? total.good_flagged / good : 0.0, share, ms);
                 std::printf(
-                    "light fields: %s %s %d cameras %d^2 depth %d threshold %.2f%s: mean error "
-                    "%.2f "
-                    "(%.2f%%), "
-                    "PSNR %.1f dB, flagged %.0f%% of wrong, %.0f%% of good, %.0f ms/frame\n",
+                    "light fields: %s %s %d cameras %d^2 depth %d threshold %.2f segments %s%s: "
+                    "mean error %.2f (%.2f%%), PSNR %.1f dB, flagged %.0f%% of wrong, %.0f%% of "
+                    "good, %.0f ms/frame\n",
                     scene->name.c_str(), source_name, c.cameras, c.map, c.depth_bits,
-                    c.depth_threshold, edit ? " edits" : "", total.mean_abs_255,
-                    100.0 * total.mean_abs_255 / 255.0, psnr,
+                    c.depth_threshold, segments_text.c_str(), edit ? " edits" : "",
+                    total.mean_abs_255, 100.0 * total.mean_abs_255 / 255.0, psnr,
                     total.wrong > 0 ? 100.0 * total.wrong_flagged / total.wrong : 100.0,
                     good > 0 ? 100.0 * total.good_flagged / good : 0.0, ms);
             };
@@ -1036,7 +1062,8 @@ void section_light_fields(const std::vector<const Scene*>& scenes, const Options
             if (c.attenuation) run("lightfield", ProxySource::lightfield, true, stored_bytes);
             // What each kind adds: the view's own proxies, and both fused per pixel.
             if (c.cameras == 42 && c.depth_bits == 8 && !c.attenuation &&
-                c.depth_threshold == LightFieldSettings{}.depth_threshold) {
+                c.depth_threshold == LightFieldSettings{}.depth_threshold &&
+                c.segments == SegmentRule::whole_ray) {
                 run("single", ProxySource::single, false, view_bytes);
                 run("fused", ProxySource::automatic, false, view_bytes + stored_bytes);
             }
