@@ -111,20 +111,18 @@ def chart_light_fields(d, rows):
         axes[0].step([p[0] for p in front], [p[1] for p in front], where="post", color=colour,
                      label="%s Pareto front" % scene)
         for size in sorted({r["map"] for r in mine if r["source"] == "lightfield"}, key=int):
-            pts = sorted((int(r["cameras"]), num(r, "mean_abs_percent")) for r in mine
-                         if r["source"] == "lightfield" and r["map"] == size
-                         and r["depth_bits"] == "8" and r["attenuation"] == "0"
-                         and num(r, "depth_threshold") == 0.3
-                         and r.get("segments", "none") == "none")
+            # The camera sweep at this map size: default settings but for the cameras.
+            sweep = [r for r in mine
+                     if r["source"] == "lightfield" and r["map"] == size
+                     and r["depth_bits"] == "8" and r["attenuation"] == "0"
+                     and num(r, "depth_threshold") == 0.3
+                     and r.get("segments", "none") == "none"]
+            pts = sorted((int(r["cameras"]), num(r, "mean_abs_percent")) for r in sweep)
             axes[1].plot([p[0] for p in pts], [p[1] for p in pts], marker="o", color=colour,
                          linestyle="-" if size == "512" else "--",
                          label="%s, %s² maps" % (scene, size))
             cost = sorted((int(r["cameras"]), num(r, "capture_ms_per_camera"),
-                           num(r, "proxy_pass_ms_per_camera")) for r in mine
-                          if r["source"] == "lightfield" and r["map"] == size
-                          and r["depth_bits"] == "8" and r["attenuation"] == "0"
-                          and num(r, "depth_threshold") == 0.3
-                         and r.get("segments", "none") == "none")
+                           num(r, "proxy_pass_ms_per_camera")) for r in sweep)
             axes[2].plot([p[0] for p in cost], [p[1] for p in cost], marker="o", color=colour,
                          linestyle="-" if size == "512" else "--",
                          label="%s capture, %s²" % (scene, size))
