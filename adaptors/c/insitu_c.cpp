@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cstdint>
 #include <exception>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -17,6 +18,7 @@
 #include "insitu/error.hpp"
 #include "insitu/field.hpp"
 #include "insitu/instrument.hpp"
+#include "insitu_c_internal.hpp"
 
 // The opaque handle of insitu.h.
 struct insitu_instrument {
@@ -160,7 +162,8 @@ int code_for_status(insitu::Status status, const insitu::Instrument& instrument,
 int create(const char* function, insitu_instrument** out,
            std::unique_ptr<insitu::Instrument> (*make)(const std::string&,
                                                        insitu::InstrumentOptions),
-           const char* argument_name, const char* argument) {
+           const char* argument_name, const char* argument,
+           const std::function<void(insitu::InstrumentOptions&)>& add_options = {}) {
     return guarded(function, [&]() -> int {
         require_not_null(out, "out");
         *out = nullptr;  // defined on failure too, so the caller may destroy it unconditionally
@@ -171,6 +174,7 @@ int create(const char* function, insitu_instrument** out,
         options.rethrow_errors = false;
         auto handle = std::make_unique<insitu_instrument>();
         try {
+            if (add_options) add_options(options);  // another adaptor's, insitu_c_internal.hpp
             handle->instrument = make(argument, options);
         } catch (...) {
             // The caller says it once, from insitu_last_error() (the library prints nothing, so
@@ -254,6 +258,15 @@ int add_block(const char* function, insitu_instrument* instrument, const char* n
 }
 
 }  // namespace
+
+int insitu::c_api::create_with_options(
+    const char* entry, const char* argument_name, const char* argument, bool is_path,
+    const std::function<void(insitu::InstrumentOptions&)>& add_options, insitu_instrument** out) {
+    return create(
+        entry, out,
+        is_path ? &insitu::Instrument::from_json_file : &insitu::Instrument::from_json_text,
+        argument_name, argument, add_options);
+}
 
 extern "C" {
 

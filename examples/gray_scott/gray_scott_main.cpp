@@ -27,6 +27,7 @@
 
 #include "arguments.hpp"
 #include "cli.hpp"
+#include "gray_scott_coupling.hpp"
 #include "gray_scott_simulation.hpp"
 #include "insitu/config.hpp"
 #include "insitu/core/transfer_function.hpp"
@@ -41,17 +42,9 @@ namespace {
 using insitu::cli::default_text;
 using insitu::cli::UsageError;
 
-struct Options {
+struct Options : gray_scott::CouplingOptions {
     gray_scott::Parameters simulation;
     std::int64_t steps = 200;
-    std::optional<std::string> config_path;
-    std::optional<std::string> archive;
-    // Set only when given, so that they override a configuration file and nothing else.
-    std::optional<std::int64_t> every;
-    std::optional<int> image_width;
-    std::optional<int> image_height;
-    std::optional<double> azimuth_deg;
-    std::optional<double> elevation_deg;
 };
 
 // The shared strict rules (arguments.hpp) in gray-scott's wording: "FLAG VALUE: problem".
@@ -153,25 +146,6 @@ Options parse_arguments(int argc, char** argv) {
     return options;
 }
 
-/// v is 0 in the trivial state (u = 1, v = 0) that fills most of the box and rises to about 0.45
-/// inside the patterns. Up to 0.12 (background and the thin diffusion halo around patterns) stays
-/// transparent, so the structures are seen rather than a fog; above it opacity and colour climb
-/// together, blue at the fringes to warm yellow in the cores. Opacity is per voxel
-/// (unit_length = 1 world unit = 1 voxel) and kept at or below 0.4: v changes by up to 0.1 per
-/// voxel across a front, and a steeper function shows the sampling as wood-grain rings.
-insitu::TransferFunction v_transfer_function() {
-    return insitu::TransferFunction(
-        {
-            {0.00, {0.10f, 0.25f, 0.75f, 0.00f}},
-            {0.12, {0.10f, 0.25f, 0.75f, 0.00f}},
-            {0.20, {0.15f, 0.55f, 0.90f, 0.04f}},
-            {0.28, {0.35f, 0.85f, 0.70f, 0.10f}},
-            {0.36, {0.95f, 0.80f, 0.30f, 0.22f}},
-            {0.45, {1.00f, 0.40f, 0.15f, 0.40f}},
-        },
-        /*unit_length=*/1.0);
-}
-
 double milliseconds_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
         .count();
@@ -180,28 +154,12 @@ double milliseconds_since(std::chrono::steady_clock::time_point start) {
 /// Error texts may carry OpenCL build logs; the one-line promise holds for them too.
 using insitu::one_line;
 
-/// The configuration without --config: field v seen from one orbit view, gray-scott's transfer
-/// function, layers and intervals chosen from the data (the library's defaults).
-insitu::InstrumentConfig default_config() {
-    insitu::InstrumentConfig config;
-    config.fields = {"v"};
-    config.views[0].orbit.width = 256;
-    config.views[0].orbit.height = 256;
-    config.transfer_function = v_transfer_function();
-    // Half-voxel steps: at one voxel the fronts show sampling rings (checked by eye at 64^3; a
-    // quarter voxel looks the same as a half and costs twice as much).
-    config.step_voxels = 0.5;
-    config.every = 50;
-    config.archive = "gray-scott.cdb";
-    return config;
-}
-
 /// --help, its defaults taken from the code that applies them.
 const insitu::cli::CommandHelp& command_help() {
     static const insitu::cli::CommandHelp help = [] {
         const gray_scott::Parameters defaults;
         const Options options;
-        const insitu::InstrumentConfig config = default_config();
+        const insitu::InstrumentConfig config = gray_scott::default_config("gray-scott.cdb");
         const insitu::OrbitView& orbit = config.views[0].orbit;
         return insitu::cli::CommandHelp{
             "gray-scott [options]",
@@ -247,41 +205,6 @@ const insitu::cli::CommandHelp& command_help() {
 
 /// The configuration file (or the defaults) with the command line's overrides applied. Throws
 /// UsageError naming the file for anything libinsitu rejects.
-insitu::InstrumentConfig make_config(const Options& options) {
-    insitu::InstrumentConfig config;
-    if (options.config_path) {
-        std::vector<std::string> unknown;
-        std::string warning;
-        try {
-            config = insitu::InstrumentConfig::from_json_file(*options.config_path, &unknown);
-            // A typo is an error unless the configuration says "strict": false.
-            warning = insitu::refuse_unknown_keys(config, unknown, *options.config_path + ": ");
-        } catch (const insitu::Error& error) {
-            throw UsageError(std::string("--config: ") + error.what());  // names the file
-        }
-        if (!warning.empty()) std::cerr << "gray-scott: warning: " << warning << std::endl;
-    } else {
-        config = default_config();
-    }
-    if (options.archive) config.archive = *options.archive;
-    if (options.every) {
-        config.every = *options.every;
-        config.steps.clear();
-    }
-    for (insitu::ViewConfig& view : config.views) {
-        if (options.image_width) view.orbit.width = *options.image_width;
-        if (options.image_height) view.orbit.height = *options.image_height;
-        if (options.azimuth_deg) view.orbit.azimuth_deg = *options.azimuth_deg;
-        if (options.elevation_deg) view.orbit.elevation_deg = *options.elevation_deg;
-    }
-    try {
-        config.validate();
-    } catch (const insitu::Error& error) {
-        throw UsageError(error.what());
-    }
-    return config;
-}
-
 int run(const Options& options, const insitu::InstrumentConfig& config) {
     gray_scott::Simulation simulation(options.simulation);
     // Throws (exit 1) when the archive cannot be opened or no compute device exists: a
@@ -386,7 +309,7 @@ int main(int argc, char** argv) {
     }
     try {
         options = parse_arguments(argc, argv);
-        config = make_config(options);
+        config = gray_scott::make_config(options, "gray-scott.cdb", "gray-scott", true);
     } catch (const UsageError& error) {
         std::cerr << "gray-scott: " << one_line(error.what()) << " (see --help)" << std::endl;
         return 2;

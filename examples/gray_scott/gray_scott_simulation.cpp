@@ -143,11 +143,6 @@ void Simulation::fill_ghosts(std::vector<double>& species) const {
 
 void Simulation::step() {
     const int n = parameters_.size;
-    const double dt = parameters_.dt;
-    const double feed = parameters_.feed;
-    const double feed_plus_kill = parameters_.feed + parameters_.kill;
-    const double diffusion_u = parameters_.diffusion_u;
-    const double diffusion_v = parameters_.diffusion_v;
     const std::ptrdiff_t stride_y = allocated_size();
     const std::ptrdiff_t stride_z = stride_y * stride_y;
     const double* u = u_.data();
@@ -162,17 +157,11 @@ void Simulation::step() {
         for (int j = 1; j <= n; ++j) {
             const auto row = static_cast<std::ptrdiff_t>(index(0, j, k));
             for (std::ptrdiff_t at = row + 1; at <= row + n; ++at) {
-                const double uc = u[at];
-                const double vc = v[at];
-                const double laplacian_u = u[at - 1] + u[at + 1] + u[at - stride_y] +
-                                           u[at + stride_y] + u[at - stride_z] + u[at + stride_z] -
-                                           6.0 * uc;
-                const double laplacian_v = v[at - 1] + v[at + 1] + v[at - stride_y] +
-                                           v[at + stride_y] + v[at - stride_z] + v[at + stride_z] -
-                                           6.0 * vc;
-                const double reaction = uc * vc * vc;
-                u_next[at] = uc + dt * (diffusion_u * laplacian_u - reaction + feed * (1.0 - uc));
-                v_next[at] = vc + dt * (diffusion_v * laplacian_v + reaction - feed_plus_kill * vc);
+                const double u6[6] = {u[at - 1],        u[at + 1],        u[at - stride_y],
+                                      u[at + stride_y], u[at - stride_z], u[at + stride_z]};
+                const double v6[6] = {v[at - 1],        v[at + 1],        v[at - stride_y],
+                                      v[at + stride_y], v[at - stride_z], v[at + stride_z]};
+                euler_update(parameters_, u[at], v[at], u6, v6, u_next[at], v_next[at]);
             }
         }
     }

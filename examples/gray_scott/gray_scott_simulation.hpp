@@ -48,6 +48,22 @@ std::ostream& operator<<(std::ostream& out, const Parameters& parameters);
 /// the offending parameter and value (the CLI prints it, the simulation throws it).
 std::string check(const Parameters& parameters);
 
+/// One explicit Euler step of one node from its values and its six neighbours' in the order -x,
+/// +x, -y, +y, -z, +z: the one definition of the update, which examples/gray_scott_mpi shares, so
+/// that a decomposed run adds in the same order (floating-point addition is not associative) and
+/// agrees with this one bit for bit.
+inline void euler_update(const Parameters& parameters, double u, double v, const double (&u6)[6],
+                         const double (&v6)[6], double& u_next, double& v_next) {
+    const double laplacian_u = u6[0] + u6[1] + u6[2] + u6[3] + u6[4] + u6[5] - 6.0 * u;
+    const double laplacian_v = v6[0] + v6[1] + v6[2] + v6[3] + v6[4] + v6[5] - 6.0 * v;
+    const double reaction = u * v * v;
+    const double dt = parameters.dt;
+    u_next =
+        u + dt * (parameters.diffusion_u * laplacian_u - reaction + parameters.feed * (1.0 - u));
+    v_next = v + dt * (parameters.diffusion_v * laplacian_v + reaction -
+                       (parameters.feed + parameters.kill) * v);
+}
+
 /// Threads Simulation::step() runs on: OpenMP's maximum, or 1 in a build without OpenMP.
 int worker_threads();
 

@@ -38,17 +38,18 @@ inline void store_segment(int wanted, __global float4* rgba_out, __global float*
 
 __kernel void render_proxies(
     __global const float* volume, int4 dims, float4 origin_world, float4 inv_spacing,
-    float4 box_lower, float4 box_upper, __global const float4* tf_table, int2 tf_bins,
-    float4 tf_domain, float4 cam_position, float4 cam_forward, float4 cam_right, float4 cam_up,
-    float4 cam_half_extent, int2 size, float4 march, int wanted, int layer_count,
-    __global const float* isovalues, int interval_count, float uniform_interval_scale,
-    __global const float* interval_edges, __global float* depth_out, __global float* distortion_out,
+    float4 box_lower, float4 box_upper, float4 data_offset, float4 owned_lower, float4 owned_upper,
+    __global const float4* tf_table, int2 tf_bins, float4 tf_domain, float4 cam_position,
+    float4 cam_forward, float4 cam_right, float4 cam_up, float4 cam_half_extent, int2 size,
+    float4 march, int wanted, int layer_count, __global const float* isovalues, int interval_count,
+    float uniform_interval_scale, __global const float* interval_edges, __global float* depth_out,
+    __global float* distortion_out,
     __global float* attenuation_out,  // always given when accumulating
     __global float* mean_depth_out, __global float* optical_depth_out, int segment_rule,
     int segment_count, __global const float* segment_thresholds, float depth_threshold,
     __global float4* segment_rgba_out, __global float* segment_depth_out,
     __global float* first_hit_out, __global const uchar* skippable_blocks, int4 block_counts,
-    int block_size) {
+    int block_size, __global float* fragment_out) {
     const int x = get_global_id(0);
     const int y = get_global_id(1);
     if (x >= size.x || y >= size.y) return;
@@ -64,7 +65,17 @@ __kernel void render_proxies(
 
     const MarchRay ray =
         march_ray(x, y, size, cam_position, cam_forward, cam_right, cam_up, cam_half_extent,
-                  sin_tilt, cos_tilt, origin_world, inv_spacing, box_lower, box_upper);
+                  sin_tilt, cos_tilt, origin_world, inv_spacing, box_lower, box_upper, data_offset);
+    // A block of a distributed run marches only the samples it owns and records where its part
+    // of the ray begins and ends (the fragment: sample indices, values, depths and t of its
+    // first and last sample, its transmittance), so that partial images composite into what one
+    // pass over the whole grid gives (insitu/parallel/compositing.hpp).
+    const bool partial = (wanted & WANT_FRAGMENT) != 0;
+    int fragment_first = -1;
+    int fragment_last = -1;
+    float fragment_value_first = NAN, fragment_value_last = NAN;
+    float fragment_depth_first = INFINITY, fragment_depth_last = INFINITY;
+    float fragment_t_first = INFINITY, fragment_t_last = INFINITY;
 
     const bool want_layers = (wanted & WANT_DEPTH) != 0 && layer_count > 0;
     const bool want_attenuation = (wanted & WANT_ATTENUATION) != 0;
@@ -102,8 +113,11 @@ __kernel void render_proxies(
     float ray_transmittance = 1.0f;
     float first_hit = INFINITY;
 
-    if (ray_hits_box(&ray)) {
-        float transmittance = 1.0f;
+    float transmittance = 1.0f;
+    float owned_t_exit;
+    const int first_sample =
+        first_marched_sample(&ray, partial, step, owned_lower, owned_upper, &owned_t_exit);
+    if (first_sample >= 0) {
         bool accumulating = accumulate;
         // Like `accumulating`, these stop at the early-termination opacity: the segment's own,
         // and the whole ray's (which only opacity thresholds and the first hit read).
@@ -112,11 +126,28 @@ __kernel void render_proxies(
         float previous_value = NAN;
         float previous_t = 0.0f;
         float next_block_t = -INFINITY;  // t where the ray leaves the block looked up last
-        for (int i = 0;; ++i) {
+        for (int i = first_sample;; ++i) {
             const float t = sample_t(&ray, i, step);
             if (t >= ray.t_far) break;
+            if (partial && !owns_sample(sample_grid_voxels(&ray, t), owned_lower, owned_upper)) {
+                // Owned samples are consecutive (the box is convex): past them, this block is done.
+                if (fragment_first >= 0 || t > owned_t_exit + step) break;
+                continue;
+            }
             const float3 p = sample_position_voxels(&ray, t);
             const float value = sample_trilinear(volume, dims, p);
+            if (partial) {
+                if (fragment_first < 0) {
+                    fragment_first = i;
+                    fragment_value_first = value;
+                    fragment_depth_first = sample_depth(&ray, t);
+                    fragment_t_first = t;
+                }
+                fragment_last = i;
+                fragment_value_last = value;
+                fragment_depth_last = sample_depth(&ray, t);
+                fragment_t_last = t;
+            }
             if (isnan(value)) {
                 previous_value = NAN;
                 continue;
@@ -227,14 +258,21 @@ __kernel void render_proxies(
                 const float3 lower = convert_float3(block * block_size);
                 const float3 upper = lower + (float3)(block_size);
                 const float3 exit_plane = select(lower, upper, ray.direction_voxels > 0.0f);
-                const float3 t_axis = select((exit_plane - ray.start_voxels) / ray.direction_voxels,
-                                             (float3)(INFINITY), ray.direction_voxels == 0.0f);
+                // Blocks are the volume buffer's; t is measured in the whole grid's coordinates.
+                const float3 t_axis = select(
+                    (exit_plane + ray.offset_voxels - ray.start_voxels) / ray.direction_voxels,
+                    (float3)(INFINITY), ray.direction_voxels == 0.0f);
                 next_block_t = fmin(fmin(t_axis.x, t_axis.y), t_axis.z);
                 const int block_index =
                     (block.z * block_counts.y + block.y) * block_counts.x + block.x;
                 if (skippable_blocks[block_index]) {
                     const int last = (int)ceil((next_block_t - ray.t_near) / step - 0.5f) - 1;
-                    if (last > i + 1) i = last - 1;
+                    // A block of a distributed run must still meet its last owned sample.
+                    const float last_t = sample_t(&ray, last, step);
+                    if (last > i + 1 && (!partial || owns_sample(sample_grid_voxels(&ray, last_t),
+                                                                 owned_lower, owned_upper))) {
+                        i = last - 1;
+                    }
                 }
             }
         }
@@ -263,5 +301,17 @@ __kernel void render_proxies(
             weighted_depth[j] =
                 attenuation[j] > 0.0f ? weighted_depth[j] / attenuation[j] : INFINITY;
         }
+    }
+    if (partial) {
+        __global float* fragment = fragment_out + pixel * FRAGMENT_CHANNELS;
+        fragment[0] = (float)fragment_first;
+        fragment[1] = (float)fragment_last;
+        fragment[2] = fragment_value_first;
+        fragment[3] = fragment_value_last;
+        fragment[4] = fragment_depth_first;
+        fragment[5] = fragment_depth_last;
+        fragment[6] = fragment_t_first;
+        fragment[7] = fragment_t_last;
+        fragment[8] = transmittance;
     }
 }

@@ -70,20 +70,25 @@ typedef struct {
     float3 origin;        // world space: on the camera plane (orthographic) or the eye
     float3 direction;     // world space, unit length
     float t_near, t_far;  // the span inside the box; t_near > t_far where the ray misses
-    float3 start_voxels;  // the position in voxel coordinates is start + t direction_voxels
+    float3 start_voxels;  // the position in grid coordinates is start + t direction_voxels
     float3 direction_voxels;
+    // Grid coordinates count samples from the first sample of the whole grid; the volume buffer
+    // of a rank (a block of it) starts at sample offset_voxels of that grid (0 for a whole one).
+    float3 offset_voxels;
     float depth_origin;  // depth from the camera plane is depth_origin + t depth_per_t
     float depth_per_t;
 } MarchRay;
 
 // The ray of pixel (x, y) (centre (x + 0.5, y + 0.5), see insitu/core/camera.hpp), clipped to
-// the box [box_lower, box_upper]. half_extent.z is the projection: 0 orthographic, 1
-// perspective. A non-zero tilt makes the volume distortion camera (seed 000 Eq. 1): the ray
-// heads for the pole line through the image centre, v cos θ − r̂(p) sin θ.
+// the box [box_lower, box_upper] (the whole grid's box, on every rank of a distributed run: all
+// ranks then take the same samples, t_near + (i + 1/2) step, and each keeps those it owns).
+// half_extent.z is the projection: 0 orthographic, 1 perspective. A non-zero tilt makes the volume
+// distortion camera (seed 000 Eq. 1): the ray heads for the pole line through the image centre, v
+// cos θ − r̂(p) sin θ.
 inline MarchRay march_ray(int x, int y, int2 size, float4 cam_position, float4 cam_forward,
                           float4 cam_right, float4 cam_up, float4 cam_half_extent, float sin_tilt,
                           float cos_tilt, float4 origin_world, float4 inv_spacing, float4 box_lower,
-                          float4 box_upper) {
+                          float4 box_upper, float4 data_offset) {
     MarchRay ray;
     const float2 uv = plane_coordinates(x, y, size, cam_half_extent);
     if (cam_half_extent.z == 0.0f) {
@@ -111,6 +116,7 @@ inline MarchRay march_ray(int x, int y, int2 size, float4 cam_position, float4 c
 
     ray.start_voxels = (ray.origin - origin_world.xyz) * inv_spacing.xyz;
     ray.direction_voxels = ray.direction * inv_spacing.xyz;
+    ray.offset_voxels = data_offset.xyz;
     ray.depth_origin = dot(ray.origin - cam_position.xyz, cam_forward.xyz);
     ray.depth_per_t = dot(ray.direction, cam_forward.xyz);
     return ray;
@@ -125,8 +131,62 @@ inline float sample_t(const MarchRay* ray, int i, float step) {
     return ray->t_near + ((float)i + 0.5f) * step;
 }
 
-inline float3 sample_position_voxels(const MarchRay* ray, float t) {
+// Position of the sample at t in the whole grid's sample coordinates: every rank computes it
+// from the same numbers, so all agree on who owns a sample.
+inline float3 sample_grid_voxels(const MarchRay* ray, float t) {
     return ray->start_voxels + t * ray->direction_voxels;
+}
+
+// Position in the volume buffer's voxel coordinates. Subtracting the whole-number offset is exact
+// (the result is smaller and on the same float grid), so a block samples bit for bit what the
+// whole grid samples there: the trilinear weights are the same floats.
+inline float3 sample_position_voxels(const MarchRay* ray, float t) {
+    return sample_grid_voxels(ray, t) - ray->offset_voxels;
+}
+
+// Ownership of a sample in a distributed run: owned_lower <= grid position < owned_upper on every
+// axis (+-inf where the block reaches the grid's faces), so the blocks' half-open boxes give each
+// sample to exactly one rank. A whole grid owns everything.
+inline bool owns_sample(float3 grid_position, float4 owned_lower, float4 owned_upper) {
+    return grid_position.x >= owned_lower.x && grid_position.y >= owned_lower.y &&
+           grid_position.z >= owned_lower.z && grid_position.x < owned_upper.x &&
+           grid_position.y < owned_upper.y && grid_position.z < owned_upper.z;
+}
+
+// First sample index worth testing for ownership: one and a half samples before the ray enters
+// the owned box (the exact test above decides; this only saves the samples before), or -1 where
+// the ray cannot reach the box. *t_exit is where it leaves it.
+inline int first_owned_candidate(const MarchRay* ray, float step, float4 owned_lower,
+                                 float4 owned_upper, float* t_exit) {
+    float t_enter = -INFINITY;
+    *t_exit = INFINITY;
+    const float start[3] = {ray->start_voxels.x, ray->start_voxels.y, ray->start_voxels.z};
+    const float direction[3] = {ray->direction_voxels.x, ray->direction_voxels.y,
+                                ray->direction_voxels.z};
+    const float lower[3] = {owned_lower.x, owned_lower.y, owned_lower.z};
+    const float upper[3] = {owned_upper.x, owned_upper.y, owned_upper.z};
+    for (int axis = 0; axis < 3; ++axis) {
+        if (direction[axis] == 0.0f) {
+            if (start[axis] < lower[axis] || start[axis] >= upper[axis]) return -1;
+            continue;
+        }
+        const float t0 = (lower[axis] - start[axis]) / direction[axis];
+        const float t1 = (upper[axis] - start[axis]) / direction[axis];
+        t_enter = fmax(t_enter, fmin(t0, t1));
+        *t_exit = fmin(*t_exit, fmax(t0, t1));
+    }
+    if (t_enter > *t_exit) return -1;
+    if (!(t_enter > ray->t_near)) return 0;
+    return max(0, (int)floor((t_enter - ray->t_near) / step - 0.5f) - 1);
+}
+
+// The first sample a pass marches: 0 for a whole volume, the first owned candidate for a block
+// (`partial`), -1 where the ray misses the grid or the block.
+inline int first_marched_sample(const MarchRay* ray, bool partial, float step, float4 owned_lower,
+                                float4 owned_upper, float* owned_t_exit) {
+    *owned_t_exit = INFINITY;
+    if (!ray_hits_box(ray)) return -1;
+    return partial ? first_owned_candidate(ray, step, owned_lower, owned_upper, owned_t_exit) : 0;
 }
 
 inline float sample_depth(const MarchRay* ray, float t) {

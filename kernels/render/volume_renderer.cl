@@ -5,10 +5,12 @@
 
 __kernel void render_volume(__global const float* volume, int4 dims, float4 origin_world,
                             float4 inv_spacing, float4 box_lower, float4 box_upper,
+                            float4 data_offset, float4 owned_lower, float4 owned_upper,
                             __global const float4* tf_table, int2 tf_bins, float4 tf_domain,
                             float4 cam_position, float4 cam_forward, float4 cam_right,
                             float4 cam_up, float4 cam_half_extent, int2 size, float4 march,
-                            float4 phong, __global float4* rgba_out, __global float* depth_out) {
+                            float4 phong, __global float4* rgba_out, __global float* depth_out,
+                            __global float* fragment_out) {
     const int x = get_global_id(0);
     const int y = get_global_id(1);
     if (x >= size.x || y >= size.y) return;
@@ -23,15 +25,29 @@ __kernel void render_volume(__global const float* volume, int4 dims, float4 orig
 
     const MarchRay ray =
         march_ray(x, y, size, cam_position, cam_forward, cam_right, cam_up, cam_half_extent, 0.0f,
-                  1.0f, origin_world, inv_spacing, box_lower, box_upper);
+                  1.0f, origin_world, inv_spacing, box_lower, box_upper, data_offset);
+    // A block of a distributed run (data_offset.w = 1) marches the samples it owns and records
+    // the index of the first (see proxy_renderer.cl): its RGBA composites "over" the others'.
+    const bool partial = data_offset.w != 0.0f;
+    int fragment_first = -1;
     float3 colour = (float3)(0.0f);
     float transmittance = 1.0f;
     float depth = INFINITY;
-    if (ray_hits_box(&ray)) {
+    float owned_t_exit;
+    const int first_sample =
+        first_marched_sample(&ray, partial, step, owned_lower, owned_upper, &owned_t_exit);
+    if (first_sample >= 0) {
         const float3 light = -ray.direction;
-        for (int i = 0;; ++i) {
+        for (int i = first_sample;; ++i) {
             const float t = sample_t(&ray, i, step);
             if (t >= ray.t_far) break;
+            if (partial) {
+                if (!owns_sample(sample_grid_voxels(&ray, t), owned_lower, owned_upper)) {
+                    if (fragment_first >= 0 || t > owned_t_exit + step) break;
+                    continue;
+                }
+                if (fragment_first < 0) fragment_first = i;
+            }
             const float3 p = sample_position_voxels(&ray, t);
             const float value = sample_trilinear(volume, dims, p);
             if (isnan(value)) continue;
@@ -62,4 +78,5 @@ __kernel void render_volume(__global const float* volume, int4 dims, float4 orig
     }
     rgba_out[pixel] = (float4)(colour, 1.0f - transmittance);
     depth_out[pixel] = depth;
+    if (partial) fragment_out[pixel] = (float)fragment_first;
 }

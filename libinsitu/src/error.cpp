@@ -21,6 +21,25 @@ ErrorKind classify(const std::exception_ptr& error) {
     }
 }
 
+void fail_as(ErrorKind kind, const std::string& message) {
+    switch (kind) {
+        case ErrorKind::invalid_argument:
+            throw InvalidArgument(message);
+        case ErrorKind::parse:
+            throw ParseError(message);
+        case ErrorKind::compute:
+            throw ComputeError(message);
+        case ErrorKind::io:
+            throw IoError(message);
+        case ErrorKind::state:
+            throw StateError(message);
+        case ErrorKind::none:
+        case ErrorKind::unknown:
+            break;
+    }
+    throw Error(message);
+}
+
 std::string one_line(const std::string& message) {
     std::string line;
     for (char c : message) {

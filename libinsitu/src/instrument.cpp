@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <condition_variable>
+#include <cstring>
 #include <deque>
 #include <exception>
 #include <filesystem>
@@ -18,8 +19,12 @@
 #include "archive/writer_thread.hpp"
 #include "insitu/archive/archive.hpp"
 #include "insitu/core/camera.hpp"
+#include "insitu/core/check.hpp"
+#include "insitu/core/layers.hpp"
 #include "insitu/error.hpp"
 #include "insitu/explore/colour_model.hpp"
+#include "insitu/parallel/compositing.hpp"
+#include "insitu/parallel/decomposition.hpp"
 #include "insitu/render/distortion_camera.hpp"
 #include "insitu/render/light_field_capture.hpp"
 #include "insitu/render/proxy_renderer.hpp"
@@ -57,6 +62,7 @@ std::ostream& operator<<(std::ostream& out, const InstrumentStatistics& s) {
          << s.blocked_seconds << " s, writing " << s.write_seconds << " s";
     if (s.steps_replayed > 0) line << ", replayed " << s.steps_replayed << " (skipped)";
     if (s.nonfinite_samples > 0) line << ", " << s.nonfinite_samples << " NaN/Inf samples";
+    if (s.composite_seconds > 0.0) line << ", compositing " << s.composite_seconds << " s";
     return out << line.str();
 }
 
@@ -78,6 +84,96 @@ std::string joined_names(const std::vector<Field>& fields) {
     return names.empty() ? "none" : names;
 }
 
+// Agreement in a distributed run. A rank that fails between two collectives must not skip the
+// next one (the others would wait for it for ever), so local work records its failure here and
+// goes on, and the next agreement raises it on every rank: the same error, naming the rank.
+struct LocalFailure {
+    std::string message;
+    ErrorKind kind = ErrorKind::none;
+
+    bool failed() const { return !message.empty(); }
+    /// Runs `work` unless an earlier step failed; records what it throws.
+    template <typename Work>
+    void guard(Work&& work) {
+        if (failed()) return;
+        try {
+            work();
+        } catch (const std::exception& error) {
+            message = error.what();
+            if (message.empty()) message = "unnamed error";
+            kind = classify(std::current_exception());
+        } catch (...) {
+            message = "unknown exception";
+            kind = ErrorKind::unknown;
+        }
+    }
+};
+
+void append_bytes(Bytes& bytes, const void* data, std::size_t size) {
+    const auto* begin = static_cast<const std::uint8_t*>(data);
+    bytes.insert(bytes.end(), begin, begin + size);
+}
+
+// A rank's say: failed (1 byte), kind (1 byte), message length (8 bytes) and text, then the
+// payload every rank exchanges at that point anyway (so agreeing costs no extra collective).
+Bytes encode_say(const LocalFailure& failure, const Bytes& payload) {
+    Bytes bytes{static_cast<std::uint8_t>(failure.failed() ? 1 : 0),
+                static_cast<std::uint8_t>(failure.kind)};
+    const std::uint64_t length = failure.message.size();
+    append_bytes(bytes, &length, sizeof length);
+    append_bytes(bytes, failure.message.data(), failure.message.size());
+    append_bytes(bytes, payload.data(), payload.size());
+    return bytes;
+}
+
+// Raises on every rank the first failure any rank said; returns each rank's payload otherwise.
+std::vector<Bytes> agree(Communicator& communicator, const LocalFailure& failure,
+                         const Bytes& payload = {}) {
+    const std::vector<Bytes> says = communicator.all_gather(encode_say(failure, payload));
+    int failed_ranks = 0;
+    int first = -1;
+    std::vector<Bytes> payloads(says.size());
+    for (std::size_t r = 0; r < says.size(); ++r) {
+        const Bytes& say = says[r];
+        std::uint64_t length = 0;
+        if (say.size() < 2 + sizeof length) fail<Error>("agreement: rank ", r, " said nothing");
+        std::memcpy(&length, &say[2], sizeof length);
+        const std::size_t payload_at = 2 + sizeof length + length;
+        if (payload_at > say.size()) fail<Error>("agreement: rank ", r, "'s say is cut short");
+        payloads[r].assign(say.begin() + static_cast<std::ptrdiff_t>(payload_at), say.end());
+        if (say[0] != 0) {
+            ++failed_ranks;
+            if (first < 0) first = static_cast<int>(r);
+        }
+    }
+    if (first >= 0) {
+        const Bytes& say = says[static_cast<std::size_t>(first)];
+        std::uint64_t length = 0;
+        std::memcpy(&length, &say[2], sizeof length);
+        const std::string message(reinterpret_cast<const char*>(say.data()) + 2 + sizeof length,
+                                  length);
+        std::string text = "rank " + std::to_string(first) + ": " + message;
+        if (failed_ranks > 1) {
+            text += " (and " + std::to_string(failed_ranks - 1) + " more of the " +
+                    std::to_string(says.size()) + " ranks failed)";
+        }
+        fail_as(static_cast<ErrorKind>(say[1]), text);
+    }
+    return payloads;
+}
+
+Bytes doubles_bytes(const std::vector<double>& values) {
+    Bytes bytes(values.size() * sizeof(double));
+    if (!values.empty()) std::memcpy(bytes.data(), values.data(), bytes.size());
+    return bytes;
+}
+
+std::vector<double> bytes_doubles(const Bytes& bytes) {
+    std::vector<double> values(bytes.size() / sizeof(double));
+    if (!values.empty()) std::memcpy(values.data(), bytes.data(), values.size() * sizeof(double));
+    return values;
+}
+
 }  // namespace
 
 struct Instrument::Impl {
@@ -96,8 +192,16 @@ struct Instrument::Impl {
     /// When the last execute() returned: the simulation's own time runs from there.
     std::optional<Clock::time_point> last_return;
 
-    // Touched by the writer thread only (after construction).
+    // Touched by the writer thread only (after construction); rank 0's alone when distributed.
     std::unique_ptr<ArchiveWriter> archive;
+
+    /// The ranks of a distributed run (InstrumentOptions::communicator), or null.
+    std::shared_ptr<Communicator> communicator;
+    /// Write failures (under `mutex`) and how many of them the ranks have been told of.
+    std::int64_t write_failures = 0;
+    std::int64_t write_failures_told = 0;
+    /// Whether this process writes (and logs): rank 0, or the only process.
+    bool writes() const { return !communicator || communicator->rank() == 0; }
 
     // Shared between the two threads, under `mutex`.
     mutable std::mutex mutex;
@@ -117,7 +221,8 @@ struct Instrument::Impl {
     std::thread writer;
 
     void log(const std::string& line) const {
-        if (options.log) std::cerr << "insitu: " << one_line(line) << std::endl;
+        // In a distributed run every rank meets the same warnings: rank 0 says them once.
+        if (options.log && writes()) std::cerr << "insitu: " << one_line(line) << std::endl;
     }
 
     /// Counts an error of execute() or of the writer; each source logs its first error only, so a
@@ -149,16 +254,154 @@ struct Instrument::Impl {
     }
 
     Status execute(std::int64_t step, double time, const std::vector<Field>& fields);
-    StepRecord compute(std::int64_t step, double time, const std::vector<Field>& fields);
-    /// Renders the views of one configured field into `record`, numbering them from
-    /// record.views.size().
-    void compute_field(const Field& field, StepRecord& record);
+    /// The checks of execute() that need no field (step, time, order, finalize).
+    void check_step(std::int64_t step, double time) const;
+    /// The step's record: every configured field planned and rendered (on rank 0, composited;
+    /// elsewhere the record is not kept). Adds the time spent agreeing and compositing.
+    StepRecord compute(std::int64_t step, double time, const std::vector<Field>& fields,
+                       double& composite_seconds);
+    /// What the views of one field are rendered from: the uploaded field, or this rank's block
+    /// of it, and what was agreed about the whole grid.
+    struct FieldPlan {
+        std::string name;
+        Bounds bounds;  ///< the whole grid's
+        std::vector<double> isovalues;
+        IntervalSet intervals = IntervalSet::uniform(0.0, 1.0, 1);
+        bool has_block = true;  ///< false: a rank that owns nothing of the field
+    };
+    /// Uploads one field and chooses its layers and intervals (one process).
+    FieldPlan plan_field(const Field& field, std::int64_t step);
+    /// The same for this rank's block (or none) of a distributed field, agreed over the ranks.
+    FieldPlan plan_distributed_field(const std::string& name,
+                                     const std::vector<const Field*>& blocks, std::int64_t step,
+                                     double& composite_seconds);
+    /// Checks the value range and reports NaN/Inf samples (once per run).
+    void check_range(const std::string& name, const ValueRange& range, std::int64_t step);
+    /// Renders the views of one planned field into `record`, numbering them from
+    /// record.views.size(); distributed, every pass is composited at rank 0.
+    void compute_field(const FieldPlan& plan, StepRecord& record, double& composite_seconds);
+    Status execute_distributed(std::int64_t step, double time, const std::vector<Field>& fields);
     Status enqueue(StepRecord record, double compute_seconds);
     void writer_loop();
     Status finalize();
+    /// Opens (or continues) the archive and notes the steps it holds.
+    void open_archive();
+    /// The constructor's work with a communicator: every rank validates and makes its device,
+    /// rank 0 opens the archive, and all agree (one failure fails every rank) and learn the
+    /// archived steps.
+    void open_distributed(InstrumentConfig distributed_config);
 };
 
-Status Instrument::Impl::execute(std::int64_t step, double time, const std::vector<Field>& fields) {
+void Instrument::Impl::open_archive() {
+    const std::string& path = config.archive;
+    std::error_code ignored;
+    const bool continuing = fs::exists(fs::path(path) / "manifest.json", ignored);
+    try {
+        archive = std::make_unique<ArchiveWriter>(config);
+    } catch (const fs::filesystem_error& error) {
+        fail<IoError>("cannot open archive \"", path, "\": ", error.what());
+    }
+    if (continuing) {
+        // execute() rejects these up front, so a replayed step fails at once and synchronously
+        // instead of later on the writer thread.
+        const ArchiveReader existing(path);
+        for (std::int64_t step : existing.steps()) archived_steps.insert(step);
+    }
+}
+
+void Instrument::Impl::open_distributed(InstrumentConfig distributed_config) {
+    LocalFailure failure;
+    failure.guard([&] {
+        distributed_config.validate();
+        if (distributed_config.light_field) {
+            fail<InvalidArgument>(
+                "\"light_field\": light fields are not composited across ranks (their segments "
+                "and first hits depend on the opacity in front of a block, which the block "
+                "cannot know); capture them in a run without a communicator");
+        }
+    });
+    config = std::move(distributed_config);
+    failure.guard([&] { renderer = std::make_unique<ProxyRenderer>(); });
+    std::vector<double> archived;
+    if (writes()) {
+        failure.guard([&] {
+            open_archive();
+            for (std::int64_t step : archived_steps) archived.push_back(static_cast<double>(step));
+        });
+    }
+    // Steps are below 2^53 (execute() checks), so doubles carry them exactly.
+    const std::vector<Bytes> said = agree(*communicator, failure, doubles_bytes(archived));
+    for (double step : bytes_doubles(said.at(0))) {
+        archived_steps.insert(static_cast<std::int64_t>(step));
+    }
+    if (writes()) writer = std::thread(&Impl::writer_loop, this);
+}
+
+Status Instrument::Impl::execute_distributed(std::int64_t step, double time,
+                                             const std::vector<Field>& fields) {
+    Communicator& ranks = *communicator;
+    double composite_seconds = 0.0;
+    LocalFailure failure;
+    failure.guard([&] { check_step(step, time); });
+    // Rank 0 tells the others of writes that failed since the last step: the run's status is
+    // the same on every rank.
+    if (writes() && !failure.failed()) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (write_failures > write_failures_told) {
+            write_failures_told = write_failures;
+            failure.message = "an earlier step could not be written (" + last_error +
+                              "); this step was not computed";
+            failure.kind = ErrorKind::io;
+        }
+    }
+    auto start = Clock::now();
+    const std::vector<Bytes> said =
+        agree(ranks, failure, doubles_bytes({static_cast<double>(step), time}));
+    composite_seconds += seconds_since(start);
+    const std::vector<double> reference = bytes_doubles(said.at(0));
+    for (std::size_t r = 1; r < said.size(); ++r) {
+        const std::vector<double> values = bytes_doubles(said[r]);
+        if (values != reference) {
+            fail<InvalidArgument>("ranks disagree on the step: rank ", r, " passed step ",
+                                  values.at(0), " at time ", values.at(1), ", rank 0 step ",
+                                  reference.at(0), " at time ", reference.at(1),
+                                  " (every rank calls execute with the same step and time)");
+        }
+    }
+    // The same on every rank: the archived steps and the cadence are.
+    if (archived_steps.count(step) != 0 || !config.selects(step)) {
+        const bool replayed = archived_steps.count(step) != 0;
+        last_step = step;
+        if (replayed) {
+            std::lock_guard<std::mutex> lock(mutex);
+            ++statistics.steps_replayed;
+        }
+        return Status::not_selected;
+    }
+
+    const auto compute_start = Clock::now();
+    StepRecord record = compute(step, time, fields, composite_seconds);
+    const double compute_seconds = seconds_since(compute_start);
+    last_step = step;
+    {
+        std::lock_guard<std::mutex> lock(mutex);
+        statistics.composite_seconds += composite_seconds;
+    }
+    Status status = Status::ok;
+    if (writes()) {
+        status = enqueue(std::move(record), compute_seconds);
+    } else {
+        std::lock_guard<std::mutex> lock(mutex);
+        ++statistics.steps_executed;
+        statistics.compute_seconds += compute_seconds;
+    }
+    // Every rank returns rank 0's status: a step dropped there is dropped for all.
+    Bytes verdict{static_cast<std::uint8_t>(status)};
+    ranks.broadcast(verdict, 0);
+    return static_cast<Status>(verdict.at(0));
+}
+
+void Instrument::Impl::check_step(std::int64_t step, double time) const {
     if (finalized) fail<StateError>("execute(step ", step, ") after finalize()");
     // Archive files are named by step number; a negative one has no name.
     if (step < 0) fail<InvalidArgument>("step ", step, ": step numbers must be >= 0");
@@ -178,6 +421,11 @@ Status Instrument::Impl::execute(std::int64_t step, double time, const std::vect
         fail<InvalidArgument>("step ", step, ": not after the previous step ", *last_step,
                               " (step numbers must increase)");
     }
+}
+
+Status Instrument::Impl::execute(std::int64_t step, double time, const std::vector<Field>& fields) {
+    if (communicator) return execute_distributed(step, time, fields);
+    check_step(step, time);
     // A restarted simulation replays steps an earlier run already archived: those are kept as
     // they are ("on_existing": "append") and skipped, with one notice.
     if (archived_steps.count(step) != 0) {
@@ -209,7 +457,8 @@ Status Instrument::Impl::execute(std::int64_t step, double time, const std::vect
     }
 
     const auto start = Clock::now();
-    StepRecord record = compute(step, time, fields);
+    double composite_seconds = 0.0;  // none without a communicator
+    StepRecord record = compute(step, time, fields, composite_seconds);
     const double compute_seconds = seconds_since(start);
     // From here the step number is used, even if the queue drops the step.
     last_step = step;
@@ -217,7 +466,7 @@ Status Instrument::Impl::execute(std::int64_t step, double time, const std::vect
 }
 
 StepRecord Instrument::Impl::compute(std::int64_t step, double time,
-                                     const std::vector<Field>& fields) {
+                                     const std::vector<Field>& fields, double& composite_seconds) {
     StepRecord record;
     record.step = step;
     record.time = time;
@@ -227,52 +476,215 @@ StepRecord Instrument::Impl::compute(std::int64_t step, double time,
         for (const Field& field : fields) {
             if (field.name() == name) blocks.push_back(&field);
         }
-        // One block is marched where it lies (zero-copy up to the upload); tiles are joined.
-        if (blocks.size() == 1) {
-            compute_field(*blocks.front(), record);
+        if (communicator) {
+            // A rank may own nothing of a field: it passes no block, and marches nothing.
+            compute_field(plan_distributed_field(name, blocks, step, composite_seconds), record,
+                          composite_seconds);
+        } else if (blocks.size() == 1) {
+            // One block is marched where it lies (zero-copy up to the upload); tiles are joined.
+            compute_field(plan_field(*blocks.front(), step), record, composite_seconds);
         } else {
-            compute_field(join_blocks(blocks, joined_blocks), record);
+            compute_field(plan_field(join_blocks(blocks, joined_blocks), step), record,
+                          composite_seconds);
         }
     }
     return record;
 }
 
-void Instrument::Impl::compute_field(const Field& field, StepRecord& record) {
-    const std::int64_t step = record.step;
-    // The one read of the simulation's memory: the upload packs the interior into the renderer's
-    // host staging vector and the device buffer; everything below reads those copies.
-    renderer->upload(field);
-    const DeviceVolume& volume = renderer->volume();
+void Instrument::Impl::check_range(const std::string& name, const ValueRange& range,
+                                   std::int64_t step) {
     // The renderers sample float32: a finite double beyond its range becomes Inf there, and the
     // intervals and layers chosen from the range would describe values no sample holds.
     const double float_max = std::numeric_limits<float>::max();
-    if (volume.range.min < -float_max || volume.range.max > float_max) {
-        fail<InvalidArgument>("step ", step, ": field \"", field.name(), "\" has values in [",
-                              volume.range.min, ", ", volume.range.max,
-                              "], beyond the float32 range +-", float_max,
+    if (range.min < -float_max || range.max > float_max) {
+        fail<InvalidArgument>("step ", step, ": field \"", name, "\" has values in [", range.min,
+                              ", ", range.max, "], beyond the float32 range +-", float_max,
                               " the renderers sample in");
     }
-    if (volume.range.nonfinite_count > 0) {
+    if (range.nonfinite_count > 0) {
         {
             std::lock_guard<std::mutex> lock(mutex);
-            statistics.nonfinite_samples += volume.range.nonfinite_count;
+            statistics.nonfinite_samples += range.nonfinite_count;
         }
         if (!nonfinite_reported) {
             nonfinite_reported = true;
-            log("warning: step " + std::to_string(step) + ": field \"" + field.name() + "\" has " +
-                std::to_string(volume.range.nonfinite_count) +
+            log("warning: step " + std::to_string(step) + ": field \"" + name + "\" has " +
+                std::to_string(range.nonfinite_count) +
                 " NaN/Inf samples, treated as empty space (counted in statistics, reported "
                 "once)");
         }
     }
+}
 
+Instrument::Impl::FieldPlan Instrument::Impl::plan_field(const Field& field, std::int64_t step) {
+    // The one read of the simulation's memory: the upload packs the interior into the renderer's
+    // host staging vector and the device buffer; everything below reads those copies.
+    renderer->upload(field);
+    const DeviceVolume& volume = renderer->volume();
+    check_range(field.name(), volume.range, step);
     // Layers and intervals come from this step's data: "model no more than a scene needs".
-    const TransferFunction& transfer_function = config.transfer_function_of(field.name());
+    FieldPlan plan;
+    plan.name = field.name();
+    plan.bounds = volume.bounds;
     const std::optional<std::vector<double>>& layers = config.layers_of(field.name());
-    const std::vector<double> isovalues =
-        layers ? *layers : renderer->choose_layers(transfer_function, config.max_auto_layers);
-    const IntervalSet intervals =
-        renderer->choose_intervals(config.interval_count, config.interval_mode);
+    plan.isovalues = layers ? *layers
+                            : renderer->choose_layers(config.transfer_function_of(field.name()),
+                                                      config.max_auto_layers);
+    plan.intervals = renderer->choose_intervals(config.interval_count, config.interval_mode);
+    return plan;
+}
+
+Instrument::Impl::FieldPlan Instrument::Impl::plan_distributed_field(
+    const std::string& name, const std::vector<const Field*>& blocks, std::int64_t step,
+    double& composite_seconds) {
+    Communicator& ranks = *communicator;
+    const int me = ranks.rank();
+    LocalFailure failure;
+    std::optional<Field> block;
+    failure.guard([&] {
+        if (blocks.size() == 1) block = *blocks.front();
+        if (blocks.size() > 1) block = join_blocks(blocks, joined_blocks);
+    });
+    // Every rank learns every block's extent, and decomposes the grid the same way.
+    const BlockExtent mine = block ? BlockExtent::of(*block) : BlockExtent{};
+    auto start = Clock::now();
+    const std::vector<Bytes> extents = agree(ranks, failure, doubles_bytes(mine.to_values()));
+    composite_seconds += seconds_since(start);
+    std::vector<BlockExtent> all;
+    for (const Bytes& bytes : extents) {
+        const std::vector<double> values = bytes_doubles(bytes);
+        if (values.size() != BlockExtent::kValues) fail<Error>("block extent of a rank cut short");
+        all.push_back(BlockExtent::from_values(values.data()));
+    }
+    const Decomposition grid = decompose(name, all);
+
+    // This rank's part: the upload, and what it owns of the range and histogram.
+    ValueRange local;
+    local.min = std::numeric_limits<double>::infinity();
+    local.max = -local.min;
+    failure.guard([&] {
+        if (!block) return;
+        renderer->upload(grid.marched_block(*block, me));
+        renderer->set_region(grid.region(me));
+        const DeviceVolume& volume = renderer->volume();
+        const ValueRange counts = grid.owned_counts(volume.host_values, volume.dims, me);
+        local.finite_count = counts.finite_count;
+        local.nonfinite_count = counts.nonfinite_count;
+        // The marched ghost layer holds the neighbour's own values, so min and max over the
+        // marched blocks are those of the grid.
+        if (!volume.range.empty()) {
+            local.min = volume.range.min;
+            local.max = volume.range.max;
+        }
+    });
+    start = Clock::now();
+    agree(ranks, failure);
+    std::vector<double> low{local.min};
+    std::vector<double> high{local.max};
+    std::vector<double> counts{static_cast<double>(local.finite_count),
+                               static_cast<double>(local.nonfinite_count)};
+    ranks.all_reduce(low, Reduction::min);
+    ranks.all_reduce(high, Reduction::max);
+    ranks.all_reduce(counts, Reduction::sum);
+    composite_seconds += seconds_since(start);
+    ValueRange range;
+    range.finite_count = static_cast<std::int64_t>(counts[0]);
+    range.nonfinite_count = static_cast<std::int64_t>(counts[1]);
+    if (!range.empty()) {
+        range.min = low[0];
+        range.max = high[0];
+    }
+    check_range(name, range, step);
+
+    FieldPlan plan;
+    plan.name = name;
+    plan.bounds = grid.bounds;
+    plan.has_block = block.has_value();
+    const std::optional<std::vector<double>>& layers = config.layers_of(name);
+    plan.isovalues =
+        layers ? *layers
+               : opacity_peaks(config.transfer_function_of(name), range, config.max_auto_layers);
+    const double min = range.empty() ? 0.0 : range.min;
+    const double max = range.empty() ? 0.0 : range.max;
+    if (config.interval_mode == IntervalMode::uniform) {
+        plan.intervals = IntervalSet::uniform(min, max, config.interval_count);
+    } else {
+        // The sum of the ranks' histograms of the samples each owns: the grid's histogram.
+        std::vector<double> histogram(static_cast<std::size_t>(64 * config.interval_count), 0.0);
+        if (block) {
+            const DeviceVolume& volume = renderer->volume();
+            histogram = IntervalSet::equalization_histogram(
+                grid.owned_values(volume.host_values, volume.dims, me), min, max,
+                config.interval_count);
+        }
+        start = Clock::now();
+        ranks.all_reduce(histogram, Reduction::sum);
+        composite_seconds += seconds_since(start);
+        plan.intervals =
+            IntervalSet::from_equalization_histogram(histogram, min, max, config.interval_count);
+    }
+    return plan;
+}
+
+void Instrument::Impl::compute_field(const FieldPlan& plan, StepRecord& record,
+                                     double& composite_seconds) {
+    const std::string& name = plan.name;
+    const TransferFunction& transfer_function = config.transfer_function_of(name);
+    const std::vector<double>& isovalues = plan.isovalues;
+    const IntervalSet& intervals = plan.intervals;
+
+    // The passes: on one process straight from the renderer; distributed, this rank's block's
+    // partial pass (none without a block) composited at rank 0, which alone keeps the result.
+    // A rank whose pass fails still takes part in every composite and says so afterwards.
+    LocalFailure failure;
+    const auto timed = [&](auto&& composite) {
+        const auto start = Clock::now();
+        auto result = composite();
+        composite_seconds += seconds_since(start);
+        return result;
+    };
+    const auto truth = [&](const Camera& camera, const TransferFunction& tf,
+                           const RenderSettings& settings) -> Image {
+        if (!communicator) return renderer->render_ground_truth(camera, tf, settings).rgba;
+        std::optional<Rendering> partial;
+        if (plan.has_block) {
+            failure.guard([&] { partial = renderer->render_ground_truth(camera, tf, settings); });
+        }
+        return timed([&] {
+                   return composite_rendering(*communicator, camera.width(), camera.height(),
+                                              partial ? &*partial : nullptr, 0);
+               })
+            .rgba;
+    };
+    // A view's single-perspective pass (tilt 0) or its volume distortion camera's.
+    const auto proxies = [&](const OrbitView& orbit, double tilt_deg, bool multi_perspective,
+                             const ProxyRequest& request) -> ProxyFrame {
+        const Camera camera = Camera::orbit(orbit, plan.bounds);
+        const DistortionCamera distortion = DistortionCamera::orbit(orbit, plan.bounds, tilt_deg);
+        if (!communicator) {
+            return multi_perspective ? renderer->render(distortion, request)
+                                     : renderer->render(camera, request);
+        }
+        ProxyRequest march = request;
+        march.training_transfer_functions.clear();
+        std::optional<ProxyFrame> partial;
+        if (plan.has_block) {
+            failure.guard([&] {
+                partial = multi_perspective ? renderer->render(distortion, march)
+                                            : renderer->render(camera, march);
+            });
+        }
+        ProxyFrame frame = timed([&] {
+            const ProxyFrame shell = multi_perspective
+                                         ? frame_shell(distortion.base(), tilt_deg, true, march)
+                                         : frame_shell(camera, 0.0, false, march);
+            return composite_proxies(*communicator, shell, partial ? &*partial : nullptr, 0);
+        });
+        for (const TransferFunction& tf : request.training_transfer_functions) {
+            frame.training.push_back(truth(camera, tf, request.march));
+        }
+        return frame;
+    };
 
     ProxyRequest base;
     base.isovalues = isovalues;
@@ -289,7 +701,7 @@ void Instrument::Impl::compute_field(const Field& field, StepRecord& record) {
     // attenuation is stored. Training renderings are rendered when the model or the archive
     // needs them, and stored only on request ("keep_training_images").
     // Training functions are in the top-level function's units: only its fields train.
-    const bool trains = config.trains(field.name()) && !config.training_transfer_functions.empty();
+    const bool trains = config.trains(name) && !config.training_transfer_functions.empty();
     const bool fits_model = trains && config.colour_model.enabled && config.proxies.attenuation;
     if (trains && (config.keep_training_images || fits_model)) {
         single.training_transfer_functions = config.training_transfer_functions;
@@ -312,42 +724,54 @@ void Instrument::Impl::compute_field(const Field& field, StepRecord& record) {
     const bool wants_multi = config.proxies.distortion || config.proxies.multi_attenuation;
 
     // The preview is what Cinema viewers show: the ground truth, unshaded like the proxies'
-    // emission-absorption model, at the proxies' step.
+    // emission-absorption model, at the proxies' step. Distributed, it marches on to T = 0 like
+    // the proxies: a block cannot stop at an opacity it does not know is reached in front of it.
     RenderSettings preview_settings;
     preview_settings.step_voxels = config.step_voxels;
+    if (communicator) preview_settings.early_termination_opacity = 1.0;
 
-    for (const ViewConfig& view : config.views_of(field.name())) {
+    for (const ViewConfig& view : config.views_of(name)) {
         ViewRecord out;
         out.view_index = static_cast<int>(record.views.size());
-        out.field = field.name();
+        out.field = name;
         out.view = view;
         out.transfer_function = transfer_function;
         out.training_transfer_functions = single.training_transfer_functions;
-        const Camera camera = Camera::orbit(view.orbit, volume.bounds);
-        if (wants_single) out.single = renderer->render(camera, single);
+        const Camera camera = Camera::orbit(view.orbit, plan.bounds);
+        if (wants_single) out.single = proxies(view.orbit, 0.0, false, single);
         if (fits_model) {
             std::vector<Image> attenuations;
             for (const TransferFunction& tf : config.training_transfer_functions) {
                 training_attenuation.transfer_function = tf;
-                attenuations.push_back(renderer->render(camera, training_attenuation).attenuation);
+                attenuations.push_back(
+                    proxies(view.orbit, 0.0, false, training_attenuation).attenuation);
             }
-            out.single->colour_model =
-                ColourModel::fit(attenuations, out.single->training, model_settings);
+            // Only the writing rank holds the composited images.
+            if (writes()) {
+                failure.guard([&] {
+                    out.single->colour_model =
+                        ColourModel::fit(attenuations, out.single->training, model_settings);
+                });
+            }
             if (!config.keep_training_images) out.single->training.clear();
         }
-        if (wants_multi) {
-            out.multi = renderer->render(
-                DistortionCamera::orbit(view.orbit, volume.bounds, view.distortion_tilt_deg),
-                multi);
-        }
-        out.preview =
-            renderer->render_ground_truth(camera, transfer_function, preview_settings).rgba;
+        if (wants_multi) out.multi = proxies(view.orbit, view.distortion_tilt_deg, true, multi);
+        out.preview = truth(camera, transfer_function, preview_settings);
         record.views.push_back(std::move(out));
+    }
+    if (communicator) {
+        const auto start = Clock::now();
+        agree(*communicator, failure);
+        composite_seconds += seconds_since(start);
+    } else if (failure.failed()) {
+        fail_as(failure.kind, failure.message);
     }
 
     // The light field (seed 001) takes the proxies' samples, layers and intervals, so its
     // segments and attenuation mean what the views' proxies mean.
     if (config.light_field) {
+        // Refused with a communicator at construction: segments have no exact composite.
+        INSITU_CHECK(!communicator);
         LightFieldRequest request;
         request.settings = *config.light_field;
         request.transfer_function = transfer_function;
@@ -355,8 +779,8 @@ void Instrument::Impl::compute_field(const Field& field, StepRecord& record) {
         if (request.settings.attenuation) request.intervals = intervals;
         request.march.step_voxels = config.step_voxels;
         const LightFieldRig rig =
-            LightFieldRig::around(volume.bounds, request.settings.cameras, request.settings.size);
-        record.light_fields.push_back({field.name(), capture_light_field(*renderer, rig, request)});
+            LightFieldRig::around(plan.bounds, request.settings.cameras, request.settings.size);
+        record.light_fields.push_back({name, capture_light_field(*renderer, rig, request)});
     }
 }
 
@@ -428,6 +852,7 @@ void Instrument::Impl::writer_loop() {
                 statistics.bytes_written += bytes;
             } else {
                 write_failure = failure_exception;
+                ++write_failures;
             }
         }
         // After the unlock: the waiting simulation wakes and preempts this low-priority thread
@@ -469,6 +894,24 @@ Status Instrument::Impl::finalize() {
         }
         log(summary.str());
     }
+    if (communicator) {
+        // Every rank returns what rank 0's writer met.
+        Bytes verdict{static_cast<std::uint8_t>(failure ? 1 : 0)};
+        if (failure) {
+            std::lock_guard<std::mutex> lock(mutex);
+            append_bytes(verdict, last_error.data(), last_error.size());
+        }
+        communicator->broadcast(verdict, 0);
+        if (verdict.at(0) == 0) return Status::ok;
+        if (!writes()) {
+            const std::string message =
+                "rank 0: writing the archive failed: " +
+                std::string(reinterpret_cast<const char*>(verdict.data()) + 1, verdict.size() - 1);
+            record_error(message, ErrorKind::io, /*from_writer=*/true);
+            if (options.rethrow_errors) fail<IoError>(message);
+            return Status::error;
+        }
+    }
     if (!failure) return Status::ok;
     if (options.rethrow_errors) std::rethrow_exception(failure);
     return Status::error;
@@ -477,26 +920,17 @@ Status Instrument::Impl::finalize() {
 Instrument::Instrument(InstrumentConfig config, InstrumentOptions options)
     : impl_(std::make_unique<Impl>()) {
     Impl& impl = *impl_;
+    impl.options = options;
+    impl.communicator = options.communicator;
+    if (impl.communicator) {
+        impl.open_distributed(std::move(config));
+        return;
+    }
     config.validate();
     impl.config = std::move(config);
-    impl.options = options;
     // The compute device first: without one nothing is written, not even an empty archive.
     impl.renderer = std::make_unique<ProxyRenderer>();
-
-    const std::string& path = impl.config.archive;
-    std::error_code ignored;
-    const bool continuing = fs::exists(fs::path(path) / "manifest.json", ignored);
-    try {
-        impl.archive = std::make_unique<ArchiveWriter>(impl.config);
-    } catch (const fs::filesystem_error& error) {
-        fail<IoError>("cannot open archive \"", path, "\": ", error.what());
-    }
-    if (continuing) {
-        // execute() rejects these up front, so a replayed step fails at once and synchronously
-        // instead of later on the writer thread.
-        const ArchiveReader existing(path);
-        for (std::int64_t step : existing.steps()) impl.archived_steps.insert(step);
-    }
+    impl.open_archive();
     impl.writer = std::thread(&Impl::writer_loop, &impl);
 }
 

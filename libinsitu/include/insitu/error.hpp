@@ -50,6 +50,9 @@ enum class ErrorKind { none, invalid_argument, parse, compute, io, state, unknow
 
 /// Kind of the exception `error` points at (unknown for non-libinsitu exceptions).
 ErrorKind classify(const std::exception_ptr& error);
+/// Throws the exception type of `kind` (Error for none and unknown) with `message`: how a
+/// failure classified on one rank of a distributed run is raised on every rank.
+[[noreturn]] void fail_as(ErrorKind kind, const std::string& message);
 
 /// `message` on one line, for logs and one-line reports: nested errors and OpenCL build logs
 /// may span several. Line breaks become one space; trailing spaces go.

@@ -19,6 +19,8 @@
 
 namespace insitu {
 
+class Communicator;
+
 enum class Status {
     ok,            ///< proxies computed and queued (or written)
     not_selected,  ///< the cadence skipped this step
@@ -40,6 +42,9 @@ struct InstrumentStatistics {
     double compute_seconds = 0.0;  ///< in execute(), computing proxies
     double blocked_seconds = 0.0;  ///< in execute(), waiting for room in the writer queue
     double write_seconds = 0.0;    ///< on the writer thread
+    /// Distributed only: in execute(), agreeing on bounds, ranges and errors and compositing the
+    /// partial images (part of compute_seconds).
+    double composite_seconds = 0.0;
     /// Wall time inside execute() (every call, whatever its status): what the simulation waited.
     double execute_seconds = 0.0;
     /// Wall time between one execute() returning and the next being called: the simulation's
@@ -53,8 +58,17 @@ std::ostream& operator<<(std::ostream& out, const InstrumentStatistics& statisti
 struct InstrumentOptions {
     /// Let exceptions out of execute()/finalize() instead of turning them into Status (tests).
     bool rethrow_errors = false;
-    /// Print warnings and the finalize() summary to stderr.
+    /// Print warnings and the finalize() summary to stderr (under a communicator: rank 0 only).
     bool log = true;
+    /// The simulation's ranks (insitu/mpi.hpp makes one of an MPI_Comm). When set, the
+    /// Instrument is distributed: each rank's execute() passes its own block of every field and
+    /// every rank calls the constructor, execute() and finalize() collectively, with the same
+    /// step and time. Bounds, value range, layers, intervals and histogram are agreed over all
+    /// ranks; each rank marches the samples it owns, the partial images are composited sort-last
+    /// (direct send over image tiles, insitu/parallel/compositing.hpp) and rank 0 alone writes
+    /// the archive. A failure on any rank makes every rank return error for that step, with the
+    /// same message naming the rank. Blocks: see insitu/parallel/decomposition.hpp.
+    std::shared_ptr<Communicator> communicator;
 };
 std::ostream& operator<<(std::ostream& out, const InstrumentOptions& options);
 

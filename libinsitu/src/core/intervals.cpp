@@ -69,22 +69,41 @@ IntervalSet IntervalSet::uniform(double min, double max, int count) {
 
 IntervalSet IntervalSet::histogram_equalized(const std::vector<float>& values, double min,
                                              double max, int count) {
-    IntervalSet fallback = uniform(min, max, count);
+    return from_equalization_histogram(equalization_histogram(values, min, max, count), min, max,
+                                       count);
+}
+
+std::vector<double> IntervalSet::equalization_histogram(const std::vector<float>& values,
+                                                        double min, double max, int count) {
+    const IntervalSet fallback = uniform(min, max, count);
     const double lo = fallback.edges_.front();
     const double hi = fallback.edges_.back();
     // A fine histogram (64 bins per interval) is enough to place quantiles well and costs one
     // pass over the data.
     const int bins = 64 * count;
     std::vector<double> histogram(static_cast<std::size_t>(bins), 0.0);
-    double total = 0.0;
     for (float value : values) {
         if (std::isnan(value)) continue;
         // Halves: value - lo and hi - lo may overflow; halving is exact, the ratio unchanged.
         const double position = (0.5 * value - 0.5 * lo) / (0.5 * hi - 0.5 * lo) * bins;
         const int bin = static_cast<int>(std::clamp(position, 0.0, bins - 1.0));
         histogram[bin] += 1.0;
-        total += 1.0;
     }
+    return histogram;
+}
+
+IntervalSet IntervalSet::from_equalization_histogram(const std::vector<double>& histogram,
+                                                     double min, double max, int count) {
+    IntervalSet fallback = uniform(min, max, count);
+    const double lo = fallback.edges_.front();
+    const double hi = fallback.edges_.back();
+    const int bins = 64 * count;
+    if (static_cast<int>(histogram.size()) != bins) {
+        fail<InvalidArgument>("equalization histogram of ", histogram.size(), " bins for ", count,
+                              " intervals (expected ", bins, ")");
+    }
+    double total = 0.0;
+    for (double n : histogram) total += n;
     if (total == 0.0) return fallback;
     std::vector<double> edges{lo};
     double cumulative = 0.0;

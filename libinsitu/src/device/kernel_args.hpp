@@ -6,6 +6,7 @@
 #include <cmath>
 #include <glm/trigonometric.hpp>
 #include <glm/vec3.hpp>
+#include <limits>
 
 #include "device/opencl_device.hpp"
 #include "insitu/core/camera.hpp"
@@ -66,14 +67,30 @@ inline auto camera_args(const Camera& camera) {
 }
 
 /// An uploaded volume: buffer, dims (int4, voxels), origin (world units), inverse spacing
-/// (voxels per world unit), bounding box lower and upper corners (world units).
+/// (voxels per world unit), bounding box lower and upper corners (world units), then where the
+/// buffer lies in the grid it is a block of: data offset (grid samples; w = 1 for a block),
+/// owned box lower and upper (grid samples). A whole volume is its own grid: its origin and box,
+/// offset 0 (w = 0), owned everywhere. A block passes the whole grid's origin and box instead
+/// (kernels/render/ray_march.cl march_ray, owns_sample).
 inline auto volume_args(const DeviceVolume& volume) {
     const Index3& d = volume.dims;
     const cl_int4 dims = {
         {static_cast<cl_int>(d[0]), static_cast<cl_int>(d[1]), static_cast<cl_int>(d[2]), 0}};
-    return pack_args(volume.memory->buffer, dims, to_float4(volume.origin),
-                     to_float4(1.0 / volume.spacing), to_float4(volume.bounds.lower),
-                     to_float4(volume.bounds.upper));
+    const double inf = std::numeric_limits<double>::infinity();
+    if (!volume.region) {
+        return pack_args(volume.memory->buffer, dims, to_float4(volume.origin),
+                         to_float4(1.0 / volume.spacing), to_float4(volume.bounds.lower),
+                         to_float4(volume.bounds.upper), to_float4(0.0, 0.0, 0.0, 0.0),
+                         to_float4(-inf, -inf, -inf, 0.0), to_float4(inf, inf, inf, 0.0));
+    }
+    const MarchRegion& region = *volume.region;
+    const Index3& offset = region.block_offset;
+    return pack_args(volume.memory->buffer, dims, to_float4(region.grid_first_sample),
+                     to_float4(1.0 / volume.spacing), to_float4(region.grid_bounds.lower),
+                     to_float4(region.grid_bounds.upper),
+                     to_float4(static_cast<double>(offset[0]), static_cast<double>(offset[1]),
+                               static_cast<double>(offset[2]), 1.0),
+                     to_float4(region.owned_lower), to_float4(region.owned_upper));
 }
 
 /// A transfer table uploaded to `buffer`: buffer, bins (value, gradient), domain = (value_min,

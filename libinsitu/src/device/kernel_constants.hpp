@@ -21,6 +21,11 @@ constexpr int kWantOpticalDepth = 16;
 constexpr int kWantSegmentRgba = 32;
 constexpr int kWantSegmentDepth = 64;
 constexpr int kWantFirstHitDepth = 128;
+/// A block's partial image in a distributed run: the fragment record of each pixel
+/// (insitu/parallel/compositing.hpp), from which partial images composite exactly.
+constexpr int kWantFragment = 256;
+/// Floats per pixel of that record (kernels/render/proxy_renderer.cl writes them).
+constexpr int kFragmentChannels = 9;
 
 /// render_proxies' `segment_rule` argument: SegmentRule as the kernel spells it.
 constexpr int kSegmentsWholeRay = static_cast<int>(SegmentRule::whole_ray);
@@ -34,7 +39,7 @@ struct KernelConstant {
 
 /// Every constant passed to the kernels. Private arrays are sized by the MAX_* limits, so they
 /// bound each work-item's private memory.
-inline constexpr std::array<KernelConstant, 14> kKernelConstants{{
+inline constexpr std::array<KernelConstant, 16> kKernelConstants{{
     {"MAX_LAYERS", kMaxLayers},        // depth layers per pass (layer_t[] in the proxy kernel)
     {"MAX_INTERVALS", kMaxIntervals},  // intensity intervals (a[] in colour model, edits)
     {"MAX_LIGHTS", kMaxLights},        // lights per relighting call (half_vectors[])
@@ -46,6 +51,8 @@ inline constexpr std::array<KernelConstant, 14> kKernelConstants{{
     {"WANT_SEGMENT_RGBA", kWantSegmentRgba},
     {"WANT_SEGMENT_DEPTH", kWantSegmentDepth},
     {"WANT_FIRST_HIT_DEPTH", kWantFirstHitDepth},
+    {"WANT_FRAGMENT", kWantFragment},
+    {"FRAGMENT_CHANNELS", kFragmentChannels},
     {"SEGMENTS_WHOLE_RAY", kSegmentsWholeRay},
     {"SEGMENTS_LAYERS", kSegmentsLayers},
     {"SEGMENTS_OPACITY", kSegmentsOpacity},
@@ -57,9 +64,9 @@ static_assert(kMaxLayers >= 1 && kMaxLayers <= 64, "layer_t[] is a private array
 static_assert(kMaxLights >= 1 && kMaxLights <= 64, "half_vectors[] is a private array per pixel");
 // The wanted bits must be distinct powers of two.
 static_assert((kWantDepth | kWantDistortion | kWantAttenuation | kWantMeanDepth |
-               kWantOpticalDepth | kWantSegmentRgba | kWantSegmentDepth | kWantFirstHitDepth) ==
-                  255,
-              "wanted bits are the eight distinct low bits");
+               kWantOpticalDepth | kWantSegmentRgba | kWantSegmentDepth | kWantFirstHitDepth |
+               kWantFragment) == 511,
+              "wanted bits are the nine distinct low bits");
 static_assert(kSegmentsWholeRay != kSegmentsLayers && kSegmentsLayers != kSegmentsOpacity &&
                   kSegmentsWholeRay != kSegmentsOpacity,
               "the kernel tells the segment rules apart by these values");

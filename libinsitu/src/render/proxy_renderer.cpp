@@ -111,7 +111,7 @@ struct ProxyRenderer::DeviceState {
     cl::Kernel kernel;
     detail::DeviceMemory table, isovalues, edges, thresholds, depth_out, distortion_out,
         attenuation_out, mean_depth_out, optical_depth_out, segment_rgba_out, segment_depth_out,
-        first_hit_out, skippable;
+        first_hit_out, skippable, fragment_out;
     /// Block ranges of the uploaded volume, rescanned when its generation changes.
     detail::BlockRanges blocks;
     std::uint64_t blocks_generation = 0;
@@ -198,6 +198,23 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     if (request.segment_rgba) wanted |= detail::kWantSegmentRgba;
     if (request.segment_depth) wanted |= detail::kWantSegmentDepth;
     if (request.first_hit_depth) wanted |= detail::kWantFirstHitDepth;
+    const bool partial = volume.region.has_value();
+    if (partial) {
+        // A segment's and the first hit's opacity thresholds depend on the opacity in front of
+        // the block, which a block does not know.
+        if (want_segments) {
+            fail<InvalidArgument>(
+                "segment and first-hit outputs (light fields) are not composited across blocks: "
+                "a block of a distributed run cannot know the opacity in front of it");
+        }
+        if (request.march.early_termination_opacity < 1.0) {
+            fail<InvalidArgument>(
+                "early_termination_opacity = ", request.march.early_termination_opacity,
+                " for a block (a block cannot know the opacity in front of it: "
+                "partial frames composite exactly only with 1)");
+        }
+        wanted |= detail::kWantFragment;
+    }
 
     // Only requested outputs get device memory; the others are passed as null buffers.
     auto output = [&](detail::DeviceMemory& reused, bool needed, int planes) -> cl::Buffer {
@@ -222,6 +239,8 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     const cl::Buffer segment_depth_out =
         output(state_->segment_depth_out, request.segment_depth, segments);
     const cl::Buffer first_hit_out = output(state_->first_hit_out, request.first_hit_depth, 1);
+    const cl::Buffer fragment_out =
+        output(state_->fragment_out, partial, detail::kFragmentChannels);
 
     auto upload_floats = [&](detail::DeviceMemory& reused, const std::vector<float>& values,
                              const char* what) -> cl::Buffer {
@@ -301,7 +320,7 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
         attenuation_out, mean_depth_out, optical_depth_out, static_cast<cl_int>(request.segments),
         static_cast<cl_int>(segments), threshold_buffer,
         static_cast<cl_float>(request.first_hit_threshold), segment_rgba_out, segment_depth_out,
-        first_hit_out, skippable_buffer, block_counts, block_voxels);
+        first_hit_out, skippable_buffer, block_counts, block_voxels, fragment_out);
 
     std::vector<float> planar;
     auto fetch = [&](const cl::Buffer& buffer, int planes, const char* what) {
@@ -340,6 +359,11 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
         frame.first_hit_depth = Image(width, height, 1);
         device_->opencl().download(first_hit_out, frame.first_hit_depth.pixels.data(),
                                    pixels * sizeof(float), "first-hit depth");
+    }
+    if (partial) {
+        frame.fragment = Image(width, height, detail::kFragmentChannels);
+        device_->opencl().download(fragment_out, frame.fragment.pixels.data(),
+                                   frame.fragment.pixels.size() * sizeof(float), "fragments");
     }
     return frame;
 }

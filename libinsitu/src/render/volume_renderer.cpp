@@ -77,12 +77,13 @@ void DeviceVolume::upload(ComputeDevice& device, const Field& field) {
     origin = field.first_sample();  // the renderers sample nodes: a cell's is its centre
     spacing = field.spacing();
     bounds = field.bounds();
+    region.reset();
     ++generation;
 }
 
 struct VolumeRenderer::DeviceState {
     cl::Kernel kernel;
-    detail::DeviceMemory table, rgba_out, depth_out;
+    detail::DeviceMemory table, rgba_out, depth_out, fragment_out;
 };
 
 VolumeRenderer::VolumeRenderer(std::shared_ptr<ComputeDevice> device)
@@ -97,6 +98,28 @@ VolumeRenderer& VolumeRenderer::operator=(VolumeRenderer&&) noexcept = default;
 
 void VolumeRenderer::upload(const Field& field) {
     volume_.upload(*device_, field);
+}
+
+void VolumeRenderer::set_region(std::optional<MarchRegion> region) {
+    if (region) {
+        if (volume_.empty()) fail<Error>("VolumeRenderer::set_region called before upload()");
+        for (int axis = 0; axis < 3; ++axis) {
+            // Grid coordinates are floats on the device: whole numbers beyond 2^24 would round.
+            const double limit = 16777216.0;
+            if (region->block_offset[axis] < 0 ||
+                region->block_offset[axis] + volume_.dims[axis] > limit) {
+                fail<InvalidArgument>("block offset ", region->block_offset[axis], " along ",
+                                      "xyz"[axis], " (must be >= 0 and, with the block's ",
+                                      volume_.dims[axis], " samples, <= 2^24)");
+            }
+            if (!(region->owned_lower[axis] < region->owned_upper[axis])) {
+                fail<InvalidArgument>("owned box [", region->owned_lower[axis], ", ",
+                                      region->owned_upper[axis], ") along ", "xyz"[axis],
+                                      " is empty");
+            }
+        }
+    }
+    volume_.region = std::move(region);
 }
 
 Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& tf,
@@ -120,6 +143,12 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
     opencl.ensure_buffer(state_->depth_out.buffer, state_->depth_out.capacity,
                          pixels * sizeof(float), CL_MEM_WRITE_ONLY);
 
+    cl::Buffer fragment_buffer;
+    if (volume_.region) {
+        opencl.ensure_buffer(state_->fragment_out.buffer, state_->fragment_out.capacity,
+                             pixels * sizeof(float), CL_MEM_WRITE_ONLY);
+        fragment_buffer = state_->fragment_out.buffer;
+    }
     const bool needs_gradient = settings.shading || tf.is_2d();
     const cl_float4 march = to_float4(step_world, settings.early_termination_opacity,
                                       settings.shading ? 1.0 : 0.0, needs_gradient ? 1.0 : 0.0);
@@ -131,7 +160,7 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
                   detail::image_local_range(), detail::volume_args(volume_),
                   detail::transfer_args(state_->table.buffer, table), detail::camera_args(camera),
                   detail::image_size(camera), march, phong_parameters, state_->rgba_out.buffer,
-                  state_->depth_out.buffer);
+                  state_->depth_out.buffer, fragment_buffer);
 
     Rendering result;
     result.rgba = Image(width, height, 4);
@@ -140,12 +169,29 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
                     "rendered RGBA");
     opencl.download(state_->depth_out.buffer, result.depth.pixels.data(), pixels * sizeof(float),
                     "rendered depth");
+    if (volume_.region) {
+        result.fragment = Image(width, height, 1);
+        opencl.download(fragment_buffer, result.fragment.pixels.data(), pixels * sizeof(float),
+                        "rendered fragment");
+    }
     return result;
 }
 
 std::ostream& operator<<(std::ostream& out, const PhongParameters& phong) {
     return out << "Phong{ambient " << phong.ambient << ", diffuse " << phong.diffuse
                << ", specular " << phong.specular << ", shininess " << phong.shininess << "}";
+}
+
+std::ostream& operator<<(std::ostream& out, const MarchRegion& region) {
+    const glm::dvec3& first = region.grid_first_sample;
+    out << "MarchRegion{grid first sample (" << first.x << ", " << first.y << ", " << first.z
+        << "), grid " << region.grid_bounds << ", block offset (" << region.block_offset[0] << ", "
+        << region.block_offset[1] << ", " << region.block_offset[2] << "), owned ";
+    for (int axis = 0; axis < 3; ++axis) {
+        out << (axis ? " x " : "") << "[" << region.owned_lower[axis] << ", "
+            << region.owned_upper[axis] << ")";
+    }
+    return out << "}";
 }
 
 std::ostream& operator<<(std::ostream& out, const RenderSettings& settings) {

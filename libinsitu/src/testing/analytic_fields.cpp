@@ -1,6 +1,7 @@
 #include "insitu/testing/analytic_fields.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <random>
@@ -13,6 +14,71 @@ Field SampledVolume::field() const {
     Field view(name, values.data(), ScalarType::float32, dims);
     view.set_origin(origin).set_spacing(spacing);
     return view;
+}
+
+Field VolumeBlock::field() const {
+    Field view(name, values.data(), ScalarType::float32, allocated);
+    view.set_origin(origin).set_spacing(spacing).set_ghost_layers(ghost_low, ghost_high);
+    return view;
+}
+
+VolumeBlock cut_block(const SampledVolume& volume, Index3 lower, Index3 upper, int ghosts) {
+    VolumeBlock block;
+    block.name = volume.name;
+    block.spacing = volume.spacing;
+    Index3 start{0, 0, 0};
+    for (int axis = 0; axis < 3; ++axis) {
+        if (lower[axis] < 0 || upper[axis] < lower[axis] || upper[axis] >= volume.dims[axis]) {
+            fail<InvalidArgument>("cut_block: ", "xyz"[axis], " [", lower[axis], ", ", upper[axis],
+                                  "] is not inside 0..", volume.dims[axis] - 1);
+        }
+        block.ghost_low[axis] = std::min<std::int64_t>(ghosts, lower[axis]);
+        block.ghost_high[axis] =
+            std::min<std::int64_t>(ghosts, volume.dims[axis] - 1 - upper[axis]);
+        start[axis] = lower[axis] - block.ghost_low[axis];
+        block.allocated[axis] = upper[axis] + block.ghost_high[axis] - start[axis] + 1;
+        block.origin[axis] = volume.origin[axis] + lower[axis] * volume.spacing[axis];
+    }
+    block.values.reserve(
+        static_cast<std::size_t>(block.allocated[0] * block.allocated[1] * block.allocated[2]));
+    for (std::int64_t k = 0; k < block.allocated[2]; ++k) {
+        for (std::int64_t j = 0; j < block.allocated[1]; ++j) {
+            const std::size_t row = static_cast<std::size_t>(
+                ((start[2] + k) * volume.dims[1] + start[1] + j) * volume.dims[0] + start[0]);
+            block.values.insert(
+                block.values.end(), volume.values.begin() + static_cast<std::ptrdiff_t>(row),
+                volume.values.begin() + static_cast<std::ptrdiff_t>(row + block.allocated[0]));
+        }
+    }
+    return block;
+}
+
+std::vector<std::pair<Index3, Index3>> split_grid(Index3 dims, Index3 parts, bool share_faces) {
+    std::array<std::vector<std::pair<std::int64_t, std::int64_t>>, 3> ranges;
+    for (int axis = 0; axis < 3; ++axis) {
+        const std::int64_t n = dims[axis];
+        const std::int64_t p = parts[axis];
+        // Face-sharing tiles cut the n - 1 cells, partitions the n samples.
+        const std::int64_t units = share_faces ? n - 1 : n;
+        if (p < 1 || p > units) {
+            fail<InvalidArgument>("split_grid: ", p, " parts of ", n, " samples along ",
+                                  "xyz"[axis]);
+        }
+        for (std::int64_t i = 0; i < p; ++i) {
+            const std::int64_t begin = units * i / p;
+            const std::int64_t end = units * (i + 1) / p;
+            ranges[axis].push_back({begin, share_faces ? end : end - 1});
+        }
+    }
+    std::vector<std::pair<Index3, Index3>> blocks;
+    for (const auto& z : ranges[2]) {
+        for (const auto& y : ranges[1]) {
+            for (const auto& x : ranges[0]) {
+                blocks.push_back({{x.first, y.first, z.first}, {x.second, y.second, z.second}});
+            }
+        }
+    }
+    return blocks;
 }
 
 namespace {

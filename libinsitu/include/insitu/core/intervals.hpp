@@ -29,6 +29,14 @@ public:
     /// histogram); NaN values are ignored. Falls back to uniform where quantiles coincide.
     static IntervalSet histogram_equalized(const std::vector<float>& values, double min, double max,
                                            int count);
+    /// The histogram histogram_equalized() places its edges by: 64 bins per interval over
+    /// [min, max] (widened as uniform() widens it), counting the finite `values`.
+    static std::vector<double> equalization_histogram(const std::vector<float>& values, double min,
+                                                      double max, int count);
+    /// histogram_equalized() from such a histogram, e.g. the sum of the ranks' histograms in a
+    /// distributed run: the same intervals as from all their values at once.
+    static IntervalSet from_equalization_histogram(const std::vector<double>& histogram, double min,
+                                                   double max, int count);
 
     int count() const { return static_cast<int>(edges_.size()) - 1; }
     const std::vector<double>& edges() const { return edges_; }

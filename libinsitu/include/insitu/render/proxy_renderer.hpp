@@ -98,6 +98,9 @@ struct ProxyFrame {
     std::vector<Image> segment_depth;      ///< 1 channel each, one per segment
     Image first_hit_depth;                 ///< 1 channel
     std::vector<Image> training;           ///< RGBA each
+    /// A block's pass only (a region set, see ProxyRenderer::set_region): per pixel the
+    /// fragment record that partial frames composite by (insitu/parallel/compositing.hpp).
+    Image fragment;
     /// Colour model fitted on the training renderings (seed 000 §6.2), single perspective only.
     std::optional<ColourModel> colour_model;
 };
@@ -114,6 +117,11 @@ public:
     /// Uploads a field (device memory reused across timesteps); see VolumeRenderer::upload.
     void upload(const Field& field);
     const DeviceVolume& volume() const { return renderer_.volume(); }
+    /// Makes the uploaded volume a block of a larger grid: passes then march the samples the
+    /// block owns and return partial frames (ProxyFrame::fragment set), whose composite is the
+    /// whole grid's frame. Segment outputs (light fields) have no exact composite and are
+    /// refused for a block. See VolumeRenderer::set_region.
+    void set_region(std::optional<MarchRegion> region) { renderer_.set_region(std::move(region)); }
 
     /// Intervals over the values actually present in the uploaded field: uniform, or
     /// histogram-equalised over its samples.

@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <iosfwd>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "insitu/core/camera.hpp"
@@ -65,7 +66,24 @@ std::ostream& operator<<(std::ostream& out, const RenderSettings& settings);
 struct Rendering {
     Image rgba;   ///< 4 channels
     Image depth;  ///< 1 channel, world units from the camera plane
+    /// A block's rendering only (DeviceVolume::region set): per pixel the whole grid's index of
+    /// the first sample the block owns along the ray, -1 where it owns none.
+    Image fragment;
 };
+
+/// The part of a larger grid that an uploaded block is (a distributed run,
+/// insitu/parallel/decomposition.hpp): rays are set up in the whole grid's box, so every block
+/// takes the whole grid's samples, and a block marches the samples it owns.
+struct MarchRegion {
+    glm::dvec3 grid_first_sample{0.0};  ///< world position of the whole grid's sample (0, 0, 0)
+    Bounds grid_bounds;                 ///< the box the whole grid's samples span
+    /// Grid coordinates (in samples) of the uploaded buffer's first sample: whole numbers.
+    Index3 block_offset{0, 0, 0};
+    /// The owned box in grid coordinates, half open, +-inf where it reaches the grid's faces.
+    glm::dvec3 owned_lower{0.0};
+    glm::dvec3 owned_upper{0.0};
+};
+std::ostream& operator<<(std::ostream& out, const MarchRegion& region);
 
 /// A field's interior resident on the device as float32, x fastest. Re-uploading a field that
 /// fits reuses the buffer, so successive timesteps allocate nothing.
@@ -81,6 +99,8 @@ struct DeviceVolume {
     std::vector<float> host_values;
     /// Incremented by every upload, so derived data (block ranges) knows when it is stale.
     std::uint64_t generation = 0;
+    /// Set after an upload when the volume is a block of a larger grid; an upload clears it.
+    std::optional<MarchRegion> region;
 
     bool empty() const { return dims[0] == 0; }
     /// Bytes of device memory held for the values.
@@ -102,6 +122,10 @@ public:
     /// new field fits, so successive timesteps allocate nothing. Throws InvalidArgument when an
     /// axis has fewer than 2 samples.
     void upload(const Field& field);
+
+    /// Makes the uploaded volume a block of a larger grid (or, with nullopt, whole again); the
+    /// next upload makes it whole. Throws InvalidArgument for an offset or box that does not fit.
+    void set_region(std::optional<MarchRegion> region);
 
     /// Renders the uploaded field. Throws InvalidArgument for bad settings, Error if nothing has
     /// been uploaded.

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <glm/vec3.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "insitu/field.hpp"
@@ -25,6 +26,31 @@ struct SampledVolume {
         return values[static_cast<std::size_t>((k * dims[1] + j) * dims[0] + i)];
     }
 };
+
+/// One rank's block of a SampledVolume as a simulation would hold it: its interior and the ghost
+/// layers around it (where the volume has them) copied into an array of its own.
+struct VolumeBlock {
+    std::string name = "f";
+    std::vector<float> values;  ///< allocated samples, x fastest
+    Index3 allocated{0, 0, 0};
+    Index3 ghost_low{0, 0, 0};
+    Index3 ghost_high{0, 0, 0};
+    glm::dvec3 origin{0.0};  ///< world position of the first interior sample
+    glm::dvec3 spacing{1.0};
+
+    /// A non-owning view with the ghost layers set; valid while this block lives.
+    Field field() const;
+};
+
+/// The block of `volume` whose interior spans grid indices [lower, upper] (inclusive), with up
+/// to `ghosts` layers on each side.
+VolumeBlock cut_block(const SampledVolume& volume, Index3 lower, Index3 upper, int ghosts);
+
+/// Interiors of a parts[0] x parts[1] x parts[2] decomposition of a grid of `dims` samples,
+/// x fastest, as evenly as whole samples allow (uneven where dims do not divide): either a
+/// partition of the samples (each block ends one sample before the next begins) or, with
+/// `share_faces`, tiles that share their boundary samples. Pairs of (lower, upper), inclusive.
+std::vector<std::pair<Index3, Index3>> split_grid(Index3 dims, Index3 parts, bool share_faces);
 
 /// Signed distance to a sphere: |p - center| - radius (voxel units); negative inside.
 SampledVolume make_sphere_distance(Index3 dims, glm::dvec3 center_voxels, double radius_voxels);

@@ -1,0 +1,67 @@
+#pragma once
+// Two archives of the same run compared step by step, view by view, proxy by proxy: how the MPI
+// tests and gray-scott-mpi-compare show that N ranks write what one rank writes. What
+// compositing need not reproduce (insitu/parallel/compositing.hpp: what lies behind a saturated
+// ray) is left out: the mean depth of an interval holding attenuation below 1e-6 in either
+// archive, and the optical depth of a ray saturated in the first (sum of a_j > 1 - 1e-6).
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace insitu {
+
+struct ArchiveTolerances {
+    /// Attenuation a_j is a fraction in [0, 1]: an absolute difference. Half-precision archives
+    /// resolve 2^-11 near 1 (two values rounding either side of a step differ by 5e-4 there):
+    /// compare float archives at this default, or loosen it for half ones.
+    double attenuation = 1e-4;
+    /// Depths (layers, distortion, mean depth) and optical depths: relative to the larger
+    /// magnitude, at least 1, so depths near 0 are held to an absolute 1e-3.
+    double depth = 1e-3;
+    /// Previews are 8-bit sRGB, compared as the linear values they decode to, where one code at
+    /// the top of the range is 0.009: values rounding either side of a code pass.
+    double preview = 0.02;
+    /// Isovalues and interval edges (relative, at least 1).
+    double value = 1e-6;
+};
+
+/// One quantity of one (step, view, perspective): its largest difference, or why the two could
+/// not be compared at all.
+struct ProxyMeasurement {
+    std::string quantity;  ///< "depth", "attenuation", ..., "preview"
+    double largest = 0.0;
+    double tolerance = 0.0;
+    std::string mismatch;  ///< empty when the two could be compared
+    std::string at;        ///< where the largest difference is: image, pixel, channel, values
+    bool passed() const { return mismatch.empty() && largest <= tolerance; }
+};
+std::ostream& operator<<(std::ostream& out, const ProxyMeasurement& measurement);
+
+struct FrameComparison {
+    std::int64_t step = 0;
+    int view = 0;
+    std::string perspective;  ///< "single", "multi" or "preview"
+    std::vector<ProxyMeasurement> measurements;
+};
+
+struct ArchiveComparison {
+    /// Problems of structure: different steps or views.
+    std::vector<std::string> problems;
+    std::vector<FrameComparison> frames;
+    /// Per quantity (multi-perspective ones prefixed "multi."), the largest over all frames.
+    std::vector<ProxyMeasurement> largest;
+
+    /// Measurements beyond tolerance (or mismatched), plus the structural problems.
+    int failures() const;
+    bool passed() const { return failures() == 0 && !frames.empty(); }
+};
+/// The largest difference of every quantity, one line.
+std::ostream& operator<<(std::ostream& out, const ArchiveComparison& comparison);
+
+/// Compares every step and view of the archives at `expected` and `actual` (paths); throws what
+/// ArchiveReader throws for an archive that cannot be read.
+ArchiveComparison compare_archives(const std::string& expected, const std::string& actual,
+                                   const ArchiveTolerances& tolerances = {});
+
+}  // namespace insitu

@@ -1,0 +1,498 @@
+#include "insitu/parallel/compositing.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <glm/trigonometric.hpp>
+#include <limits>
+
+#include "insitu/core/check.hpp"
+#include "insitu/error.hpp"
+
+namespace insitu {
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// The fragment record's channels, as kernels/render/proxy_renderer.cl writes them.
+enum FragmentChannel {
+    kFirstIndex,
+    kLastIndex,
+    kFirstValue,
+    kLastValue,
+    kFirstDepth,
+    kLastDepth,
+    kFirstT,
+    kLastT,
+    kTransmittance,
+    kFragmentChannels
+};
+
+// What one pixel's record holds: the fragment, then the pass's outputs in a fixed order. The
+// folded (final) record is the same without the fragment.
+struct ProxyLayout {
+    int layers = 0;
+    bool distortion = false;
+    int intervals = 0;
+    bool attenuation = false;
+    bool mean_depth = false;
+    bool optical_depth = false;
+    float sin_tilt = 0.0f;
+    std::vector<float> isovalues;
+
+    int outputs() const {
+        return layers * (distortion ? 2 : 1) +
+               intervals * ((attenuation ? 1 : 0) + (mean_depth ? 1 : 0) + (optical_depth ? 1 : 0));
+    }
+    int record() const { return kFragmentChannels + outputs(); }
+};
+
+ProxyLayout layout_of(const ProxyFrame& shell) {
+    ProxyLayout layout;
+    layout.layers = static_cast<int>(shell.depth_layers.size());
+    layout.distortion = !shell.distortion_layers.empty();
+    layout.attenuation = !shell.attenuation.pixels.empty();
+    layout.mean_depth = !shell.mean_depth.pixels.empty();
+    layout.optical_depth = !shell.optical_depth.pixels.empty();
+    layout.intervals = shell.intervals ? shell.intervals->count() : 0;
+    if (layout.mean_depth && !layout.attenuation) {
+        fail<InvalidArgument>("compositing mean depth needs the attenuation it is weighted by");
+    }
+    layout.sin_tilt = static_cast<float>(std::sin(glm::radians(shell.distortion_tilt_deg)));
+    layout.isovalues.assign(shell.isovalues.begin(), shell.isovalues.end());
+    return layout;
+}
+
+void append(Bytes& bytes, const void* data, std::size_t size) {
+    const auto* begin = static_cast<const std::uint8_t*>(data);
+    bytes.insert(bytes.end(), begin, begin + size);
+}
+
+// This rank's records of the pixels in [begin, end) it has a fragment for: (pixel, record)*.
+Bytes pack_proxy_records(const ProxyLayout& layout, const ProxyFrame& partial, std::int64_t begin,
+                         std::int64_t end) {
+    Bytes bytes;
+    std::vector<float> record(static_cast<std::size_t>(layout.record()));
+    const int I = layout.intervals;
+    for (std::int64_t pixel = begin; pixel < end; ++pixel) {
+        const float* fragment = &partial.fragment.pixels[pixel * kFragmentChannels];
+        if (fragment[kFirstIndex] < 0.0f) continue;
+        std::copy(fragment, fragment + kFragmentChannels, record.begin());
+        std::size_t next = kFragmentChannels;
+        for (const Image& layer : partial.depth_layers) record[next++] = layer.pixels[pixel];
+        for (const Image& layer : partial.distortion_layers) record[next++] = layer.pixels[pixel];
+        for (const Image* image :
+             {&partial.attenuation, &partial.mean_depth, &partial.optical_depth}) {
+            if (image->pixels.empty()) continue;
+            const float* channels = &image->pixels[pixel * I];
+            std::copy(channels, channels + I, record.begin() + static_cast<std::ptrdiff_t>(next));
+            next += static_cast<std::size_t>(I);
+        }
+        const auto index = static_cast<std::uint32_t>(pixel);
+        append(bytes, &index, sizeof index);
+        append(bytes, record.data(), record.size() * sizeof(float));
+    }
+    return bytes;
+}
+
+// One received record: its pixel, and its floats in RecordIndex::values.
+struct RecordRef {
+    std::uint32_t pixel;
+    float first_index;
+    const float* values;
+};
+
+// The records of every message, copied out of the bytes (floats are not read through a byte
+// pointer) and sorted so that each pixel's fragments are consecutive, in ray order.
+struct RecordIndex {
+    std::vector<float> values;
+    std::vector<RecordRef> refs;
+};
+
+RecordIndex index_records(const std::vector<Bytes>& messages, int record_floats) {
+    RecordIndex index;
+    const std::size_t stride = sizeof(std::uint32_t) + record_floats * sizeof(float);
+    std::size_t count = 0;
+    for (const Bytes& message : messages) {
+        if (message.size() % stride != 0) {
+            fail<Error>("compositing: a message of ", message.size(),
+                        " bytes is not a whole number of ", stride, "-byte records");
+        }
+        count += message.size() / stride;
+    }
+    index.values.resize(count * static_cast<std::size_t>(record_floats));
+    std::vector<std::uint32_t> pixels(count);
+    std::size_t record = 0;
+    for (const Bytes& message : messages) {
+        for (std::size_t at = 0; at < message.size(); at += stride, ++record) {
+            std::memcpy(&pixels[record], &message[at], sizeof(std::uint32_t));
+            std::memcpy(&index.values[record * record_floats], &message[at + sizeof(std::uint32_t)],
+                        record_floats * sizeof(float));
+        }
+    }
+    index.refs.resize(count);
+    for (std::size_t r = 0; r < count; ++r) {
+        const float* values = &index.values[r * record_floats];
+        index.refs[r] = RecordRef{pixels[r], values[0], values};
+    }
+    // A pixel's fragments in ray order: by the index of their first sample.
+    std::sort(index.refs.begin(), index.refs.end(), [](const RecordRef& a, const RecordRef& b) {
+        return a.pixel != b.pixel ? a.pixel < b.pixel : a.first_index < b.first_index;
+    });
+    return index;
+}
+
+// The identity of the fold: what a pass over nothing gives (a ray that misses the grid).
+void identity_outputs(const ProxyLayout& layout, float* out) {
+    int next = 0;
+    for (int l = 0; l < layout.layers * (layout.distortion ? 2 : 1); ++l) out[next++] = kInf;
+    const int I = layout.intervals;
+    if (layout.attenuation) {
+        for (int j = 0; j < I; ++j) out[next++] = 0.0f;
+    }
+    if (layout.mean_depth) {
+        for (int j = 0; j < I; ++j) out[next++] = kInf;
+    }
+    if (layout.optical_depth) {
+        for (int j = 0; j < I; ++j) out[next++] = 0.0f;
+    }
+}
+
+// Folds the fragments [first, last) of one pixel, front to back, into `out` (outputs()).
+void fold_proxy_pixel(const ProxyLayout& layout, const RecordRef* first, const RecordRef* last,
+                      float* out) {
+    const int L = layout.layers;
+    const int I = layout.intervals;
+    const int depth_at = 0;
+    const int distortion_at = L;
+    const int attenuation_at = L * (layout.distortion ? 2 : 1);
+    const int mean_at = attenuation_at + (layout.attenuation ? I : 0);
+    const int optical_at = mean_at + (layout.mean_depth ? I : 0);
+    const float* f = first->values;
+    std::copy(f + kFragmentChannels, f + kFragmentChannels + layout.outputs(), out);
+    // The mean depth is carried as attenuation-weighted depth until the end.
+    std::vector<double> weighted(static_cast<std::size_t>(layout.mean_depth ? I : 0), 0.0);
+    for (int j = 0; j < static_cast<int>(weighted.size()); ++j) {
+        const float a = out[attenuation_at + j];
+        weighted[j] = a > 0.0f ? static_cast<double>(a) * out[mean_at + j] : 0.0;
+    }
+    double transmittance = f[kTransmittance];
+    float last_index = f[kLastIndex];
+    float last_value = f[kLastValue];
+    float last_depth = f[kLastDepth];
+    float last_t = f[kLastT];
+    for (const RecordRef* ref = first + 1; ref != last; ++ref) {
+        const float* b = ref->values;
+        const float* b_out = b + kFragmentChannels;
+        const bool adjacent = b[kFirstIndex] == last_index + 1.0f;
+        for (int l = 0; l < L; ++l) {
+            if (!std::isinf(out[depth_at + l])) continue;  // found in front
+            const float iso = layout.isovalues[l];
+            const float before = last_value;
+            const float after = b[kFirstValue];
+            if (adjacent && !std::isnan(before) && !std::isnan(after) &&
+                ((before >= iso) != (after >= iso))) {
+                // The pair the whole pass compares across the boundary, refined as it refines.
+                const float fraction = (iso - before) / (after - before);
+                out[depth_at + l] = last_depth + fraction * (b[kFirstDepth] - last_depth);
+                if (layout.distortion) {
+                    out[distortion_at + l] =
+                        (last_t + fraction * (b[kFirstT] - last_t)) * layout.sin_tilt;
+                }
+            } else {
+                out[depth_at + l] = b_out[depth_at + l];
+                if (layout.distortion) out[distortion_at + l] = b_out[distortion_at + l];
+            }
+        }
+        // The whole pass stops accumulating once 1 - T rounds to 1 in float (its early
+        // termination at opacity 1): nothing behind a front that saturated counts.
+        if (1.0f - static_cast<float>(transmittance) < 1.0f) {
+            for (int j = 0; j < I; ++j) {
+                const float a_back = layout.attenuation ? b_out[attenuation_at + j] : 0.0f;
+                if (layout.attenuation) {
+                    out[attenuation_at + j] =
+                        static_cast<float>(out[attenuation_at + j] + transmittance * a_back);
+                }
+                if (layout.mean_depth && a_back > 0.0f) {
+                    weighted[j] += transmittance * a_back * b_out[mean_at + j];
+                }
+                if (layout.optical_depth) out[optical_at + j] += b_out[optical_at + j];
+            }
+            transmittance *= b[kTransmittance];
+        }
+        last_index = b[kLastIndex];
+        last_value = b[kLastValue];
+        last_depth = b[kLastDepth];
+        last_t = b[kLastT];
+    }
+    if (layout.mean_depth) {
+        for (int j = 0; j < I; ++j) {
+            const float a = out[attenuation_at + j];
+            out[mean_at + j] = a > 0.0f ? static_cast<float>(weighted[j] / a) : kInf;
+        }
+    }
+}
+
+// Folds the pixels [begin, end) from the records every rank sent: outputs() floats per pixel.
+std::vector<float> fold_proxy_tile(const ProxyLayout& layout, const std::vector<Bytes>& messages,
+                                   std::int64_t begin, std::int64_t end) {
+    const int outputs = layout.outputs();
+    std::vector<float> tile(static_cast<std::size_t>((end - begin) * outputs));
+    for (std::int64_t pixel = begin; pixel < end; ++pixel) {
+        identity_outputs(layout, &tile[(pixel - begin) * outputs]);
+    }
+    const RecordIndex index = index_records(messages, layout.record());
+    const std::vector<RecordRef>& refs = index.refs;
+    for (std::size_t at = 0; at < refs.size();) {
+        std::size_t run = at + 1;
+        while (run < refs.size() && refs[run].pixel == refs[at].pixel) ++run;
+        const std::int64_t pixel = refs[at].pixel;
+        if (pixel < begin || pixel >= end) {
+            fail<Error>("compositing: a record for pixel ", pixel, " outside the tile [", begin,
+                        ", ", end, ")");
+        }
+        fold_proxy_pixel(layout, &refs[at], refs.data() + run, &tile[(pixel - begin) * outputs]);
+        at = run;
+    }
+    return tile;
+}
+
+// Writes folded pixels [begin, begin + count) into the shell's images.
+void unpack_proxy_outputs(const ProxyLayout& layout, const float* values, std::int64_t begin,
+                          std::int64_t count, ProxyFrame& frame) {
+    const int outputs = layout.outputs();
+    const int I = layout.intervals;
+    for (std::int64_t p = 0; p < count; ++p) {
+        const float* in = values + p * outputs;
+        const std::int64_t pixel = begin + p;
+        int next = 0;
+        for (Image& layer : frame.depth_layers) layer.pixels[pixel] = in[next++];
+        for (Image& layer : frame.distortion_layers) layer.pixels[pixel] = in[next++];
+        for (Image* image : {&frame.attenuation, &frame.mean_depth, &frame.optical_depth}) {
+            if (image->pixels.empty()) continue;
+            std::copy(in + next, in + next + I, &image->pixels[pixel * I]);
+            next += I;
+        }
+    }
+}
+
+void check_partial(const ProxyLayout& layout, const ProxyFrame& shell, const ProxyFrame& partial) {
+    const std::size_t pixels =
+        static_cast<std::size_t>(shell.camera.width()) * shell.camera.height();
+    if (partial.fragment.pixels.size() != pixels * kFragmentChannels) {
+        fail<InvalidArgument>("compositing: the partial frame has no fragment records for its ",
+                              pixels, " pixels (was the volume given a region?)");
+    }
+    if (static_cast<int>(partial.depth_layers.size()) != layout.layers ||
+        partial.distortion_layers.size() != shell.distortion_layers.size() ||
+        partial.attenuation.pixels.size() != shell.attenuation.pixels.size() ||
+        partial.mean_depth.pixels.size() != shell.mean_depth.pixels.size() ||
+        partial.optical_depth.pixels.size() != shell.optical_depth.pixels.size()) {
+        fail<InvalidArgument>("compositing: the partial frame ", partial,
+                              " does not hold the images of ", shell);
+    }
+}
+
+std::int64_t tile_begin(std::int64_t pixels, int tiles, int tile) {
+    return pixels * tile / tiles;
+}
+
+// Ground truth: the fragment's first index, premultiplied RGBA, depth.
+constexpr int kRenderingRecord = 6;
+constexpr int kRenderingOutputs = 5;
+
+Bytes pack_rendering_records(const Rendering& partial, std::int64_t begin, std::int64_t end) {
+    Bytes bytes;
+    for (std::int64_t pixel = begin; pixel < end; ++pixel) {
+        const float first = partial.fragment.pixels[pixel];
+        if (first < 0.0f) continue;
+        const float* rgba = &partial.rgba.pixels[pixel * 4];
+        const float record[kRenderingRecord] = {first,   rgba[0], rgba[1],
+                                                rgba[2], rgba[3], partial.depth.pixels[pixel]};
+        const auto index = static_cast<std::uint32_t>(pixel);
+        append(bytes, &index, sizeof index);
+        append(bytes, record, sizeof record);
+    }
+    return bytes;
+}
+
+std::vector<float> fold_rendering_tile(const std::vector<Bytes>& messages, std::int64_t begin,
+                                       std::int64_t end) {
+    std::vector<float> tile(static_cast<std::size_t>((end - begin) * kRenderingOutputs), 0.0f);
+    for (std::int64_t pixel = begin; pixel < end; ++pixel) {
+        tile[(pixel - begin) * kRenderingOutputs + 4] = kInf;
+    }
+    const RecordIndex index = index_records(messages, kRenderingRecord);
+    const std::vector<RecordRef>& refs = index.refs;
+    for (std::size_t at = 0; at < refs.size();) {
+        std::size_t run = at + 1;
+        while (run < refs.size() && refs[run].pixel == refs[at].pixel) ++run;
+        const std::int64_t pixel = refs[at].pixel;
+        if (pixel < begin || pixel >= end) {
+            fail<Error>("compositing: a record for pixel ", pixel, " outside the tile");
+        }
+        double colour[3] = {0.0, 0.0, 0.0};
+        double transmittance = 1.0;
+        float depth = kInf;
+        for (std::size_t r = at; r < run; ++r) {
+            const float* v = refs[r].values;
+            for (int c = 0; c < 3; ++c) colour[c] += transmittance * v[1 + c];
+            transmittance *= 1.0 - static_cast<double>(v[4]);
+            if (std::isinf(depth)) depth = v[5];
+        }
+        float* out = &tile[(pixel - begin) * kRenderingOutputs];
+        for (int c = 0; c < 3; ++c) out[c] = static_cast<float>(colour[c]);
+        out[3] = static_cast<float>(1.0 - transmittance);
+        out[4] = depth;
+        at = run;
+    }
+    return tile;
+}
+
+Rendering unpack_rendering(const std::vector<float>& image, int width, int height) {
+    Rendering result;
+    result.rgba = Image(width, height, 4);
+    result.depth = Image(width, height, 1);
+    const std::int64_t pixels = static_cast<std::int64_t>(width) * height;
+    for (std::int64_t pixel = 0; pixel < pixels; ++pixel) {
+        const float* in = &image[pixel * kRenderingOutputs];
+        std::copy(in, in + 4, &result.rgba.pixels[pixel * 4]);
+        result.depth.pixels[pixel] = in[4];
+    }
+    return result;
+}
+
+// Direct send: tile k of every rank's records to rank k, fold, gather the tiles at the root.
+template <typename Pack, typename Fold>
+std::vector<float> direct_send(Communicator& communicator, std::int64_t pixels, int outputs,
+                               int root, Pack pack, Fold fold) {
+    const int ranks = communicator.size();
+    if (pixels >= std::int64_t{1} << 32) {
+        fail<InvalidArgument>("compositing: ", pixels, " pixels exceed 2^32");
+    }
+    std::vector<Bytes> to_each(static_cast<std::size_t>(ranks));
+    for (int k = 0; k < ranks; ++k) {
+        to_each[k] = pack(tile_begin(pixels, ranks, k), tile_begin(pixels, ranks, k + 1));
+    }
+    const std::vector<Bytes> received = communicator.all_to_all(to_each);
+    const int me = communicator.rank();
+    const std::int64_t begin = tile_begin(pixels, ranks, me);
+    const std::int64_t end = tile_begin(pixels, ranks, me + 1);
+    const std::vector<float> tile = fold(received, begin, end);
+    Bytes mine(tile.size() * sizeof(float));
+    if (!tile.empty()) std::memcpy(mine.data(), tile.data(), mine.size());
+    const std::vector<Bytes> tiles = communicator.gather(mine, root);
+    std::vector<float> image;
+    if (me != root) return image;
+    image.resize(static_cast<std::size_t>(pixels * outputs));
+    std::size_t at = 0;
+    for (int k = 0; k < ranks; ++k) {
+        const std::size_t expected = static_cast<std::size_t>(
+            (tile_begin(pixels, ranks, k + 1) - tile_begin(pixels, ranks, k)) * outputs);
+        if (tiles[k].size() != expected * sizeof(float)) {
+            fail<Error>("compositing: rank ", k, " sent a tile of ", tiles[k].size(),
+                        " bytes, expected ", expected * sizeof(float));
+        }
+        if (expected > 0) std::memcpy(&image[at], tiles[k].data(), tiles[k].size());
+        at += expected;
+    }
+    return image;
+}
+
+}  // namespace
+
+ProxyFrame frame_shell(const Camera& camera, double tilt_deg, bool multi_perspective,
+                       const ProxyRequest& request) {
+    ProxyFrame frame;
+    frame.multi_perspective = multi_perspective;
+    frame.camera = camera;
+    frame.distortion_tilt_deg = tilt_deg;
+    const int width = camera.width();
+    const int height = camera.height();
+    const bool want_layers = request.depth_layers && !request.isovalues.empty();
+    const bool accumulates = request.attenuation || request.mean_depth || request.optical_depth;
+    if (want_layers) {
+        frame.isovalues = request.isovalues;
+        for (std::size_t l = 0; l < request.isovalues.size(); ++l) {
+            frame.depth_layers.emplace_back(width, height, 1, kInf);
+            if (multi_perspective) frame.distortion_layers.emplace_back(width, height, 1, kInf);
+        }
+    }
+    if (accumulates) {
+        if (!request.intervals) fail<InvalidArgument>("attenuation requested without intervals");
+        frame.intervals = request.intervals;
+        const int I = request.intervals->count();
+        if (request.attenuation) frame.attenuation = Image(width, height, I, 0.0f);
+        if (request.mean_depth) frame.mean_depth = Image(width, height, I, kInf);
+        if (request.optical_depth) frame.optical_depth = Image(width, height, I, 0.0f);
+    }
+    return frame;
+}
+
+ProxyFrame composite_proxies(Communicator& communicator, const ProxyFrame& shell,
+                             const ProxyFrame* partial, int root) {
+    const ProxyLayout layout = layout_of(shell);
+    if (partial != nullptr) check_partial(layout, shell, *partial);
+    const std::int64_t pixels =
+        static_cast<std::int64_t>(shell.camera.width()) * shell.camera.height();
+    const std::vector<float> image = direct_send(
+        communicator, pixels, layout.outputs(), root,
+        [&](std::int64_t begin, std::int64_t end) {
+            return partial != nullptr ? pack_proxy_records(layout, *partial, begin, end) : Bytes{};
+        },
+        [&](const std::vector<Bytes>& messages, std::int64_t begin, std::int64_t end) {
+            return fold_proxy_tile(layout, messages, begin, end);
+        });
+    ProxyFrame frame = shell;
+    if (communicator.rank() == root) unpack_proxy_outputs(layout, image.data(), 0, pixels, frame);
+    return frame;
+}
+
+Rendering composite_rendering(Communicator& communicator, int width, int height,
+                              const Rendering* partial, int root) {
+    const std::int64_t pixels = static_cast<std::int64_t>(width) * height;
+    if (partial != nullptr && partial->fragment.pixels.size() != static_cast<std::size_t>(pixels)) {
+        fail<InvalidArgument>("compositing: the partial rendering has no fragment records for its ",
+                              pixels, " pixels (was the volume given a region?)");
+    }
+    const std::vector<float> image = direct_send(
+        communicator, pixels, kRenderingOutputs, root,
+        [&](std::int64_t begin, std::int64_t end) {
+            return partial != nullptr ? pack_rendering_records(*partial, begin, end) : Bytes{};
+        },
+        [&](const std::vector<Bytes>& messages, std::int64_t begin, std::int64_t end) {
+            return fold_rendering_tile(messages, begin, end);
+        });
+    if (communicator.rank() != root) return Rendering{};
+    return unpack_rendering(image, width, height);
+}
+
+ProxyFrame composite_proxies(const ProxyFrame& shell, const std::vector<ProxyFrame>& partials) {
+    const ProxyLayout layout = layout_of(shell);
+    const std::int64_t pixels =
+        static_cast<std::int64_t>(shell.camera.width()) * shell.camera.height();
+    std::vector<Bytes> messages;
+    for (const ProxyFrame& partial : partials) {
+        check_partial(layout, shell, partial);
+        messages.push_back(pack_proxy_records(layout, partial, 0, pixels));
+    }
+    const std::vector<float> image = fold_proxy_tile(layout, messages, 0, pixels);
+    ProxyFrame frame = shell;
+    unpack_proxy_outputs(layout, image.data(), 0, pixels, frame);
+    return frame;
+}
+
+Rendering composite_rendering(int width, int height, const std::vector<Rendering>& partials) {
+    const std::int64_t pixels = static_cast<std::int64_t>(width) * height;
+    std::vector<Bytes> messages;
+    for (const Rendering& partial : partials) {
+        if (partial.fragment.pixels.size() != static_cast<std::size_t>(pixels)) {
+            fail<InvalidArgument>("compositing: a partial rendering has no fragment records");
+        }
+        messages.push_back(pack_rendering_records(partial, 0, pixels));
+    }
+    return unpack_rendering(fold_rendering_tile(messages, 0, pixels), width, height);
+}
+
+}  // namespace insitu

@@ -1,0 +1,240 @@
+#include "insitu/testing/archive_comparison.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <ostream>
+#include <sstream>
+
+#include "insitu/archive/archive.hpp"
+#include "insitu/error.hpp"
+
+namespace insitu {
+
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+/// How far apart two values are: 0 when equal (NaN against NaN and an infinity against the same
+/// infinity included), infinite when only one is finite, otherwise |a - b|, divided for relative
+/// measures by the larger magnitude, at least 1.
+double difference(double a, double b, bool relative) {
+    if (a == b || (std::isnan(a) && std::isnan(b))) return 0.0;
+    if (!std::isfinite(a) || !std::isfinite(b)) return kInfinity;
+    const double absolute = std::abs(a - b);
+    return relative ? absolute / std::max({1.0, std::abs(a), std::abs(b)}) : absolute;
+}
+
+std::string shape_text(const Image& image) {
+    return std::to_string(image.width) + "x" + std::to_string(image.height) + "x" +
+           std::to_string(image.channels);
+}
+
+ProxyMeasurement compare_images(const std::string& quantity, const std::vector<Image>& one,
+                                const std::vector<Image>& other, bool relative, double tolerance) {
+    ProxyMeasurement measurement{quantity, 0.0, tolerance, {}, {}};
+    if (one.size() != other.size()) {
+        measurement.mismatch =
+            std::to_string(one.size()) + " against " + std::to_string(other.size()) + " images";
+        return measurement;
+    }
+    for (std::size_t i = 0; i < one.size(); ++i) {
+        const Image& a = one[i];
+        const Image& b = other[i];
+        if (a.width != b.width || a.height != b.height || a.channels != b.channels) {
+            measurement.mismatch =
+                "image " + std::to_string(i) + " is " + shape_text(a) + " against " + shape_text(b);
+            return measurement;
+        }
+        for (std::size_t at = 0; at < a.pixels.size(); ++at) {
+            const double d = difference(a.pixels[at], b.pixels[at], relative);
+            if (!(d > measurement.largest)) continue;
+            measurement.largest = d;
+            const std::size_t pixel = at / static_cast<std::size_t>(a.channels);
+            const auto width = static_cast<std::size_t>(a.width);
+            std::ostringstream where;
+            where << (one.size() > 1 ? "image " + std::to_string(i) + " " : "") << "pixel ("
+                  << pixel % width << ", " << pixel / width << ")"
+                  << (a.channels > 1 ? " channel " + std::to_string(at % a.channels) : "") << ": "
+                  << a.pixels[at] << " against " << b.pixels[at];
+            measurement.at = where.str();
+        }
+    }
+    return measurement;
+}
+
+ProxyMeasurement compare_values(const std::string& quantity, const std::vector<double>& one,
+                                const std::vector<double>& other, double tolerance) {
+    ProxyMeasurement measurement{quantity, 0.0, tolerance, {}, {}};
+    if (one.size() != other.size()) {
+        measurement.mismatch =
+            std::to_string(one.size()) + " against " + std::to_string(other.size()) + " values";
+        return measurement;
+    }
+    for (std::size_t i = 0; i < one.size(); ++i) {
+        measurement.largest = std::max(measurement.largest, difference(one[i], other[i], true));
+    }
+    return measurement;
+}
+
+/// What a ray cannot show and compositing need not reproduce, zeroed in both frames alike (see
+/// the header).
+void mask_unseen(ProxyFrame& one, ProxyFrame& other) {
+    constexpr float kMinAttenuation = 1e-6f;
+    constexpr double kSaturated = 1.0 - 1e-6;
+    const Image& a = one.attenuation;
+    const Image& b = other.attenuation;
+    if (a.pixels.size() != b.pixels.size() || a.channels == 0) return;
+    const auto intervals = static_cast<std::size_t>(a.channels);
+    const bool mean = one.mean_depth.pixels.size() == a.pixels.size() &&
+                      other.mean_depth.pixels.size() == a.pixels.size();
+    const bool optical = one.optical_depth.pixels.size() == a.pixels.size() &&
+                         other.optical_depth.pixels.size() == a.pixels.size();
+    for (std::size_t first = 0; first < a.pixels.size(); first += intervals) {
+        double total = 0.0;
+        for (std::size_t j = 0; j < intervals; ++j) total += a.pixels[first + j];
+        for (std::size_t at = first; at < first + intervals; ++at) {
+            if (mean && (a.pixels[at] < kMinAttenuation || b.pixels[at] < kMinAttenuation)) {
+                one.mean_depth.pixels[at] = other.mean_depth.pixels[at] = 0.0f;
+            }
+            if (optical && total > kSaturated) {
+                one.optical_depth.pixels[at] = other.optical_depth.pixels[at] = 0.0f;
+            }
+        }
+    }
+}
+
+std::vector<ProxyMeasurement> compare_frames(ProxyFrame& one, ProxyFrame& other,
+                                             const ArchiveTolerances& tolerances) {
+    mask_unseen(one, other);
+    const double depth = tolerances.depth;
+    std::vector<ProxyMeasurement> measurements = {
+        compare_values("isovalues", one.isovalues, other.isovalues, tolerances.value),
+        compare_values("intervals", one.intervals ? one.intervals->edges() : std::vector<double>{},
+                       other.intervals ? other.intervals->edges() : std::vector<double>{},
+                       tolerances.value),
+        compare_images("depth", one.depth_layers, other.depth_layers, true, depth),
+        compare_images("attenuation", {one.attenuation}, {other.attenuation}, false,
+                       tolerances.attenuation),
+        compare_images("mean_depth", {one.mean_depth}, {other.mean_depth}, true, depth),
+        compare_images("optical_depth", {one.optical_depth}, {other.optical_depth}, true, depth),
+    };
+    if (one.multi_perspective || other.multi_perspective) {
+        measurements.push_back(compare_images("distortion", one.distortion_layers,
+                                              other.distortion_layers, true, depth));
+    }
+    return measurements;
+}
+
+/// (step, view) of one perspective from both archives; a perspective that only one of them can
+/// load is a mismatch, one that neither stores is skipped (no measurements).
+std::vector<ProxyMeasurement> compare_perspective(const ArchiveReader& one,
+                                                  const ArchiveReader& other, std::int64_t step,
+                                                  int view, bool multi,
+                                                  const ArchiveTolerances& tolerances) {
+    ProxyFrame frames[2];
+    std::string failures[2];
+    const ArchiveReader* readers[2] = {&one, &other};
+    for (int side = 0; side < 2; ++side) {
+        try {
+            frames[side] = readers[side]->load(step, view, multi);
+        } catch (const InvalidArgument& error) {
+            failures[side] = error.what();  // the archive lists no such perspective
+        }
+    }
+    if (!failures[0].empty() && !failures[1].empty()) return {};
+    if (!failures[0].empty() || !failures[1].empty()) {
+        ProxyMeasurement missing{multi ? "multi" : "single", kInfinity, 0.0, {}, {}};
+        missing.mismatch = failures[0].empty() ? "second archive: " + failures[1]
+                                               : "first archive: " + failures[0];
+        return {missing};
+    }
+    return compare_frames(frames[0], frames[1], tolerances);
+}
+
+void keep_largest(std::vector<ProxyMeasurement>& largest, ProxyMeasurement measurement,
+                  const std::string& name) {
+    measurement.quantity = name;
+    auto kept = std::find_if(largest.begin(), largest.end(),
+                             [&](const ProxyMeasurement& m) { return m.quantity == name; });
+    if (kept == largest.end()) {
+        largest.push_back(std::move(measurement));
+    } else if (!measurement.mismatch.empty() || measurement.largest > kept->largest) {
+        *kept = std::move(measurement);
+    }
+}
+
+}  // namespace
+
+std::ostream& operator<<(std::ostream& out, const ProxyMeasurement& measurement) {
+    std::ostringstream text;
+    text << measurement.quantity << " ";
+    if (!measurement.mismatch.empty()) {
+        text << "MISMATCH (" << measurement.mismatch << ")";
+    } else {
+        text << std::setprecision(3) << measurement.largest;
+        if (!measurement.passed()) {
+            text << " EXCEEDS " << measurement.tolerance << " [at " << measurement.at << "]";
+        }
+    }
+    return out << text.str();
+}
+
+int ArchiveComparison::failures() const {
+    int failed = static_cast<int>(problems.size());
+    for (const FrameComparison& frame : frames) {
+        for (const ProxyMeasurement& measurement : frame.measurements) {
+            if (!measurement.passed()) ++failed;
+        }
+    }
+    return failed;
+}
+
+std::ostream& operator<<(std::ostream& out, const ArchiveComparison& comparison) {
+    out << comparison.frames.size() << " frames compared; largest";
+    for (const ProxyMeasurement& measurement : comparison.largest) out << " " << measurement;
+    for (const std::string& problem : comparison.problems) out << "; " << problem;
+    return out;
+}
+
+ArchiveComparison compare_archives(const std::string& expected, const std::string& actual,
+                                   const ArchiveTolerances& tolerances) {
+    ArchiveComparison comparison;
+    const ArchiveReader one(expected);
+    const ArchiveReader other(actual);
+    const std::vector<std::int64_t> steps = one.steps();
+    if (steps != other.steps() || one.view_count() != other.view_count()) {
+        comparison.problems.push_back(
+            "the archives differ in their steps or views: " + std::to_string(steps.size()) +
+            " steps x " + std::to_string(one.view_count()) + " views against " +
+            std::to_string(other.steps().size()) + " x " + std::to_string(other.view_count()));
+        return comparison;
+    }
+    for (const std::int64_t step : steps) {
+        for (int view = 0; view < one.view_count(); ++view) {
+            for (const bool multi : {false, true}) {
+                FrameComparison frame{
+                    step, view, multi ? "multi" : "single",
+                    compare_perspective(one, other, step, view, multi, tolerances)};
+                if (frame.measurements.empty()) continue;
+                for (const ProxyMeasurement& measurement : frame.measurements) {
+                    keep_largest(comparison.largest, measurement,
+                                 (multi ? "multi." : "") + measurement.quantity);
+                }
+                comparison.frames.push_back(std::move(frame));
+            }
+            FrameComparison preview{
+                step,
+                view,
+                "preview",
+                {compare_images("preview", {one.load_preview(step, view)},
+                                {other.load_preview(step, view)}, false, tolerances.preview)}};
+            keep_largest(comparison.largest, preview.measurements.front(), "preview");
+            comparison.frames.push_back(std::move(preview));
+        }
+    }
+    return comparison;
+}
+
+}  // namespace insitu

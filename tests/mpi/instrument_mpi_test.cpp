@@ -1,0 +1,262 @@
+// A distributed Instrument (InstrumentOptions::communicator over MPI) against one process: N
+// ranks, each passing its block, write the archive one rank writes from the whole field
+// (insitu/parallel/compositing.hpp states the tolerance), for 1 to 4 ranks under mpiexec
+// (tests/mpi/CMakeLists.txt): uneven slabs and 3D grids, features and isovalues on block
+// boundaries, ranks that own nothing. And the faults: a failure on one rank is every rank's
+// error for that step, naming the rank, and the run goes on.
+#include <gtest/gtest.h>
+#include <mpi.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "insitu/instrument.hpp"
+#include "insitu/mpi.hpp"
+#include "insitu/parallel/communicator.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "insitu/testing/archive_comparison.hpp"
+#include "mpi_test_main.hpp"
+
+namespace insitu {
+namespace {
+
+using insitu::testing::world_rank;
+using insitu::testing::world_size;
+
+// A fresh directory that every rank knows: made by rank 0, its name broadcast.
+std::string shared_directory(const std::string& name) {
+    std::string path;
+    if (world_rank() == 0) {
+        path = (std::filesystem::temp_directory_path() /
+                ("insitu_mpi_" + std::to_string(::getpid()) + "_" + name))
+                   .string();
+        std::filesystem::remove_all(path);
+        std::filesystem::create_directories(path);
+    }
+    int length = static_cast<int>(path.size());
+    MPI_Bcast(&length, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    path.resize(static_cast<std::size_t>(length));
+    MPI_Bcast(path.data(), length, MPI_CHAR, 0, MPI_COMM_WORLD);
+    return path;
+}
+
+// Whether `ok` holds on every rank.
+bool on_every_rank(bool ok) {
+    int all = ok ? 1 : 0;
+    MPI_Allreduce(MPI_IN_PLACE, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    return all == 1;
+}
+
+// The run's field at a step: blobs, with a ramp added so that isosurfaces cross every block.
+SampledVolume field_at(int step) {
+    SampledVolume volume = make_gaussian_blobs({37, 33, 30}, 9, 17);
+    for (std::int64_t k = 0; k < volume.dims[2]; ++k) {
+        for (std::int64_t j = 0; j < volume.dims[1]; ++j) {
+            for (std::int64_t i = 0; i < volume.dims[0]; ++i) {
+                volume.at(i, j, k) = volume.at(i, j, k) * (1.0f + 0.2f * static_cast<float>(step)) +
+                                     0.01f * static_cast<float>(i);
+            }
+        }
+    }
+    volume.name = "f";
+    volume.spacing = {0.5, 0.5, 0.25};
+    volume.origin = {-3.0, 1.0, 2.0};
+    return volume;
+}
+
+std::string configuration(const std::string& archive, const std::string& layers,
+                          const std::string& interval_mode) {
+    return R"({"archive": ")" + archive +
+           R"(", "fields": ["f"], "on_existing": "replace", "every": 1,
+        "views": [{"azimuth": 30, "elevation": 20, "camera": "perspective", "size": [48, 40]},
+                  {"azimuth": 200, "elevation": -35, "size": [40, 40]}],
+        "layers": )" +
+           layers + R"(, "intervals": {"count": 6, "mode": ")" + interval_mode + R"("},
+        "proxies": ["depth", "distortion", "attenuation", "optical_depth", "multi_attenuation"],
+        "precision": "float",
+        "transfer_function": {"points": [[0.0, 0.1, 0.2, 0.9, 0.0], [0.4, 0.9, 0.6, 0.1, 0.3],
+                                          [1.5, 1.0, 1.0, 1.0, 0.9]]},
+        "training_transfer_functions": [
+            {"points": [[0.0, 1.0, 0.0, 0.0, 0.0], [1.5, 0.0, 0.0, 1.0, 0.8]]}]})";
+}
+
+// This rank's block of `volume` under a decomposition into `parts` (one block per rank; ranks
+// beyond the blocks own nothing), or none.
+std::vector<VolumeBlock> my_blocks(const SampledVolume& volume, Index3 parts) {
+    const auto interiors = split_grid(volume.dims, parts, false);
+    std::vector<VolumeBlock> mine;
+    const std::size_t rank = static_cast<std::size_t>(world_rank());
+    if (rank < interiors.size()) {
+        mine.push_back(cut_block(volume, interiors[rank].first, interiors[rank].second, 1));
+    }
+    return mine;
+}
+
+std::vector<Field> views_of(const std::vector<VolumeBlock>& blocks) {
+    std::vector<Field> fields;
+    for (const VolumeBlock& block : blocks) fields.push_back(block.field());
+    return fields;
+}
+
+// Runs three steps distributed over `parts`, then (rank 0) the same steps in one process, and
+// compares the archives.
+void expect_same_archive_as_one_process(const std::string& name, Index3 parts,
+                                        const std::string& layers,
+                                        const std::string& interval_mode) {
+    const std::string directory = shared_directory(name);
+    const std::string distributed = directory + "/ranks.cdb";
+    const std::string reference = directory + "/one.cdb";
+    InstrumentOptions options;
+    options.rethrow_errors = true;
+    {
+        auto instrument = mpi::instrument_from_json_text(
+            configuration(distributed, layers, interval_mode), MPI_COMM_WORLD, options);
+        for (int step = 0; step < 3; ++step) {
+            const SampledVolume volume = field_at(step);
+            const std::vector<VolumeBlock> blocks = my_blocks(volume, parts);
+            EXPECT_EQ(instrument->execute(step, 0.5 * step, views_of(blocks)), Status::ok);
+        }
+        EXPECT_EQ(instrument->finalize(), Status::ok);
+        if (world_size() > 1) {
+            EXPECT_GT(instrument->statistics().composite_seconds, 0.0);
+        }
+    }
+    bool same = true;
+    if (world_rank() == 0) {
+        InstrumentOptions one = options;
+        one.communicator = single_process_communicator();
+        one.log = false;
+        Instrument instrument(
+            InstrumentConfig::from_json_text(configuration(reference, layers, interval_mode)), one);
+        for (int step = 0; step < 3; ++step) {
+            const SampledVolume volume = field_at(step);
+            EXPECT_EQ(instrument.execute(step, 0.5 * step, {volume.field()}), Status::ok);
+        }
+        EXPECT_EQ(instrument.finalize(), Status::ok);
+        // Tighter than gray-scott-mpi-compare's defaults: the field here is small and smooth.
+        ArchiveTolerances tolerances;
+        tolerances.attenuation = 1e-5;
+        tolerances.depth = 1e-4;
+        const ArchiveComparison comparison = compare_archives(reference, distributed, tolerances);
+        std::cout << "[ " << name << " at " << world_size() << " ranks ] " << comparison
+                  << std::endl;
+        same = comparison.passed();
+        EXPECT_TRUE(same) << comparison;
+        // 3 steps x 2 views x (single, multi, preview)
+        EXPECT_EQ(comparison.frames.size(), 18u);
+    }
+    EXPECT_TRUE(on_every_rank(same));
+}
+
+TEST(InstrumentMpi, SlabsWriteTheArchiveOneProcessWrites) {
+    expect_same_archive_as_one_process("slabs", {world_size(), 1, 1}, "[0.35, 0.6]", "uniform");
+}
+
+TEST(InstrumentMpi, GridWithAutoLayersAndHistogramIntervals) {
+    int dims[3] = {0, 0, 0};
+    MPI_Dims_create(world_size(), 3, dims);
+    expect_same_archive_as_one_process("grid", {dims[0], dims[1], dims[2]}, "\"auto\"",
+                                       "histogram");
+}
+
+// One rank fewer blocks than ranks (at 1 rank: one block): the last rank owns nothing.
+TEST(InstrumentMpi, ARankThatOwnsNothingTakesPart) {
+    const int blocks = std::max(1, world_size() - 1);
+    expect_same_archive_as_one_process("empty_rank", {1, 1, blocks}, "[0.35]", "uniform");
+}
+
+// A failure on one rank is every rank's error, naming the rank; the next step is fine again.
+TEST(InstrumentMpi, AFailureOnOneRankFailsTheStepOnEveryRank) {
+    const std::string directory = shared_directory("faults");
+    InstrumentOptions options;
+    options.log = false;
+    auto instrument = mpi::instrument_from_json_text(
+        configuration(directory + "/faults.cdb", "[0.35]", "uniform"), MPI_COMM_WORLD, options);
+    const int last = world_size() - 1;
+    const SampledVolume volume = field_at(0);
+    std::vector<VolumeBlock> blocks = my_blocks(volume, {world_size(), 1, 1});
+
+    // A time no JSON can hold, on the last rank only.
+    const double time = world_rank() == last ? std::nan("") : 0.0;
+    EXPECT_EQ(instrument->execute(0, time, views_of(blocks)), Status::error);
+    EXPECT_NE(instrument->last_error().find("rank " + std::to_string(last) + ": step 0: time"),
+              std::string::npos)
+        << instrument->last_error();
+
+    // A block on another grid: spacing differs on the last rank (at 1 rank: nothing to differ
+    // from, so an overlap of the rank with itself cannot be made either; skip to the next).
+    if (world_size() > 1) {
+        std::vector<Field> fields = views_of(blocks);
+        if (world_rank() == last) fields.front().set_spacing({0.5, 0.5, 0.5});
+        EXPECT_EQ(instrument->execute(1, 1.0, fields), Status::error);
+        EXPECT_NE(
+            instrument->last_error().find("rank " + std::to_string(last) + "'s block has spacing"),
+            std::string::npos)
+            << instrument->last_error();
+        // Blocks that overlap: the last rank's starts two samples early (one would make tiles
+        // that share a face sample, which is allowed).
+        std::vector<VolumeBlock> overlapping = blocks;
+        if (world_rank() == last) {
+            const auto interiors = split_grid(volume.dims, {world_size(), 1, 1}, false);
+            Index3 lower = interiors[last].first;
+            lower[0] -= 2;
+            overlapping = {cut_block(volume, lower, interiors[last].second, 1)};
+        }
+        EXPECT_EQ(instrument->execute(2, 2.0, views_of(overlapping)), Status::error);
+        EXPECT_NE(instrument->last_error().find("overlap"), std::string::npos)
+            << instrument->last_error();
+    }
+    // Values the renderers cannot sample, on rank 0's block: every rank fails the step.
+    {
+        std::vector<Field> fields = views_of(blocks);
+        std::vector<double> doubles;
+        if (world_rank() == 0 && !blocks.empty()) {
+            doubles.assign(blocks.front().values.begin(), blocks.front().values.end());
+            doubles[doubles.size() / 2] = 1e300;
+            Field bad("f", doubles.data(), ScalarType::float64, blocks.front().allocated);
+            bad.set_origin(blocks.front().origin)
+                .set_spacing(blocks.front().spacing)
+                .set_ghost_layers(blocks.front().ghost_low, blocks.front().ghost_high);
+            fields = {bad};
+        }
+        EXPECT_EQ(instrument->execute(3, 3.0, fields), Status::error);
+        EXPECT_NE(instrument->last_error().find("beyond the float32 range"), std::string::npos)
+            << instrument->last_error();
+    }
+    // The run goes on: a good step is written.
+    EXPECT_EQ(instrument->execute(4, 4.0, views_of(blocks)), Status::ok);
+    EXPECT_EQ(instrument->finalize(), Status::ok);
+    EXPECT_EQ(instrument->statistics().errors, world_size() > 1 ? 4 : 2);
+}
+
+// Light fields have no exact composite: refused on every rank, at construction.
+TEST(InstrumentMpi, RefusesLightFields) {
+    const std::string directory = shared_directory("light_field");
+    std::string config = configuration(directory + "/lf.cdb", "[0.35]", "uniform");
+    config.insert(config.size() - 1, R"(, "light_field": {"cameras": 12, "size": 16})");
+    try {
+        mpi::instrument_from_json_text(config, MPI_COMM_WORLD);
+        ADD_FAILURE() << "a distributed instrument took a light field";
+    } catch (const InvalidArgument& error) {
+        EXPECT_NE(std::string(error.what()).find("rank 0: \"light_field\""), std::string::npos)
+            << error.what();
+    }
+}
+
+}  // namespace
+}  // namespace insitu
+
+int main(int argc, char** argv) {
+    MPI_Init(&argc, &argv);
+    ::testing::InitGoogleTest(&argc, argv);
+    insitu::testing::report_from_rank_zero();
+    const int failed_ranks =
+        insitu::testing::ranks_that_failed(RUN_ALL_TESTS(), "instrument_mpi_test");
+    MPI_Finalize();
+    return failed_ranks == 0 ? 0 : 1;
+}
