@@ -52,9 +52,9 @@ ProxyLayout layout_of(const ProxyFrame& shell) {
     ProxyLayout layout;
     layout.layers = static_cast<int>(shell.depth_layers.size());
     layout.distortion = !shell.distortion_layers.empty();
-    layout.attenuation = !shell.attenuation.pixels.empty();
-    layout.mean_depth = !shell.mean_depth.pixels.empty();
-    layout.optical_depth = !shell.optical_depth.pixels.empty();
+    layout.attenuation = shell.attenuation.channels > 0;
+    layout.mean_depth = shell.mean_depth.channels > 0;
+    layout.optical_depth = shell.optical_depth.channels > 0;
     layout.intervals = shell.intervals ? shell.intervals->count() : 0;
     if (layout.mean_depth && !layout.attenuation) {
         fail<InvalidArgument>("compositing mean depth needs the attenuation it is weighted by");
@@ -64,16 +64,48 @@ ProxyLayout layout_of(const ProxyFrame& shell) {
     return layout;
 }
 
+// An image of that size whose pixels are not allocated yet: the shells of non-root ranks stay
+// small, and the root allocates what it fills (allocate_images).
+Image sized(int width, int height, int channels) {
+    Image image;
+    image.width = width;
+    image.height = height;
+    image.channels = channels;
+    return image;
+}
+
+void allocate_images(ProxyFrame& frame) {
+    for (std::vector<Image>* list : {&frame.depth_layers, &frame.distortion_layers}) {
+        for (Image& image : *list) image.pixels.assign(image.pixel_count() * image.channels, 0.0f);
+    }
+    for (Image* image : {&frame.attenuation, &frame.mean_depth, &frame.optical_depth}) {
+        image->pixels.assign(image->pixel_count() * image->channels, 0.0f);
+    }
+}
+
 void append(Bytes& bytes, const void* data, std::size_t size) {
     const auto* begin = static_cast<const std::uint8_t*>(data);
     bytes.insert(bytes.end(), begin, begin + size);
 }
 
+// How many of the pixels [begin, end) have a fragment (first index >= 0) in a fragment image
+// of `channels` floats per pixel: messages are sized once, not grown.
+std::size_t fragments_in(const Image& fragment, int channels, std::int64_t begin,
+                         std::int64_t end) {
+    std::size_t count = 0;
+    for (std::int64_t pixel = begin; pixel < end; ++pixel) {
+        if (fragment.pixels[pixel * channels] >= 0.0f) ++count;
+    }
+    return count;
+}
+
 // This rank's records of the pixels in [begin, end) it has a fragment for: (pixel, record)*.
 Bytes pack_proxy_records(const ProxyLayout& layout, const ProxyFrame& partial, std::int64_t begin,
                          std::int64_t end) {
-    Bytes bytes;
     std::vector<float> record(static_cast<std::size_t>(layout.record()));
+    Bytes bytes;
+    bytes.reserve(fragments_in(partial.fragment, kFragmentChannels, begin, end) *
+                  (sizeof(std::uint32_t) + record.size() * sizeof(float)));
     const int I = layout.intervals;
     for (std::int64_t pixel = begin; pixel < end; ++pixel) {
         const float* fragment = &partial.fragment.pixels[pixel * kFragmentChannels];
@@ -96,50 +128,71 @@ Bytes pack_proxy_records(const ProxyLayout& layout, const ProxyFrame& partial, s
     return bytes;
 }
 
-// One received record: its pixel, and its floats in RecordIndex::values.
+// One received record: its pixel, the index of its first sample, and where its floats are in
+// the message (read with memcpy: floats are not read through a byte pointer).
 struct RecordRef {
     std::uint32_t pixel;
     float first_index;
-    const float* values;
+    const std::uint8_t* values;
 };
 
-// The records of every message, copied out of the bytes (floats are not read through a byte
-// pointer) and sorted so that each pixel's fragments are consecutive, in ray order.
+void load_record(const RecordRef& ref, int record_floats, float* into) {
+    std::memcpy(into, ref.values, static_cast<std::size_t>(record_floats) * sizeof(float));
+}
+
+// The records of every message for the pixels [begin, end), grouped by pixel (a counting sort:
+// one pass, no allocation per record) and, within a pixel, in ray order: by the index of their
+// first sample. Pixel p's records are refs[starts[p - begin], starts[p - begin + 1]).
 struct RecordIndex {
-    std::vector<float> values;
     std::vector<RecordRef> refs;
+    std::vector<std::uint32_t> starts;
 };
 
-RecordIndex index_records(const std::vector<Bytes>& messages, int record_floats) {
-    RecordIndex index;
+RecordIndex index_records(const std::vector<Bytes>& messages, int record_floats, std::int64_t begin,
+                          std::int64_t end) {
     const std::size_t stride = sizeof(std::uint32_t) + record_floats * sizeof(float);
+    RecordIndex index;
+    index.starts.assign(static_cast<std::size_t>(end - begin) + 1, 0);
     std::size_t count = 0;
     for (const Bytes& message : messages) {
         if (message.size() % stride != 0) {
             fail<Error>("compositing: a message of ", message.size(),
                         " bytes is not a whole number of ", stride, "-byte records");
         }
-        count += message.size() / stride;
-    }
-    index.values.resize(count * static_cast<std::size_t>(record_floats));
-    std::vector<std::uint32_t> pixels(count);
-    std::size_t record = 0;
-    for (const Bytes& message : messages) {
-        for (std::size_t at = 0; at < message.size(); at += stride, ++record) {
-            std::memcpy(&pixels[record], &message[at], sizeof(std::uint32_t));
-            std::memcpy(&index.values[record * record_floats], &message[at + sizeof(std::uint32_t)],
-                        record_floats * sizeof(float));
+        for (std::size_t at = 0; at < message.size(); at += stride) {
+            std::uint32_t pixel = 0;
+            std::memcpy(&pixel, &message[at], sizeof pixel);
+            if (pixel < begin || pixel >= end) {
+                fail<Error>("compositing: a record for pixel ", pixel, " outside the tile [", begin,
+                            ", ", end, ")");
+            }
+            ++index.starts[pixel - begin + 1];
+            ++count;
         }
     }
+    for (std::size_t p = 1; p < index.starts.size(); ++p) index.starts[p] += index.starts[p - 1];
     index.refs.resize(count);
-    for (std::size_t r = 0; r < count; ++r) {
-        const float* values = &index.values[r * record_floats];
-        index.refs[r] = RecordRef{pixels[r], values[0], values};
+    std::vector<std::uint32_t> next(index.starts.begin(), index.starts.end() - 1);
+    for (const Bytes& message : messages) {
+        for (std::size_t at = 0; at < message.size(); at += stride) {
+            RecordRef ref;
+            std::memcpy(&ref.pixel, &message[at], sizeof ref.pixel);
+            ref.values = &message[at + sizeof ref.pixel];
+            std::memcpy(&ref.first_index, ref.values, sizeof(float));
+            index.refs[next[ref.pixel - begin]++] = ref;
+        }
     }
-    // A pixel's fragments in ray order: by the index of their first sample.
-    std::sort(index.refs.begin(), index.refs.end(), [](const RecordRef& a, const RecordRef& b) {
-        return a.pixel != b.pixel ? a.pixel < b.pixel : a.first_index < b.first_index;
-    });
+    // A pixel has at most one record per rank: insertion sort of short runs.
+    for (std::size_t p = 0; p + 1 < index.starts.size(); ++p) {
+        RecordRef* first = index.refs.data() + index.starts[p];
+        RecordRef* last = index.refs.data() + index.starts[p + 1];
+        for (RecordRef* i = first + 1; i < last; ++i) {
+            const RecordRef moving = *i;
+            RecordRef* j = i;
+            for (; j > first && (j - 1)->first_index > moving.first_index; --j) *j = *(j - 1);
+            *j = moving;
+        }
+    }
     return index;
 }
 
@@ -159,9 +212,15 @@ void identity_outputs(const ProxyLayout& layout, float* out) {
     }
 }
 
+// Scratch memory of a fold, allocated once per tile.
+struct FoldScratch {
+    std::vector<float> record;
+    std::vector<double> weighted;
+};
+
 // Folds the fragments [first, last) of one pixel, front to back, into `out` (outputs()).
 void fold_proxy_pixel(const ProxyLayout& layout, const RecordRef* first, const RecordRef* last,
-                      float* out) {
+                      FoldScratch& scratch, float* out) {
     const int L = layout.layers;
     const int I = layout.intervals;
     const int depth_at = 0;
@@ -169,10 +228,14 @@ void fold_proxy_pixel(const ProxyLayout& layout, const RecordRef* first, const R
     const int attenuation_at = L * (layout.distortion ? 2 : 1);
     const int mean_at = attenuation_at + (layout.attenuation ? I : 0);
     const int optical_at = mean_at + (layout.mean_depth ? I : 0);
-    const float* f = first->values;
+    scratch.record.resize(static_cast<std::size_t>(layout.record()));
+    float* const record = scratch.record.data();
+    load_record(*first, layout.record(), record);
+    const float* f = record;
     std::copy(f + kFragmentChannels, f + kFragmentChannels + layout.outputs(), out);
     // The mean depth is carried as attenuation-weighted depth until the end.
-    std::vector<double> weighted(static_cast<std::size_t>(layout.mean_depth ? I : 0), 0.0);
+    std::vector<double>& weighted = scratch.weighted;
+    weighted.assign(static_cast<std::size_t>(layout.mean_depth ? I : 0), 0.0);
     for (int j = 0; j < static_cast<int>(weighted.size()); ++j) {
         const float a = out[attenuation_at + j];
         weighted[j] = a > 0.0f ? static_cast<double>(a) * out[mean_at + j] : 0.0;
@@ -183,7 +246,8 @@ void fold_proxy_pixel(const ProxyLayout& layout, const RecordRef* first, const R
     float last_depth = f[kLastDepth];
     float last_t = f[kLastT];
     for (const RecordRef* ref = first + 1; ref != last; ++ref) {
-        const float* b = ref->values;
+        load_record(*ref, layout.record(), record);
+        const float* b = record;
         const float* b_out = b + kFragmentChannels;
         const bool adjacent = b[kFirstIndex] == last_index + 1.0f;
         for (int l = 0; l < L; ++l) {
@@ -242,18 +306,14 @@ std::vector<float> fold_proxy_tile(const ProxyLayout& layout, const std::vector<
     for (std::int64_t pixel = begin; pixel < end; ++pixel) {
         identity_outputs(layout, &tile[(pixel - begin) * outputs]);
     }
-    const RecordIndex index = index_records(messages, layout.record());
-    const std::vector<RecordRef>& refs = index.refs;
-    for (std::size_t at = 0; at < refs.size();) {
-        std::size_t run = at + 1;
-        while (run < refs.size() && refs[run].pixel == refs[at].pixel) ++run;
-        const std::int64_t pixel = refs[at].pixel;
-        if (pixel < begin || pixel >= end) {
-            fail<Error>("compositing: a record for pixel ", pixel, " outside the tile [", begin,
-                        ", ", end, ")");
-        }
-        fold_proxy_pixel(layout, &refs[at], refs.data() + run, &tile[(pixel - begin) * outputs]);
-        at = run;
+    const RecordIndex index = index_records(messages, layout.record(), begin, end);
+    FoldScratch scratch;
+    for (std::int64_t pixel = begin; pixel < end; ++pixel) {
+        const std::uint32_t first = index.starts[pixel - begin];
+        const std::uint32_t last = index.starts[pixel - begin + 1];
+        if (first == last) continue;
+        fold_proxy_pixel(layout, index.refs.data() + first, index.refs.data() + last, scratch,
+                         &tile[(pixel - begin) * outputs]);
     }
     return tile;
 }
@@ -284,11 +344,18 @@ void check_partial(const ProxyLayout& layout, const ProxyFrame& shell, const Pro
         fail<InvalidArgument>("compositing: the partial frame has no fragment records for its ",
                               pixels, " pixels (was the volume given a region?)");
     }
-    if (static_cast<int>(partial.depth_layers.size()) != layout.layers ||
-        partial.distortion_layers.size() != shell.distortion_layers.size() ||
-        partial.attenuation.pixels.size() != shell.attenuation.pixels.size() ||
-        partial.mean_depth.pixels.size() != shell.mean_depth.pixels.size() ||
-        partial.optical_depth.pixels.size() != shell.optical_depth.pixels.size()) {
+    const auto same = [](const Image& a, const Image& b) {
+        return a.width == b.width && a.height == b.height && a.channels == b.channels;
+    };
+    bool matches = static_cast<int>(partial.depth_layers.size()) == layout.layers &&
+                   partial.distortion_layers.size() == shell.distortion_layers.size() &&
+                   same(partial.attenuation, shell.attenuation) &&
+                   same(partial.mean_depth, shell.mean_depth) &&
+                   same(partial.optical_depth, shell.optical_depth);
+    for (std::size_t l = 0; matches && l < shell.depth_layers.size(); ++l) {
+        matches = same(partial.depth_layers[l], shell.depth_layers[l]);
+    }
+    if (!matches) {
         fail<InvalidArgument>("compositing: the partial frame ", partial,
                               " does not hold the images of ", shell);
     }
@@ -304,6 +371,8 @@ constexpr int kRenderingOutputs = 5;
 
 Bytes pack_rendering_records(const Rendering& partial, std::int64_t begin, std::int64_t end) {
     Bytes bytes;
+    bytes.reserve(fragments_in(partial.fragment, 1, begin, end) *
+                  (sizeof(std::uint32_t) + kRenderingRecord * sizeof(float)));
     for (std::int64_t pixel = begin; pixel < end; ++pixel) {
         const float first = partial.fragment.pixels[pixel];
         if (first < 0.0f) continue;
@@ -323,20 +392,17 @@ std::vector<float> fold_rendering_tile(const std::vector<Bytes>& messages, std::
     for (std::int64_t pixel = begin; pixel < end; ++pixel) {
         tile[(pixel - begin) * kRenderingOutputs + 4] = kInf;
     }
-    const RecordIndex index = index_records(messages, kRenderingRecord);
-    const std::vector<RecordRef>& refs = index.refs;
-    for (std::size_t at = 0; at < refs.size();) {
-        std::size_t run = at + 1;
-        while (run < refs.size() && refs[run].pixel == refs[at].pixel) ++run;
-        const std::int64_t pixel = refs[at].pixel;
-        if (pixel < begin || pixel >= end) {
-            fail<Error>("compositing: a record for pixel ", pixel, " outside the tile");
-        }
+    const RecordIndex index = index_records(messages, kRenderingRecord, begin, end);
+    float v[kRenderingRecord];
+    for (std::int64_t pixel = begin; pixel < end; ++pixel) {
+        const std::uint32_t first = index.starts[pixel - begin];
+        const std::uint32_t last = index.starts[pixel - begin + 1];
+        if (first == last) continue;
         double colour[3] = {0.0, 0.0, 0.0};
         double transmittance = 1.0;
         float depth = kInf;
-        for (std::size_t r = at; r < run; ++r) {
-            const float* v = refs[r].values;
+        for (std::uint32_t r = first; r < last; ++r) {
+            load_record(index.refs[r], kRenderingRecord, v);
             for (int c = 0; c < 3; ++c) colour[c] += transmittance * v[1 + c];
             transmittance *= 1.0 - static_cast<double>(v[4]);
             if (std::isinf(depth)) depth = v[5];
@@ -345,59 +411,67 @@ std::vector<float> fold_rendering_tile(const std::vector<Bytes>& messages, std::
         for (int c = 0; c < 3; ++c) out[c] = static_cast<float>(colour[c]);
         out[3] = static_cast<float>(1.0 - transmittance);
         out[4] = depth;
-        at = run;
     }
     return tile;
 }
 
-Rendering unpack_rendering(const std::vector<float>& image, int width, int height) {
-    Rendering result;
-    result.rgba = Image(width, height, 4);
-    result.depth = Image(width, height, 1);
-    const std::int64_t pixels = static_cast<std::int64_t>(width) * height;
-    for (std::int64_t pixel = 0; pixel < pixels; ++pixel) {
-        const float* in = &image[pixel * kRenderingOutputs];
+// Writes folded pixels [begin, end) into a rendering's rgba and depth.
+void unpack_rendering(const float* values, std::int64_t begin, std::int64_t end,
+                      Rendering& result) {
+    for (std::int64_t pixel = begin; pixel < end; ++pixel) {
+        const float* in = values + (pixel - begin) * kRenderingOutputs;
         std::copy(in, in + 4, &result.rgba.pixels[pixel * 4]);
         result.depth.pixels[pixel] = in[4];
     }
-    return result;
 }
 
-// Direct send: tile k of every rank's records to rank k, fold, gather the tiles at the root.
-template <typename Pack, typename Fold>
-std::vector<float> direct_send(Communicator& communicator, std::int64_t pixels, int outputs,
-                               int root, Pack pack, Fold fold) {
+// Direct send: tile k of every rank's records to rank k, fold, gather the tiles at the root,
+// which hands each folded tile to unpack(begin, end, values). A rank's share of its own tile
+// and the root's own folded tile never go through the communicator (no copy of them).
+template <typename Pack, typename Fold, typename Unpack>
+void direct_send(Communicator& communicator, std::int64_t pixels, int outputs, int root, Pack pack,
+                 Fold fold, Unpack unpack) {
     const int ranks = communicator.size();
     if (pixels >= std::int64_t{1} << 32) {
         fail<InvalidArgument>("compositing: ", pixels, " pixels exceed 2^32");
     }
+    const int me = communicator.rank();
     std::vector<Bytes> to_each(static_cast<std::size_t>(ranks));
     for (int k = 0; k < ranks; ++k) {
-        to_each[k] = pack(tile_begin(pixels, ranks, k), tile_begin(pixels, ranks, k + 1));
+        if (k != me)
+            to_each[k] = pack(tile_begin(pixels, ranks, k), tile_begin(pixels, ranks, k + 1));
     }
-    const std::vector<Bytes> received = communicator.all_to_all(to_each);
-    const int me = communicator.rank();
     const std::int64_t begin = tile_begin(pixels, ranks, me);
     const std::int64_t end = tile_begin(pixels, ranks, me + 1);
+    Bytes own = pack(begin, end);
+    std::vector<Bytes> received = communicator.all_to_all(to_each);
+    received[me] = std::move(own);
     const std::vector<float> tile = fold(received, begin, end);
-    Bytes mine(tile.size() * sizeof(float));
-    if (!tile.empty()) std::memcpy(mine.data(), tile.data(), mine.size());
+    received.clear();
+    Bytes mine;
+    if (me != root) {
+        const auto* tile_bytes = reinterpret_cast<const std::uint8_t*>(tile.data());
+        mine.assign(tile_bytes, tile_bytes + tile.size() * sizeof(float));
+    }
     const std::vector<Bytes> tiles = communicator.gather(mine, root);
-    std::vector<float> image;
-    if (me != root) return image;
-    image.resize(static_cast<std::size_t>(pixels * outputs));
-    std::size_t at = 0;
+    if (me != root) return;
+    std::vector<float> values;
     for (int k = 0; k < ranks; ++k) {
-        const std::size_t expected = static_cast<std::size_t>(
-            (tile_begin(pixels, ranks, k + 1) - tile_begin(pixels, ranks, k)) * outputs);
+        const std::int64_t first = tile_begin(pixels, ranks, k);
+        const std::int64_t last = tile_begin(pixels, ranks, k + 1);
+        if (k == root) {
+            unpack(first, last, tile.data());
+            continue;
+        }
+        const std::size_t expected = static_cast<std::size_t>((last - first) * outputs);
         if (tiles[k].size() != expected * sizeof(float)) {
             fail<Error>("compositing: rank ", k, " sent a tile of ", tiles[k].size(),
                         " bytes, expected ", expected * sizeof(float));
         }
-        if (expected > 0) std::memcpy(&image[at], tiles[k].data(), tiles[k].size());
-        at += expected;
+        values.resize(expected);
+        if (expected > 0) std::memcpy(values.data(), tiles[k].data(), tiles[k].size());
+        unpack(first, last, values.data());
     }
-    return image;
 }
 
 }  // namespace
@@ -415,17 +489,17 @@ ProxyFrame frame_shell(const Camera& camera, double tilt_deg, bool multi_perspec
     if (want_layers) {
         frame.isovalues = request.isovalues;
         for (std::size_t l = 0; l < request.isovalues.size(); ++l) {
-            frame.depth_layers.emplace_back(width, height, 1, kInf);
-            if (multi_perspective) frame.distortion_layers.emplace_back(width, height, 1, kInf);
+            frame.depth_layers.push_back(sized(width, height, 1));
+            if (multi_perspective) frame.distortion_layers.push_back(sized(width, height, 1));
         }
     }
     if (accumulates) {
         if (!request.intervals) fail<InvalidArgument>("attenuation requested without intervals");
         frame.intervals = request.intervals;
         const int I = request.intervals->count();
-        if (request.attenuation) frame.attenuation = Image(width, height, I, 0.0f);
-        if (request.mean_depth) frame.mean_depth = Image(width, height, I, kInf);
-        if (request.optical_depth) frame.optical_depth = Image(width, height, I, 0.0f);
+        if (request.attenuation) frame.attenuation = sized(width, height, I);
+        if (request.mean_depth) frame.mean_depth = sized(width, height, I);
+        if (request.optical_depth) frame.optical_depth = sized(width, height, I);
     }
     return frame;
 }
@@ -436,16 +510,19 @@ ProxyFrame composite_proxies(Communicator& communicator, const ProxyFrame& shell
     if (partial != nullptr) check_partial(layout, shell, *partial);
     const std::int64_t pixels =
         static_cast<std::int64_t>(shell.camera.width()) * shell.camera.height();
-    const std::vector<float> image = direct_send(
+    ProxyFrame frame = shell;
+    if (communicator.rank() == root) allocate_images(frame);
+    direct_send(
         communicator, pixels, layout.outputs(), root,
         [&](std::int64_t begin, std::int64_t end) {
             return partial != nullptr ? pack_proxy_records(layout, *partial, begin, end) : Bytes{};
         },
         [&](const std::vector<Bytes>& messages, std::int64_t begin, std::int64_t end) {
             return fold_proxy_tile(layout, messages, begin, end);
+        },
+        [&](std::int64_t begin, std::int64_t end, const float* values) {
+            unpack_proxy_outputs(layout, values, begin, end - begin, frame);
         });
-    ProxyFrame frame = shell;
-    if (communicator.rank() == root) unpack_proxy_outputs(layout, image.data(), 0, pixels, frame);
     return frame;
 }
 
@@ -456,16 +533,23 @@ Rendering composite_rendering(Communicator& communicator, int width, int height,
         fail<InvalidArgument>("compositing: the partial rendering has no fragment records for its ",
                               pixels, " pixels (was the volume given a region?)");
     }
-    const std::vector<float> image = direct_send(
+    Rendering result;
+    if (communicator.rank() == root) {
+        result.rgba = Image(width, height, 4);
+        result.depth = Image(width, height, 1);
+    }
+    direct_send(
         communicator, pixels, kRenderingOutputs, root,
         [&](std::int64_t begin, std::int64_t end) {
             return partial != nullptr ? pack_rendering_records(*partial, begin, end) : Bytes{};
         },
         [&](const std::vector<Bytes>& messages, std::int64_t begin, std::int64_t end) {
             return fold_rendering_tile(messages, begin, end);
+        },
+        [&](std::int64_t begin, std::int64_t end, const float* values) {
+            unpack_rendering(values, begin, end, result);
         });
-    if (communicator.rank() != root) return Rendering{};
-    return unpack_rendering(image, width, height);
+    return result;
 }
 
 ProxyFrame composite_proxies(const ProxyFrame& shell, const std::vector<ProxyFrame>& partials) {
@@ -479,6 +563,7 @@ ProxyFrame composite_proxies(const ProxyFrame& shell, const std::vector<ProxyFra
     }
     const std::vector<float> image = fold_proxy_tile(layout, messages, 0, pixels);
     ProxyFrame frame = shell;
+    allocate_images(frame);
     unpack_proxy_outputs(layout, image.data(), 0, pixels, frame);
     return frame;
 }
@@ -492,7 +577,11 @@ Rendering composite_rendering(int width, int height, const std::vector<Rendering
         }
         messages.push_back(pack_rendering_records(partial, 0, pixels));
     }
-    return unpack_rendering(fold_rendering_tile(messages, 0, pixels), width, height);
+    Rendering result;
+    result.rgba = Image(width, height, 4);
+    result.depth = Image(width, height, 1);
+    unpack_rendering(fold_rendering_tile(messages, 0, pixels).data(), 0, pixels, result);
+    return result;
 }
 
 }  // namespace insitu

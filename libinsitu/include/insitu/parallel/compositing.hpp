@@ -34,13 +34,13 @@
 
 namespace insitu {
 
-/// The frame a pass of `request` from `camera` returns, without images: the metadata every rank
-/// knows without rendering (a rank with no block composites with it too).
+/// The frame a pass of `request` from `camera` returns, its images sized but not allocated: the
+/// metadata every rank knows without rendering (a rank with no block composites with it too).
 ProxyFrame frame_shell(const Camera& camera, double tilt_deg, bool multi_perspective,
                        const ProxyRequest& request);
 
 /// Composites the ranks' partial frames of one pass into `shell`'s images at `root` (the shell
-/// with images there, the shell alone elsewhere). `partial` is this rank's pass (fragment set)
+/// with its images filled there, the shell as it is elsewhere). `partial` is this rank's pass (fragment set)
 /// or null for a rank without a block. Collective.
 ProxyFrame composite_proxies(Communicator& communicator, const ProxyFrame& shell,
                              const ProxyFrame* partial, int root);
