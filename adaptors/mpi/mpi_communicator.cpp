@@ -1,10 +1,13 @@
 // insitu::Communicator on an MPI communicator (insitu/mpi.hpp).
 //
-// Every exchange of byte arrays is two collectives: the sizes first (as 64-bit counts, so that
-// every rank that needs them knows them before anything is allocated), then the bytes with the
-// v-variant of the collective. MPI counts and displacements are int; the checks that a call
-// fits are made where every rank sees the same numbers, or agreed over the ranks, so that an
-// oversized call throws on every rank instead of throwing on one while the others wait.
+// Every exchange of byte arrays takes two steps: the sizes first (as 64-bit counts, so that every
+// rank that needs them knows them before anything is allocated), then the bytes: with the
+// v-variant of the collective (all_gather), or, where each message has its own destination
+// (all_to_all, gather: the compositing's partial and folded tiles, megabytes each), point to
+// point straight from and into each message's own buffer, skipping empty ones, so that nothing
+// is packed into or copied out of one contiguous buffer. MPI counts are int; the checks that a
+// call fits are made where every rank sees the same numbers, or agreed over the ranks, so that
+// an oversized call throws on every rank instead of throwing on one while the others wait.
 #include <algorithm>
 #include <chrono>
 #include <cstddef>
@@ -54,6 +57,35 @@ void* receive_data(Bytes& bytes) {
     return bytes.empty() ? no_bytes : bytes.data();
 }
 
+// Tags of the point-to-point messages on the duplicate, which carries nothing else: each call
+// completes all its messages before it returns, so the calls' messages never mix.
+constexpr int kAllToAllTag = 1;
+constexpr int kGatherTag = 2;
+
+// Posts the receives and sends of one exchange and waits for all: `receive[r]` (sized) from
+// rank r, `send[r]` to rank r, empty ones and those to this rank skipped.
+void exchange(MPI_Comm comm, int me, std::vector<Bytes>& receive,
+              const std::vector<const Bytes*>& send, int tag, const char* operation) {
+    std::vector<MPI_Request> requests;
+    requests.reserve(receive.size() + send.size());
+    for (std::size_t r = 0; r < receive.size(); ++r) {
+        if (static_cast<int>(r) == me || receive[r].empty()) continue;
+        requests.emplace_back();
+        check(MPI_Irecv(receive[r].data(), static_cast<int>(receive[r].size()), MPI_BYTE,
+                        static_cast<int>(r), tag, comm, &requests.back()),
+              operation, "MPI_Irecv");
+    }
+    for (std::size_t r = 0; r < send.size(); ++r) {
+        if (static_cast<int>(r) == me || send[r] == nullptr || send[r]->empty()) continue;
+        requests.emplace_back();
+        check(MPI_Isend(send[r]->data(), static_cast<int>(send[r]->size()), MPI_BYTE,
+                        static_cast<int>(r), tag, comm, &requests.back()),
+              operation, "MPI_Isend");
+    }
+    check(MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE),
+          operation, "MPI_Waitall");
+}
+
 std::uint64_t total_of(const std::vector<std::uint64_t>& sizes) {
     std::uint64_t total = 0;
     for (const std::uint64_t size : sizes) total += size;
@@ -88,14 +120,6 @@ void require_int_count(std::uint64_t bytes, const char* operation, const char* w
                               " bytes, more than the ", max_count_bytes,
                               " that MPI's int counts address in one call");
     }
-}
-
-Bytes packed(const std::vector<Bytes>& messages, const Layout& layout) {
-    Bytes buffer(layout.total_bytes);
-    for (std::size_t i = 0; i < messages.size(); ++i) {
-        std::copy(messages[i].begin(), messages[i].end(), buffer.begin() + layout.displacements[i]);
-    }
-    return buffer;
 }
 
 std::vector<Bytes> unpacked(const Bytes& buffer, const Layout& layout) {
@@ -234,11 +258,12 @@ public:
         check(MPI_Alltoall(send_sizes.data(), 1, MPI_UINT64_T, receive_sizes.data(), 1,
                            MPI_UINT64_T, comm_),
               "all_to_all", "MPI_Alltoall");
-        const std::uint64_t send_total = total_of(send_sizes);
-        const std::uint64_t receive_total = total_of(receive_sizes);
-        const std::uint64_t largest = std::max(send_total, receive_total);
+        // Each message is one point-to-point call: its own size must fit an int count.
+        const std::uint64_t largest =
+            std::max(*std::max_element(send_sizes.begin(), send_sizes.end()),
+                     *std::max_element(receive_sizes.begin(), receive_sizes.end()));
         // Agreed over the ranks (largest wins): the highest rank with a wrong list, plus one,
-        // and the largest total that does not fit MPI's counts.
+        // and the largest message that does not fit MPI's counts.
         long long problems[2] = {wrong_list ? rank_ + 1LL : 0LL,
                                  largest > max_count_bytes ? static_cast<long long>(largest) : 0};
         check(MPI_Allreduce(MPI_IN_PLACE, problems, 2, MPI_LONG_LONG, MPI_MAX, comm_), "all_to_all",
@@ -254,24 +279,23 @@ public:
         }
         if (problems[1] != 0) {
             require_int_count(static_cast<std::uint64_t>(problems[1]), "all_to_all",
-                              "a rank sends or receives");
+                              "a message of");
         }
-        const Layout send_layout = layout_of(send_sizes);
-        const Layout receive_layout = layout_of(receive_sizes);
-        const Bytes send_buffer = packed(to_each, send_layout);
-        Bytes received(receive_layout.total_bytes);
-        check(MPI_Alltoallv(send_data(send_buffer), send_layout.counts.data(),
-                            send_layout.displacements.data(), MPI_BYTE, receive_data(received),
-                            receive_layout.counts.data(), receive_layout.displacements.data(),
-                            MPI_BYTE, comm_),
-              "all_to_all", "MPI_Alltoallv");
+        std::vector<Bytes> received(ranks);
+        std::vector<const Bytes*> sends(ranks, nullptr);
+        for (std::size_t r = 0; r < ranks; ++r) {
+            received[r].resize(static_cast<std::size_t>(receive_sizes[r]));
+            sends[r] = &to_each[r];
+        }
+        exchange(comm_, rank_, received, sends, kAllToAllTag, "all_to_all");
+        received[static_cast<std::size_t>(rank_)] = to_each[static_cast<std::size_t>(rank_)];
         for (std::size_t r = 0; r < ranks; ++r) {
             if (static_cast<int>(r) == rank_) continue;  // to itself: no message
             counters_.bytes_sent += send_sizes[r];
             counters_.bytes_received += receive_sizes[r];
             counters_.messages_sent += send_sizes[r] > 0 ? 1 : 0;
         }
-        return unpacked(received, receive_layout);
+        return received;
     }
 
     std::vector<Bytes> gather(const Bytes& mine, int root) override {
@@ -283,21 +307,26 @@ public:
         std::vector<std::uint64_t> sizes(static_cast<std::size_t>(size_));
         check(MPI_Allgather(&my_bytes, 1, MPI_UINT64_T, sizes.data(), 1, MPI_UINT64_T, comm_),
               "gather", "MPI_Allgather");
-        require_int_count(total_of(sizes), "gather", "the ranks' messages total");
-        const Layout layout = layout_of(sizes);
+        require_int_count(*std::max_element(sizes.begin(), sizes.end()), "gather", "a message of");
         const bool is_root = rank_ == root;
-        Bytes received(is_root ? layout.total_bytes : 0);
-        check(MPI_Gatherv(send_data(mine), static_cast<int>(my_bytes), MPI_BYTE,
-                          receive_data(received), layout.counts.data(), layout.displacements.data(),
-                          MPI_BYTE, root, comm_),
-              "gather", "MPI_Gatherv");
+        std::vector<Bytes> received(is_root ? sizes.size() : 0);
+        std::vector<const Bytes*> sends(sizes.size(), nullptr);
+        if (is_root) {
+            for (std::size_t r = 0; r < sizes.size(); ++r) {
+                received[r].resize(static_cast<std::size_t>(sizes[r]));
+            }
+        } else {
+            sends[static_cast<std::size_t>(root)] = &mine;
+        }
+        exchange(comm_, rank_, received, sends, kGatherTag, "gather");
         if (!is_root) {
             counters_.bytes_sent += my_bytes;
             counters_.messages_sent += my_bytes > 0 ? 1 : 0;
             return {};
         }
-        counters_.bytes_received += layout.total_bytes - my_bytes;
-        return unpacked(received, layout);
+        received[static_cast<std::size_t>(root)] = mine;
+        counters_.bytes_received += total_of(sizes) - my_bytes;
+        return received;
     }
 
     void broadcast(Bytes& bytes, int root) override {

@@ -40,8 +40,8 @@ ProxyFrame frame_shell(const Camera& camera, double tilt_deg, bool multi_perspec
                        const ProxyRequest& request);
 
 /// Composites the ranks' partial frames of one pass into `shell`'s images at `root` (the shell
-/// with its images filled there, the shell as it is elsewhere). `partial` is this rank's pass (fragment set)
-/// or null for a rank without a block. Collective.
+/// with its images filled there, the shell as it is elsewhere). `partial` is this rank's pass
+/// (fragment set) or null for a rank without a block. Collective.
 ProxyFrame composite_proxies(Communicator& communicator, const ProxyFrame& shell,
                              const ProxyFrame* partial, int root);
 /// The same for ground-truth renderings of `width` x `height` pixels (rgba, depth).
