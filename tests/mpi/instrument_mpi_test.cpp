@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -232,6 +233,50 @@ TEST(InstrumentMpi, AFailureOnOneRankFailsTheStepOnEveryRank) {
     EXPECT_EQ(instrument->execute(4, 4.0, views_of(blocks)), Status::ok);
     EXPECT_EQ(instrument->finalize(), Status::ok);
     EXPECT_EQ(instrument->statistics().errors, world_size() > 1 ? 4 : 2);
+}
+
+// Rank 0's writer fails (its proxies folder replaced by a file, as a full or failing disk would
+// fail it): the next step is every rank's error, saying so, finalize() too, and nothing hangs.
+TEST(InstrumentMpi, ARankZeroWriteFailureIsEveryRanksError) {
+    const std::string directory = shared_directory("write_failure");
+    const std::string archive = directory + "/failing.cdb";
+    InstrumentOptions options;
+    options.log = false;
+    auto instrument = mpi::instrument_from_json_text(configuration(archive, "[0.35]", "uniform"),
+                                                     MPI_COMM_WORLD, options);
+    const SampledVolume volume = field_at(0);
+    const std::vector<VolumeBlock> blocks = my_blocks(volume, {world_size(), 1, 1});
+    EXPECT_EQ(instrument->execute(0, 0.0, views_of(blocks)), Status::ok);
+    if (world_rank() == 0) {
+        // Step 0 written, then the folder its files go to becomes a file.
+        for (int wait = 0; wait < 1000 && instrument->statistics().steps_written < 1; ++wait) {
+            ::usleep(10000);
+        }
+        std::filesystem::remove_all(archive + "/proxies");
+        std::ofstream(archive + "/proxies") << "not a folder";
+    }
+    MPI_Barrier(MPI_COMM_WORLD);
+    // Queued at rank 0, so ok everywhere; its write then fails on rank 0's writer thread.
+    EXPECT_EQ(instrument->execute(1, 1.0, views_of(blocks)), Status::ok);
+    if (world_rank() == 0) {
+        for (int wait = 0; wait < 1000 && instrument->statistics().errors < 1; ++wait) {
+            ::usleep(10000);
+        }
+        EXPECT_EQ(instrument->statistics().errors, 1);
+    }
+    MPI_Barrier(MPI_COMM_WORLD);
+    EXPECT_EQ(instrument->execute(2, 2.0, views_of(blocks)), Status::error);
+    EXPECT_NE(instrument->last_error().find("rank 0: an earlier step could not be written"),
+              std::string::npos)
+        << instrument->last_error();
+    EXPECT_EQ(instrument->finalize(), Status::error);
+    EXPECT_NE(instrument->last_error().find("writing"), std::string::npos)
+        << instrument->last_error();
+    // What was written before the failure is still there.
+    if (world_rank() == 0) {
+        std::filesystem::remove(archive + "/proxies");
+        EXPECT_TRUE(std::filesystem::exists(archive + "/manifest.json"));
+    }
 }
 
 // Light fields have no exact composite: refused on every rank, at construction.
