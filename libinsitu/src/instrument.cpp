@@ -95,14 +95,21 @@ struct LocalFailure {
     /// Runs `work` unless an earlier step failed; records what it throws.
     template <typename Work>
     void guard(Work&& work) {
-        if (failed()) return;
+        if (!failed()) always(work);
+    }
+    /// Runs `work` even after a failure (a collective every rank must take part in); records
+    /// what it throws unless a failure was recorded before.
+    template <typename Work>
+    void always(Work&& work) {
         try {
             work();
         } catch (const std::exception& error) {
+            if (failed()) return;
             message = error.what();
             if (message.empty()) message = "unnamed error";
             kind = classify(std::current_exception());
         } catch (...) {
+            if (failed()) return;
             message = "unknown exception";
             kind = ErrorKind::unknown;
         }
@@ -388,16 +395,20 @@ Status Instrument::Impl::execute_distributed(std::int64_t step, double time,
         statistics.composite_seconds += composite_seconds;
     }
     Status status = Status::ok;
-    if (writes()) {
-        status = enqueue(std::move(record), compute_seconds);
-    } else {
-        std::lock_guard<std::mutex> lock(mutex);
-        ++statistics.steps_executed;
-        statistics.compute_seconds += compute_seconds;
-    }
+    LocalFailure failure_to_queue;
+    failure_to_queue.guard([&] {
+        if (writes()) {
+            status = enqueue(std::move(record), compute_seconds);
+        } else {
+            std::lock_guard<std::mutex> lock(mutex);
+            ++statistics.steps_executed;
+            statistics.compute_seconds += compute_seconds;
+        }
+    });
     // Every rank returns rank 0's status: a step dropped there is dropped for all.
     Bytes verdict{static_cast<std::uint8_t>(status)};
     ranks.broadcast(verdict, 0);
+    agree(ranks, failure_to_queue);
     return static_cast<Status>(verdict.at(0));
 }
 
@@ -610,15 +621,19 @@ Instrument::Impl::FieldPlan Instrument::Impl::plan_distributed_field(
         plan.intervals = IntervalSet::uniform(min, max, config.interval_count);
     } else {
         // The sum of the ranks' histograms of the samples each owns: the grid's histogram.
-        std::vector<double> histogram(static_cast<std::size_t>(64 * config.interval_count), 0.0);
-        if (block) {
+        const std::size_t bins = static_cast<std::size_t>(64 * config.interval_count);
+        std::vector<double> histogram(bins, 0.0);
+        failure.guard([&] {
+            if (!block) return;
             const DeviceVolume& volume = renderer->volume();
             histogram = IntervalSet::equalization_histogram(
                 grid.owned_values(volume.host_values, volume.dims, me), min, max,
                 config.interval_count);
-        }
+        });
+        if (histogram.size() != bins) histogram.assign(bins, 0.0);  // as every rank reduces
         start = Clock::now();
         ranks.all_reduce(histogram, Reduction::sum);
+        agree(ranks, failure);
         composite_seconds += seconds_since(start);
         plan.intervals =
             IntervalSet::from_equalization_histogram(histogram, min, max, config.interval_count);
@@ -650,11 +665,15 @@ void Instrument::Impl::compute_field(const FieldPlan& plan, StepRecord& record,
         if (plan.has_block) {
             failure.guard([&] { partial = renderer->render_ground_truth(camera, tf, settings); });
         }
-        return timed([&] {
-                   return composite_rendering(*communicator, camera.width(), camera.height(),
-                                              partial ? &*partial : nullptr, 0);
-               })
-            .rgba;
+        // Every rank takes part in every composite, failed or not (see LocalFailure).
+        Rendering composited;
+        failure.always([&] {
+            composited = timed([&] {
+                return composite_rendering(*communicator, camera.width(), camera.height(),
+                                           partial ? &*partial : nullptr, 0);
+            });
+        });
+        return composited.rgba;
     };
     // A view's single-perspective pass (tilt 0) or its volume distortion camera's.
     const auto proxies = [&](const OrbitView& orbit, double tilt_deg, bool multi_perspective,
@@ -674,11 +693,14 @@ void Instrument::Impl::compute_field(const FieldPlan& plan, StepRecord& record,
                                             : renderer->render(camera, march);
             });
         }
-        ProxyFrame frame = timed([&] {
-            const ProxyFrame shell = multi_perspective
-                                         ? frame_shell(distortion.base(), tilt_deg, true, march)
-                                         : frame_shell(camera, 0.0, false, march);
-            return composite_proxies(*communicator, shell, partial ? &*partial : nullptr, 0);
+        ProxyFrame frame;
+        failure.always([&] {
+            frame = timed([&] {
+                const ProxyFrame shell = multi_perspective
+                                             ? frame_shell(distortion.base(), tilt_deg, true, march)
+                                             : frame_shell(camera, 0.0, false, march);
+                return composite_proxies(*communicator, shell, partial ? &*partial : nullptr, 0);
+            });
         });
         for (const TransferFunction& tf : request.training_transfer_functions) {
             frame.training.push_back(truth(camera, tf, request.march));

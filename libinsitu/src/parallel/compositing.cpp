@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <glm/trigonometric.hpp>
 #include <limits>
 
@@ -435,18 +436,36 @@ void direct_send(Communicator& communicator, std::int64_t pixels, int outputs, i
     if (pixels >= std::int64_t{1} << 32) {
         fail<InvalidArgument>("compositing: ", pixels, " pixels exceed 2^32");
     }
+    // A rank whose own work fails (packing, folding, unpacking) still takes part in both
+    // exchanges, with nothing to send, and throws once they are done: the others must not wait
+    // for it. (Its caller then agrees on the failure with them.)
+    std::exception_ptr failure;
+    const auto local = [&](auto&& work) {
+        try {
+            work();
+        } catch (...) {
+            if (!failure) failure = std::current_exception();
+        }
+    };
     const int me = communicator.rank();
     std::vector<Bytes> to_each(static_cast<std::size_t>(ranks));
-    for (int k = 0; k < ranks; ++k) {
-        if (k != me)
-            to_each[k] = pack(tile_begin(pixels, ranks, k), tile_begin(pixels, ranks, k + 1));
-    }
+    Bytes own;
     const std::int64_t begin = tile_begin(pixels, ranks, me);
     const std::int64_t end = tile_begin(pixels, ranks, me + 1);
-    Bytes own = pack(begin, end);
+    local([&] {
+        for (int k = 0; k < ranks; ++k) {
+            if (k != me) {
+                to_each[k] = pack(tile_begin(pixels, ranks, k), tile_begin(pixels, ranks, k + 1));
+            }
+        }
+        own = pack(begin, end);
+    });
+    if (failure) to_each.assign(static_cast<std::size_t>(ranks), Bytes{});
     std::vector<Bytes> received = communicator.all_to_all(to_each);
     received[me] = std::move(own);
-    const std::vector<float> tile = fold(received, begin, end);
+    std::vector<float> tile;
+    local([&] { tile = fold(received, begin, end); });
+    tile.resize(static_cast<std::size_t>((end - begin) * outputs));  // what the root expects
     received.clear();
     Bytes mine;
     if (me != root) {
@@ -454,24 +473,28 @@ void direct_send(Communicator& communicator, std::int64_t pixels, int outputs, i
         mine.assign(tile_bytes, tile_bytes + tile.size() * sizeof(float));
     }
     const std::vector<Bytes> tiles = communicator.gather(mine, root);
-    if (me != root) return;
-    std::vector<float> values;
-    for (int k = 0; k < ranks; ++k) {
-        const std::int64_t first = tile_begin(pixels, ranks, k);
-        const std::int64_t last = tile_begin(pixels, ranks, k + 1);
-        if (k == root) {
-            unpack(first, last, tile.data());
-            continue;
-        }
-        const std::size_t expected = static_cast<std::size_t>((last - first) * outputs);
-        if (tiles[k].size() != expected * sizeof(float)) {
-            fail<Error>("compositing: rank ", k, " sent a tile of ", tiles[k].size(),
-                        " bytes, expected ", expected * sizeof(float));
-        }
-        values.resize(expected);
-        if (expected > 0) std::memcpy(values.data(), tiles[k].data(), tiles[k].size());
-        unpack(first, last, values.data());
+    if (me == root) {
+        local([&] {
+            std::vector<float> values;
+            for (int k = 0; k < ranks; ++k) {
+                const std::int64_t first = tile_begin(pixels, ranks, k);
+                const std::int64_t last = tile_begin(pixels, ranks, k + 1);
+                if (k == root) {
+                    unpack(first, last, tile.data());
+                    continue;
+                }
+                const std::size_t expected = static_cast<std::size_t>((last - first) * outputs);
+                if (tiles[k].size() != expected * sizeof(float)) {
+                    fail<Error>("compositing: rank ", k, " sent a tile of ", tiles[k].size(),
+                                " bytes, expected ", expected * sizeof(float));
+                }
+                values.resize(expected);
+                if (expected > 0) std::memcpy(values.data(), tiles[k].data(), tiles[k].size());
+                unpack(first, last, values.data());
+            }
+        });
     }
+    if (failure) std::rethrow_exception(failure);
 }
 
 }  // namespace
