@@ -141,30 +141,29 @@ void Simulation::fill_ghosts(std::vector<double>& species) const {
     }
 }
 
-void Simulation::step() {
-    const int n = parameters_.size;
-    const std::ptrdiff_t stride_y = allocated_size();
-    const std::ptrdiff_t stride_z = stride_y * stride_y;
-    const double* u = u_.data();
-    const double* v = v_.data();
-    double* u_next = u_next_.data();
-    double* v_next = v_next_.data();
-
-    // Every interior cell reads only the current arrays, so z slices are independent and the
-    // result does not depend on the thread count.
+void euler_step_box(const Parameters& parameters, const double* u, const double* v, double* u_next,
+                    double* v_next, int nx, int ny, int nz, std::ptrdiff_t stride_y,
+                    std::ptrdiff_t stride_z) {
 #pragma omp parallel for schedule(static)
-    for (int k = 1; k <= n; ++k) {
-        for (int j = 1; j <= n; ++j) {
-            const auto row = static_cast<std::ptrdiff_t>(index(0, j, k));
-            for (std::ptrdiff_t at = row + 1; at <= row + n; ++at) {
+    for (int k = 1; k <= nz; ++k) {
+        for (int j = 1; j <= ny; ++j) {
+            const std::ptrdiff_t row = k * stride_z + j * stride_y;
+            for (std::ptrdiff_t at = row + 1; at <= row + nx; ++at) {
                 const double u6[6] = {u[at - 1],        u[at + 1],        u[at - stride_y],
                                       u[at + stride_y], u[at - stride_z], u[at + stride_z]};
                 const double v6[6] = {v[at - 1],        v[at + 1],        v[at - stride_y],
                                       v[at + stride_y], v[at - stride_z], v[at + stride_z]};
-                euler_update(parameters_, u[at], v[at], u6, v6, u_next[at], v_next[at]);
+                euler_update(parameters, u[at], v[at], u6, v6, u_next[at], v_next[at]);
             }
         }
     }
+}
+
+void Simulation::step() {
+    const int n = parameters_.size;
+    const std::ptrdiff_t stride_y = allocated_size();
+    euler_step_box(parameters_, u_.data(), v_.data(), u_next_.data(), v_next_.data(), n, n, n,
+                   stride_y, stride_y * stride_y);
     std::swap(u_, u_next_);
     std::swap(v_, v_next_);
     fill_ghosts(u_);

@@ -64,6 +64,13 @@ inline void euler_update(const Parameters& parameters, double u, double v, const
                        (parameters.feed + parameters.kill) * v);
 }
 
+/// euler_update of every interior node of a box of nx x ny x nz nodes stored with one ghost layer
+/// per side (x fastest, strides in nodes), into u_next, v_next; parallel over z slices (OpenMP):
+/// each node reads only the current arrays, so the result does not depend on the thread count.
+void euler_step_box(const Parameters& parameters, const double* u, const double* v, double* u_next,
+                    double* v_next, int nx, int ny, int nz, std::ptrdiff_t stride_y,
+                    std::ptrdiff_t stride_z);
+
 /// Threads Simulation::step() runs on: OpenMP's maximum, or 1 in a build without OpenMP.
 int worker_threads();
 

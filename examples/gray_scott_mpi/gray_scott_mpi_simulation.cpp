@@ -279,32 +279,12 @@ void Simulation::exchange_halos(std::vector<double>& species) {
 }
 
 void Simulation::step() {
-    const int nx = block_dims_[0];
-    const int ny = block_dims_[1];
-    const int nz = block_dims_[2];
     const Int3 all = allocated_dims();
-    const std::ptrdiff_t stride_y = all[0];
-    const std::ptrdiff_t stride_z = stride_y * all[1];
-    const double* u = u_.data();
-    const double* v = v_.data();
-    double* u_next = u_next_.data();
-    double* v_next = v_next_.data();
-
-    // examples/gray_scott's update (euler_update): the same arithmetic per node is what makes
+    // examples/gray_scott's update (euler_step_box): the same arithmetic per node is what makes
     // the result independent of the decomposition.
-#pragma omp parallel for schedule(static)
-    for (int k = 1; k <= nz; ++k) {
-        for (int j = 1; j <= ny; ++j) {
-            const auto row = static_cast<std::ptrdiff_t>(index(0, j, k));
-            for (std::ptrdiff_t at = row + 1; at <= row + nx; ++at) {
-                const double u6[6] = {u[at - 1],        u[at + 1],        u[at - stride_y],
-                                      u[at + stride_y], u[at - stride_z], u[at + stride_z]};
-                const double v6[6] = {v[at - 1],        v[at + 1],        v[at - stride_y],
-                                      v[at + stride_y], v[at - stride_z], v[at + stride_z]};
-                euler_update(parameters_, u[at], v[at], u6, v6, u_next[at], v_next[at]);
-            }
-        }
-    }
+    euler_step_box(parameters_, u_.data(), v_.data(), u_next_.data(), v_next_.data(),
+                   block_dims_[0], block_dims_[1], block_dims_[2], all[0],
+                   static_cast<std::ptrdiff_t>(all[0]) * all[1]);
     std::swap(u_, u_next_);
     std::swap(v_, v_next_);
     exchange_halos(u_);
