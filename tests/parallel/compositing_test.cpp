@@ -253,6 +253,30 @@ TEST(Compositing, CrossingsOnTheBoundaryAreFoundOnce) {
         check_blocks_composite_to_whole(volume, blocks, request,
                                         view_at(azimuth, 0, Projection::orthographic, 32));
     }
+    // Isovalues equal to the very samples on either side of the boundary along a ray (block 0's
+    // last, block 1's first, as their fragment records hold them): the whole pass's "value >=
+    // iso" rule decides, and the composite must decide the same.
+    const Decomposition grid = decompose_blocks(blocks);
+    const OrbitView oblique = view_at(60, 0, Projection::orthographic, 32);
+    const Camera camera = Camera::orbit(oblique, grid.bounds);
+    ProxyRenderer renderer;
+    std::vector<std::vector<float>> records;  // the centre pixel's fragment of each block
+    for (int r = 0; r < 2; ++r) {
+        renderer.upload(grid.marched_block(blocks[r].field(), r));
+        renderer.set_region(grid.region(r));
+        const ProxyFrame partial = renderer.render(camera, request);
+        const auto centre = partial.fragment.pixels.begin() + (16 * 32 + 16) * 9;
+        records.emplace_back(centre, centre + 9);
+        ASSERT_GE(records.back()[0], 0.0f) << "block " << r << " misses the centre";
+    }
+    // Front and back along the ray, by first sample index; adjacent by construction.
+    const int front = records[0][0] < records[1][0] ? 0 : 1;
+    const std::vector<float>& f = records[front];
+    const std::vector<float>& b = records[1 - front];
+    ASSERT_EQ(f[1] + 1.0f, b[0]);
+    const std::vector<double> boundary_values = {f[3], b[2]};
+    ASSERT_NE(boundary_values[0], boundary_values[1]);
+    check_blocks_composite_to_whole(volume, blocks, full_request(volume, boundary_values), oblique);
 }
 
 TEST(Compositing, BlocksThatSeeNothingAddNothing) {
