@@ -124,7 +124,7 @@ void run_scene(const char* name, const SampledVolume& volume, const TransferFunc
                 proxies.render(camera, request);
         });
     };
-    // The block min/max scan runs on the host once per upload (every timestep in situ).
+    // The block min/max scan runs on the device once per upload (every timestep in situ).
     {
         request.skip_empty_space = true;
         proxies.render(camera, request);  // kernel build and buffers, not timed

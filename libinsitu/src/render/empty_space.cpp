@@ -4,16 +4,62 @@
 #include <cmath>
 #include <limits>
 
+#include "device/opencl_device.hpp"
+#include "insitu/error.hpp"
+
 namespace insitu::detail {
+
+namespace {
+
+// Blocks per axis of an axis of n samples: its n - 1 cells in blocks of B, ceil((n - 1) / B).
+Index3 block_counts(const Index3& dims, int block_voxels) {
+    Index3 counts{0, 0, 0};
+    for (int axis = 0; axis < 3; ++axis) {
+        counts[axis] = std::max<std::int64_t>(1, (dims[axis] - 2) / block_voxels + 1);
+    }
+    return counts;
+}
+
+}  // namespace
+
+BlockRanges scan_blocks_on_device(OpenClDevice& opencl, cl::Kernel& kernel, DeviceMemory& ranges,
+                                  const DeviceVolume& volume, int block_voxels) {
+    if (volume.empty()) fail<Error>("scan_blocks_on_device called before upload()");
+    BlockRanges blocks;
+    blocks.block_voxels = block_voxels;
+    blocks.counts = block_counts(volume.dims, block_voxels);
+    const std::size_t count =
+        static_cast<std::size_t>(blocks.counts[0] * blocks.counts[1] * blocks.counts[2]);
+    opencl.ensure_buffer(ranges.buffer, ranges.capacity, count * 2 * sizeof(float),
+                         CL_MEM_WRITE_ONLY);
+    const Index3& d = volume.dims;
+    const cl_int4 dims = {
+        {static_cast<cl_int>(d[0]), static_cast<cl_int>(d[1]), static_cast<cl_int>(d[2]), 0}};
+    const cl_int4 counts = {{static_cast<cl_int>(blocks.counts[0]),
+                             static_cast<cl_int>(blocks.counts[1]),
+                             static_cast<cl_int>(blocks.counts[2]), 0}};
+    opencl.launch(kernel,
+                  cl::NDRange(static_cast<std::size_t>(blocks.counts[0]),
+                              static_cast<std::size_t>(blocks.counts[1]),
+                              static_cast<std::size_t>(blocks.counts[2])),
+                  cl::NullRange, volume.memory->buffer, dims, counts,
+                  static_cast<cl_int>(block_voxels), ranges.buffer);
+    std::vector<float> pairs(count * 2);
+    opencl.download(ranges.buffer, pairs.data(), pairs.size() * sizeof(float), "block ranges");
+    blocks.min.resize(count);
+    blocks.max.resize(count);
+    for (std::size_t b = 0; b < count; ++b) {
+        blocks.min[b] = pairs[2 * b];
+        blocks.max[b] = pairs[2 * b + 1];
+    }
+    return blocks;
+}
 
 BlockRanges scan_blocks(const std::vector<float>& values, const Index3& dims, int block_voxels) {
     const std::int64_t b_voxels = block_voxels;
     BlockRanges blocks;
     blocks.block_voxels = block_voxels;
-    // An axis of n samples has n - 1 cells between them: ceil((n - 1) / B) blocks.
-    for (int axis = 0; axis < 3; ++axis) {
-        blocks.counts[axis] = std::max<std::int64_t>(1, (dims[axis] - 2) / b_voxels + 1);
-    }
+    blocks.counts = block_counts(dims, block_voxels);
     const std::size_t count =
         static_cast<std::size_t>(blocks.counts[0] * blocks.counts[1] * blocks.counts[2]);
     blocks.min.assign(count, std::numeric_limits<float>::infinity());

@@ -5,8 +5,10 @@
 #include <cstdint>
 #include <vector>
 
+#include "device/opencl_device.hpp"
 #include "insitu/core/transfer_function.hpp"
 #include "insitu/field.hpp"
+#include "insitu/render/volume_renderer.hpp"
 
 namespace insitu::detail {
 
@@ -29,6 +31,13 @@ struct BlockRanges {
 /// ranges of blocks of `block_voxels` voxels.
 BlockRanges scan_blocks(const std::vector<float>& values, const Index3& dims,
                         int block_voxels = kBlockVoxels);
+
+/// The same ranges computed on the device from the uploaded copy (kernels/render/empty_space.cl,
+/// `kernel` its block_ranges, `ranges` a reused output buffer): what the proxy pass uses, so that
+/// an upload costs no host scan of the volume. Equal to scan_blocks(volume.host_values,
+/// volume.dims) value for value.
+BlockRanges scan_blocks_on_device(OpenClDevice& opencl, cl::Kernel& kernel, DeviceMemory& ranges,
+                                  const DeviceVolume& volume, int block_voxels = kBlockVoxels);
 
 /// Per block, 1 when the pass may skip it: no isovalue within its range (inclusive), and, when
 /// the pass `accumulates` attenuation, zero opacity in every table bin a lookup of a value in

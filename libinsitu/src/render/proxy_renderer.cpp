@@ -111,7 +111,8 @@ struct ProxyRenderer::DeviceState {
     cl::Kernel kernel;
     detail::DeviceMemory table, isovalues, edges, thresholds, depth_out, distortion_out,
         attenuation_out, mean_depth_out, optical_depth_out, segment_rgba_out, segment_depth_out,
-        first_hit_out, skippable, fragment_out;
+        first_hit_out, skippable, fragment_out, block_ranges_out;
+    cl::Kernel block_ranges;  ///< kernels/render/empty_space.cl
     /// Block ranges of the uploaded volume, rescanned when its generation changes.
     detail::BlockRanges blocks;
     std::uint64_t blocks_generation = 0;
@@ -120,6 +121,7 @@ struct ProxyRenderer::DeviceState {
 ProxyRenderer::ProxyRenderer(std::shared_ptr<ComputeDevice> device)
     : device_(device), renderer_(device), state_(std::make_unique<DeviceState>()) {
     state_->kernel = device_->opencl().kernel("proxy_renderer", "render_proxies");
+    state_->block_ranges = device_->opencl().kernel("empty_space", "block_ranges");
 }
 
 ProxyRenderer::~ProxyRenderer() = default;
@@ -285,7 +287,8 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     last_skippable_fraction_ = 0.0;
     if (request.skip_empty_space) {
         if (state_->blocks_generation != volume.generation) {
-            state_->blocks = detail::scan_blocks(volume.host_values, volume.dims);
+            state_->blocks = detail::scan_blocks_on_device(device_->opencl(), state_->block_ranges,
+                                                           state_->block_ranges_out, volume);
             state_->blocks_generation = volume.generation;
         }
         const detail::BlockRanges& blocks = state_->blocks;
