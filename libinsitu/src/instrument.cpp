@@ -263,6 +263,9 @@ struct Instrument::Impl {
     Status execute(std::int64_t step, double time, const std::vector<Field>& fields);
     /// The checks of execute() that need no field (step, time, order, finalize).
     void check_step(std::int64_t step, double time) const;
+    /// Whether a checked step is skipped (already archived, counted and noticed once; or not
+    /// selected by the cadence); notes it as the last step then.
+    bool skips(std::int64_t step);
     /// The step's record: every configured field planned and rendered (on rank 0, composited;
     /// elsewhere the record is not kept). Adds the time spent agreeing and compositing.
     StepRecord compute(std::int64_t step, double time, const std::vector<Field>& fields,
@@ -376,15 +379,7 @@ Status Instrument::Impl::execute_distributed(std::int64_t step, double time,
         }
     }
     // The same on every rank: the archived steps and the cadence are.
-    if (archived_steps.count(step) != 0 || !config.selects(step)) {
-        const bool replayed = archived_steps.count(step) != 0;
-        last_step = step;
-        if (replayed) {
-            std::lock_guard<std::mutex> lock(mutex);
-            ++statistics.steps_replayed;
-        }
-        return Status::not_selected;
-    }
+    if (skips(step)) return Status::not_selected;
 
     const auto compute_start = Clock::now();
     StepRecord record = compute(step, time, fields, composite_seconds);
@@ -412,6 +407,31 @@ Status Instrument::Impl::execute_distributed(std::int64_t step, double time,
     return static_cast<Status>(verdict.at(0));
 }
 
+bool Instrument::Impl::skips(std::int64_t step) {
+    // A restarted simulation replays steps an earlier run already archived: those are kept as
+    // they are ("on_existing": "append") and skipped, with one notice.
+    if (archived_steps.count(step) != 0) {
+        last_step = step;
+        {
+            std::lock_guard<std::mutex> lock(mutex);
+            ++statistics.steps_replayed;
+        }
+        if (!replay_reported) {
+            replay_reported = true;
+            log("notice: step " + std::to_string(step) + " is already in archive \"" +
+                config.archive +
+                "\" (a restarted run replaying it): archived steps are skipped, counted in "
+                "statistics (\"on_existing\": \"replace\" starts the archive anew)");
+        }
+        return true;
+    }
+    if (!config.selects(step)) {
+        last_step = step;
+        return true;
+    }
+    return false;
+}
+
 void Instrument::Impl::check_step(std::int64_t step, double time) const {
     if (finalized) fail<StateError>("execute(step ", step, ") after finalize()");
     // Archive files are named by step number; a negative one has no name.
@@ -437,27 +457,7 @@ void Instrument::Impl::check_step(std::int64_t step, double time) const {
 Status Instrument::Impl::execute(std::int64_t step, double time, const std::vector<Field>& fields) {
     if (communicator) return execute_distributed(step, time, fields);
     check_step(step, time);
-    // A restarted simulation replays steps an earlier run already archived: those are kept as
-    // they are ("on_existing": "append") and skipped, with one notice.
-    if (archived_steps.count(step) != 0) {
-        last_step = step;
-        {
-            std::lock_guard<std::mutex> lock(mutex);
-            ++statistics.steps_replayed;
-        }
-        if (!replay_reported) {
-            replay_reported = true;
-            log("notice: step " + std::to_string(step) + " is already in archive \"" +
-                config.archive +
-                "\" (a restarted run replaying it): archived steps are skipped, counted in "
-                "statistics (\"on_existing\": \"replace\" starts the archive anew)");
-        }
-        return Status::not_selected;
-    }
-    if (!config.selects(step)) {
-        last_step = step;
-        return Status::not_selected;
-    }
+    if (skips(step)) return Status::not_selected;
     for (const std::string& name : config.fields) {
         const bool present = std::any_of(fields.begin(), fields.end(),
                                          [&](const Field& f) { return f.name() == name; });
