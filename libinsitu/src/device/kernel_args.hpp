@@ -77,19 +77,18 @@ inline auto volume_args(const DeviceVolume& volume) {
     const cl_int4 dims = {
         {static_cast<cl_int>(d[0]), static_cast<cl_int>(d[1]), static_cast<cl_int>(d[2]), 0}};
     const double inf = std::numeric_limits<double>::infinity();
-    if (!volume.region) {
-        return pack_args(volume.memory->buffer, dims, to_float4(volume.origin),
-                         to_float4(1.0 / volume.spacing), to_float4(volume.bounds.lower),
-                         to_float4(volume.bounds.upper), to_float4(0.0, 0.0, 0.0, 0.0),
-                         to_float4(-inf, -inf, -inf, 0.0), to_float4(inf, inf, inf, 0.0));
-    }
-    const MarchRegion& region = *volume.region;
+    MarchRegion whole;  // a whole volume is its own grid, owned everywhere
+    whole.grid_first_sample = volume.origin;
+    whole.grid_bounds = volume.bounds;
+    whole.owned_lower = glm::dvec3(-inf);
+    whole.owned_upper = glm::dvec3(inf);
+    const MarchRegion& region = volume.region ? *volume.region : whole;
     const Index3& offset = region.block_offset;
     return pack_args(volume.memory->buffer, dims, to_float4(region.grid_first_sample),
                      to_float4(1.0 / volume.spacing), to_float4(region.grid_bounds.lower),
                      to_float4(region.grid_bounds.upper),
                      to_float4(static_cast<double>(offset[0]), static_cast<double>(offset[1]),
-                               static_cast<double>(offset[2]), 1.0),
+                               static_cast<double>(offset[2]), volume.region ? 1.0 : 0.0),
                      to_float4(region.owned_lower), to_float4(region.owned_upper));
 }
 
