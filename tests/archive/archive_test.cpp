@@ -36,12 +36,15 @@
 #include "insitu/render/distortion_camera.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "support/expect_error.hpp"
+#include "support/half_precision.hpp"
 #include "support/test_files.hpp"
 
 namespace insitu {
 namespace {
 
 using insitu::testing::file_crc;
+using insitu::testing::kHalfAbsolute;
+using insitu::testing::kHalfRelative;
 using insitu::testing::read_text;
 using insitu::testing::write_text;
 using ::testing::AllOf;
@@ -49,10 +52,6 @@ using ::testing::HasSubstr;
 using ::testing::Not;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
-// Half keeps 10 explicit mantissa bits: round-to-nearest is within 2^-11 relative for normal
-// values; below half's smallest normal (6.1e-5) the spacing is 2^-24, so half of that absolute.
-constexpr double kHalfRelative = 1.0 / 2048.0;
-constexpr double kHalfAbsolute = 1.0 / (1 << 25);
 // Camera vectors are rebuilt from orbit angles that went through degrees: a few ulps.
 constexpr double kCameraTolerance = 1e-12;
 // An 8-bit sRGB preview decodes within half a step of 255 in sRGB, i.e. ~0.5/255 * 2.4 in

@@ -30,6 +30,7 @@
 #include "insitu/error.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "support/expect_error.hpp"
+#include "support/half_precision.hpp"
 #include "support/test_files.hpp"
 
 namespace insitu {
@@ -37,6 +38,8 @@ namespace {
 
 using insitu::testing::expect_error_naming;
 using insitu::testing::file_crc;
+using insitu::testing::kHalfAbsolute;
+using insitu::testing::kHalfRelative;
 using insitu::testing::read_text;
 using insitu::testing::write_text;
 using ::testing::AllOf;
@@ -44,10 +47,6 @@ using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
-// Half keeps 10 explicit mantissa bits: round-to-nearest is within 2^-11 relative for normal
-// values; below half's smallest normal (6.1e-5) the spacing is 2^-24, so half of that absolute.
-constexpr double kHalfRelative = 1.0 / 2048.0;
-constexpr double kHalfAbsolute = 1.0 / (1 << 25);
 // 8-bit depth rounds the secant fraction to the nearest of 254 steps (seed 001), plus float's
 // rounding of code / 254.
 constexpr double kEightBitTolerance = 0.5 / 254.0 + 1e-7;
