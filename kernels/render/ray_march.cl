@@ -200,3 +200,154 @@ inline float absorb(float* transmittance, float alpha) {
     *transmittance *= 1.0f - alpha;
     return weight;
 }
+
+// ---- Ray packets --------------------------------------------------------------------------------
+// PoCL runs a work-group's work-items one after another on a core and vectorises across them only
+// where every work-item takes the same path; a ray loop with a data-dependent trip count never
+// does, so one ray per work-item runs scalar. A packet instead gives each work-item a tile of
+// PACKET_W x PACKET_H neighbouring pixels, one SIMD lane per ray, marched in lockstep (lanes that
+// have finished are masked): the compiler then emits 16-wide arithmetic and AVX-512 gathers for
+// the trilinear corners and the transfer table. Every lane computes what march_ray(),
+// sample_trilinear() and lookup_transfer() compute for its ray, with the same formulas, so a
+// packet pass takes the same samples as the one-ray-per-work-item pass (tests compare the two).
+// 16 lanes measured 2.8x, 8 lanes 2.2x faster than one ray per work-item at 128^3 / 256^2.
+#define PACKET_LANES 16
+#define PACKET_W 4
+#define PACKET_H 4
+typedef float16 floatp;
+typedef int16 intp;
+#define convert_intp convert_int16
+#define convert_floatp convert_float16
+// Lane k of a packet is buf[index.sk]: one gather.
+#define GATHER(buf, index)                                                                         \
+    ((floatp)(buf[(index).s0], buf[(index).s1], buf[(index).s2], buf[(index).s3], buf[(index).s4], \
+              buf[(index).s5], buf[(index).s6], buf[(index).s7], buf[(index).s8], buf[(index).s9], \
+              buf[(index).sa], buf[(index).sb], buf[(index).sc], buf[(index).sd], buf[(index).se], \
+              buf[(index).sf]))
+// Lane access to a packet held in private memory (set-up and stores only, not the inner loop).
+#define LANE(packet, lane) (((float*)&(packet))[lane])
+#define LANE_INT(packet, lane) (((int*)&(packet))[lane])
+
+// Pixel of lane `lane` in the packet of work-item (gx, gy).
+inline int2 packet_pixel(int gx, int gy, int lane) {
+    return (int2)(gx * PACKET_W + lane % PACKET_W, gy * PACKET_H + lane / PACKET_W);
+}
+
+// A packet of rays: MarchRay's fields, one lane per ray. hits is -1 (true) for a lane whose
+// pixel is inside the image and whose ray crosses the box; start is in the volume buffer's
+// coordinates (the grid's minus the buffer's offset, as sample_position_voxels() takes it).
+typedef struct {
+    floatp t_near, t_far;
+    floatp start_x, start_y, start_z;
+    floatp direction_x, direction_y, direction_z;  // voxels per unit t
+    floatp depth_origin, depth_per_t;
+    floatp light_x, light_y, light_z;  // -direction in world space (headlight shading)
+    intp hits;
+} MarchPacket;
+
+inline MarchPacket march_packet(int gx, int gy, int2 size, float4 cam_position, float4 cam_forward,
+                                float4 cam_right, float4 cam_up, float4 cam_half_extent,
+                                float sin_tilt, float cos_tilt, float4 origin_world,
+                                float4 inv_spacing, float4 box_lower, float4 box_upper,
+                                float4 data_offset) {
+    MarchPacket packet;
+    for (int lane = 0; lane < PACKET_LANES; ++lane) {
+        const int2 pixel = packet_pixel(gx, gy, lane);
+        const bool in_image = pixel.x < size.x && pixel.y < size.y;
+        const MarchRay ray = march_ray(pixel.x, pixel.y, size, cam_position, cam_forward, cam_right,
+                                       cam_up, cam_half_extent, sin_tilt, cos_tilt, origin_world,
+                                       inv_spacing, box_lower, box_upper, data_offset);
+        const bool hits = in_image && ray_hits_box(&ray);
+        LANE_INT(packet.hits, lane) = hits ? -1 : 0;
+        // Lanes that miss get an empty span [0, 0): they never sample.
+        LANE(packet.t_near, lane) = hits ? ray.t_near : 0.0f;
+        LANE(packet.t_far, lane) = hits ? ray.t_far : 0.0f;
+        const float3 start = ray.start_voxels - ray.offset_voxels;
+        LANE(packet.start_x, lane) = hits ? start.x : 0.0f;
+        LANE(packet.start_y, lane) = hits ? start.y : 0.0f;
+        LANE(packet.start_z, lane) = hits ? start.z : 0.0f;
+        LANE(packet.direction_x, lane) = hits ? ray.direction_voxels.x : 0.0f;
+        LANE(packet.direction_y, lane) = hits ? ray.direction_voxels.y : 0.0f;
+        LANE(packet.direction_z, lane) = hits ? ray.direction_voxels.z : 0.0f;
+        LANE(packet.depth_origin, lane) = ray.depth_origin;
+        LANE(packet.depth_per_t, lane) = ray.depth_per_t;
+        LANE(packet.light_x, lane) = -ray.direction.x;
+        LANE(packet.light_y, lane) = -ray.direction.y;
+        LANE(packet.light_z, lane) = -ray.direction.z;
+    }
+    return packet;
+}
+
+// sample_trilinear() for a packet of positions. Lanes outside `active` sample the grid's first
+// cell (any in-grid address would do): their positions may be anything, and a gather must not
+// leave the buffer.
+inline floatp packet_trilinear(__global const float* volume, int4 dims, floatp x, floatp y,
+                               floatp z, intp active) {
+    const floatp px = clamp(select((floatp)0.0f, x, active), 0.0f, (float)(dims.x - 1));
+    const floatp py = clamp(select((floatp)0.0f, y, active), 0.0f, (float)(dims.y - 1));
+    const floatp pz = clamp(select((floatp)0.0f, z, active), 0.0f, (float)(dims.z - 1));
+    const intp ix = min(convert_intp(px), dims.x - 2);
+    const intp iy = min(convert_intp(py), dims.y - 2);
+    const intp iz = min(convert_intp(pz), dims.z - 2);
+    const floatp fx = px - convert_floatp(ix);
+    const floatp fy = py - convert_floatp(iy);
+    const floatp fz = pz - convert_floatp(iz);
+    const int stride_y = dims.x;
+    const int stride_z = dims.x * dims.y;
+    const intp c = iz * stride_z + iy * stride_y + ix;
+    const intp c_y = c + stride_y;
+    const intp c_z = c + stride_z;
+    const intp c_zy = c_z + stride_y;
+    const floatp c00 = mix(GATHER(volume, c), GATHER(volume, c + 1), fx);
+    const floatp c10 = mix(GATHER(volume, c_y), GATHER(volume, c_y + 1), fx);
+    const floatp c01 = mix(GATHER(volume, c_z), GATHER(volume, c_z + 1), fx);
+    const floatp c11 = mix(GATHER(volume, c_zy), GATHER(volume, c_zy + 1), fx);
+    return mix(mix(c00, c10, fy), mix(c01, c11, fy), fz);
+}
+
+// gradient_central() for a packet: central differences one voxel apart, in field units per world
+// unit.
+inline void packet_gradient(__global const float* volume, int4 dims, floatp x, floatp y, floatp z,
+                            intp active, float4 inv_spacing, floatp* gx, floatp* gy, floatp* gz) {
+    *gx = (packet_trilinear(volume, dims, x + 1.0f, y, z, active) -
+           packet_trilinear(volume, dims, x - 1.0f, y, z, active)) *
+          (0.5f * inv_spacing.x);
+    *gy = (packet_trilinear(volume, dims, x, y + 1.0f, z, active) -
+           packet_trilinear(volume, dims, x, y - 1.0f, z, active)) *
+          (0.5f * inv_spacing.y);
+    *gz = (packet_trilinear(volume, dims, x, y, z + 1.0f, active) -
+           packet_trilinear(volume, dims, x, y, z - 1.0f, active)) *
+          (0.5f * inv_spacing.z);
+}
+
+// lookup_transfer() for a packet: colour and step-corrected opacity, bilinear in (value, gradient
+// magnitude). Values must not be NaN (callers replace them and mask their opacity).
+inline void packet_lookup_transfer(__global const float4* table4, int2 bins, float4 domain,
+                                   floatp value, floatp gradient_magnitude, floatp* r, floatp* g,
+                                   floatp* b, floatp* a) {
+    __global const float* table = (__global const float*)table4;
+    const floatp x = clamp((value - domain.x) * domain.y, 0.0f, 1.0f) * (float)(bins.x - 1);
+    const intp ix = min(convert_intp(x), bins.x - 2);
+    const floatp fx = x - convert_floatp(ix);
+    const intp e0 = 4 * ix;
+    if (bins.y == 1) {
+        *r = mix(GATHER(table, e0), GATHER(table, e0 + 4), fx);
+        *g = mix(GATHER(table, e0 + 1), GATHER(table, e0 + 5), fx);
+        *b = mix(GATHER(table, e0 + 2), GATHER(table, e0 + 6), fx);
+        *a = mix(GATHER(table, e0 + 3), GATHER(table, e0 + 7), fx);
+        return;
+    }
+    const floatp y = clamp(gradient_magnitude * domain.z, 0.0f, 1.0f) * (float)(bins.y - 1);
+    const intp iy = min(convert_intp(y), bins.y - 2);
+    const floatp fy = y - convert_floatp(iy);
+    const intp r0 = e0 + 4 * iy * bins.x;  // row iy, entry ix
+    const intp r1 = r0 + 4 * bins.x;
+    *r = mix(mix(GATHER(table, r0), GATHER(table, r0 + 4), fx),
+             mix(GATHER(table, r1), GATHER(table, r1 + 4), fx), fy);
+    *g = mix(mix(GATHER(table, r0 + 1), GATHER(table, r0 + 5), fx),
+             mix(GATHER(table, r1 + 1), GATHER(table, r1 + 5), fx), fy);
+    *b = mix(mix(GATHER(table, r0 + 2), GATHER(table, r0 + 6), fx),
+             mix(GATHER(table, r1 + 2), GATHER(table, r1 + 6), fx), fy);
+    *a = mix(mix(GATHER(table, r0 + 3), GATHER(table, r0 + 7), fx),
+             mix(GATHER(table, r1 + 3), GATHER(table, r1 + 7), fx), fy);
+}

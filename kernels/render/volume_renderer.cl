@@ -80,3 +80,83 @@ __kernel void render_volume(__global const float* volume, int4 dims, float4 orig
     depth_out[pixel] = depth;
     if (partial) fragment_out[pixel] = (float)fragment_first;
 }
+
+// render_volume for a whole volume, one packet of rays per work-item (ray_march.cl): the same
+// samples, classification, shading and compositing per lane. A lane stops at the end of its span
+// or at the early-termination opacity, like `break` above; the packet stops when all have.
+__kernel void render_volume_packets(__global const float* volume, int4 dims, float4 origin_world,
+                                    float4 inv_spacing, float4 box_lower, float4 box_upper,
+                                    float4 data_offset, float4 owned_lower, float4 owned_upper,
+                                    __global const float4* tf_table, int2 tf_bins, float4 tf_domain,
+                                    float4 cam_position, float4 cam_forward, float4 cam_right,
+                                    float4 cam_up, float4 cam_half_extent, int2 size, float4 march,
+                                    float4 phong, __global float4* rgba_out,
+                                    __global float* depth_out) {
+    const int gx = get_global_id(0);
+    const int gy = get_global_id(1);
+    if (gx * PACKET_W >= size.x || gy * PACKET_H >= size.y) return;
+    const float step = march.x;
+    const float stop_opacity = march.y;
+    const bool shading = march.z != 0.0f;
+    const bool needs_gradient = march.w != 0.0f;
+
+    const MarchPacket rays =
+        march_packet(gx, gy, size, cam_position, cam_forward, cam_right, cam_up, cam_half_extent,
+                     0.0f, 1.0f, origin_world, inv_spacing, box_lower, box_upper, data_offset);
+    floatp red = 0.0f, green = 0.0f, blue = 0.0f, transmittance = 1.0f;
+    floatp depth = INFINITY;
+    intp marching = rays.hits;
+    for (int i = 0;; ++i) {
+        const floatp t = rays.t_near + ((float)i + 0.5f) * step;
+        const intp active = marching & (t < rays.t_far);
+        if (!any(active)) break;
+        const floatp x = rays.start_x + t * rays.direction_x;
+        const floatp y = rays.start_y + t * rays.direction_y;
+        const floatp z = rays.start_z + t * rays.direction_z;
+        const floatp sampled = packet_trilinear(volume, dims, x, y, z, active);
+        const intp usable = active & ~isnan(sampled);  // NaN is empty space
+        const floatp value = select((floatp)tf_domain.x, sampled, usable);
+
+        floatp gradient_x = 0.0f, gradient_y = 0.0f, gradient_z = 0.0f, magnitude = 0.0f;
+        if (needs_gradient) {
+            packet_gradient(volume, dims, x, y, z, usable, inv_spacing, &gradient_x, &gradient_y,
+                            &gradient_z);
+            magnitude =
+                sqrt(gradient_x * gradient_x + gradient_y * gradient_y + gradient_z * gradient_z);
+            magnitude = select((floatp)0.0f, magnitude, isfinite(magnitude));
+        }
+        floatp sample_red, sample_green, sample_blue, alpha;
+        packet_lookup_transfer(tf_table, tf_bins, tf_domain, value, magnitude, &sample_red,
+                               &sample_green, &sample_blue, &alpha);
+        alpha = select((floatp)0.0f, alpha, usable & (alpha > 0.0f));
+        const intp contributes = alpha > 0.0f;
+        if (!any(contributes)) continue;
+        depth = select(depth, rays.depth_origin + t * rays.depth_per_t, isinf(depth) & contributes);
+
+        if (shading) {
+            const intp lit = magnitude > 1e-12f;
+            const floatp n_dot_l = fabs((gradient_x / magnitude) * rays.light_x +
+                                        (gradient_y / magnitude) * rays.light_y +
+                                        (gradient_z / magnitude) * rays.light_z);
+            const floatp diffuse = phong.x + phong.y * n_dot_l;
+            const floatp specular = phong.z * pow(select((floatp)0.0f, n_dot_l, lit), phong.w);
+            sample_red = select(sample_red, sample_red * diffuse + specular, lit);
+            sample_green = select(sample_green, sample_green * diffuse + specular, lit);
+            sample_blue = select(sample_blue, sample_blue * diffuse + specular, lit);
+        }
+        const floatp weight = transmittance * alpha;  // absorb(), per lane
+        transmittance *= 1.0f - alpha;
+        red += weight * sample_red;
+        green += weight * sample_green;
+        blue += weight * sample_blue;
+        marching &= 1.0f - transmittance < stop_opacity;
+    }
+    for (int lane = 0; lane < PACKET_LANES; ++lane) {
+        const int2 pixel = packet_pixel(gx, gy, lane);
+        if (pixel.x >= size.x || pixel.y >= size.y) continue;
+        const int index = pixel.y * size.x + pixel.x;
+        rgba_out[index] = (float4)(LANE(red, lane), LANE(green, lane), LANE(blue, lane),
+                                   1.0f - LANE(transmittance, lane));
+        depth_out[index] = LANE(depth, lane);
+    }
+}

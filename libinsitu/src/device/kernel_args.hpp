@@ -110,4 +110,19 @@ inline cl::NDRange image_local_range() {
     return cl::NDRange(8, 8);
 }
 
+/// Ray packets (PACKET_W x PACKET_H = 4x4 pixels per work-item, kernels/render/ray_march.cl) in
+/// work-groups of 4x4 packets: 16x16 pixels, enough groups to keep every core busy at 128^2.
+constexpr int kPacketSide = 4;
+constexpr int kPacketGroupSide = 4;
+inline cl::NDRange packet_global_range(int width, int height) {
+    const auto round_up = [](int pixels) {
+        const int packets = (pixels + kPacketSide - 1) / kPacketSide;
+        return (packets + kPacketGroupSide - 1) / kPacketGroupSide * kPacketGroupSide;
+    };
+    return cl::NDRange(round_up(width), round_up(height));
+}
+inline cl::NDRange packet_local_range() {
+    return cl::NDRange(kPacketGroupSide, kPacketGroupSide);
+}
+
 }  // namespace insitu::detail

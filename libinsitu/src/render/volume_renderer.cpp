@@ -82,7 +82,7 @@ void DeviceVolume::upload(ComputeDevice& device, const Field& field) {
 }
 
 struct VolumeRenderer::DeviceState {
-    cl::Kernel kernel;
+    cl::Kernel kernel, packet_kernel;
     detail::DeviceMemory table, rgba_out, depth_out, fragment_out;
 };
 
@@ -90,6 +90,7 @@ VolumeRenderer::VolumeRenderer(std::shared_ptr<ComputeDevice> device)
     : device_(std::move(device)), state_(std::make_unique<DeviceState>()) {
     if (!device_) fail<InvalidArgument>("VolumeRenderer: compute device is null");
     state_->kernel = device_->opencl().kernel("volume_renderer", "render_volume");
+    state_->packet_kernel = device_->opencl().kernel("volume_renderer", "render_volume_packets");
 }
 
 VolumeRenderer::~VolumeRenderer() = default;
@@ -156,11 +157,19 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
     const cl_float4 phong_parameters =
         to_float4(phong.ambient, phong.diffuse, phong.specular, phong.shininess);
 
-    opencl.launch(state_->kernel, detail::image_global_range(width, height),
-                  detail::image_local_range(), detail::volume_args(volume_),
-                  detail::transfer_args(state_->table.buffer, table), detail::camera_args(camera),
-                  detail::image_size(camera), march, phong_parameters, state_->rgba_out.buffer,
-                  state_->depth_out.buffer, fragment_buffer);
+    if (settings.ray_packets && !volume_.region) {
+        opencl.launch(state_->packet_kernel, detail::packet_global_range(width, height),
+                      detail::packet_local_range(), detail::volume_args(volume_),
+                      detail::transfer_args(state_->table.buffer, table),
+                      detail::camera_args(camera), detail::image_size(camera), march,
+                      phong_parameters, state_->rgba_out.buffer, state_->depth_out.buffer);
+    } else {
+        opencl.launch(
+            state_->kernel, detail::image_global_range(width, height), detail::image_local_range(),
+            detail::volume_args(volume_), detail::transfer_args(state_->table.buffer, table),
+            detail::camera_args(camera), detail::image_size(camera), march, phong_parameters,
+            state_->rgba_out.buffer, state_->depth_out.buffer, fragment_buffer);
+    }
 
     Rendering result;
     result.rgba = Image(width, height, 4);
@@ -198,6 +207,7 @@ std::ostream& operator<<(std::ostream& out, const RenderSettings& settings) {
     out << "RenderSettings{step " << settings.step_voxels << " voxels, early termination at "
         << settings.early_termination_opacity << ", shading " << (settings.shading ? "on" : "off");
     if (settings.shading) out << " " << settings.phong;
+    if (!settings.ray_packets) out << ", one ray per work-item";
     return out << ", table " << settings.tf_value_bins << "x" << settings.tf_gradient_bins << "}";
 }
 
