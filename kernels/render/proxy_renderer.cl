@@ -315,3 +315,207 @@ __kernel void render_proxies(
         fragment[8] = transmittance;
     }
 }
+
+// Adds one sample's contribution to the interleaved per-interval outputs of the lanes in
+// `contributes`, one lane at a time (a lane's interval is data-dependent, and its pixel's
+// intervals share one or two cache lines, as in render_proxies).
+inline void accumulate_lanes(intp contributes, floatp value, floatp weight, floatp depth,
+                             floatp alpha, int gx, int gy, int2 size, int interval_count,
+                             float uniform_interval_scale, __global const float* interval_edges,
+                             bool want_mean_depth, bool want_optical_depth,
+                             __global float* attenuation_out, __global float* mean_depth_out,
+                             __global float* optical_depth_out) {
+    for (int lane = 0; lane < PACKET_LANES; ++lane) {
+        if (!LANE_INT(contributes, lane)) continue;
+        const int2 pixel_xy = packet_pixel(gx, gy, lane);
+        const int pixel = pixel_xy.y * size.x + pixel_xy.x;
+        const float v = LANE(value, lane);
+        const int j = uniform_interval_scale > 0.0f
+                          ? clamp((int)((v - interval_edges[0]) * uniform_interval_scale), 0,
+                                  interval_count - 1)
+                          : interval_of(interval_edges, interval_count, v);
+        const int index = pixel * interval_count + j;
+        const float w = LANE(weight, lane);
+        attenuation_out[index] += w;
+        if (want_mean_depth) mean_depth_out[index] += w * LANE(depth, lane);
+        if (want_optical_depth) {
+            const float a = LANE(alpha, lane);
+            optical_depth_out[index] += a < 1.0f ? -log(1.0f - a) : FLT_MAX;
+        }
+    }
+}
+
+// render_proxies for a whole volume without segment outputs (depth and distortion layers,
+// attenuation, mean and optical depth: what a view of the archive needs), one packet of rays per
+// work-item (ray_march.cl). Every lane takes the samples, finds the crossings, accumulates and
+// skips empty blocks as render_proxies does for its ray; each lane keeps its own sample index,
+// so lanes skip blocks independently. The arguments are render_proxies' (segment and fragment
+// buffers unused), so the host launches either with one argument list.
+__kernel void render_proxies_packets(
+    __global const float* volume, int4 dims, float4 origin_world, float4 inv_spacing,
+    float4 box_lower, float4 box_upper, float4 data_offset, float4 owned_lower, float4 owned_upper,
+    __global const float4* tf_table, int2 tf_bins, float4 tf_domain, float4 cam_position,
+    float4 cam_forward, float4 cam_right, float4 cam_up, float4 cam_half_extent, int2 size,
+    float4 march, int wanted, int layer_count, __global const float* isovalues, int interval_count,
+    float uniform_interval_scale, __global const float* interval_edges, __global float* depth_out,
+    __global float* distortion_out, __global float* attenuation_out, __global float* mean_depth_out,
+    __global float* optical_depth_out, int segment_rule, int segment_count,
+    __global const float* segment_thresholds, float depth_threshold,
+    __global float4* segment_rgba_out, __global float* segment_depth_out,
+    __global float* first_hit_out, __global const uchar* skippable_blocks, int4 block_counts,
+    int block_size, __global float* fragment_out) {
+    const int gx = get_global_id(0);
+    const int gy = get_global_id(1);
+    if (gx * PACKET_W >= size.x || gy * PACKET_H >= size.y) return;
+    const int pixel_count = size.x * size.y;
+    const float step = march.x;
+    const float stop_opacity = march.y;
+    const float sin_tilt = march.z;
+    const float cos_tilt = march.w;
+    const bool want_layers = (wanted & WANT_DEPTH) != 0 && layer_count > 0;
+    const bool want_mean_depth = (wanted & WANT_MEAN_DEPTH) != 0;
+    const bool want_optical_depth = (wanted & WANT_OPTICAL_DEPTH) != 0;
+    const bool accumulate =
+        (wanted & WANT_ATTENUATION) != 0 || want_mean_depth || want_optical_depth;
+
+    const MarchPacket rays = march_packet(gx, gy, size, cam_position, cam_forward, cam_right,
+                                          cam_up, cam_half_extent, sin_tilt, cos_tilt, origin_world,
+                                          inv_spacing, box_lower, box_upper, data_offset);
+    intp in_image = 0;
+    for (int lane = 0; lane < PACKET_LANES; ++lane) {
+        const int2 pixel_xy = packet_pixel(gx, gy, lane);
+        if (pixel_xy.x >= size.x || pixel_xy.y >= size.y) continue;
+        LANE_INT(in_image, lane) = -1;
+        if (!accumulate) continue;
+        const int base = (pixel_xy.y * size.x + pixel_xy.x) * interval_count;
+        for (int j = 0; j < interval_count; ++j) {
+            attenuation_out[base + j] = 0.0f;
+            if (want_mean_depth) mean_depth_out[base + j] = 0.0f;
+            if (want_optical_depth) optical_depth_out[base + j] = 0.0f;
+        }
+    }
+
+    floatp layer_t[MAX_LAYERS];
+    for (int l = 0; l < layer_count; ++l) layer_t[l] = INFINITY;
+    intp layers_found = 0;
+    floatp transmittance = 1.0f;
+    intp accumulating = accumulate ? (intp)(-1) : (intp)(0);
+    floatp previous_value = NAN;
+    floatp previous_t = 0.0f;
+    floatp next_block_t = -INFINITY;
+    intp sample = 0;  // each lane's sample index
+    intp marching = rays.hits;
+    while (true) {
+        const floatp t = rays.t_near + (convert_floatp(sample) + 0.5f) * step;
+        const intp active = marching & (t < rays.t_far);
+        if (!any(active)) break;
+        const floatp x = rays.start_x + t * rays.direction_x;
+        const floatp y = rays.start_y + t * rays.direction_y;
+        const floatp z = rays.start_z + t * rays.direction_z;
+        const floatp sampled = packet_trilinear(volume, dims, x, y, z, active);
+        const intp usable = active & ~isnan(sampled);
+        const floatp value = select((floatp)tf_domain.x, sampled, usable);
+
+        if (want_layers) {
+            const intp bracketed = usable & ~isnan(previous_value);
+            for (int l = 0; l < layer_count; ++l) {
+                const float iso = isovalues[l];
+                const intp crossed =
+                    bracketed & isinf(layer_t[l]) & ((previous_value >= iso) ^ (value >= iso));
+                // Linear refinement between the two bracketing samples.
+                layer_t[l] = select(
+                    layer_t[l],
+                    previous_t + (iso - previous_value) / (value - previous_value) * step, crossed);
+                layers_found -= crossed;  // true is -1
+            }
+        }
+        // NaN is empty space and breaks the bracket.
+        previous_value = select((floatp)NAN, value, usable);
+        previous_t = select(previous_t, t, usable);
+
+        const intp classify = usable & accumulating;
+        if (any(classify)) {
+            floatp red, green, blue, alpha;
+            packet_lookup_transfer(tf_table, tf_bins, tf_domain, value, 0.0f, &red, &green, &blue,
+                                   &alpha);
+            const intp contributes = classify & (alpha > 0.0f);
+            if (any(contributes)) {
+                alpha = select((floatp)0.0f, alpha, contributes);
+                const floatp weight = transmittance * alpha;  // seed 000 Eq. 7
+                transmittance *= 1.0f - alpha;
+                accumulate_lanes(contributes, value, weight,
+                                 rays.depth_origin + t * rays.depth_per_t, alpha, gx, gy, size,
+                                 interval_count, uniform_interval_scale, interval_edges,
+                                 want_mean_depth, want_optical_depth, attenuation_out,
+                                 mean_depth_out, optical_depth_out);
+                accumulating &= ~(contributes & (1.0f - transmittance >= stop_opacity));
+            }
+        }
+        intp done = ~accumulating;
+        if (want_layers) done &= layers_found == layer_count;
+        marching &= ~(usable & done);
+
+        // Empty-space skipping as in render_proxies, per lane: a lane entering a block looks it
+        // up and, if it is skippable, jumps to the block's last sample.
+        intp advance = 1;
+        if (block_size > 0) {
+            const intp look_up = usable & ~done & (t >= next_block_t);
+            if (any(look_up)) {
+                const float bs = (float)block_size;
+                const floatp px = x, py = y, pz = z;
+                const intp bx = clamp(convert_intp(floor(px / bs)), 0, block_counts.x - 1);
+                const intp by = clamp(convert_intp(floor(py / bs)), 0, block_counts.y - 1);
+                const intp bz = clamp(convert_intp(floor(pz / bs)), 0, block_counts.z - 1);
+                const floatp exit_x = convert_floatp(bx * block_size) +
+                                      select((floatp)0.0f, (floatp)bs, rays.direction_x > 0.0f);
+                const floatp exit_y = convert_floatp(by * block_size) +
+                                      select((floatp)0.0f, (floatp)bs, rays.direction_y > 0.0f);
+                const floatp exit_z = convert_floatp(bz * block_size) +
+                                      select((floatp)0.0f, (floatp)bs, rays.direction_z > 0.0f);
+                // start is already in the buffer's coordinates (grid minus offset).
+                const floatp t_x = select((exit_x - rays.start_x) / rays.direction_x,
+                                          (floatp)INFINITY, rays.direction_x == 0.0f);
+                const floatp t_y = select((exit_y - rays.start_y) / rays.direction_y,
+                                          (floatp)INFINITY, rays.direction_y == 0.0f);
+                const floatp t_z = select((exit_z - rays.start_z) / rays.direction_z,
+                                          (floatp)INFINITY, rays.direction_z == 0.0f);
+                next_block_t = select(next_block_t, fmin(fmin(t_x, t_y), t_z), look_up);
+                const intp block_index = (bz * block_counts.y + by) * block_counts.x + bx;
+                intp skippable = 0;
+                for (int lane = 0; lane < PACKET_LANES; ++lane) {
+                    if (LANE_INT(look_up, lane) && skippable_blocks[LANE_INT(block_index, lane)]) {
+                        LANE_INT(skippable, lane) = -1;
+                    }
+                }
+                const intp last =
+                    convert_intp(ceil((next_block_t - rays.t_near) / step - 0.5f)) - 1;
+                const intp jump = skippable & (last > sample + 1);
+                advance = select(advance, last - sample, jump);
+            }
+        }
+        sample += advance;
+    }
+
+    for (int lane = 0; lane < PACKET_LANES; ++lane) {
+        if (!LANE_INT(in_image, lane)) continue;
+        const int2 pixel_xy = packet_pixel(gx, gy, lane);
+        const int pixel = pixel_xy.y * size.x + pixel_xy.x;
+        if (want_layers) {
+            for (int l = 0; l < layer_count; ++l) {
+                const float t = LANE(layer_t[l], lane);
+                depth_out[l * pixel_count + pixel] =
+                    LANE(rays.depth_origin, lane) + t * LANE(rays.depth_per_t, lane);
+                if ((wanted & WANT_DISTORTION) != 0) {
+                    distortion_out[l * pixel_count + pixel] = isinf(t) ? INFINITY : t * sin_tilt;
+                }
+            }
+        }
+        if (want_mean_depth) {
+            const int base = pixel * interval_count;
+            for (int j = 0; j < interval_count; ++j) {
+                const float a = attenuation_out[base + j];
+                mean_depth_out[base + j] = a > 0.0f ? mean_depth_out[base + j] / a : INFINITY;
+            }
+        }
+    }
+}

@@ -108,7 +108,7 @@ int segment_count(const ProxyRequest& request) {
 }
 
 struct ProxyRenderer::DeviceState {
-    cl::Kernel kernel;
+    cl::Kernel kernel, packet_kernel;  // one ray per work-item; ray packets
     detail::DeviceMemory table, isovalues, edges, thresholds, depth_out, distortion_out,
         attenuation_out, mean_depth_out, optical_depth_out, segment_rgba_out, segment_depth_out,
         first_hit_out, skippable, fragment_out, block_ranges_out;
@@ -121,6 +121,7 @@ struct ProxyRenderer::DeviceState {
 ProxyRenderer::ProxyRenderer(std::shared_ptr<ComputeDevice> device)
     : device_(device), renderer_(device), state_(std::make_unique<DeviceState>()) {
     state_->kernel = device_->opencl().kernel("proxy_renderer", "render_proxies");
+    state_->packet_kernel = device_->opencl().kernel("proxy_renderer", "render_proxies_packets");
     state_->block_ranges = device_->opencl().kernel("empty_space", "block_ranges");
 }
 
@@ -314,8 +315,14 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     const double tilt = glm::radians(tilt_deg);
     const cl_float4 march = to_float4(step_world, request.march.early_termination_opacity,
                                       std::sin(tilt), std::cos(tilt));
+    // Whole volumes without segment outputs march in ray packets (ray_march.cl); light-field
+    // segments and blocks of a distributed run one ray per work-item.
+    const bool packets = request.march.ray_packets && !partial && !want_segments;
     device_->opencl().launch(
-        state_->kernel, detail::image_global_range(width, height), detail::image_local_range(),
+        packets ? state_->packet_kernel : state_->kernel,
+        packets ? detail::packet_global_range(width, height)
+                : detail::image_global_range(width, height),
+        packets ? detail::packet_local_range() : detail::image_local_range(),
         detail::volume_args(volume), detail::transfer_args(table_buffer, table),
         detail::camera_args(camera), detail::image_size(camera), march, static_cast<cl_int>(wanted),
         static_cast<cl_int>(layer_count), isovalue_buffer, static_cast<cl_int>(interval_count),
