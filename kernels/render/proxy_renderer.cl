@@ -345,12 +345,13 @@ inline void accumulate_lanes(intp contributes, floatp value, floatp weight, floa
     }
 }
 
-// render_proxies for a whole volume without segment outputs (depth and distortion layers,
-// attenuation, mean and optical depth: what a view of the archive needs), one packet of rays per
-// work-item (ray_march.cl). Every lane takes the samples, finds the crossings, accumulates and
-// skips empty blocks as render_proxies does for its ray; each lane keeps its own sample index,
-// so lanes skip blocks independently. The arguments are render_proxies' (segment and fragment
-// buffers unused), so the host launches either with one argument list.
+// render_proxies for a whole volume whose segments, if any, are the whole ray (depth and
+// distortion layers, attenuation, mean and optical depth: what a view of the archive needs; the
+// default light-field capture), one packet of rays per work-item (ray_march.cl). Every lane takes
+// the samples, finds the crossings, accumulates and skips empty blocks as render_proxies does for
+// its ray; each lane keeps its own sample index, so lanes skip blocks independently. The arguments
+// are render_proxies' (segment and fragment buffers unused), so the host launches either with one
+// argument list.
 __kernel void render_proxies_packets(
     __global const float* volume, int4 dims, float4 origin_world, float4 inv_spacing,
     float4 box_lower, float4 box_upper, float4 data_offset, float4 owned_lower, float4 owned_upper,
@@ -377,6 +378,10 @@ __kernel void render_proxies_packets(
     const bool want_optical_depth = (wanted & WANT_OPTICAL_DEPTH) != 0;
     const bool accumulate =
         (wanted & WANT_ATTENUATION) != 0 || want_mean_depth || want_optical_depth;
+    // Segments here are only the whole ray (the host sends other rules to render_proxies): one
+    // segment composited from T = 1, which is the ray itself, so its depth is the first hit.
+    const bool want_segments =
+        (wanted & (WANT_SEGMENT_RGBA | WANT_SEGMENT_DEPTH | WANT_FIRST_HIT_DEPTH)) != 0;
 
     const MarchPacket rays = march_packet(gx, gy, size, cam_position, cam_forward, cam_right,
                                           cam_up, cam_half_extent, sin_tilt, cos_tilt, origin_world,
@@ -400,6 +405,9 @@ __kernel void render_proxies_packets(
     intp layers_found = 0;
     floatp transmittance = 1.0f;
     intp accumulating = accumulate ? (intp)(-1) : (intp)(0);
+    intp compositing = want_segments ? (intp)(-1) : (intp)(0);
+    floatp red = 0.0f, green = 0.0f, blue = 0.0f, ray_transmittance = 1.0f;
+    floatp first_hit = INFINITY;
     floatp previous_value = NAN;
     floatp previous_t = 0.0f;
     floatp next_block_t = -INFINITY;
@@ -433,25 +441,38 @@ __kernel void render_proxies_packets(
         previous_value = select((floatp)NAN, value, usable);
         previous_t = select(previous_t, t, usable);
 
-        const intp classify = usable & accumulating;
+        const intp classify = usable & (accumulating | compositing);
         if (any(classify)) {
-            floatp red, green, blue, alpha;
-            packet_lookup_transfer(tf_table, tf_bins, tf_domain, value, 0.0f, &red, &green, &blue,
-                                   &alpha);
-            const intp contributes = classify & (alpha > 0.0f);
+            floatp sample_red, sample_green, sample_blue, alpha;
+            packet_lookup_transfer(tf_table, tf_bins, tf_domain, value, 0.0f, &sample_red,
+                                   &sample_green, &sample_blue, &alpha);
+            const floatp depth = rays.depth_origin + t * rays.depth_per_t;
+            const intp contributes = usable & accumulating & (alpha > 0.0f);
             if (any(contributes)) {
-                alpha = select((floatp)0.0f, alpha, contributes);
-                const floatp weight = transmittance * alpha;  // seed 000 Eq. 7
-                transmittance *= 1.0f - alpha;
-                accumulate_lanes(contributes, value, weight,
-                                 rays.depth_origin + t * rays.depth_per_t, alpha, gx, gy, size,
-                                 interval_count, uniform_interval_scale, interval_edges,
-                                 want_mean_depth, want_optical_depth, attenuation_out,
-                                 mean_depth_out, optical_depth_out);
+                const floatp a = select((floatp)0.0f, alpha, contributes);
+                const floatp weight = transmittance * a;  // seed 000 Eq. 7
+                transmittance *= 1.0f - a;
+                accumulate_lanes(contributes, value, weight, depth, a, gx, gy, size, interval_count,
+                                 uniform_interval_scale, interval_edges, want_mean_depth,
+                                 want_optical_depth, attenuation_out, mean_depth_out,
+                                 optical_depth_out);
                 accumulating &= ~(contributes & (1.0f - transmittance >= stop_opacity));
             }
+            const intp composites = usable & compositing & (alpha > 0.0f);
+            if (any(composites)) {
+                const floatp a = select((floatp)0.0f, alpha, composites);
+                const floatp weight = ray_transmittance * a;  // absorb()
+                ray_transmittance *= 1.0f - a;
+                red += weight * sample_red;
+                green += weight * sample_green;
+                blue += weight * sample_blue;
+                first_hit = select(
+                    first_hit, depth,
+                    composites & isinf(first_hit) & (1.0f - ray_transmittance >= depth_threshold));
+                compositing &= ~(composites & (1.0f - ray_transmittance >= stop_opacity));
+            }
         }
-        intp done = ~accumulating;
+        intp done = ~accumulating & ~compositing;
         if (want_layers) done &= layers_found == layer_count;
         marching &= ~(usable & done);
 
@@ -510,6 +531,12 @@ __kernel void render_proxies_packets(
                 }
             }
         }
+        if ((wanted & WANT_SEGMENT_RGBA) != 0) {
+            segment_rgba_out[pixel] = (float4)(LANE(red, lane), LANE(green, lane), LANE(blue, lane),
+                                               1.0f - LANE(ray_transmittance, lane));
+        }
+        if ((wanted & WANT_SEGMENT_DEPTH) != 0) segment_depth_out[pixel] = LANE(first_hit, lane);
+        if ((wanted & WANT_FIRST_HIT_DEPTH) != 0) first_hit_out[pixel] = LANE(first_hit, lane);
         if (want_mean_depth) {
             const int base = pixel * interval_count;
             for (int j = 0; j < interval_count; ++j) {

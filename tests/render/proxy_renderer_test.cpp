@@ -574,6 +574,19 @@ void expect_packets_match(const ProxyFrame& packets, const ProxyFrame& rays) {
     const ImageAgreement optical = agreement(packets.optical_depth, rays.optical_depth);
     EXPECT_EQ(optical.finiteness_mismatches, 0u);
     EXPECT_LE(optical.max_difference, kPacketWeightTolerance * 10.0);
+    // The whole-ray segment of a light field: its RGBA and first hit.
+    ASSERT_EQ(packets.segment_rgba.size(), rays.segment_rgba.size());
+    for (std::size_t s = 0; s < rays.segment_rgba.size(); ++s) {
+        const ImageAgreement rgba = agreement(packets.segment_rgba[s], rays.segment_rgba[s]);
+        EXPECT_EQ(rgba.finiteness_mismatches, 0u);
+        EXPECT_LE(rgba.max_difference, kPacketWeightTolerance);
+        const ImageAgreement depth = agreement(packets.segment_depth[s], rays.segment_depth[s]);
+        EXPECT_EQ(depth.finiteness_mismatches, 0u);
+        EXPECT_LE(depth.max_difference, kPacketDepthTolerance);
+    }
+    const ImageAgreement first_hit = agreement(packets.first_hit_depth, rays.first_hit_depth);
+    EXPECT_EQ(first_hit.finiteness_mismatches, 0u);
+    EXPECT_LE(first_hit.max_difference, kPacketDepthTolerance);
 }
 
 TEST(ProxyRenderer, RayPacketsEqualOneRayPerWorkItem) {
@@ -590,6 +603,7 @@ TEST(ProxyRenderer, RayPacketsEqualOneRayPerWorkItem) {
     ProxyRequest request;
     request.optical_depth = true;
     request.isovalues = {0.15, 0.3, 0.45, 0.6, 0.75};
+    request.first_hit_threshold = 0.3;
     request.transfer_function = TransferFunction(
         {{0.0, {0, 0, 1, 0}}, {0.1, {0, 0, 1, 0}}, {0.5, {0, 1, 0, 0.3}}, {1.0, {1, 0, 0, 0.8}}});
     const IntervalSet uniform = IntervalSet::uniform(0.0, max, 16);
@@ -613,6 +627,10 @@ TEST(ProxyRenderer, RayPacketsEqualOneRayPerWorkItem) {
         for (const IntervalSet* intervals : {&uniform, &uneven}) {
             for (const bool skip : {false, true}) {
                 for (const double stop : {1.0, 0.6}) {
+                    // Every other case captures a light field's whole-ray segment too.
+                    const bool segment = (compared % 2) == 1;
+                    request.segment_rgba = request.segment_depth = segment;
+                    request.first_hit_depth = segment;
                     request.intervals = *intervals;
                     request.skip_empty_space = skip;
                     request.march.early_termination_opacity = stop;

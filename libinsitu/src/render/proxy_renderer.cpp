@@ -315,9 +315,10 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     const double tilt = glm::radians(tilt_deg);
     const cl_float4 march = to_float4(step_world, request.march.early_termination_opacity,
                                       std::sin(tilt), std::cos(tilt));
-    // Whole volumes without segment outputs march in ray packets (ray_march.cl); light-field
-    // segments and blocks of a distributed run one ray per work-item.
-    const bool packets = request.march.ray_packets && !partial && !want_segments;
+    // Whole volumes march in ray packets (ray_march.cl) unless a light field splits its rays
+    // into segments; blocks of a distributed run march one ray per work-item.
+    const bool packets = request.march.ray_packets && !partial &&
+                         (!want_segments || request.segments == SegmentRule::whole_ray);
     device_->opencl().launch(
         packets ? state_->packet_kernel : state_->kernel,
         packets ? detail::packet_global_range(width, height)
