@@ -113,14 +113,14 @@ __kernel void render_volume_packets(__global const float* volume, int4 dims, flo
         const floatp x = rays.start_x + t * rays.direction_x;
         const floatp y = rays.start_y + t * rays.direction_y;
         const floatp z = rays.start_z + t * rays.direction_z;
-        const floatp sampled = packet_trilinear(volume, dims, x, y, z, active);
+        floatp gradient_x = 0.0f, gradient_y = 0.0f, gradient_z = 0.0f, magnitude = 0.0f;
+        const floatp sampled =
+            needs_gradient ? packet_sample_with_gradient(volume, dims, x, y, z, active, inv_spacing,
+                                                         &gradient_x, &gradient_y, &gradient_z)
+                           : packet_trilinear(volume, dims, x, y, z, active);
         const intp usable = active & ~isnan(sampled);  // NaN is empty space
         const floatp value = select((floatp)tf_domain.x, sampled, usable);
-
-        floatp gradient_x = 0.0f, gradient_y = 0.0f, gradient_z = 0.0f, magnitude = 0.0f;
         if (needs_gradient) {
-            packet_gradient(volume, dims, x, y, z, usable, inv_spacing, &gradient_x, &gradient_y,
-                            &gradient_z);
             magnitude =
                 sqrt(gradient_x * gradient_x + gradient_y * gradient_y + gradient_z * gradient_z);
             magnitude = select((floatp)0.0f, magnitude, isfinite(magnitude));
