@@ -278,35 +278,46 @@ inline MarchPacket march_packet(int gx, int gy, int2 size, float4 cam_position, 
     return packet;
 }
 
-// sample_trilinear() for a packet of positions. Lanes outside `active` sample the grid's first
-// cell (any in-grid address would do): their positions may be anything, and a gather must not
-// leave the buffer.
-inline floatp packet_trilinear(__global const float* volume, int4 dims, floatp x, floatp y,
-                               floatp z, intp active) {
+// The cell of a packet of sample positions (sample_trilinear's clamping and fractions) and its
+// eight corner values c_xyz, x, y, z in {0, 1}. Lanes outside `active` take the grid's first cell
+// (any in-grid address would do): their positions may be anything, and a gather must not leave
+// the buffer.
+typedef struct {
+    intp ix, iy, iz;
+    floatp fx, fy, fz;
+    floatp c000, c100, c010, c110, c001, c101, c011, c111;
+} PacketCell;
+
+// Lanes of a gather at the stencil offsets (x, y, z) of a cell: whole offsets into the buffer.
+#define AT(xo, yo, zo) GATHER(volume, (xo) + (yo) + (zo))
+
+inline PacketCell packet_cell(__global const float* volume, int4 dims, floatp x, floatp y, floatp z,
+                              intp active) {
+    PacketCell cell;
     const floatp px = clamp(select((floatp)0.0f, x, active), 0.0f, (float)(dims.x - 1));
     const floatp py = clamp(select((floatp)0.0f, y, active), 0.0f, (float)(dims.y - 1));
     const floatp pz = clamp(select((floatp)0.0f, z, active), 0.0f, (float)(dims.z - 1));
-    const intp ix = min(convert_intp(px), dims.x - 2);
-    const intp iy = min(convert_intp(py), dims.y - 2);
-    const intp iz = min(convert_intp(pz), dims.z - 2);
-    const floatp fx = px - convert_floatp(ix);
-    const floatp fy = py - convert_floatp(iy);
-    const floatp fz = pz - convert_floatp(iz);
-    const int stride_y = dims.x;
-    const int stride_z = dims.x * dims.y;
-    const intp c = iz * stride_z + iy * stride_y + ix;
-    const intp c_y = c + stride_y;
-    const intp c_z = c + stride_z;
-    const intp c_zy = c_z + stride_y;
-    const floatp c00 = mix(GATHER(volume, c), GATHER(volume, c + 1), fx);
-    const floatp c10 = mix(GATHER(volume, c_y), GATHER(volume, c_y + 1), fx);
-    const floatp c01 = mix(GATHER(volume, c_z), GATHER(volume, c_z + 1), fx);
-    const floatp c11 = mix(GATHER(volume, c_zy), GATHER(volume, c_zy + 1), fx);
-    return mix(mix(c00, c10, fy), mix(c01, c11, fy), fz);
+    cell.ix = min(convert_intp(px), dims.x - 2);
+    cell.iy = min(convert_intp(py), dims.y - 2);
+    cell.iz = min(convert_intp(pz), dims.z - 2);
+    cell.fx = px - convert_floatp(cell.ix);
+    cell.fy = py - convert_floatp(cell.iy);
+    cell.fz = pz - convert_floatp(cell.iz);
+    const intp x_0 = cell.ix, x_1 = x_0 + 1;
+    const intp y_0 = cell.iy * dims.x, y_1 = y_0 + dims.x;
+    const intp z_0 = cell.iz * (dims.x * dims.y), z_1 = z_0 + dims.x * dims.y;
+    cell.c000 = AT(x_0, y_0, z_0);
+    cell.c100 = AT(x_1, y_0, z_0);
+    cell.c010 = AT(x_0, y_1, z_0);
+    cell.c110 = AT(x_1, y_1, z_0);
+    cell.c001 = AT(x_0, y_0, z_1);
+    cell.c101 = AT(x_1, y_0, z_1);
+    cell.c011 = AT(x_0, y_1, z_1);
+    cell.c111 = AT(x_1, y_1, z_1);
+    return cell;
 }
 
-// Trilinear interpolation of one cell's corners c_xyz (x, y, z in {0, 1}) in sample_trilinear's
-// order of operations.
+// Trilinear interpolation of one cell's corners in sample_trilinear's order of operations.
 inline floatp packet_cell_trilinear(floatp c000, floatp c100, floatp c010, floatp c110, floatp c001,
                                     floatp c101, floatp c011, floatp c111, floatp fx, floatp fy,
                                     floatp fz) {
@@ -317,66 +328,68 @@ inline floatp packet_cell_trilinear(floatp c000, floatp c100, floatp c010, float
     return mix(mix(c00, c10, fy), mix(c01, c11, fy), fz);
 }
 
-// sample_trilinear() and gradient_central() together, for a packet. The six samples one voxel
-// to either side fall in the neighbouring cells with the same fractions, so they share the
-// sample's own eight corners and need only 24 more values (x, y or z at -1 and +2 around the
-// cell) instead of six full trilinear samples' 48. Clamping the neighbour's index to the grid
-// gives what clamping its position gives (a face value), so this is gradient_central's
-// definition, to rounding of the fractions.
-inline floatp packet_sample_with_gradient(__global const float* volume, int4 dims, floatp x,
-                                          floatp y, floatp z, intp active, float4 inv_spacing,
-                                          floatp* gx, floatp* gy, floatp* gz) {
-    const floatp px = clamp(select((floatp)0.0f, x, active), 0.0f, (float)(dims.x - 1));
-    const floatp py = clamp(select((floatp)0.0f, y, active), 0.0f, (float)(dims.y - 1));
-    const floatp pz = clamp(select((floatp)0.0f, z, active), 0.0f, (float)(dims.z - 1));
-    const intp ix = min(convert_intp(px), dims.x - 2);
-    const intp iy = min(convert_intp(py), dims.y - 2);
-    const intp iz = min(convert_intp(pz), dims.z - 2);
-    const floatp fx = px - convert_floatp(ix);
-    const floatp fy = py - convert_floatp(iy);
-    const floatp fz = pz - convert_floatp(iz);
+inline floatp packet_cell_value(const PacketCell* c) {
+    return packet_cell_trilinear(c->c000, c->c100, c->c010, c->c110, c->c001, c->c101, c->c011,
+                                 c->c111, c->fx, c->fy, c->fz);
+}
+
+// sample_trilinear() for a packet of positions.
+inline floatp packet_trilinear(__global const float* volume, int4 dims, floatp x, floatp y,
+                               floatp z, intp active) {
+    const PacketCell cell = packet_cell(volume, dims, x, y, z, active);
+    return packet_cell_value(&cell);
+}
+
+// gradient_central() at a packet's samples, from their cells. The six samples one voxel to
+// either side fall in the neighbouring cells with the same fractions, so they share the cell's
+// eight corners and need only 24 more values (x, y or z at -1 and +2 around the cell) instead of
+// six full trilinear samples' 48. Clamping the neighbour's index to the grid gives what clamping
+// its position gives (a face value), so this is gradient_central's definition, to rounding of
+// the fractions.
+inline void packet_cell_gradient(__global const float* volume, int4 dims, const PacketCell* c,
+                                 float4 inv_spacing, floatp* gx, floatp* gy, floatp* gz) {
     const int stride_y = dims.x;
     const int stride_z = dims.x * dims.y;
     // Row, column and slice offsets of the stencil: -1, 0, 1, 2 around the cell, clamped.
-    const intp x_m = max(ix - 1, 0), x_0 = ix, x_1 = ix + 1, x_2 = min(ix + 2, dims.x - 1);
-    const intp y_m = max(iy - 1, 0) * stride_y, y_0 = iy * stride_y, y_1 = y_0 + stride_y,
-               y_2 = min(iy + 2, dims.y - 1) * stride_y;
-    const intp z_m = max(iz - 1, 0) * stride_z, z_0 = iz * stride_z, z_1 = z_0 + stride_z,
-               z_2 = min(iz + 2, dims.z - 1) * stride_z;
-#define AT(xo, yo, zo) GATHER(volume, (xo) + (yo) + (zo))
-    const floatp c000 = AT(x_0, y_0, z_0), c100 = AT(x_1, y_0, z_0);
-    const floatp c010 = AT(x_0, y_1, z_0), c110 = AT(x_1, y_1, z_0);
-    const floatp c001 = AT(x_0, y_0, z_1), c101 = AT(x_1, y_0, z_1);
-    const floatp c011 = AT(x_0, y_1, z_1), c111 = AT(x_1, y_1, z_1);
-    const floatp value =
-        packet_cell_trilinear(c000, c100, c010, c110, c001, c101, c011, c111, fx, fy, fz);
+    const intp x_m = max(c->ix - 1, 0), x_0 = c->ix, x_1 = c->ix + 1,
+               x_2 = min(c->ix + 2, dims.x - 1);
+    const intp y_m = max(c->iy - 1, 0) * stride_y, y_0 = c->iy * stride_y, y_1 = y_0 + stride_y,
+               y_2 = min(c->iy + 2, dims.y - 1) * stride_y;
+    const intp z_m = max(c->iz - 1, 0) * stride_z, z_0 = c->iz * stride_z, z_1 = z_0 + stride_z,
+               z_2 = min(c->iz + 2, dims.z - 1) * stride_z;
+    const floatp fx = c->fx, fy = c->fy, fz = c->fz;
     // x: the cells at ix - 1 and ix + 1.
     const floatp xm00 = AT(x_m, y_0, z_0), xm10 = AT(x_m, y_1, z_0);
     const floatp xm01 = AT(x_m, y_0, z_1), xm11 = AT(x_m, y_1, z_1);
     const floatp x200 = AT(x_2, y_0, z_0), x210 = AT(x_2, y_1, z_0);
     const floatp x201 = AT(x_2, y_0, z_1), x211 = AT(x_2, y_1, z_1);
-    *gx = (packet_cell_trilinear(c100, x200, c110, x210, c101, x201, c111, x211, fx, fy, fz) -
-           packet_cell_trilinear(xm00, c000, xm10, c010, xm01, c001, xm11, c011, fx, fy, fz)) *
+    *gx = (packet_cell_trilinear(c->c100, x200, c->c110, x210, c->c101, x201, c->c111, x211, fx, fy,
+                                 fz) -
+           packet_cell_trilinear(xm00, c->c000, xm10, c->c010, xm01, c->c001, xm11, c->c011, fx, fy,
+                                 fz)) *
           (0.5f * inv_spacing.x);
     // y: the cells at iy - 1 and iy + 1.
     const floatp ym00 = AT(x_0, y_m, z_0), ym10 = AT(x_1, y_m, z_0);
     const floatp ym01 = AT(x_0, y_m, z_1), ym11 = AT(x_1, y_m, z_1);
     const floatp y200 = AT(x_0, y_2, z_0), y210 = AT(x_1, y_2, z_0);
     const floatp y201 = AT(x_0, y_2, z_1), y211 = AT(x_1, y_2, z_1);
-    *gy = (packet_cell_trilinear(c010, c110, y200, y210, c011, c111, y201, y211, fx, fy, fz) -
-           packet_cell_trilinear(ym00, ym10, c000, c100, ym01, ym11, c001, c101, fx, fy, fz)) *
+    *gy = (packet_cell_trilinear(c->c010, c->c110, y200, y210, c->c011, c->c111, y201, y211, fx, fy,
+                                 fz) -
+           packet_cell_trilinear(ym00, ym10, c->c000, c->c100, ym01, ym11, c->c001, c->c101, fx, fy,
+                                 fz)) *
           (0.5f * inv_spacing.y);
     // z: the cells at iz - 1 and iz + 1.
     const floatp zm00 = AT(x_0, y_0, z_m), zm10 = AT(x_1, y_0, z_m);
     const floatp zm01 = AT(x_0, y_1, z_m), zm11 = AT(x_1, y_1, z_m);
     const floatp z200 = AT(x_0, y_0, z_2), z210 = AT(x_1, y_0, z_2);
     const floatp z201 = AT(x_0, y_1, z_2), z211 = AT(x_1, y_1, z_2);
-#undef AT
-    *gz = (packet_cell_trilinear(c001, c101, c011, c111, z200, z210, z201, z211, fx, fy, fz) -
-           packet_cell_trilinear(zm00, zm10, zm01, zm11, c000, c100, c010, c110, fx, fy, fz)) *
+    *gz = (packet_cell_trilinear(c->c001, c->c101, c->c011, c->c111, z200, z210, z201, z211, fx, fy,
+                                 fz) -
+           packet_cell_trilinear(zm00, zm10, zm01, zm11, c->c000, c->c100, c->c010, c->c110, fx, fy,
+                                 fz)) *
           (0.5f * inv_spacing.z);
-    return value;
 }
+#undef AT
 
 // lookup_transfer() for a packet: colour and step-corrected opacity, bilinear in (value, gradient
 // magnitude). Values must not be NaN (callers replace them and mask their opacity).

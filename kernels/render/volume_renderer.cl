@@ -113,21 +113,31 @@ __kernel void render_volume_packets(__global const float* volume, int4 dims, flo
         const floatp x = rays.start_x + t * rays.direction_x;
         const floatp y = rays.start_y + t * rays.direction_y;
         const floatp z = rays.start_z + t * rays.direction_z;
-        floatp gradient_x = 0.0f, gradient_y = 0.0f, gradient_z = 0.0f, magnitude = 0.0f;
-        const floatp sampled =
-            needs_gradient ? packet_sample_with_gradient(volume, dims, x, y, z, active, inv_spacing,
-                                                         &gradient_x, &gradient_y, &gradient_z)
-                           : packet_trilinear(volume, dims, x, y, z, active);
+        const PacketCell cell = packet_cell(volume, dims, x, y, z, active);
+        const floatp sampled = packet_cell_value(&cell);
         const intp usable = active & ~isnan(sampled);  // NaN is empty space
         const floatp value = select((floatp)tf_domain.x, sampled, usable);
+        floatp gradient_x = 0.0f, gradient_y = 0.0f, gradient_z = 0.0f, magnitude = 0.0f;
+        floatp sample_red, sample_green, sample_blue, alpha;
+        // A 1D function classifies without the gradient: where no lane of the packet is opaque
+        // enough to be seen, shading needs none (transparent space costs what it does unshaded).
+        const bool classify_first = tf_bins.y == 1;
+        if (classify_first) {
+            packet_lookup_transfer(tf_table, tf_bins, tf_domain, value, 0.0f, &sample_red,
+                                   &sample_green, &sample_blue, &alpha);
+            if (!any(usable & (alpha > 0.0f))) continue;
+        }
         if (needs_gradient) {
+            packet_cell_gradient(volume, dims, &cell, inv_spacing, &gradient_x, &gradient_y,
+                                 &gradient_z);
             magnitude =
                 sqrt(gradient_x * gradient_x + gradient_y * gradient_y + gradient_z * gradient_z);
             magnitude = select((floatp)0.0f, magnitude, isfinite(magnitude));
         }
-        floatp sample_red, sample_green, sample_blue, alpha;
-        packet_lookup_transfer(tf_table, tf_bins, tf_domain, value, magnitude, &sample_red,
-                               &sample_green, &sample_blue, &alpha);
+        if (!classify_first) {
+            packet_lookup_transfer(tf_table, tf_bins, tf_domain, value, magnitude, &sample_red,
+                                   &sample_green, &sample_blue, &alpha);
+        }
         alpha = select((floatp)0.0f, alpha, usable & (alpha > 0.0f));
         const intp contributes = alpha > 0.0f;
         if (!any(contributes)) continue;
