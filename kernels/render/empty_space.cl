@@ -19,11 +19,13 @@ __kernel void block_ranges(__global const float* volume, int4 dims, int4 block_c
     float low = INFINITY;
     float high = -INFINITY;
     bool has_nan = false;
+    const int2 bricks = volume_bricks(dims);
     for (int k = k0; k <= k1; ++k) {
         for (int j = j0; j <= j1; ++j) {
-            __global const float* row = volume + ((size_t)k * dims.y + j) * dims.x;
+            __global const float* row = volume + volume_offset_y((uint)j, (uint)bricks.x) +
+                                        volume_offset_z((uint)k, (uint)bricks.x, (uint)bricks.y);
             for (int i = i0; i <= i1; ++i) {
-                const float v = row[i];
+                const float v = row[volume_offset_x((uint)i)];
                 has_nan = has_nan || isnan(v);
                 // fmin/fmax skip a NaN operand; has_nan overrides the range then anyway.
                 low = fmin(low, v);

@@ -2,10 +2,10 @@
 // (proxy_renderer.cl, seed 000), prepended to both families by ComputeDevice. Proxies must take
 // the samples the ground truth takes, so that Σ_j a_j = 1 − T and Σ_j c_j a_j equal its image;
 // both march with these functions instead of two copies that could drift apart.
-// Volumes are float32 buffers, x fastest (buffers, not image3d: image3d is emulated on PoCL and
-// several times slower). Coordinates named *_voxels are in grid units of the volume. Argument
-// groups arrive as the host packs them (libinsitu/src/device/kernel_args.hpp): camera_args(),
-// volume_args(), transfer_args().
+// Volumes are float32 buffers in bricks (volume_offset_* in common.cl; buffers, not image3d:
+// image3d is emulated on PoCL and several times slower). Coordinates named *_voxels are in grid
+// units of the volume. Argument groups arrive as the host packs them
+// (libinsitu/src/device/kernel_args.hpp): camera_args(), volume_args(), transfer_args().
 
 // Trilinear sample at a position in voxel coordinates, clamped to the grid. dims must be >= 2 on
 // every axis (the host checks). NaN samples propagate, which callers treat as empty space.
@@ -21,13 +21,16 @@ inline float sample_trilinear(__global const float* volume, int4 dims, float3 po
     const float fx = px - (float)ix;
     const float fy = py - (float)iy;
     const float fz = pz - (float)iz;
-    const uint stride_y = (uint)dims.x;
-    const uint stride_z = (uint)dims.x * (uint)dims.y;
-    __global const float* c = volume + ((uint)iz * stride_z + (uint)iy * stride_y + (uint)ix);
-    const float c00 = mix(c[0], c[1], fx);
-    const float c10 = mix(c[stride_y], c[stride_y + 1], fx);
-    const float c01 = mix(c[stride_z], c[stride_z + 1], fx);
-    const float c11 = mix(c[stride_z + stride_y], c[stride_z + stride_y + 1], fx);
+    const int2 bricks = volume_bricks(dims);
+    const uint x0 = volume_offset_x((uint)ix), x1 = volume_offset_x((uint)ix + 1);
+    const uint y0 = volume_offset_y((uint)iy, (uint)bricks.x);
+    const uint y1 = volume_offset_y((uint)iy + 1, (uint)bricks.x);
+    const uint z0 = volume_offset_z((uint)iz, (uint)bricks.x, (uint)bricks.y);
+    const uint z1 = volume_offset_z((uint)iz + 1, (uint)bricks.x, (uint)bricks.y);
+    const float c00 = mix(volume[x0 + y0 + z0], volume[x1 + y0 + z0], fx);
+    const float c10 = mix(volume[x0 + y1 + z0], volume[x1 + y1 + z0], fx);
+    const float c01 = mix(volume[x0 + y0 + z1], volume[x1 + y0 + z1], fx);
+    const float c11 = mix(volume[x0 + y1 + z1], volume[x1 + y1 + z1], fx);
     return mix(mix(c00, c10, fy), mix(c01, c11, fy), fz);
 }
 
@@ -303,9 +306,12 @@ inline PacketCell packet_cell(__global const float* volume, int4 dims, floatp x,
     cell.fx = px - convert_floatp(cell.ix);
     cell.fy = py - convert_floatp(cell.iy);
     cell.fz = pz - convert_floatp(cell.iz);
-    const intp x_0 = cell.ix, x_1 = x_0 + 1;
-    const intp y_0 = cell.iy * dims.x, y_1 = y_0 + dims.x;
-    const intp z_0 = cell.iz * (dims.x * dims.y), z_1 = z_0 + dims.x * dims.y;
+    const int2 bricks = volume_bricks(dims);
+    const intp x_0 = volume_offset_x(cell.ix), x_1 = volume_offset_x(cell.ix + 1);
+    const intp y_0 = volume_offset_y(cell.iy, bricks.x);
+    const intp y_1 = volume_offset_y(cell.iy + 1, bricks.x);
+    const intp z_0 = volume_offset_z(cell.iz, bricks.x, bricks.y);
+    const intp z_1 = volume_offset_z(cell.iz + 1, bricks.x, bricks.y);
     cell.c000 = AT(x_0, y_0, z_0);
     cell.c100 = AT(x_1, y_0, z_0);
     cell.c010 = AT(x_0, y_1, z_0);
@@ -348,15 +354,16 @@ inline floatp packet_trilinear(__global const float* volume, int4 dims, floatp x
 // the fractions.
 inline void packet_cell_gradient(__global const float* volume, int4 dims, const PacketCell* c,
                                  float4 inv_spacing, floatp* gx, floatp* gy, floatp* gz) {
-    const int stride_y = dims.x;
-    const int stride_z = dims.x * dims.y;
+    const int2 b = volume_bricks(dims);
     // Row, column and slice offsets of the stencil: -1, 0, 1, 2 around the cell, clamped.
-    const intp x_m = max(c->ix - 1, 0), x_0 = c->ix, x_1 = c->ix + 1,
-               x_2 = min(c->ix + 2, dims.x - 1);
-    const intp y_m = max(c->iy - 1, 0) * stride_y, y_0 = c->iy * stride_y, y_1 = y_0 + stride_y,
-               y_2 = min(c->iy + 2, dims.y - 1) * stride_y;
-    const intp z_m = max(c->iz - 1, 0) * stride_z, z_0 = c->iz * stride_z, z_1 = z_0 + stride_z,
-               z_2 = min(c->iz + 2, dims.z - 1) * stride_z;
+    const intp x_m = volume_offset_x(max(c->ix - 1, 0)), x_0 = volume_offset_x(c->ix),
+               x_1 = volume_offset_x(c->ix + 1), x_2 = volume_offset_x(min(c->ix + 2, dims.x - 1));
+    const intp y_m = volume_offset_y(max(c->iy - 1, 0), b.x), y_0 = volume_offset_y(c->iy, b.x),
+               y_1 = volume_offset_y(c->iy + 1, b.x),
+               y_2 = volume_offset_y(min(c->iy + 2, dims.y - 1), b.x);
+    const intp z_m = volume_offset_z(max(c->iz - 1, 0), b.x, b.y),
+               z_0 = volume_offset_z(c->iz, b.x, b.y), z_1 = volume_offset_z(c->iz + 1, b.x, b.y),
+               z_2 = volume_offset_z(min(c->iz + 2, dims.z - 1), b.x, b.y);
     const floatp fx = c->fx, fy = c->fy, fz = c->fz;
     // x: the cells at ix - 1 and ix + 1.
     const floatp xm00 = AT(x_m, y_0, z_0), xm10 = AT(x_m, y_1, z_0);

@@ -306,10 +306,10 @@ void OpenClDevice::ensure_buffer(cl::Buffer& buffer, std::size_t& capacity_bytes
     }
 }
 
-void OpenClDevice::upload(cl::Buffer& buffer, const void* host, std::size_t bytes,
-                          const char* what) {
+void OpenClDevice::upload(cl::Buffer& buffer, const void* host, std::size_t bytes, const char* what,
+                          std::size_t offset) {
     try {
-        queue_.enqueueWriteBuffer(buffer, CL_TRUE, 0, bytes, host);
+        queue_.enqueueWriteBuffer(buffer, CL_TRUE, offset, bytes, host);
     } catch (const cl::Error& error) {
         fail<ComputeError>("uploading ", what, " (", bytes,
                            " bytes): ", opencl_status_name(error.err()));

@@ -32,6 +32,14 @@ constexpr int kSegmentsWholeRay = static_cast<int>(SegmentRule::whole_ray);
 constexpr int kSegmentsLayers = static_cast<int>(SegmentRule::layers);
 constexpr int kSegmentsOpacity = static_cast<int>(SegmentRule::opacity);
 
+/// The device volume is stored in bricks of 2^kVolumeBrickShift samples a side (x fastest within
+/// a brick, bricks x fastest): a cell's eight corners then usually share one or two cache lines
+/// instead of four, which is what rays further apart than a voxel (coarse images of large
+/// volumes) pay for. Host upload (DeviceVolume::upload) and every kernel that reads the volume
+/// (volume_offset_* in kernels/device/common.cl) agree on it through this constant.
+constexpr int kVolumeBrickShift = 2;
+constexpr int kVolumeBrickSide = 1 << kVolumeBrickShift;
+
 struct KernelConstant {
     const char* name;  ///< the macro the kernels use
     int value;
@@ -39,7 +47,7 @@ struct KernelConstant {
 
 /// Every constant passed to the kernels. Private arrays are sized by the MAX_* limits, so they
 /// bound each work-item's private memory.
-inline constexpr std::array<KernelConstant, 16> kKernelConstants{{
+inline constexpr std::array<KernelConstant, 17> kKernelConstants{{
     {"MAX_LAYERS", kMaxLayers},        // depth layers per pass (layer_t[] in the proxy kernel)
     {"MAX_INTERVALS", kMaxIntervals},  // intensity intervals (a[] in colour model, edits)
     {"MAX_LIGHTS", kMaxLights},        // lights per relighting call (half_vectors[])
@@ -56,6 +64,7 @@ inline constexpr std::array<KernelConstant, 16> kKernelConstants{{
     {"SEGMENTS_WHOLE_RAY", kSegmentsWholeRay},
     {"SEGMENTS_LAYERS", kSegmentsLayers},
     {"SEGMENTS_OPACITY", kSegmentsOpacity},
+    {"VOLUME_BRICK_SHIFT", kVolumeBrickShift},
 }};
 
 // Archive channel names number intervals with two digits ("attenuation.a07").

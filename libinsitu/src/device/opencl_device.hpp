@@ -106,8 +106,10 @@ public:
     void ensure_buffer(cl::Buffer& buffer, std::size_t& capacity_bytes, std::size_t bytes,
                        cl_mem_flags flags);
 
-    /// Blocking copies that turn OpenCL failures into ComputeError naming `what`.
-    void upload(cl::Buffer& buffer, const void* host, std::size_t bytes, const char* what);
+    /// Blocking copies that turn OpenCL failures into ComputeError naming `what`; an upload
+    /// writes `bytes` at `offset` bytes into the buffer.
+    void upload(cl::Buffer& buffer, const void* host, std::size_t bytes, const char* what,
+                std::size_t offset = 0);
     void download(const cl::Buffer& buffer, void* host, std::size_t bytes, const char* what);
 
 private:

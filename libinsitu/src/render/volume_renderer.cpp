@@ -6,6 +6,7 @@
 #include <ostream>
 
 #include "device/kernel_args.hpp"
+#include "device/kernel_constants.hpp"
 #include "device/opencl_device.hpp"
 #include "insitu/error.hpp"
 
@@ -69,10 +70,40 @@ void DeviceVolume::upload(ComputeDevice& device, const Field& field) {
                               " samples exceed the 2^32 a device buffer index can address");
     }
     range = field.copy_interior_as_float(host_values);
-    const std::size_t bytes = host_values.size() * sizeof(float);
+    // Bricked on the way up, one slab of bricks (4 z-slices) at a time: the host holds the
+    // linear copy and one slab, not a second copy of the volume.
+    constexpr std::int64_t side = detail::kVolumeBrickSide;
+    const std::int64_t nx = field_dims[0], ny = field_dims[1], nz = field_dims[2];
+    const std::int64_t bricks_x = (nx + side - 1) / side, bricks_y = (ny + side - 1) / side;
+    const std::int64_t bricks_z = (nz + side - 1) / side;
+    const std::int64_t slab_samples = bricks_x * bricks_y * side * side * side;
+    device_samples = static_cast<std::uint64_t>(slab_samples * bricks_z);
+    if (device_samples > std::numeric_limits<std::uint32_t>::max()) {
+        fail<InvalidArgument>("field \"", field.name(), "\": ", device_samples,
+                              " samples in whole bricks exceed the 2^32 a device buffer index can "
+                              "address");
+    }
     if (!memory) memory = std::make_shared<detail::DeviceMemory>();
-    device.opencl().ensure_buffer(memory->buffer, memory->capacity, bytes, CL_MEM_READ_ONLY);
-    device.opencl().upload(memory->buffer, host_values.data(), bytes, "volume");
+    device.opencl().ensure_buffer(memory->buffer, memory->capacity, device_samples * sizeof(float),
+                                  CL_MEM_READ_ONLY);
+    std::vector<float> slab(static_cast<std::size_t>(slab_samples), 0.0f);
+    for (std::int64_t brick_z = 0; brick_z < bricks_z; ++brick_z) {
+        for (std::int64_t z = brick_z * side; z < std::min(nz, (brick_z + 1) * side); ++z) {
+            for (std::int64_t y = 0; y < ny; ++y) {
+                const float* row = host_values.data() + (z * ny + y) * nx;
+                // The offset of (0, y, z) within the slab, then per x the brick and position.
+                float* out = slab.data() + (y / side) * bricks_x * side * side * side +
+                             (z % side) * side * side + (y % side) * side;
+                // A brick's row holds `side` consecutive x samples: copied as one run.
+                for (std::int64_t x0 = 0; x0 < nx; x0 += side) {
+                    std::copy_n(row + x0, std::min(side, nx - x0), out);
+                    out += side * side * side;
+                }
+            }
+        }
+        device.opencl().upload(memory->buffer, slab.data(), slab.size() * sizeof(float), "volume",
+                               static_cast<std::size_t>(brick_z * slab_samples) * sizeof(float));
+    }
     dims = field_dims;
     origin = field.first_sample();  // the renderers sample nodes: a cell's is its centre
     spacing = field.spacing();
@@ -157,7 +188,7 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
     const cl_float4 phong_parameters =
         to_float4(phong.ambient, phong.diffuse, phong.specular, phong.shininess);
 
-    if (settings.ray_packets && !volume_.region) {
+    if (settings.ray_packets && !volume_.region && volume_.packets_addressable()) {
         opencl.launch(state_->packet_kernel, detail::packet_global_range(width, height),
                       detail::packet_local_range(), detail::volume_args(volume_),
                       detail::transfer_args(state_->table.buffer, table),

@@ -90,8 +90,9 @@ struct MarchRegion {
 };
 std::ostream& operator<<(std::ostream& out, const MarchRegion& region);
 
-/// A field's interior resident on the device as float32, x fastest. Re-uploading a field that
-/// fits reuses the buffer, so successive timesteps allocate nothing.
+/// A field's interior resident on the device as float32, in bricks of 4^3 samples (x fastest in
+/// a brick, bricks x fastest: libinsitu/src/device/kernel_constants.hpp, kVolumeBrickShift).
+/// Re-uploading a field that fits reuses the buffer, so successive timesteps allocate nothing.
 struct DeviceVolume {
     /// The device copy (opaque here: defined in libinsitu/src/device/opencl_device.hpp).
     std::shared_ptr<detail::DeviceMemory> memory;
@@ -100,8 +101,13 @@ struct DeviceVolume {
     glm::dvec3 spacing{1.0};
     Bounds bounds;
     ValueRange range;
-    /// The host copy that was uploaded (kept: histograms and interval choices read it).
+    /// The host copy that was uploaded, x fastest (kept: histograms and interval choices read
+    /// it).
     std::vector<float> host_values;
+    /// Samples the device buffer holds: dims padded to whole bricks.
+    std::uint64_t device_samples = 0;
+    /// Whether ray packets can address the buffer: their gathers take 32-bit signed offsets.
+    bool packets_addressable() const { return device_samples <= 2147483647u; }
     /// Incremented by every upload, so derived data (block ranges) knows when it is stale.
     std::uint64_t generation = 0;
     /// Set after an upload when the volume is a block of a larger grid; an upload clears it.
