@@ -1,8 +1,10 @@
 // insitu_evaluate_vtk: the peer comparison of bench/evaluate. The same field, view and transfer
 // function rendered in one run by VTK's CPU ray caster (vtkFixedPointVolumeRayCastMapper,
-// off-screen), by our ground-truth renderer, and as all proxies of the camera (single- and
-// multi-perspective passes): ms per frame for each, and the PSNR between VTK's image and ours
-// (a sanity check of our ground truth). Writes peer.csv; measures and prints, asserts nothing.
+// off-screen), by our ground-truth renderer (unshaded and shaded), and as all proxies of the
+// camera (single- and multi-perspective passes): ms per frame for each, best of R rounds that run
+// every renderer once (so that their ratios meet the same load), with median and slowest, the
+// counted samples of each camera, and the PSNR between VTK's image and ours (a sanity check of
+// our ground truth). Writes peer.csv; measures and prints, asserts nothing.
 //
 //   insitu_evaluate_vtk --out DIR [--size N] [--image P] [--repeats R]
 //
@@ -39,11 +41,12 @@
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/metrics.hpp"
 #include "median_time.hpp"
+#include "sample_count.hpp"
 
 namespace {
 
 using namespace insitu;
-using bench::median_ms;
+using bench::Timing;
 namespace fs = std::filesystem;
 
 struct Options {
@@ -114,18 +117,21 @@ int main(int argc, char** argv) {
         const Bounds& bounds = proxies.volume().bounds;
         const Camera camera = Camera::orbit(view, bounds);
         RenderSettings settings;
+        RenderSettings shaded = settings;
+        shaded.shading = true;
         Rendering ours;
-        const double ours_ms = median_ms(
-            options.repeats, [&] { ours = proxies.render_ground_truth(camera, tf, settings); });
         ProxyRequest request;
         request.isovalues = {0.3, 0.45, 0.6, 0.75};
         request.intervals = proxies.choose_intervals(16, IntervalMode::uniform);
         request.transfer_function = tf;
-        const double single_ms =
-            median_ms(options.repeats, [&] { proxies.render(camera, request); });
         const DistortionCamera distortion = DistortionCamera::orbit(view, bounds, 45.0);
-        const double multi_ms =
-            median_ms(options.repeats, [&] { proxies.render(distortion, request); });
+        // Samples along the rays of each camera (rays that stop early count their whole span):
+        // the multi-perspective camera's tilted rays cross more of the volume.
+        const double step_world = proxies.volume().step_world(settings.step_voxels);
+        const double camera_samples = static_cast<double>(
+            bench::samples_per_frame(camera, options.image, options.image, bounds, step_world));
+        const double distortion_samples = static_cast<double>(
+            bench::samples_per_frame(distortion, options.image, options.image, bounds, step_world));
 
         // VTK: the same samples, transfer function and camera.
         vtkNew<vtkImageData> image;
@@ -177,7 +183,20 @@ int main(int argc, char** argv) {
         vtk_camera->SetViewUp(camera.up().x, camera.up().y, camera.up().z);
         vtk_camera->SetParallelScale(camera.half_height());
         vtk_camera->SetClippingRange(0.01 * camera.orbit_radius(), 4.0 * camera.orbit_radius());
-        const double vtk_ms = median_ms(options.repeats, [&] { window->Render(); });
+        // Every renderer once per round, best of the rounds (issue 13: best of three).
+        const std::vector<Timing> timings = bench::interleaved_timings(
+            options.repeats, {[&] { window->Render(); },
+                              [&] { ours = proxies.render_ground_truth(camera, tf, settings); },
+                              [&] { proxies.render_ground_truth(camera, tf, shaded); },
+                              [&] { proxies.render(camera, request); },
+                              [&] { proxies.render(distortion, request); }});
+        const Timing& vtk = timings[0];
+        const Timing& ground_truth = timings[1];
+        const Timing& ground_truth_shaded = timings[2];
+        const Timing& single = timings[3];
+        const Timing& multi = timings[4];
+        const Timing all = {single.best + multi.best, single.median + multi.median,
+                            single.worst + multi.worst};
 
         // VTK's pixels: RGB over black, bottom row first; ours: premultiplied RGBA, top first.
         unsigned char* rgb = window->GetPixelData(0, 0, options.image - 1, options.image - 1, 0);
@@ -200,22 +219,36 @@ int main(int argc, char** argv) {
         write_png((fs::path(options.out) / "peer_ours.png").string(), ours_opaque);
 
         std::ofstream csv(fs::path(options.out) / "peer.csv");
-        csv << "renderer,volume_n,image,ms_per_frame\n";
-        const std::pair<const char*, double> rows[] = {{"vtk_fixed_point", vtk_ms},
-                                                       {"ours_ground_truth", ours_ms},
-                                                       {"ours_proxies_single", single_ms},
-                                                       {"ours_proxies_multi", multi_ms},
-                                                       {"ours_proxies_all", single_ms + multi_ms}};
-        for (const auto& [name, ms] : rows) {
-            csv << name << ',' << n << ',' << options.image << ',' << ms << '\n';
+        // ms_per_frame is the best of the rounds; samples are the camera's counted samples.
+        csv << "renderer,volume_n,image,ms_per_frame,ms_median,ms_max,samples\n";
+        struct Row {
+            const char* name;
+            const Timing& timing;
+            double samples;
+        };
+        const Row rows[] = {{"vtk_fixed_point", vtk, camera_samples},
+                            {"ours_ground_truth", ground_truth, camera_samples},
+                            {"ours_ground_truth_shaded", ground_truth_shaded, camera_samples},
+                            {"ours_proxies_single", single, camera_samples},
+                            {"ours_proxies_multi", multi, distortion_samples},
+                            {"ours_proxies_all", all, camera_samples + distortion_samples}};
+        for (const Row& row : rows) {
+            csv << row.name << ',' << n << ',' << options.image << ',' << row.timing.best << ','
+                << row.timing.median << ',' << row.timing.worst << ',' << row.samples << '\n';
         }
         std::ofstream accuracy(fs::path(options.out) / "peer_accuracy.csv");
         accuracy << "psnr_ours_vs_vtk,ssim_ours_vs_vtk\n" << psnr << ',' << ssim << '\n';
         std::printf(
-            "peer: %lld^3, %d^2: VTK fixed point %.1f ms, ours %.1f ms (PSNR %.2f dB vs "
-            "VTK), proxies single %.1f + multi %.1f = %.1f ms (%.2fx VTK)\n",
-            static_cast<long long>(n), options.image, vtk_ms, ours_ms, psnr, single_ms, multi_ms,
-            single_ms + multi_ms, (single_ms + multi_ms) / vtk_ms);
+            "peer: %lld^3, %d^2, best of %d (median): VTK fixed point %.1f ms (%.1f); ours %.1f "
+            "(%.1f) = %.2fx VTK, shaded %.1f (%.1f) = %.2fx unshaded (PSNR %.2f dB vs VTK); "
+            "proxies single %.1f (%.1f) = %.2fx VTK, multi %.1f (%.1f) = %.2f ns/sample vs %.2f "
+            "single\n",
+            static_cast<long long>(n), options.image, options.repeats, vtk.best, vtk.median,
+            ground_truth.best, ground_truth.median, ground_truth.best / vtk.best,
+            ground_truth_shaded.best, ground_truth_shaded.median,
+            ground_truth_shaded.best / ground_truth.best, psnr, single.best, single.median,
+            single.best / vtk.best, multi.best, multi.median, 1e6 * multi.best / distortion_samples,
+            1e6 * single.best / camera_samples);
     } catch (const std::exception& error) {
         std::fprintf(stderr, "insitu_evaluate_vtk: %s\n", error.what());
         return 1;

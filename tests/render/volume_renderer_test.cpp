@@ -158,6 +158,11 @@ SampledVolume blobs() {
     return make_gaussian_blobs({32, 28, 36}, 6, 11);
 }
 
+// Sides that are not multiples of the device volume's 4^3 bricks: the last bricks are partial.
+SampledVolume blobs_partial_bricks() {
+    return make_gaussian_blobs({31, 26, 37}, 6, 11);
+}
+
 TransferFunction blobs_tf() {
     return TransferFunction({point(0.15, 0.0f, 0.0f, 0.0f, 0.0f),
                              point(0.4, 0.9f, 0.6f, 0.1f, 0.3f),
@@ -203,6 +208,7 @@ const std::vector<Scene>& scenes() {
         {"shells", shells, shells_tf},
         {"shells_anisotropic", shells_anisotropic, shells_tf},
         {"blobs", blobs, blobs_tf},
+        {"blobs_partial_bricks", blobs_partial_bricks, blobs_tf},
         {"blobs_anisotropic", blobs_anisotropic, blobs_tf},
         {"blobs_2d_tf", blobs, blobs_2d_tf},
         {"blobs_anisotropic_2d_tf", blobs_anisotropic, blobs_2d_tf},
