@@ -353,10 +353,11 @@ PacketDifference packet_difference(const Rendering& packets, const Rendering& ra
 // Both forms compute the same float operations per ray; the compiler may contract a*b+c into
 // one fma in one form and not in the other, so positions differ by a float rounding, which a
 // steep transfer function magnifies (measured over these cases: at most 1.3e-5 in a channel, on
-// the Marschner-Lobb peak; never a depth mask). Shading adds the 16-wide sqrt, division and pow
-// (PoCL's vector maths library, a few ulp from the scalar ones), and pow(n.l, shininess)
-// multiplies n.l's relative error by the shininess: measured at most 1.8e-4 in a specular
-// highlight, still well inside the reference tolerance above.
+// the Marschner-Lobb peak; never a depth mask). Shading adds the 16-wide sqrt and division, the
+// specular power as exp2(w log2 n.l) where render_volume calls pow, and the normal of a faint
+// gradient magnifies the fractions' rounding (the neighbours' cells are shared here, sampled
+// apart there): measured at most 1.8e-4 in a specular highlight, still well inside the
+// reference tolerance above.
 constexpr double kPacketRgbaTolerance = 5e-5;
 constexpr double kPacketShadedRgbaTolerance = 5e-4;
 constexpr double kPacketDepthToleranceWorld = 1e-4;
