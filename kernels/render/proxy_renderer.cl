@@ -417,9 +417,8 @@ __kernel void render_proxies_packets(
         const floatp t = rays.t_near + (convert_floatp(sample) + 0.5f) * step;
         const intp active = marching & (t < rays.t_far);
         if (!any(active)) break;
-        const floatp x = rays.start_x + t * rays.direction_x;
-        const floatp y = rays.start_y + t * rays.direction_y;
-        const floatp z = rays.start_z + t * rays.direction_z;
+        floatp x, y, z;
+        packet_position(&rays, t, &x, &y, &z);
         const floatp sampled = packet_trilinear(volume, dims, x, y, z, active);
         const intp usable = active & ~isnan(sampled);
         const floatp value = select((floatp)tf_domain.x, sampled, usable);
@@ -483,10 +482,9 @@ __kernel void render_proxies_packets(
             const intp look_up = usable & ~done & (t >= next_block_t);
             if (any(look_up)) {
                 const float bs = (float)block_size;
-                const floatp px = x, py = y, pz = z;
-                const intp bx = clamp(convert_intp(floor(px / bs)), 0, block_counts.x - 1);
-                const intp by = clamp(convert_intp(floor(py / bs)), 0, block_counts.y - 1);
-                const intp bz = clamp(convert_intp(floor(pz / bs)), 0, block_counts.z - 1);
+                const intp bx = clamp(convert_intp(floor(x / bs)), 0, block_counts.x - 1);
+                const intp by = clamp(convert_intp(floor(y / bs)), 0, block_counts.y - 1);
+                const intp bz = clamp(convert_intp(floor(z / bs)), 0, block_counts.z - 1);
                 const floatp exit_x = convert_floatp(bx * block_size) +
                                       select((floatp)0.0f, (floatp)bs, rays.direction_x > 0.0f);
                 const floatp exit_y = convert_floatp(by * block_size) +

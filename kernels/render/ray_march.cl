@@ -281,6 +281,13 @@ inline MarchPacket march_packet(int gx, int gy, int2 size, float4 cam_position, 
     return packet;
 }
 
+// sample_position_voxels() for a packet: the lanes' positions at their t, in the buffer's voxels.
+inline void packet_position(const MarchPacket* rays, floatp t, floatp* x, floatp* y, floatp* z) {
+    *x = rays->start_x + t * rays->direction_x;
+    *y = rays->start_y + t * rays->direction_y;
+    *z = rays->start_z + t * rays->direction_z;
+}
+
 // The cell of a packet of sample positions (sample_trilinear's clamping and fractions) and its
 // eight corner values c_xyz, x, y, z in {0, 1}. Lanes outside `active` take the grid's first cell
 // (any in-grid address would do): their positions may be anything, and a gather must not leave

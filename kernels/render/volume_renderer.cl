@@ -120,9 +120,8 @@ __kernel void render_volume_packets(__global const float* volume, int4 dims, flo
         const floatp t = rays.t_near + ((float)i + 0.5f) * step;
         const intp active = marching & (t < rays.t_far);
         if (!any(active)) break;
-        const floatp x = rays.start_x + t * rays.direction_x;
-        const floatp y = rays.start_y + t * rays.direction_y;
-        const floatp z = rays.start_z + t * rays.direction_z;
+        floatp x, y, z;
+        packet_position(&rays, t, &x, &y, &z);
         const PacketCell cell = packet_cell(volume, dims, x, y, z, active);
         const floatp sampled = packet_cell_value(&cell);
         const intp usable = active & ~isnan(sampled);  // NaN is empty space
