@@ -77,12 +77,13 @@ void DeviceVolume::upload(ComputeDevice& device, const Field& field) {
     const std::int64_t bricks_x = (nx + side - 1) / side, bricks_y = (ny + side - 1) / side;
     const std::int64_t bricks_z = (nz + side - 1) / side;
     const std::int64_t slab_samples = bricks_x * bricks_y * side * side * side;
-    device_samples = static_cast<std::uint64_t>(slab_samples * bricks_z);
-    if (device_samples > std::numeric_limits<std::uint32_t>::max()) {
-        fail<InvalidArgument>("field \"", field.name(), "\": ", device_samples,
+    const auto padded_samples = static_cast<std::uint64_t>(slab_samples * bricks_z);
+    if (padded_samples > std::numeric_limits<std::uint32_t>::max()) {
+        fail<InvalidArgument>("field \"", field.name(), "\": ", padded_samples,
                               " samples in whole bricks exceed the 2^32 a device buffer index can "
                               "address");
     }
+    device_samples = padded_samples;
     if (!memory) memory = std::make_shared<detail::DeviceMemory>();
     device.opencl().ensure_buffer(memory->buffer, memory->capacity, device_samples * sizeof(float),
                                   CL_MEM_READ_ONLY);
