@@ -58,6 +58,10 @@ public:
     cl::Context& context() { return context_; }
     cl::CommandQueue& queue() { return queue_; }
     const cl::Device& device() const { return device_; }
+    /// Whether the device is a CPU (PoCL's pthread device, the default). Ray packets pay there,
+    /// where a work-group's work-items run one after another; a GPU runs work-items in SIMD lanes
+    /// of its own, and 16 rays per work-item would only cut its parallelism.
+    bool is_cpu() const { return (device_.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0; }
 
     /// A kernel from the embedded source of `family` (kernels/<stage>/<family>.cl), building that
     /// family on first use with the shared constants of device/kernel_constants.hpp as -D options.

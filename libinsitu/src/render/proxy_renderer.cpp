@@ -318,6 +318,7 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     // Whole volumes march in ray packets (ray_march.cl) unless a light field splits its rays
     // into segments; blocks of a distributed run march one ray per work-item.
     const bool packets = request.march.ray_packets && !partial && volume.packets_addressable() &&
+                         device_->opencl().is_cpu() &&
                          (!want_segments || request.segments == SegmentRule::whole_ray);
     device_->opencl().launch(
         packets ? state_->packet_kernel : state_->kernel,
