@@ -151,6 +151,9 @@ void check_blocks_composite_to_whole(const SampledVolume& volume, const std::vec
     const DistortionCamera distortion = DistortionCamera::orbit(view, grid.bounds, tilt_deg);
     const ProxyFrame whole =
         multi ? renderer.render(distortion, request) : renderer.render(camera, request);
+    // The whole grid marches in ray packets, the blocks one ray per work-item: the composite
+    // checks the two forms against each other too.
+    EXPECT_TRUE(renderer.last_pass_in_packets());
     RenderSettings exact;
     exact.early_termination_opacity = 1.0;
     const Rendering whole_truth =
@@ -163,6 +166,7 @@ void check_blocks_composite_to_whole(const SampledVolume& volume, const std::vec
         renderer.set_region(grid.region(static_cast<int>(r)));
         partials.push_back(multi ? renderer.render(distortion, request)
                                  : renderer.render(camera, request));
+        EXPECT_FALSE(renderer.last_pass_in_packets());
         if (skipped != nullptr) *skipped = std::max(*skipped, renderer.last_skippable_fraction());
         truths.push_back(renderer.render_ground_truth(camera, *request.transfer_function, exact));
     }

@@ -638,8 +638,10 @@ TEST(ProxyRenderer, RayPacketsEqualOneRayPerWorkItem) {
                                                       << ", skip " << skip << ", stop " << stop);
                     request.march.ray_packets = false;
                     const ProxyFrame rays = render();
+                    EXPECT_FALSE(renderer.last_pass_in_packets());
                     request.march.ray_packets = true;
                     const ProxyFrame packets = render();
+                    EXPECT_TRUE(renderer.last_pass_in_packets());
                     expect_packets_match(packets, rays);
                     // Something to compare: crossings found, opacity accumulated, blocks skipped.
                     const Image& front = rays.depth_layers[1];

@@ -368,8 +368,11 @@ void expect_packets_match_rays(const Field& field, const Camera& camera, const T
     renderer.upload(field);
     settings.ray_packets = true;
     const Rendering packets = renderer.render(camera, tf, settings);
+    // PoCL's CPU device (the tests' device) takes packets; otherwise this compares rays to rays.
+    EXPECT_TRUE(renderer.last_render_in_packets());
     settings.ray_packets = false;
     const Rendering rays = renderer.render(camera, tf, settings);
+    EXPECT_FALSE(renderer.last_render_in_packets());
     double coverage = 0.0;
     for (std::size_t p = 0; p < rays.rgba.pixel_count(); ++p)
         coverage += rays.rgba.pixels[p * 4 + 3];

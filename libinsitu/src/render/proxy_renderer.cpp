@@ -320,6 +320,7 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     const bool packets = request.march.ray_packets && !partial && volume.packets_addressable() &&
                          device_->opencl().is_cpu() &&
                          (!want_segments || request.segments == SegmentRule::whole_ray);
+    last_pass_in_packets_ = packets;
     device_->opencl().launch(
         packets ? state_->packet_kernel : state_->kernel,
         packets ? detail::packet_global_range(width, height)

@@ -189,8 +189,9 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
     const cl_float4 phong_parameters =
         to_float4(phong.ambient, phong.diffuse, phong.specular, phong.shininess);
 
-    if (settings.ray_packets && !volume_.region && volume_.packets_addressable() &&
-        opencl.is_cpu()) {
+    last_render_in_packets_ =
+        settings.ray_packets && !volume_.region && volume_.packets_addressable() && opencl.is_cpu();
+    if (last_render_in_packets_) {
         opencl.launch(state_->packet_kernel, detail::packet_global_range(width, height),
                       detail::packet_local_range(), detail::volume_args(volume_),
                       detail::transfer_args(state_->table.buffer, table),

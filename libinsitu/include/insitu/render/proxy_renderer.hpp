@@ -145,6 +145,9 @@ public:
 
     /// Fraction of blocks the last pass was allowed to skip (0 when skipping was off).
     double last_skippable_fraction() const { return last_skippable_fraction_; }
+    /// Whether the last proxy pass marched ray packets (RenderSettings::ray_packets in
+    /// ProxyRequest::march) or one ray per work-item.
+    bool last_pass_in_packets() const { return last_pass_in_packets_; }
 
 private:
     ProxyFrame march(const Camera& camera, double tilt_deg, bool multi_perspective,
@@ -157,6 +160,7 @@ private:
     struct DeviceState;
     std::unique_ptr<DeviceState> state_;
     double last_skippable_fraction_ = 0.0;
+    bool last_pass_in_packets_ = false;
 };
 
 /// Throws InvalidArgument naming what is missing or out of range in `request`.

@@ -150,10 +150,14 @@ public:
     std::size_t volume_capacity_bytes() const { return volume_.capacity_bytes(); }
     const DeviceVolume& volume() const { return volume_; }
     const std::shared_ptr<ComputeDevice>& device() const { return device_; }
+    /// Whether the last render marched ray packets (RenderSettings::ray_packets) or one ray per
+    /// work-item.
+    bool last_render_in_packets() const { return last_render_in_packets_; }
 
 private:
     std::shared_ptr<ComputeDevice> device_;
     DeviceVolume volume_;
+    bool last_render_in_packets_ = false;
     /// Kernel and reused device buffers (libinsitu/src/render/volume_renderer.cpp).
     struct DeviceState;
     std::unique_ptr<DeviceState> state_;
