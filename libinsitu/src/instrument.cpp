@@ -236,6 +236,11 @@ struct Instrument::Impl {
     /// failure that repeats every step does not flood the simulation's stderr.
     void record_error(const std::string& message, ErrorKind kind, bool from_writer) {
         std::lock_guard<std::mutex> lock(mutex);
+        record_error_locked(message, kind, from_writer);
+    }
+    /// record_error() with `mutex` held: a writer failure is counted, described and made the
+    /// run's status in one critical section, so no caller can see the count without the status.
+    void record_error_locked(const std::string& message, ErrorKind kind, bool from_writer) {
         ++statistics.errors;
         if (first_error.empty()) first_error = message;
         last_error = message;
@@ -862,9 +867,6 @@ void Instrument::Impl::writer_loop() {
             seconds = seconds_since(start);
         }  // the record's images are freed here, before the queue reports room
 
-        if (!failure.empty())
-            record_error("writing step " + std::to_string(step) + ": " + failure,
-                         classify(failure_exception), /*from_writer=*/true);
         {
             std::lock_guard<std::mutex> lock(mutex);
             --writing;
@@ -873,6 +875,10 @@ void Instrument::Impl::writer_loop() {
                 ++statistics.steps_written;
                 statistics.bytes_written += bytes;
             } else {
+                // Counted and made the status together: a distributed run tells every rank of
+                // write_failures at the next step, and must find it once the error is counted.
+                record_error_locked("writing step " + std::to_string(step) + ": " + failure,
+                                    classify(failure_exception), /*from_writer=*/true);
                 write_failure = failure_exception;
                 ++write_failures;
             }
