@@ -14,7 +14,7 @@
 // beside the unshaded ground truth of the same frame.
 // Per point: ms per frame, best of --repeats frames after one warm-up, with the median and the
 // maximum (a shared machine is noisy: the best shows what a quiet one does, the spread how noisy
-// it was; the points of a group are timed in interleaved rounds, see time_interleaved),
+// it was; the points of a group are timed in interleaved rounds, see bench::interleaved_timings),
 // the samples counted on the host with the renderers' rule (sample_count.hpp), M samples/s and ns
 // per sample. Before the runs it states a machine model (loads and instructions per sample,
 // counted from the kernels; hardware threads, clock, SIMD width) and its bounds in M samples/s,
@@ -40,6 +40,7 @@
 #include "insitu/device/compute_device.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
+#include "median_time.hpp"
 #include "sample_count.hpp"
 
 namespace {
@@ -412,49 +413,8 @@ void print_machine(const Machine& machine, const std::string& device) {
 
 // --- timing ----------------------------------------------------------------------------------
 
-struct Timing {
-    bool skipped = false;
-    double warmup_ms = 0.0;
-    double best_ms = 0.0;
-    double median_ms = 0.0;
-    double max_ms = 0.0;
-};
-
-double ms_since(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-/// The frames of a group of points timed in rounds: one warm-up frame of each (kernel build,
-/// buffers), then `repeats` rounds of one timed frame of each, so that a burst of load on the
-/// shared machine falls on every point of the group alike rather than on one. A point whose
-/// warm-up frame takes longer than `max_frame_s` is skipped.
-std::vector<Timing> time_interleaved(int repeats, double max_frame_s,
-                                     const std::vector<std::function<void()>>& frames) {
-    std::vector<Timing> timings(frames.size());
-    for (std::size_t f = 0; f < frames.size(); ++f) {
-        const auto warm = Clock::now();
-        frames[f]();
-        timings[f].warmup_ms = ms_since(warm);
-        timings[f].skipped = timings[f].warmup_ms > max_frame_s * 1e3;
-    }
-    std::vector<std::vector<double>> times(frames.size());
-    for (int r = 0; r < repeats; ++r) {
-        for (std::size_t f = 0; f < frames.size(); ++f) {
-            if (timings[f].skipped) continue;
-            const auto start = Clock::now();
-            frames[f]();
-            times[f].push_back(ms_since(start));
-        }
-    }
-    for (std::size_t f = 0; f < frames.size(); ++f) {
-        if (timings[f].skipped) continue;
-        std::sort(times[f].begin(), times[f].end());
-        timings[f].best_ms = times[f].front();
-        timings[f].median_ms = times[f][times[f].size() / 2];
-        timings[f].max_ms = times[f].back();
-    }
-    return timings;
-}
+using bench::ms_since;
+using bench::Timing;
 
 // --- the sweeps ------------------------------------------------------------------------------
 
@@ -471,7 +431,7 @@ struct Point {
 };
 
 double msamples_per_s(const Point& p) {
-    return static_cast<double>(p.samples) / (p.timing.best_ms * 1e3);
+    return static_cast<double>(p.samples) / (p.timing.best * 1e3);
 }
 
 void print_header() {
@@ -484,12 +444,12 @@ void print_point(const Point& p) {
     std::printf("%-12s %-15s %6d %5d %3d %3d %11llu", p.sweep.c_str(), p.pass.c_str(), p.volume,
                 p.image, p.intervals, p.layers, static_cast<unsigned long long>(p.samples));
     if (p.timing.skipped) {
-        std::printf("  skipped: the warm-up frame took %.1f s\n", p.timing.warmup_ms / 1e3);
+        std::printf("  skipped: the warm-up frame took %.1f s\n", p.timing.warmup / 1e3);
     } else {
         const double rate = msamples_per_s(p);
-        std::printf(" %9.1f %9.1f %9.1f %8.1f %7.2f %6.0f%% %5.0f%%\n", p.timing.best_ms,
-                    p.timing.median_ms, p.timing.max_ms, rate,
-                    p.timing.best_ms * 1e6 / static_cast<double>(p.samples),
+        std::printf(" %9.1f %9.1f %9.1f %8.1f %7.2f %6.0f%% %5.0f%%\n", p.timing.best,
+                    p.timing.median, p.timing.worst, rate,
+                    p.timing.best * 1e6 / static_cast<double>(p.samples),
                     100.0 * rate / p.bound.scalar, 100.0 * rate / p.bound.simd);
     }
     std::fflush(stdout);
@@ -596,7 +556,7 @@ private:
         points_.push_back(std::move(p));
     }
 
-    /// Points measured together (time_interleaved) and their frames.
+    /// Points measured together (bench::interleaved_timings) and their frames.
     struct Group {
         std::vector<Point> points;
         std::vector<std::function<void()>> frames;
@@ -611,7 +571,7 @@ private:
 
     std::vector<Point> measure(Group group) {
         const std::vector<Timing> timings =
-            time_interleaved(options_.repeats, options_.max_frame_s, group.frames);
+            bench::interleaved_timings(options_.repeats, group.frames, options_.max_frame_s * 1e3);
         for (std::size_t i = 0; i < group.points.size(); ++i) {
             group.points[i].timing = timings[i];
             record(group.points[i]);
@@ -718,9 +678,9 @@ void write_csv(const std::string& path, const std::vector<Point>& points) {
         char line[256];
         std::snprintf(line, sizeof line, "%s,%s,%d,%d,%d,%d,%llu,%.3f,%.3f,%.3f,%.3f,%.4f\n",
                       p.sweep.c_str(), p.pass.c_str(), p.volume, p.image, p.intervals, p.layers,
-                      static_cast<unsigned long long>(p.samples), p.timing.best_ms,
-                      p.timing.median_ms, p.timing.max_ms, msamples_per_s(p),
-                      p.timing.best_ms * 1e6 / static_cast<double>(p.samples));
+                      static_cast<unsigned long long>(p.samples), p.timing.best, p.timing.median,
+                      p.timing.worst, msamples_per_s(p),
+                      p.timing.best * 1e6 / static_cast<double>(p.samples));
         out << line;
     }
     if (!out.flush()) throw IoError("cannot write " + path);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -34,31 +35,44 @@ inline double median_ms(int repeats, const std::function<void()>& run) {
 }
 
 /// Best, median and slowest of repeated timings (ms): the best is what a quiet machine does, the
-/// spread says how noisy this one was.
+/// spread says how noisy this one was. `skipped`: the warm-up run took longer than allowed, and
+/// the run was not timed.
 struct Timing {
     double best = 0.0;
     double median = 0.0;
     double worst = 0.0;
+    double warmup = 0.0;
+    bool skipped = false;
 };
 
 /// Times each of `runs` `repeats` (>= 1) times after one untimed warm-up each, interleaved round
 /// by round, so that every run meets the same mix of load on a shared machine and their ratios
-/// compare like with like.
-inline std::vector<Timing> interleaved_timings(int repeats,
-                                               const std::vector<std::function<void()>>& runs) {
+/// compare like with like. A run whose warm-up takes longer than `max_warmup_ms` is skipped.
+inline std::vector<Timing> interleaved_timings(
+    int repeats, const std::vector<std::function<void()>>& runs,
+    double max_warmup_ms = std::numeric_limits<double>::infinity()) {
+    std::vector<Timing> timings(runs.size());
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+        const auto start = std::chrono::steady_clock::now();
+        runs[i]();
+        timings[i].warmup = ms_since(start);
+        timings[i].skipped = timings[i].warmup > max_warmup_ms;
+    }
     std::vector<std::vector<double>> times(runs.size());
-    for (const auto& run : runs) run();
     for (int r = 0; r < std::max(1, repeats); ++r) {
         for (std::size_t i = 0; i < runs.size(); ++i) {
+            if (timings[i].skipped) continue;
             const auto start = std::chrono::steady_clock::now();
             runs[i]();
             times[i].push_back(ms_since(start));
         }
     }
-    std::vector<Timing> timings;
-    for (std::vector<double>& t : times) {
-        std::sort(t.begin(), t.end());
-        timings.push_back({t.front(), t[t.size() / 2], t.back()});
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+        if (timings[i].skipped) continue;
+        std::sort(times[i].begin(), times[i].end());
+        timings[i].best = times[i].front();
+        timings[i].median = times[i][times[i].size() / 2];
+        timings[i].worst = times[i].back();
     }
     return timings;
 }
