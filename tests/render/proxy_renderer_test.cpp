@@ -14,6 +14,7 @@
 
 #include "insitu/error.hpp"
 #include "insitu/testing/analytic_fields.hpp"
+#include "support/image_agreement.hpp"
 
 namespace insitu {
 namespace {
@@ -520,29 +521,8 @@ TEST(ProxyRenderer, EmptySpaceSkippingIsExact) {
     }
 }
 
-// Largest difference between two images of the same shape, with +inf == +inf, and how many
-// values are finite in one and not in the other.
-struct ImageAgreement {
-    double max_difference = 0.0;
-    std::size_t finiteness_mismatches = 0;
-};
-
-ImageAgreement agreement(const Image& a, const Image& b) {
-    ImageAgreement result;
-    EXPECT_EQ(a.pixels.size(), b.pixels.size());
-    for (std::size_t i = 0; i < std::min(a.pixels.size(), b.pixels.size()); ++i) {
-        const float x = a.pixels[i];
-        const float y = b.pixels[i];
-        if (std::isfinite(x) != std::isfinite(y)) {
-            ++result.finiteness_mismatches;
-        } else if (std::isfinite(x)) {
-            result.max_difference = std::max(result.max_difference, std::abs(double(x) - y));
-        } else {
-            EXPECT_EQ(x, y) << "non-finite values differ at " << i;
-        }
-    }
-    return result;
-}
+using testing::agreement;
+using testing::ImageAgreement;
 
 // Packets compute each ray's samples with the same float operations: on PoCL (LLVM 15,
 // AVX-512) every output measured bit-identical to one ray per work-item. The tolerances leave

@@ -21,6 +21,7 @@
 #include "insitu/error.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/reference_renderer.hpp"
+#include "support/image_agreement.hpp"
 
 namespace insitu {
 namespace {
@@ -323,33 +324,6 @@ INSTANTIATE_TEST_SUITE_P(VolumeRenderer, MatchesReference, ::testing::ValuesIn(r
 
 // --- (a') Ray packets against one ray per work-item -------------------------------------------
 
-// Largest difference of any channel or finite depth; -1 where one depth is finite and the other
-// not (a sample classified differently).
-struct PacketDifference {
-    double max_rgba = 0.0;
-    double max_depth = 0.0;
-    std::size_t depth_mask_mismatches = 0;
-};
-
-PacketDifference packet_difference(const Rendering& packets, const Rendering& rays) {
-    PacketDifference difference;
-    for (std::size_t i = 0; i < rays.rgba.pixels.size(); ++i) {
-        difference.max_rgba =
-            std::max(difference.max_rgba,
-                     std::abs(static_cast<double>(packets.rgba.pixels[i]) - rays.rgba.pixels[i]));
-    }
-    for (std::size_t p = 0; p < rays.depth.pixels.size(); ++p) {
-        const float a = packets.depth.pixels[p];
-        const float b = rays.depth.pixels[p];
-        if (std::isfinite(a) != std::isfinite(b)) {
-            ++difference.depth_mask_mismatches;
-        } else if (std::isfinite(a)) {
-            difference.max_depth = std::max(difference.max_depth, std::abs(double(a) - b));
-        }
-    }
-    return difference;
-}
-
 // Both forms compute the same float operations per ray; the compiler may contract a*b+c into
 // one fma in one form and not in the other, so positions differ by a float rounding, which a
 // steep transfer function magnifies (measured over these cases: at most 1.3e-5 in a channel, on
@@ -377,12 +351,14 @@ void expect_packets_match_rays(const Field& field, const Camera& camera, const T
     for (std::size_t p = 0; p < rays.rgba.pixel_count(); ++p)
         coverage += rays.rgba.pixels[p * 4 + 3];
     EXPECT_GT(coverage, 0.0) << "nothing rendered: the comparison proves nothing";
-    const PacketDifference difference = packet_difference(packets, rays);
-    ::testing::Test::RecordProperty("max_rgba_difference", std::to_string(difference.max_rgba));
-    EXPECT_LE(difference.max_rgba,
+    const testing::ImageAgreement rgba = testing::agreement(packets.rgba, rays.rgba);
+    const testing::ImageAgreement depth = testing::agreement(packets.depth, rays.depth);
+    ::testing::Test::RecordProperty("max_rgba_difference", std::to_string(rgba.max_difference));
+    EXPECT_EQ(rgba.finiteness_mismatches, 0u);
+    EXPECT_LE(rgba.max_difference,
               settings.shading ? kPacketShadedRgbaTolerance : kPacketRgbaTolerance);
-    EXPECT_LE(difference.max_depth, kPacketDepthToleranceWorld);
-    EXPECT_EQ(difference.depth_mask_mismatches, 0u);
+    EXPECT_LE(depth.max_difference, kPacketDepthToleranceWorld);
+    EXPECT_EQ(depth.finiteness_mismatches, 0u);
 }
 
 class PacketsMatchRays : public ::testing::TestWithParam<ReferenceCase> {};
