@@ -143,6 +143,7 @@ OpenClDevice::OpenClDevice(const std::string& selector) {
         platform_ = choice.platform;
         device_ = choice.device;
         description_ = describe(platform_, device_);
+        is_cpu_ = (device_.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
         context_ = cl::Context(device_);
         queue_ = cl::CommandQueue(context_, device_);
     } catch (const cl::Error& error) {

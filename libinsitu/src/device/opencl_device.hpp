@@ -61,7 +61,7 @@ public:
     /// Whether the device is a CPU (PoCL's pthread device, the default). Ray packets pay there,
     /// where a work-group's work-items run one after another; a GPU runs work-items in SIMD lanes
     /// of its own, and 16 rays per work-item would only cut its parallelism.
-    bool is_cpu() const { return (device_.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0; }
+    bool is_cpu() const { return is_cpu_; }
 
     /// A kernel from the embedded source of `family` (kernels/<stage>/<family>.cl), building that
     /// family on first use with the shared constants of device/kernel_constants.hpp as -D options.
@@ -140,6 +140,7 @@ private:
     cl::Context context_;
     cl::CommandQueue queue_;
     std::string description_;
+    bool is_cpu_ = false;  ///< asked once: every pass consults it
     bool synchronous_launches_ = false;
     std::mutex program_mutex_;
     std::mutex launch_mutex_;
