@@ -65,13 +65,8 @@ void DeviceVolume::upload(ComputeDevice& device, const Field& field) {
                                   " interior samples (volume rendering needs >= 2)");
         }
     }
-    if (field.sample_count() > std::numeric_limits<std::uint32_t>::max()) {
-        fail<InvalidArgument>("field \"", field.name(), "\": ", field.sample_count(),
-                              " samples exceed the 2^32 a device buffer index can address");
-    }
-    range = field.copy_interior_as_float(host_values);
-    // Bricked on the way up, one slab of bricks (4 z-slices) at a time: the host holds the
-    // linear copy and one slab, not a second copy of the volume.
+    // The device stores whole bricks (x fastest in a brick, bricks x fastest), so the padded
+    // count is what a buffer index must reach.
     constexpr std::int64_t side = detail::kVolumeBrickSide;
     const std::int64_t nx = field_dims[0], ny = field_dims[1], nz = field_dims[2];
     const std::int64_t bricks_x = (nx + side - 1) / side, bricks_y = (ny + side - 1) / side;
@@ -79,10 +74,14 @@ void DeviceVolume::upload(ComputeDevice& device, const Field& field) {
     const std::int64_t slab_samples = bricks_x * bricks_y * side * side * side;
     const auto padded_samples = static_cast<std::uint64_t>(slab_samples * bricks_z);
     if (padded_samples > std::numeric_limits<std::uint32_t>::max()) {
-        fail<InvalidArgument>("field \"", field.name(), "\": ", padded_samples,
-                              " samples in whole bricks exceed the 2^32 a device buffer index can "
+        fail<InvalidArgument>("field \"", field.name(), "\": ", field.sample_count(), " samples (",
+                              padded_samples,
+                              " in whole bricks) exceed the 2^32 a device buffer index can "
                               "address");
     }
+    range = field.copy_interior_as_float(host_values);
+    // Bricked on the way up, one slab of bricks (4 z-slices) at a time: the host holds the
+    // linear copy and one slab, not a second copy of the volume.
     device_samples = padded_samples;
     if (!memory) memory = std::make_shared<detail::DeviceMemory>();
     device.opencl().ensure_buffer(memory->buffer, memory->capacity, device_samples * sizeof(float),
