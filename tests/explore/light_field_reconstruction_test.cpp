@@ -390,6 +390,36 @@ TEST_F(LightFieldReconstruction, MissingCamerasLowerTheConfidenceWhereTheyWereUs
     EXPECT_LT(used_reduced / used, 0.7 * used_full / used);
 }
 
+TEST_F(LightFieldReconstruction, ACameraThatSeesOnlyASurfaceTheRayPassesByAddsNothingToIt) {
+    Scenes& s = *scenes_;
+    // Camera 3's depth replaced by a phantom surface just in front of its eye everywhere: every
+    // target ray lies behind it from camera 3, never crosses it, and passes it by. Camera 3 then
+    // holds nothing of any ray, so the reconstruction is the one without camera 3 at all: the
+    // other cameras' colour, attenuation and depth, not a blend that mixes in black.
+    constexpr int kPhantom = 3;
+    LightField phantom = s.ball_42;
+    for (LightFieldImages& images : phantom.cameras) {
+        if (images.camera != kPhantom) continue;
+        for (float& fraction : images.depth.pixels) fraction = 0.02f;
+    }
+    const Camera& source = s.ball_42.rig.camera(kPhantom);
+    const Camera target = target_view(s.ball_bounds(), source.azimuth_deg() + 7.0,
+                                      source.elevation_deg() - 5.0, Projection::orthographic, 64);
+    const auto with_phantom = reconstruct_light_field(phantom, target, {});
+    const auto dropped = reconstruct_light_field(without(s.ball_42, {kPhantom}), target, {});
+    ASSERT_GT(with_phantom.attenuation.channels, 0);
+    EXPECT_LE(evaluation::max_abs_error(with_phantom.rgba, dropped.rgba), 1e-6);
+    EXPECT_LE(evaluation::max_abs_error(with_phantom.attenuation, dropped.attenuation), 1e-6);
+    // ... and the phantom camera was used: the full light field differs where camera 3 is.
+    const auto full = reconstruct_light_field(s.ball_42, target, {});
+    EXPECT_GT(evaluation::max_abs_error(full.rgba, dropped.rgba), 1e-3);
+    double covered = 0.0;
+    for (std::size_t p = 0; p < with_phantom.rgba.pixel_count(); ++p) {
+        covered += with_phantom.rgba.pixels[4 * p + 3] > 0.5f;
+    }
+    EXPECT_GT(covered, 0.1 * static_cast<double>(with_phantom.rgba.pixel_count()));
+}
+
 TEST_F(LightFieldReconstruction, SegmentOpacityScaleZeroRemovesASegmentAndOneChangesNothing) {
     Scenes& s = *scenes_;
     // Two segments of 42 cameras at 64^2: a faint film (the ball at 5% opacity) in front, the

@@ -13,9 +13,11 @@
 //     surface; a larger jump is an occluding edge seen from that camera, and the march goes on.
 //     The camera's RGBA is read (bilinear) where it sees the hit. A camera that recorded no hit
 //     along the ray is read where it sees the ray's point nearest the centre, unless it recorded
-//     a first hit there: that surface is one the ray passes by, and the camera adds nothing;
-//  3. the cameras' samples are blended with their weights (cameras the light field lacks drop
-//     out and the weights renormalise; a camera of weight 0 is not wanted, so never missing);
+//     a first hit there: that surface is one the ray passes by, and the camera holds nothing
+//     of this ray;
+//  3. per segment, the samples of the cameras that hold something of the ray are blended with
+//     their weights renormalised over them (cameras the light field lacks drop out the same
+//     way; a camera of weight 0 is not wanted, so never missing); no such camera: empty;
 //     segments are composited front to back ("over"), segment s with its opacity scaled:
 //     A' = 1 - (1 - A)^scale, colour scaled by A' / A (by the scale where A = 0);
 //  4. attenuation light fields: a_j read the same way at the whole-ray first hit, blended, and
