@@ -378,10 +378,13 @@ __kernel void render_proxies_packets(
     const bool want_optical_depth = (wanted & WANT_OPTICAL_DEPTH) != 0;
     const bool accumulate =
         (wanted & WANT_ATTENUATION) != 0 || want_mean_depth || want_optical_depth;
-    // Segments here are only the whole ray (the host sends other rules to render_proxies): one
-    // segment composited from T = 1, which is the ray itself, so its depth is the first hit.
+    // Segments here are the whole ray or opacity thresholds (the host sends layer segments to
+    // render_proxies). The whole ray is one segment composited from T = 1, the ray itself, so
+    // its depth is the first hit; opacity segments are composited on their own beside the ray,
+    // whose opacity says where each starts, as in render_proxies.
     const bool want_segments =
         (wanted & (WANT_SEGMENT_RGBA | WANT_SEGMENT_DEPTH | WANT_FIRST_HIT_DEPTH)) != 0;
+    const bool opacity_segments = want_segments && segment_rule == SEGMENTS_OPACITY;
 
     const MarchPacket rays = march_packet(gx, gy, size, cam_position, cam_forward, cam_right,
                                           cam_up, cam_half_extent, sin_tilt, cos_tilt, origin_world,
@@ -408,6 +411,11 @@ __kernel void render_proxies_packets(
     intp compositing = want_segments ? (intp)(-1) : (intp)(0);
     floatp red = 0.0f, green = 0.0f, blue = 0.0f, ray_transmittance = 1.0f;
     floatp first_hit = INFINITY;
+    // Opacity segments: each lane's segment and its own colour, T and depth.
+    intp segment = 0;
+    intp compositing_segment = opacity_segments ? (intp)(-1) : (intp)(0);
+    floatp segment_red = 0.0f, segment_green = 0.0f, segment_blue = 0.0f;
+    floatp segment_transmittance = 1.0f, segment_depth = INFINITY;
     floatp previous_value = NAN;
     floatp previous_t = 0.0f;
     floatp next_block_t = -INFINITY;
@@ -440,7 +448,43 @@ __kernel void render_proxies_packets(
         previous_value = select((floatp)NAN, value, usable);
         previous_t = select(previous_t, t, usable);
 
-        const intp classify = usable & (accumulating | compositing);
+        if (opacity_segments) {
+            // The segment of this sample: as many thresholds as the ray's opacity before it has
+            // reached (ascending, so a lane moved past threshold s is then tested against s + 1).
+            intp sample_segment = segment;
+            for (int s = 0; s + 1 < segment_count; ++s) {
+                sample_segment -= usable & (sample_segment == s) &
+                                  (1.0f - ray_transmittance >= segment_thresholds[s]);
+            }
+            const intp starts = sample_segment != segment;
+            if (any(starts)) {
+                for (int lane = 0; lane < PACKET_LANES; ++lane) {
+                    if (!LANE_INT(starts, lane)) continue;
+                    const int2 pixel_xy = packet_pixel(gx, gy, lane);
+                    const int pixel = pixel_xy.y * size.x + pixel_xy.x;
+                    const int from = LANE_INT(segment, lane);
+                    store_segment(wanted, segment_rgba_out, segment_depth_out,
+                                  from * pixel_count + pixel,
+                                  (float3)(LANE(segment_red, lane), LANE(segment_green, lane),
+                                           LANE(segment_blue, lane)),
+                                  LANE(segment_transmittance, lane), LANE(segment_depth, lane));
+                    // Segments passed over at once (thresholds reached by one sample) stay empty.
+                    for (int s = from + 1; s < LANE_INT(sample_segment, lane); ++s) {
+                        store_segment(wanted, segment_rgba_out, segment_depth_out,
+                                      s * pixel_count + pixel, (float3)(0.0f), 1.0f, INFINITY);
+                    }
+                }
+                segment = select(segment, sample_segment, starts);
+                segment_red = select(segment_red, (floatp)0.0f, starts);
+                segment_green = select(segment_green, (floatp)0.0f, starts);
+                segment_blue = select(segment_blue, (floatp)0.0f, starts);
+                segment_transmittance = select(segment_transmittance, (floatp)1.0f, starts);
+                segment_depth = select(segment_depth, (floatp)INFINITY, starts);
+                compositing_segment |= starts;
+            }
+        }
+
+        const intp classify = usable & (accumulating | compositing | compositing_segment);
         if (any(classify)) {
             floatp sample_red, sample_green, sample_blue, alpha;
             packet_lookup_transfer(tf_table, tf_bins, tf_domain, value, 0.0f, &sample_red,
@@ -470,8 +514,29 @@ __kernel void render_proxies_packets(
                     composites & isinf(first_hit) & (1.0f - ray_transmittance >= depth_threshold));
                 compositing &= ~(composites & (1.0f - ray_transmittance >= stop_opacity));
             }
+            const intp segment_composites = usable & compositing_segment & (alpha > 0.0f);
+            if (any(segment_composites)) {
+                const floatp a = select((floatp)0.0f, alpha, segment_composites);
+                const floatp weight = segment_transmittance * a;  // absorb()
+                segment_transmittance *= 1.0f - a;
+                segment_red += weight * sample_red;
+                segment_green += weight * sample_green;
+                segment_blue += weight * sample_blue;
+                segment_depth = select(segment_depth, depth,
+                                       segment_composites & isinf(segment_depth) &
+                                           (1.0f - segment_transmittance >= depth_threshold));
+                compositing_segment &=
+                    ~(segment_composites & (1.0f - segment_transmittance >= stop_opacity));
+            }
         }
-        intp done = ~accumulating & ~compositing;
+        intp done = ~accumulating & ~compositing & ~compositing_segment;
+        if (opacity_segments) {
+            // Both finished, a lane still waits for its next segment where the (now fixed) ray
+            // opacity has reached that segment's threshold.
+            for (int s = 0; s + 1 < segment_count; ++s) {
+                done &= ~((segment == s) & (1.0f - ray_transmittance >= segment_thresholds[s]));
+            }
+        }
         if (want_layers) done &= layers_found == layer_count;
         marching &= ~(usable & done);
 
@@ -529,11 +594,25 @@ __kernel void render_proxies_packets(
                 }
             }
         }
-        if ((wanted & WANT_SEGMENT_RGBA) != 0) {
-            segment_rgba_out[pixel] = (float4)(LANE(red, lane), LANE(green, lane), LANE(blue, lane),
-                                               1.0f - LANE(ray_transmittance, lane));
+        if (opacity_segments) {
+            const int last = LANE_INT(segment, lane);
+            store_segment(wanted, segment_rgba_out, segment_depth_out, last * pixel_count + pixel,
+                          (float3)(LANE(segment_red, lane), LANE(segment_green, lane),
+                                   LANE(segment_blue, lane)),
+                          LANE(segment_transmittance, lane), LANE(segment_depth, lane));
+            for (int s = last + 1; s < segment_count; ++s) {
+                store_segment(wanted, segment_rgba_out, segment_depth_out, s * pixel_count + pixel,
+                              (float3)(0.0f), 1.0f, INFINITY);
+            }
+        } else {
+            if ((wanted & WANT_SEGMENT_RGBA) != 0) {
+                segment_rgba_out[pixel] =
+                    (float4)(LANE(red, lane), LANE(green, lane), LANE(blue, lane),
+                             1.0f - LANE(ray_transmittance, lane));
+            }
+            if ((wanted & WANT_SEGMENT_DEPTH) != 0)
+                segment_depth_out[pixel] = LANE(first_hit, lane);
         }
-        if ((wanted & WANT_SEGMENT_DEPTH) != 0) segment_depth_out[pixel] = LANE(first_hit, lane);
         if ((wanted & WANT_FIRST_HIT_DEPTH) != 0) first_hit_out[pixel] = LANE(first_hit, lane);
         if (want_mean_depth) {
             const int base = pixel * interval_count;

@@ -607,21 +607,32 @@ TEST(ProxyRenderer, RayPacketsEqualOneRayPerWorkItem) {
         for (const IntervalSet* intervals : {&uniform, &uneven}) {
             for (const bool skip : {false, true}) {
                 for (const double stop : {1.0, 0.6}) {
-                    // Every other case captures a light field's whole-ray segment too.
-                    const bool segment = (compared % 2) == 1;
-                    request.segment_rgba = request.segment_depth = segment;
-                    request.first_hit_depth = segment;
+                    // Cases capture no segments, a light field's whole ray, or its opacity
+                    // segments in turn: two thresholds, or three whose first two one sample can
+                    // pass at once (the segment between stays empty).
+                    const int kind = compared % 3;
+                    request.segment_rgba = request.segment_depth = kind > 0;
+                    request.first_hit_depth = kind > 0;
+                    request.segments = kind == 2 ? SegmentRule::opacity : SegmentRule::whole_ray;
+                    request.segment_thresholds.clear();
+                    if (kind == 2) {
+                        request.segment_thresholds = compared % 2 == 0
+                                                         ? std::vector<double>{0.25, 0.5}
+                                                         : std::vector<double>{0.3, 0.31, 0.7};
+                    }
                     request.intervals = *intervals;
                     request.skip_empty_space = skip;
                     request.march.early_termination_opacity = stop;
                     SCOPED_TRACE(::testing::Message() << "tilt " << tilt << ", " << *intervals
                                                       << ", skip " << skip << ", stop " << stop);
-                    request.march.ray_packets = false;
-                    const ProxyFrame rays = render();
-                    EXPECT_FALSE(renderer.last_pass_in_packets());
+                    // Packets first: the renderer reuses its output buffers, and a pixel the
+                    // packets left unwritten would otherwise still hold the rays' value.
                     request.march.ray_packets = true;
                     const ProxyFrame packets = render();
                     EXPECT_TRUE(renderer.last_pass_in_packets());
+                    request.march.ray_packets = false;
+                    const ProxyFrame rays = render();
+                    EXPECT_FALSE(renderer.last_pass_in_packets());
                     expect_packets_match(packets, rays);
                     // Something to compare: crossings found, opacity accumulated, blocks skipped.
                     const Image& front = rays.depth_layers[1];

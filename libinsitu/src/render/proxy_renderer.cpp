@@ -316,10 +316,10 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     const cl_float4 march = to_float4(step_world, request.march.early_termination_opacity,
                                       std::sin(tilt), std::cos(tilt));
     // Whole volumes march in ray packets (ray_march.cl) unless a light field splits its rays
-    // into segments; blocks of a distributed run march one ray per work-item.
+    // at the layers' crossings; blocks of a distributed run march one ray per work-item.
     const bool packets = request.march.ray_packets && !partial && volume.packets_addressable() &&
                          device_->opencl().is_cpu() &&
-                         (!want_segments || request.segments == SegmentRule::whole_ray);
+                         (!want_segments || request.segments != SegmentRule::layers);
     last_pass_in_packets_ = packets;
     device_->opencl().launch(
         packets ? state_->packet_kernel : state_->kernel,
