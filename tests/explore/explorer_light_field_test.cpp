@@ -286,6 +286,27 @@ TEST_F(ExplorerLightField, MissingCamerasAreReconstructedFromTheRestAndSaidSo) {
     }
     EXPECT_LT(partial_confidence, 0.9 * complete_confidence);
     for (const float value : partial.colour.pixels) ASSERT_TRUE(std::isfinite(value));
+
+    // auto fills exactly the pixels the partial light field knows nothing of (no camera: empty,
+    // confidence 0) from the view's proxies, and keeps every other pixel of the light field.
+    request.source = ProxySource::automatic;
+    const ExploreFrame fused = explorer.render(request);
+    request.source = ProxySource::single;
+    const ExploreFrame single = explorer.render(request);
+    std::size_t filled = 0;
+    for (std::size_t p = 0; p < fused.confidence.pixels.size(); ++p) {
+        const bool unknown =
+            partial.confidence.pixels[p] == 0.0f && partial.colour.pixels[4 * p + 3] == 0.0f;
+        const bool from_proxies = unknown && single.confidence.pixels[p] > 0.0f;
+        const ExploreFrame& source = from_proxies ? single : partial;
+        filled += from_proxies && single.colour.pixels[4 * p + 3] > 0.0f;
+        for (int c = 0; c < 4; ++c) {
+            ASSERT_EQ(fused.colour.pixels[4 * p + c], source.colour.pixels[4 * p + c])
+                << "pixel " << p;
+        }
+    }
+    EXPECT_GT(filled, 0u);
+    EXPECT_LT(fused.light_field_share, 1.0);
 }
 
 TEST_F(ExplorerLightField, AskingForALightFieldTheArchiveLacksNamesIt) {

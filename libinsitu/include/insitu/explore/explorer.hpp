@@ -50,9 +50,10 @@ ColourSource parse_colour_source(const std::string& text);
 
 /// Which stored proxies a frame is made from. "auto": the stored view's single-perspective
 /// proxies at the stored view (exact); for other views, where the step also holds a light field
-/// of the view's field, the light-field reconstruction and the view's proxies fused per pixel by
-/// confidence (the light field keeps every pixel of confidence >= 0.1; the view's proxies fill in
-/// below that where they are more confident); otherwise the single-perspective proxies
+/// of the view's field, the light-field reconstruction and the view's proxies fused per pixel
+/// (the light field keeps every pixel it knows anything of; the view's proxies fill in where it
+/// has no camera: empty with confidence 0, and they have some); otherwise the single-perspective
+/// proxies
 /// when the archive has them (measured ahead of the multi-perspective ones for every rotation;
 /// bench/RESULTS.md), else the multi-perspective ones. "lightfield": the light field only
 /// (insitu/explore/light_field_reconstruction.hpp).
