@@ -63,6 +63,35 @@ foreach(suite IN ITEMS browser api)
                        TIMEOUT 120)
 endforeach()
 
+# The browser's own frames (WebGL2 through chromium's SwiftShader): an archive with a light field
+# of 42 cameras at 128^2 beside the stored view's proxies, at steps 300 and 600 of a 40^3 run
+# (half the image covered by then; about 2 s); webgl.test.mjs compares the
+# canvas with `insitu-view render --source lightfield` and checks the fallback without WebGL2.
+set(viewer_lf_archive ${viewer_work}/viewer_lf.cdb)
+set(viewer_lf_config ${CMAKE_CURRENT_BINARY_DIR}/viewer_lf_config.json)
+file(WRITE ${viewer_lf_config} [=[
+{"fields": ["v"],
+ "views": [{"azimuth": 30, "elevation": 20, "size": [160, 160]}],
+ "transfer_function": {"points": [[0.0, 0.1, 0.25, 0.75, 0.0], [0.12, 0.1, 0.25, 0.75, 0.0],
+                                  [0.2, 0.15, 0.55, 0.9, 0.04], [0.28, 0.35, 0.85, 0.7, 0.1],
+                                  [0.36, 0.95, 0.8, 0.3, 0.22], [0.45, 1.0, 0.4, 0.15, 0.4]],
+                       "unit_length": 1.0},
+ "intervals": {"count": 8},
+ "light_field": {"cameras": 42, "size": 128, "attenuation": false},
+ "every": 300}
+]=])
+add_test(NAME viewer.setup_lf_archive
+         COMMAND gray-scott --size 40 --steps 600 --config ${viewer_lf_config} --out ${viewer_lf_archive})
+set_tests_properties(viewer.setup_lf_archive PROPERTIES
+                     FIXTURES_REQUIRED viewer_work FIXTURES_SETUP viewer_lf_archive TIMEOUT 120)
+add_test(NAME viewer.webgl
+         COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/webgl.test.mjs
+         WORKING_DIRECTORY ${viewer_tests_dir})
+set_tests_properties(viewer.webgl PROPERTIES
+                     FIXTURES_REQUIRED viewer_lf_archive
+                     ENVIRONMENT "INSITU_VIEW=$<TARGET_FILE:insitu-view>;ARCHIVE=${viewer_lf_archive};WORK_DIR=${viewer_work}"
+                     TIMEOUT 180)
+
 # serve's command line: exit 2 and one line on stderr for bad arguments or archives.
 function(viewer_serve_case name exit_status stream text)
   string(JOIN "|" command $<TARGET_FILE:insitu-view> serve ${ARGN})

@@ -7,6 +7,7 @@
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <array>
@@ -39,6 +40,7 @@
 #include "insitu/explore/explorer.hpp"
 #include "insitu/explore/transfer_function_edit.hpp"
 #include "insitu/explore/trust.hpp"
+#include "light_field_payload.hpp"
 
 namespace insitu::viewer {
 
@@ -84,6 +86,40 @@ constexpr int kReadTimeoutSeconds = 5;
 constexpr int kWriteTimeoutSeconds = 10;
 constexpr int kKeepAliveTimeoutSeconds = 2;
 constexpr std::size_t kMaxStepInfos = 64;
+/// Light-field payloads kept in memory: the step shown and the ones a scrubbing page prefetches.
+constexpr std::size_t kMaxLightFieldPayloads = 4;
+
+/// Content type of a page file, from its name's extension.
+std::string web_content_type(const std::string& name) {
+    const auto ends_with = [&](const char* suffix) {
+        const std::string tail = suffix;
+        return name.size() >= tail.size() &&
+               name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
+    };
+    if (ends_with(".html")) return "text/html; charset=utf-8";
+    if (ends_with(".js")) return "text/javascript; charset=utf-8";
+    if (ends_with(".css")) return "text/css; charset=utf-8";
+    return "text/plain; charset=utf-8";  // the shaders (.glsl)
+}
+
+/// `bytes` as a gzip stream (zlib's deflate with the gzip wrapper) at the fastest level: half
+/// floats compress a little whatever the level, and the server should not sit on a step.
+std::string gzip(const std::string& bytes) {
+    z_stream stream{};
+    if (deflateInit2(&stream, Z_BEST_SPEED, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK) {
+        throw std::runtime_error("zlib: deflateInit2 failed");
+    }
+    std::string out(deflateBound(&stream, bytes.size()), '\0');
+    stream.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes.data()));
+    stream.avail_in = static_cast<uInt>(bytes.size());
+    stream.next_out = reinterpret_cast<Bytef*>(out.data());
+    stream.avail_out = static_cast<uInt>(out.size());
+    const int result = deflate(&stream, Z_FINISH);
+    deflateEnd(&stream);
+    if (result != Z_STREAM_END) throw std::runtime_error("zlib: deflate did not finish");
+    out.resize(stream.total_out);
+    return out;
+}
 constexpr std::size_t kMaxCachedMasks = 16;
 /// Refusals are logged with at most this many characters of target and reason.
 constexpr std::size_t kLoggedLength = 240;
@@ -214,19 +250,20 @@ public:
     const fs::path& root() const { return root_; }
 
     void install(httplib::Server& server) {
-        for (const auto& [route, name, type] :
-             {std::tuple{"/", "index.html", "text/html; charset=utf-8"},
-              std::tuple{"/index.html", "index.html", "text/html; charset=utf-8"},
-              std::tuple{"/app.js", "app.js", "text/javascript; charset=utf-8"},
-              std::tuple{"/style.css", "style.css", "text/css; charset=utf-8"}}) {
-            const std::string& content = embedded_web_files().at(name);
-            const std::string content_type = type;
-            server.Get(route, [&content, content_type](const httplib::Request&,
-                                                       httplib::Response& response) {
+        // The page's files by name (its ES modules import one another as ./name), and / for
+        // index.html.
+        for (const auto& [name, content] : embedded_web_files()) {
+            const std::string content_type = web_content_type(name);
+            const auto handler = [&content = content, content_type](const httplib::Request&,
+                                                                    httplib::Response& response) {
                 response.set_content(content, content_type.c_str());
-            });
+            };
+            server.Get("/" + name, handler);
+            if (name == "index.html") server.Get("/", handler);
         }
         server.Get("/api/archive", guarded([this](const auto& r, auto& s) { archive(r, s); }));
+        server.Get("/api/lightfield",
+                   guarded([this](const auto& r, auto& s) { light_field(r, s); }));
         server.Get("/api/step", guarded([this](const auto& r, auto& s) { step_info(r, s); }));
         server.Get("/api/trust", guarded([this](const auto& r, auto& s) { trust(r, s); }));
         server.Get("/api/status", guarded([this](const auto& r, auto& s) { status(r, s); }));
@@ -458,7 +495,8 @@ private:
                       {"elevation", camera.elevation_deg()},
                       {"isovalues", frame.isovalues},
                       {"depth_layers", frame.depth_layers.size()},
-                      {"colour_model", frame.colour_model.has_value()}};
+                      {"colour_model", frame.colour_model.has_value()},
+                      {"camera", camera.to_json()}};
             if (frame.intervals) {
                 const IntervalSet& intervals = *frame.intervals;
                 info["intervals"] = intervals.edges();
@@ -484,6 +522,55 @@ private:
             found = step_infos_.emplace(key, info.dump()).first;
         }
         response.set_content(found->second, "application/json");
+    }
+
+    /// The light field of the field that (step, view) shows, as light_field_payload encodes it
+    /// for the page's WebGL2 renderer: gzip-compressed when the client accepts it, with an ETag
+    /// (the file's modification time and size: a step's files never change once listed) so that
+    /// a revisited step costs a 304. The last few payloads stay in memory for a scrubbing page.
+    void light_field(const httplib::Request& request, httplib::Response& response) {
+        const StepKey key = step_key(request);
+        std::lock_guard<std::mutex> lock(engine_mutex_);
+        const ArchiveReader& reader = explorer_->archive();
+        const std::string field = reader.entry(key.step, key.view).field;
+        std::optional<ArchivedLightField> stored;
+        for (const ArchivedLightField& candidate : reader.light_fields(key.step)) {
+            if (candidate.field == field) stored = candidate;
+        }
+        if (!stored) {
+            throw HttpError(404, "step " + std::to_string(key.step) +
+                                     " has no light field of field \"" + field + "\"");
+        }
+        require_inside(stored->exr_path);
+        const auto [modified, size] = stamp_of(stored->exr_path);
+        const std::string etag = "\"lf" + std::to_string(kLightFieldPayloadVersion) + "-" +
+                                 std::to_string(key.step) + "-" + std::to_string(modified) + "-" +
+                                 std::to_string(size) + "\"";
+        response.set_header("ETag", etag);
+        response.set_header("Cache-Control", "no-cache");
+        if (request.get_header_value("If-None-Match") == etag) {
+            response.status = 304;
+            return;
+        }
+        auto cached = std::find_if(light_field_payloads_.begin(), light_field_payloads_.end(),
+                                   [&](const auto& entry) { return entry.first == etag; });
+        if (cached == light_field_payloads_.end()) {
+            const std::string payload =
+                light_field_payload(reader.load_light_field(key.step, field), key.step, field);
+            if (light_field_payloads_.size() >= kMaxLightFieldPayloads) {
+                light_field_payloads_.erase(light_field_payloads_.begin());
+            }
+            light_field_payloads_.emplace_back(etag, std::pair{payload, gzip(payload)});
+            cached = std::prev(light_field_payloads_.end());
+        }
+        const auto& [raw, compressed] = cached->second;
+        response.set_header("X-Insitu-Payload-Bytes", std::to_string(raw.size()));
+        if (request.get_header_value("Accept-Encoding").find("gzip") != std::string::npos) {
+            response.set_header("Content-Encoding", "gzip");
+            response.set_content(compressed, "application/octet-stream");
+        } else {
+            response.set_content(raw, "application/octet-stream");
+        }
     }
 
     /// The request's options in explore_options' spelling, plus its session.
@@ -657,6 +744,8 @@ private:
     std::optional<std::string> description_;
     std::map<StepKey, std::string> step_infos_;
     std::map<StepKey, std::string> trust_;
+    /// (ETag, (payload, its gzip)), oldest first.
+    std::vector<std::pair<std::string, std::pair<std::string, std::string>>> light_field_payloads_;
     FrameScheduler scheduler_;
     std::mutex masks_mutex_;
     /// Per session, the options and confidence of its last frame, for the overlay.

@@ -1,16 +1,22 @@
 #pragma once
 // `insitu-view serve`: the bundled web viewer. A small HTTP server (cpp-httplib) that serves a
 // single page embedded in the binary (viewer/web/, no network needed) and a JSON + PNG API over
-// one archive; every frame comes from insitu::Explorer::render, so the page shows the pixels
-// `insitu-view render` writes for the same options (explore_options.hpp is the one spelling).
+// one archive; every server frame comes from insitu::Explorer::render, so the page shows the
+// pixels `insitu-view render` writes for the same options (explore_options.hpp is the one
+// spelling). The page draws orbit views of light fields itself with WebGL2, from the data
+// /api/lightfield serves, to the same definitions.
 //
 // API (GET; /api/frame and /api/mask also accept the same keys as a POST form body):
 //   /api/archive            describe_archive + steps with times + the stored transfer function;
 //                           re-reads the manifest when it changed (a running simulation's new
 //                           steps appear without a restart)
-//   /api/step?step=S&view=V the stored camera, intervals, interval colours and, per interval,
+//   /api/step?step=S&view=V the stored camera (and its Camera::to_json, which the page reorbits
+//                           as the engine does), intervals, interval colours and, per interval,
 //                           the mean stored attenuation a_j (the archive holds no value
 //                           histogram), of one step and view
+//   /api/lightfield?step=S&view=V  the light field of the field the view shows, in the binary
+//                           form of light_field_payload.hpp (gzip when accepted, ETag); 404
+//                           when the step has none
 //   /api/frame?KEY=VALUE..  PNG (8-bit sRGB, the pixels write_png writes) of
 //                           Explorer::render; headers X-Insitu-Milliseconds (render),
 //                           -Encode-Milliseconds, -Synthesised, -Colour-Source, -Confidence

@@ -1,8 +1,10 @@
-// insitu-view's page. All synthesis happens in the server's exploration engine; this page only
-// turns controls into explore options (the same key=value spelling `insitu-view render` takes as
-// --key value) and shows the PNG frames it gets back. At most one frame request is in flight; a
-// control moved meanwhile is sent once that one returns (the server also coalesces, per session).
-'use strict';
+// insitu-view's page. It turns controls into explore options (the same key=value spelling
+// `insitu-view render` takes as --key value) and shows the frame for them: orbit views of a step
+// with a light field are drawn here by WebGL2 (gpu_frames.js, the Explorer's definitions on the
+// client's GPU); every other frame is the server's exploration engine's PNG. At most one frame is
+// in flight; a control moved meanwhile is drawn once that one is done (the server also
+// coalesces, per session).
+import { GpuFrames } from './gpu_frames.js';
 
 const DEGREES_PER_PIXEL = 0.4;  // orbit drag: degrees of azimuth/elevation per CSS pixel
 const MAX_OPACITY_SCALE = 4;    // top of the opacity-handle axis
@@ -27,14 +29,18 @@ const state = {
   colourSource: 'auto',
   mask: false,
   playing: false,
+  lightField: false,      // whether the shown step has a light field the browser can draw
 };
 
 const viewer = {
+  gpu: null,              // GpuFrames, or null without WebGL2
   frameCount: 0,
   degreesPerPixel: DEGREES_PER_PIXEL,
   displayed: null,        // {options, png: Uint8Array, url, headers}
   frameTimes: [],
   options: () => currentOptions(),
+  // The browser-drawn frame's RGBA bytes (tests compare them with `insitu-view render`).
+  gpuPixels: () => viewer.gpu.renderer.readPixels(),
 };
 window.insituViewer = viewer;
 
@@ -188,11 +194,24 @@ async function errorText(response) {
   }
 }
 
+// Whether the browser draws this frame: an orbit view (the stored view is the archive's own
+// proxies, exact) of a step with a light field, without what only the server's engine does
+// (transfer-function edits, lighting, enhancement).
+function drawnInBrowser(options) {
+  return Boolean(viewer.gpu && $('gpu-toggle').checked && state.lightField && state.info &&
+    state.info.camera && options.azimuth !== undefined && !options.tf &&
+    !options['opacity-scale'] && !options.light && !options.ao && !options.enhance);
+}
+
 function requestFrame() {
   const options = currentOptions();
   if (!options || inFlight) return;
   if (viewer.displayed && sameOptions(viewer.displayed.options, options)) return;
   inFlight = true;
+  if (drawnInBrowser(options)) {
+    drawInBrowser(options);
+    return;
+  }
   const sent = performance.now();
   const body = new URLSearchParams({ ...options, session });
   fetch('api/frame', { method: 'POST', body })
@@ -209,12 +228,51 @@ function requestFrame() {
       showError('');
     })
     .catch((error) => showError(String(error)))
-    .finally(() => {
-      inFlight = false;
-      const next = currentOptions();
-      if (!viewer.displayed || !sameOptions(viewer.displayed.options, next)) requestFrame();
-      else if (state.playing) schedulePlay();
-    });
+    .finally(frameDone);
+}
+
+function frameDone() {
+  inFlight = false;
+  const next = currentOptions();
+  if (!viewer.displayed || !sameOptions(viewer.displayed.options, next)) requestFrame();
+  else if (state.playing) schedulePlay();
+}
+
+// Frames per second over the last FPS_WINDOW_MS, counting this one.
+function countFrame() {
+  viewer.frameCount += 1;
+  const now = performance.now();
+  viewer.frameTimes.push(now);
+  while (viewer.frameTimes.length && viewer.frameTimes[0] < now - FPS_WINDOW_MS) viewer.frameTimes.shift();
+  return viewer.frameTimes.length > 1
+    ? (viewer.frameTimes.length - 1) * 1000 / (now - viewer.frameTimes[0]) : 0;
+}
+
+function showCanvas(canvas) {
+  $('frame').hidden = canvas;
+  $('gpu-frame').hidden = !canvas;
+}
+
+function drawInBrowser(options) {
+  const entry = state.timeline[state.stepIndex];
+  viewer.gpu.draw(entry.step, state.view, state.info.camera, Number(options.azimuth),
+    Number(options.elevation), [])
+    .then((timing) => {
+      if (!timing) throw new Error('the step has no light field');
+      showCanvas(true);
+      if (viewer.displayed && viewer.displayed.url) URL.revokeObjectURL(viewer.displayed.url);
+      viewer.displayed = { options, gpu: true, milliseconds: timing.milliseconds, synthesised: true };
+      const fps = countFrame();
+      const open = viewer.gpu.lastOpen;
+      $('readout').textContent =
+        `frame ${timing.milliseconds.toFixed(1)} ms (WebGL2, light field)` +
+        ` · ${fps.toFixed(1)} fps · step opened in ${(open.downloadMs + open.uploadMs).toFixed(0)} ms` +
+        ` (${(open.bytes / 1e6).toFixed(1)} MB)`;
+      showError('');
+      return updateMask();
+    })
+    .catch((error) => showError(String(error)))
+    .finally(frameDone);
 }
 
 async function display(options, png, headers, roundTripMs) {
@@ -225,7 +283,8 @@ async function display(options, png, headers, roundTripMs) {
     image.onerror = () => reject(new Error('the frame is not a readable PNG'));
     image.src = url;
   });
-  if (viewer.displayed) URL.revokeObjectURL(viewer.displayed.url);
+  if (viewer.displayed && viewer.displayed.url) URL.revokeObjectURL(viewer.displayed.url);
+  showCanvas(false);
   const header = (name) => headers.get(name);
   viewer.displayed = {
     options,
@@ -237,12 +296,7 @@ async function display(options, png, headers, roundTripMs) {
     colourSource: header('X-Insitu-Colour-Source'),
     synthesised: header('X-Insitu-Synthesised') === '1',
   };
-  viewer.frameCount += 1;
-  const now = performance.now();
-  viewer.frameTimes.push(now);
-  while (viewer.frameTimes.length && viewer.frameTimes[0] < now - FPS_WINDOW_MS) viewer.frameTimes.shift();
-  const fps = viewer.frameTimes.length > 1
-    ? (viewer.frameTimes.length - 1) * 1000 / (now - viewer.frameTimes[0]) : 0;
+  const fps = countFrame();
   const d = viewer.displayed;
   $('readout').textContent =
     `frame ${d.milliseconds.toFixed(1)} ms (engine) + ${d.encodeMilliseconds.toFixed(1)} ms (PNG)` +
@@ -257,7 +311,10 @@ async function updateMask() {
   canvas.hidden = !state.mask;
   if (!state.mask || !viewer.displayed) return;
   const options = viewer.displayed.options;
-  const response = await fetch('api/mask', { method: 'POST', body: new URLSearchParams({ ...options, session }) });
+  // A frame drawn here is the light field's: its confidence is the light field's too.
+  const source = viewer.displayed.gpu ? { source: 'lightfield' } : {};
+  const response = await fetch('api/mask',
+    { method: 'POST', body: new URLSearchParams({ ...options, ...source, session }) });
   if (!response.ok || !sameOptions(options, viewer.displayed.options)) return;
   const bitmap = await createImageBitmap(await response.blob());
   canvas.width = bitmap.width;
@@ -325,7 +382,14 @@ async function stepChanged() {
   const entry = state.timeline[state.stepIndex];
   if (!entry) return;
   const info = await getJson(`api/step?step=${entry.step}&view=${state.view}`);
+  let lightField = false;
+  if (viewer.gpu) {
+    lightField = await viewer.gpu.has(entry.step, state.view).catch(() => false);
+    const next = state.timeline[state.stepIndex + 1];
+    if (lightField && next) viewer.gpu.prefetch(next.step, state.view);
+  }
   if (state.timeline[state.stepIndex] !== entry) return;  // the slider moved on meanwhile
+  state.lightField = lightField;
   const count = info.intervals ? info.intervals.length - 1 : 0;
   if (count !== state.scales.length) {
     state.scales = new Array(count).fill(1);
@@ -646,7 +710,9 @@ function savePng() {
   if (!viewer.displayed) return;
   const o = viewer.displayed.options;
   const link = document.createElement('a');
-  link.href = viewer.displayed.url;
+  // A frame drawn here is saved as the canvas shows it; the server's full-quality frame for
+  // the same options is one `insitu-view render` away.
+  link.href = viewer.displayed.gpu ? $('gpu-frame').toDataURL('image/png') : viewer.displayed.url;
   link.download = `step${o.step}_view${o.view}` +
     (o.azimuth ? `_az${o.azimuth}_el${o.elevation}` : '') + '.png';
   link.click();
@@ -689,6 +755,9 @@ function installControls() {
 async function start() {
   installControls();
   installOrbitDrag();
+  viewer.gpu = await GpuFrames.create($('gpu-frame'));
+  $('gpu-toggle').disabled = !viewer.gpu;
+  $('gpu-toggle').addEventListener('change', requestFrame);
   try {
     await loadArchive();
     await stepChanged();

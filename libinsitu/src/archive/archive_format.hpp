@@ -38,6 +38,7 @@
 #include <string>
 
 #include "insitu/core/layers.hpp"
+#include "insitu/core/light_field.hpp"
 
 namespace insitu::archive_format {
 
@@ -114,8 +115,8 @@ inline constexpr const char* kDepthEncodingAttribute = "libinsitu.depth_encoding
 /// Segments a light field may store: one per isovalue of the layers and one more.
 inline constexpr int kMaxLightFieldSegments = kMaxLayers + 1;
 /// 8-bit depth: codes 0..254 are round(fraction * 254), 255 is "no hit".
-inline constexpr int kDepthCodeSteps = 254;
-inline constexpr int kNoHitDepthCode = 255;
+inline constexpr int kDepthCodeSteps = kLightFieldDepthCodeSteps;
+inline constexpr int kNoHitDepthCode = kLightFieldNoHitCode;
 
 /// "camera7": the part of camera 7.
 inline std::string camera_part(int camera) {

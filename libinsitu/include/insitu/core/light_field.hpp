@@ -40,6 +40,10 @@ inline constexpr std::array<int, 4> kLightFieldCameraCounts{12, 42, 162, 642};
 /// Parabolic map sizes (pixels per side) a light field may have.
 constexpr int kMinLightFieldMapSize = 8;
 constexpr int kMaxLightFieldMapSize = 4096;
+/// Seed 001's 8-bit depth: the secant fraction f in [0, 1] as the code round(f * 254), and a code
+/// of its own for "no hit" (the archive stores these; the web viewer receives them as they are).
+constexpr int kLightFieldDepthCodeSteps = 254;
+constexpr int kLightFieldNoHitCode = 255;
 
 /// How the ray of each map pixel is split into segments (seed 001 §7), each recorded as its own
 /// RGBA + depth so that segments can be faded independently.
@@ -143,6 +147,15 @@ public:
 
     /// The cameras whose positions surround `direction` (from center(), any length > 0).
     CameraNeighbourhood cameras_around(const glm::dvec3& direction) const;
+    /// The look-up cameras_around uses: a cube map over directions of cells_per_face()^2 cells
+    /// per face (face f: major axis f / 2, negative for odd f; cell (i, j) over the other two
+    /// components divided by the major one's magnitude, in axis order, each in [-1, 1] cut into
+    /// cells_per_face() equal parts), cell (f * cells_per_face() + j) * cells_per_face() + i
+    /// listing the icosphere triangles that may contain its directions, in the order they are
+    /// tried (the first that contains the direction wins; on a numerical edge, the one it
+    /// misses by least). The web viewer's shader repeats this look-up.
+    int cells_per_face() const { return cells_per_face_; }
+    const std::vector<std::vector<int>>& cell_triangles() const { return cell_triangles_; }
 
     /// {"cameras", "map_size", "center", "bounding_radius", "camera_radius", "positions"}:
     /// what the archive's headers record.

@@ -1,0 +1,164 @@
+// The page's own frames in a real browser: headless Debian chromium with WebGL2 through its
+// software rasteriser (SwiftShader), on an archive with a light field. Orbit views drawn by the
+// page's WebGL2 light-field renderer must match `insitu-view render --source lightfield` (the
+// C++ reference) for the same angles; the page must fall back to the server's frames when WebGL
+// is disabled.
+//
+//   INSITU_VIEW=build/viewer/insitu-view ARCHIVE=viewer_lf.cdb WORK_DIR=dir node webgl.test.mjs
+import assert from 'node:assert/strict';
+import { after, before, test } from 'node:test';
+
+import {
+  CHROMIUM, decodePng, env, loadPlaywright, makeWorkDir, renderWithCli, startServer, stopServer,
+} from './lib.mjs';
+
+const binary = env('INSITU_VIEW');
+const archive = env('ARCHIVE');
+const workDir = makeWorkDir('webgl-');
+const { chromium } = loadPlaywright();
+
+// WebGL2 on the CPU: ANGLE over SwiftShader, which chromium only offers when told it may.
+const WEBGL_ARGS = ['--headless', '--no-sandbox', '--disable-dev-shm-usage',
+  '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'];
+// Canvas against CLI on premultiplied linear RGB over black (the evaluation's measure): the GPU
+// searches and blends in float32, the reference in double, and both end in 8-bit sRGB.
+const MIN_PSNR_DB = 40;
+
+let server;
+let browser;
+const pageErrors = [];
+
+before(async () => {
+  server = await startServer(binary, archive);
+  browser = await chromium.launch({ executablePath: CHROMIUM, args: WEBGL_ARGS });
+});
+
+after(async () => {
+  if (browser) await browser.close();
+  if (server) assert.equal(await stopServer(server), 0, 'serve exits 0 on SIGTERM');
+});
+
+async function openPage(context) {
+  const page = await context.newPage({ viewport: { width: 1280, height: 900 } });
+  page.on('pageerror', (error) => pageErrors.push(error.message));
+  page.on('console', (message) => { if (message.type() === 'error') pageErrors.push(message.text()); });
+  await page.goto(server.url);
+  await page.waitForFunction(() => window.insituViewer.frameCount > 0, null, { timeout: 30000 });
+  return page;
+}
+
+/// Sets the orbit angles through the page's inputs and waits for that frame to be displayed.
+async function orbitTo(page, azimuth, elevation) {
+  const count = await page.evaluate(() => window.insituViewer.frameCount);
+  await page.fill('#azimuth', String(azimuth));
+  await page.fill('#elevation', String(elevation));
+  await page.dispatchEvent('#elevation', 'change');
+  await page.waitForFunction(({ n, az }) => {
+    const v = window.insituViewer;
+    return v.frameCount > n && v.displayed && Number(v.displayed.options.azimuth) === az &&
+      JSON.stringify(v.displayed.options) === JSON.stringify(v.options());
+  }, { n: count, az: azimuth }, { timeout: 60000 });
+  return page.evaluate(() => window.insituViewer.displayed.options);
+}
+
+function srgbToLinear(byte) {
+  const x = byte / 255;
+  return x <= 0.04045 ? x / 12.92 : Math.pow((x + 0.055) / 1.055, 2.4);
+}
+
+/// PSNR (dB) of two straight-alpha 8-bit sRGB RGBA images on premultiplied linear RGB.
+function psnrPremultiplied(a, b) {
+  assert.equal(a.width, b.width);
+  assert.equal(a.height, b.height);
+  let sum = 0;
+  const pixels = a.width * a.height;
+  for (let p = 0; p < pixels; ++p) {
+    const alphaA = a.data[4 * p + 3] / 255;
+    const alphaB = b.data[4 * p + 3] / 255;
+    for (let c = 0; c < 3; ++c) {
+      const d = srgbToLinear(a.data[4 * p + c]) * alphaA - srgbToLinear(b.data[4 * p + c]) * alphaB;
+      sum += d * d;
+    }
+  }
+  const mse = sum / (3 * pixels);
+  return mse > 0 ? 10 * Math.log10(1 / mse) : Infinity;
+}
+
+test('orbit views drawn with WebGL2 match insitu-view render --source lightfield', async () => {
+  const context = await browser.newContext();
+  const page = await openPage(context);
+  const gpu = await page.evaluate(() => Boolean(window.insituViewer.gpu));
+  assert.ok(gpu, 'WebGL2 is available in headless chromium (SwiftShader)');
+  const info = await (await fetch(`${server.url}api/step?step=300`)).json();
+  const results = [];
+  // 20 degrees around the stored view, both ways, and one from below.
+  for (const [da, de] of [[20, 0], [-20, 10], [35, -40]]) {
+    const azimuth = Math.round(info.azimuth + da);
+    const elevation = Math.round(info.elevation + de);
+    const options = await orbitTo(page, azimuth, elevation);
+    const displayed = await page.evaluate(() => window.insituViewer.displayed.gpu);
+    assert.equal(displayed, true, `the browser drew az ${azimuth} el ${elevation}`);
+    const shown = await page.evaluate(() => {
+      const { width, height, data } = window.insituViewer.gpuPixels();
+      return { width, height, data: Array.from(data) };
+    });
+    const expected = decodePng(renderWithCli(binary, archive,
+      { ...options, source: 'lightfield' }, workDir).colour);
+    assert.equal(expected.channels, 4);
+    const psnr = psnrPremultiplied({ ...shown, data: Uint8Array.from(shown.data) }, expected);
+    let covered = 0;
+    for (let p = 3; p < expected.data.length; p += 4) covered += expected.data[p] > 8 ? 1 : 0;
+    results.push(`az ${azimuth} el ${elevation}: ${psnr.toFixed(1)} dB`);
+    assert.ok(covered > 0.05 * expected.width * expected.height, 'something to compare');
+    assert.ok(psnr >= MIN_PSNR_DB, `WebGL2 vs C++ at az ${azimuth} el ${elevation}: ${psnr.toFixed(2)} dB`);
+  }
+  console.log(`WebGL2 light field vs insitu-view render: ${results.join(', ')}`);
+  const opened = await page.evaluate(() => window.insituViewer.gpu.lastOpen);
+  console.log(`step opened in ${(opened.downloadMs + opened.uploadMs).toFixed(0)} ms ` +
+    `(download ${opened.downloadMs.toFixed(0)}, upload ${opened.uploadMs.toFixed(0)}), ` +
+    `${(opened.bytes / 1e6).toFixed(2)} MB payload`);
+  assert.deepEqual(pageErrors, []);
+  await context.close();
+});
+
+test('the light field is served compressed, with an ETag that a revisit turns into 304', async () => {
+  const first = await fetch(`${server.url}api/lightfield?step=300`,
+    { headers: { 'Accept-Encoding': 'gzip' } });
+  assert.equal(first.status, 200);
+  assert.equal(first.headers.get('content-encoding'), 'gzip');
+  const etag = first.headers.get('etag');
+  assert.ok(etag, 'an ETag');
+  const body = new Uint8Array(await first.arrayBuffer());
+  assert.equal(new TextDecoder().decode(body.subarray(0, 8)), 'insituLF');
+  assert.equal(body.length, Number(first.headers.get('x-insitu-payload-bytes')));
+  const again = await fetch(`${server.url}api/lightfield?step=300`, { headers: { 'If-None-Match': etag } });
+  assert.equal(again.status, 304);
+  for (const [query, status] of [['step=301', 404], ['step=300&view=9', 404], ['step=x', 400],
+    ['step=300&camera=3', 400]]) {
+    const refused = await fetch(`${server.url}api/lightfield?${query}`);
+    assert.equal(refused.status, status, query);
+    assert.ok((await refused.json()).error, `${query}: a JSON error`);
+  }
+});
+
+test('without WebGL the page shows the server\'s frames', async () => {
+  const noWebgl = await chromium.launch({
+    executablePath: CHROMIUM, args: ['--headless', '--no-sandbox', '--disable-dev-shm-usage', '--disable-webgl', '--disable-3d-apis'],
+  });
+  try {
+    const page = await openPage(await noWebgl.newContext());
+    assert.equal(await page.evaluate(() => window.insituViewer.gpu), null);
+    assert.equal(await page.isDisabled('#gpu-toggle'), true);
+    const info = await (await fetch(`${server.url}api/step?step=300`)).json();
+    await orbitTo(page, Math.round(info.azimuth + 20), Math.round(info.elevation));
+    const shown = await page.evaluate(() => {
+      const v = window.insituViewer;
+      return { gpu: Boolean(v.displayed.gpu), png: v.displayed.png.length,
+        img: !document.getElementById('frame').hidden };
+    });
+    assert.deepEqual({ gpu: shown.gpu, img: shown.img }, { gpu: false, img: true });
+    assert.ok(shown.png > 0);
+  } finally {
+    await noWebgl.close();
+  }
+});

@@ -1,0 +1,169 @@
+#include "light_field_payload.hpp"
+
+#include <Imath/half.h>
+
+#include <cmath>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "insitu/core/check.hpp"
+#include "insitu/error.hpp"
+
+namespace insitu::viewer {
+namespace {
+
+using nlohmann::json;
+
+json vec3(const glm::dvec3& v) {
+    return json::array({v.x, v.y, v.z});
+}
+
+void check_plane(const Image& image, int size, int channels, int camera, const char* what) {
+    if (image.width != size || image.height != size || image.channels != channels) {
+        fail<InvalidArgument>("light field camera ", camera, ": ", what, " is ", image.width, "x",
+                              image.height, "x", image.channels, ", expected ", size, "x", size,
+                              "x", channels);
+    }
+}
+
+void append_half(std::string& out, const Image& image) {
+    const std::size_t at = out.size();
+    out.resize(at + 2 * image.pixels.size());
+    for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+        const std::uint16_t bits = Imath::half(image.pixels[i]).bits();
+        std::memcpy(&out[at + 2 * i], &bits, 2);  // little-endian hosts only (x86, ARM)
+    }
+}
+
+// The archive's 8-bit code of each secant fraction: the fractions it returns are code / 254
+// (or +inf), so rounding recovers the code exactly.
+void append_codes(std::string& out, const Image& depth, int camera) {
+    for (const float fraction : depth.pixels) {
+        if (std::isinf(fraction) && fraction > 0.0f) {
+            out.push_back(static_cast<char>(kLightFieldNoHitCode));
+            continue;
+        }
+        const double code = static_cast<double>(fraction) * kLightFieldDepthCodeSteps;
+        const long rounded = std::lround(code);
+        if (!(fraction >= 0.0f && fraction <= 1.0f) || std::abs(code - rounded) > 1e-3) {
+            fail<InvalidArgument>("light field camera ", camera, ": depth ", fraction,
+                                  " is not an 8-bit secant fraction (code / ",
+                                  kLightFieldDepthCodeSteps, ")");
+        }
+        out.push_back(static_cast<char>(rounded));
+    }
+}
+
+}  // namespace
+
+std::string light_field_payload(const LightField& light_field, std::int64_t step,
+                                const std::string& field) {
+    const LightFieldRig& rig = light_field.rig;
+    const int n = rig.map_size();
+    const int segments = light_field.segment_count();
+    const int depth_bits = light_field.settings.depth_bits;
+    std::vector<int> present;
+    for (const LightFieldImages& images : light_field.cameras) {
+        if (images.camera < 0 || images.camera >= rig.camera_count()) {
+            fail<InvalidArgument>("light field camera ", images.camera,
+                                  " is out of range for a rig of ", rig.camera_count(), " cameras");
+        }
+        if (images.segment_rgba.size() != static_cast<std::size_t>(segments) ||
+            (segments > 1 && images.segment_depth.size() != static_cast<std::size_t>(segments))) {
+            fail<InvalidArgument>("light field camera ", images.camera, ": ",
+                                  images.segment_rgba.size(), " segment images, expected ",
+                                  segments);
+        }
+        for (const Image& rgba : images.segment_rgba) {
+            check_plane(rgba, n, 4, images.camera, "segment_rgba");
+        }
+        check_plane(images.depth, n, 1, images.camera, "depth");
+        for (const Image& depth : images.segment_depth) {
+            check_plane(depth, n, 1, images.camera, "segment_depth");
+        }
+        present.push_back(images.camera);
+    }
+
+    const std::size_t pixels = static_cast<std::size_t>(n) * n;
+    const std::size_t depth_bytes = depth_bits == 8 ? 1 : 2;
+    const std::size_t slots = present.size();
+    const std::size_t rgba_bytes = slots * segments * pixels * 4 * 2;
+    const std::size_t first_hit_bytes = slots * pixels * depth_bytes;
+
+    json cameras = json::array();
+    for (int k = 0; k < rig.camera_count(); ++k) {
+        const Camera& camera = rig.camera(k);
+        cameras.push_back({{"eye", vec3(camera.position())},
+                           {"right", vec3(camera.right())},
+                           {"up", vec3(camera.up())},
+                           {"forward", vec3(camera.forward())}});
+    }
+    json vertices = json::array();
+    for (const glm::dvec3& v : rig.icosphere().vertices) vertices.push_back(vec3(v));
+    json cell_offsets = json::array({0});
+    json cell_triangles = json::array();
+    for (const std::vector<int>& cell : rig.cell_triangles()) {
+        for (const int t : cell) cell_triangles.push_back(t);
+        cell_offsets.push_back(cell_triangles.size());
+    }
+    const json header{
+        {"step", step},
+        {"field", field},
+        {"map_size", n},
+        {"map_half_extent", rig.camera(0).half_height()},
+        {"cameras", rig.camera_count()},
+        {"center", vec3(rig.center())},
+        {"bounding_radius", rig.bounding_radius()},
+        {"camera_radius", rig.camera_radius()},
+        {"vertices", vertices},
+        {"triangles", rig.icosphere().triangles},
+        {"camera_frames", cameras},
+        {"cells_per_face", rig.cells_per_face()},
+        {"cell_offsets", cell_offsets},
+        {"cell_triangles", cell_triangles},
+        {"segments", segments},
+        {"segment_rule", to_string(light_field.settings.segments)},
+        {"depth_bits", depth_bits},
+        {"depth_threshold", light_field.settings.depth_threshold},
+        {"present", present},
+        {"planes",
+         {{"rgba", 0},
+          {"depth", rgba_bytes},
+          {"segment_depth", segments > 1 ? rgba_bytes + first_hit_bytes : 0},
+          {"depth_type", depth_bits == 8 ? "uint8 code" : "half"}}}};
+    std::string text = header.dump();
+    text.resize((text.size() + 7) / 8 * 8, ' ');
+
+    std::string out = "insituLF";
+    const std::uint32_t version = kLightFieldPayloadVersion;
+    const auto header_bytes = static_cast<std::uint32_t>(text.size());
+    out.append(reinterpret_cast<const char*>(&version), 4);
+    out.append(reinterpret_cast<const char*>(&header_bytes), 4);
+    out += text;
+    const std::size_t data_start = out.size();
+    out.reserve(data_start + rgba_bytes + first_hit_bytes * (segments > 1 ? segments + 1 : 1));
+    for (const LightFieldImages& images : light_field.cameras) {
+        for (const Image& rgba : images.segment_rgba) append_half(out, rgba);
+    }
+    const auto append_depth = [&](const Image& depth, int camera) {
+        if (depth_bits == 8) {
+            append_codes(out, depth, camera);
+        } else {
+            append_half(out, depth);
+        }
+    };
+    for (const LightFieldImages& images : light_field.cameras) {
+        append_depth(images.depth, images.camera);
+    }
+    if (segments > 1) {
+        for (const LightFieldImages& images : light_field.cameras) {
+            for (const Image& depth : images.segment_depth) append_depth(depth, images.camera);
+        }
+    }
+    INSITU_CHECK_EQ(out.size() - data_start,
+                    rgba_bytes + first_hit_bytes * (segments > 1 ? segments + 1 : 1));
+    return out;
+}
+
+}  // namespace insitu::viewer

@@ -1,0 +1,238 @@
+// Draws light-field reconstructions on the client's GPU with WebGL2: the step's light field
+// (light_field_data.js) becomes textures once, then every frame is one full-screen pass of
+// light_field.frag.glsl for the target camera (camera.js). The C++ Explorer stays the reference;
+// tests/viewer/webgl.test.mjs holds the two to a stated PSNR.
+
+const TABLE_WIDTH = 1024;  // rows of the 1D tables, as the shader reads them
+const SEARCH_STEPS = 64;   // LightFieldReconstructionSettings::search_steps' default
+
+async function shaderText(name) {
+  const response = await fetch(name);
+  if (!response.ok) throw new Error(`${name}: ${response.status}`);
+  return response.text();
+}
+
+/// Whether this browser gives a WebGL2 context with what the renderer needs.
+export function webgl2Available() {
+  try {
+    const canvas = document.createElement('canvas');
+    return Boolean(canvas.getContext('webgl2'));
+  } catch (e) {
+    return false;
+  }
+}
+
+export class LightFieldRenderer {
+  /// `canvas`: the element drawn into. Throws when WebGL2 is missing.
+  static async create(canvas) {
+    const gl = canvas.getContext('webgl2', {
+      premultipliedAlpha: false,   // the frame's alpha is straight, as in the PNG frames
+      preserveDrawingBuffer: true,  // the tests and "save PNG" read the canvas back
+      antialias: false,
+    });
+    if (!gl) throw new Error('WebGL2 is not available');
+    const [vertex, fragment] = await Promise.all(
+      [shaderText('fullscreen.vert.glsl'), shaderText('light_field.frag.glsl')]);
+    return new LightFieldRenderer(canvas, gl, vertex, fragment);
+  }
+
+  constructor(canvas, gl, vertexSource, fragmentSource) {
+    this.canvas = canvas;
+    this.gl = gl;
+    this.vertexSource = vertexSource;
+    this.fragmentSource = fragmentSource;
+    this.programs = new Map();  // by "depth bits/max segments"
+    this.textures = [];
+    this.loaded = null;          // {header, program, uniforms}
+    this.vertexArray = gl.createVertexArray();
+  }
+
+  program(depthBits, maxSegments) {
+    const key = `${depthBits}/${maxSegments}`;
+    if (this.programs.has(key)) return this.programs.get(key);
+    const gl = this.gl;
+    const prefix = `#version 300 es\n#define MAX_SEGMENTS ${maxSegments}\n` +
+      (depthBits === 8 ? '#define DEPTH_CODES\n' : '');
+    const compile = (type, source) => {
+      const shader = gl.createShader(type);
+      gl.shaderSource(shader, prefix + source);
+      gl.compileShader(shader);
+      if (!gl.getShaderParameter(shader, gl.COMPILE_STATUS)) {
+        throw new Error(`shader: ${gl.getShaderInfoLog(shader)}`);
+      }
+      return shader;
+    };
+    const program = gl.createProgram();
+    gl.attachShader(program, compile(gl.VERTEX_SHADER, this.vertexSource));
+    gl.attachShader(program, compile(gl.FRAGMENT_SHADER, this.fragmentSource));
+    gl.linkProgram(program);
+    if (!gl.getProgramParameter(program, gl.LINK_STATUS)) {
+      throw new Error(`shader link: ${gl.getProgramInfoLog(program)}`);
+    }
+    this.programs.set(key, program);
+    return program;
+  }
+
+  release() {
+    for (const texture of this.textures) this.gl.deleteTexture(texture);
+    this.textures = [];
+    this.loaded = null;
+  }
+
+  texture(unit, target) {
+    const gl = this.gl;
+    const texture = gl.createTexture();
+    gl.activeTexture(gl.TEXTURE0 + unit);
+    gl.bindTexture(target, texture);
+    gl.texParameteri(target, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+    gl.texParameteri(target, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+    gl.texParameteri(target, gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE);
+    gl.texParameteri(target, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
+    this.textures.push(texture);
+    return texture;
+  }
+
+  /// Uploads a parsed light field (parseLightField). Throws when it needs more texture layers
+  /// than this GPU has.
+  load(lightField) {
+    const gl = this.gl;
+    const { header } = lightField;
+    const n = header.map_size;
+    const slots = header.present.length;
+    const segments = header.segments;
+    const layers = slots * segments;
+    const depthLayers = slots * (segments > 1 ? segments + 1 : 1);
+    const maxLayers = gl.getParameter(gl.MAX_ARRAY_TEXTURE_LAYERS);
+    if (Math.max(layers, depthLayers) > maxLayers) {
+      throw new Error(`the light field needs ${Math.max(layers, depthLayers)} texture layers, ` +
+        `this GPU has ${maxLayers}`);
+    }
+    this.release();
+    gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+
+    this.texture(0, gl.TEXTURE_2D_ARRAY);
+    gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA16F, n, n, layers, 0, gl.RGBA, gl.HALF_FLOAT,
+      lightField.rgba);
+
+    this.texture(1, gl.TEXTURE_2D_ARRAY);
+    const codes = header.depth_bits === 8;
+    const depth = new (codes ? Uint8Array : Uint16Array)(depthLayers * n * n);
+    depth.set(lightField.depth, 0);
+    if (lightField.segmentDepth) depth.set(lightField.segmentDepth, lightField.depth.length);
+    gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, codes ? gl.R8UI : gl.R16F, n, n, depthLayers, 0,
+      codes ? gl.RED_INTEGER : gl.RED, codes ? gl.UNSIGNED_BYTE : gl.HALF_FLOAT, depth);
+
+    const frames = new Float32Array(header.cameras * 4 * 4);
+    header.camera_frames.forEach((frame, k) => {
+      ['eye', 'right', 'up', 'forward'].forEach((key, i) => frames.set([...frame[key], 0], (k * 4 + i) * 4));
+    });
+    this.texture(2, gl.TEXTURE_2D);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, 4, header.cameras, 0, gl.RGBA, gl.FLOAT, frames);
+
+    // One integer table: slots by camera, triangles, cell offsets, cell candidates.
+    const slotOf = new Int32Array(header.cameras).fill(-1);
+    header.present.forEach((camera, slot) => { slotOf[camera] = slot; });
+    const parts = [slotOf, header.triangles.flat(), header.cell_offsets, header.cell_triangles];
+    const offsets = [];
+    let total = 0;
+    for (const part of parts) {
+      offsets.push(total);
+      total += part.length;
+    }
+    const rows = Math.ceil(total / TABLE_WIDTH);
+    const table = new Int32Array(rows * TABLE_WIDTH);
+    parts.forEach((part, i) => table.set(part, offsets[i]));
+    this.texture(3, gl.TEXTURE_2D);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.R32I, TABLE_WIDTH, rows, 0, gl.RED_INTEGER, gl.INT, table);
+
+    const vertexRows = Math.ceil(header.vertices.length / TABLE_WIDTH);
+    const vertices = new Float32Array(vertexRows * TABLE_WIDTH * 4);
+    header.vertices.forEach((v, k) => vertices.set([...v, 0], 4 * k));
+    this.texture(4, gl.TEXTURE_2D);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, TABLE_WIDTH, vertexRows, 0, gl.RGBA, gl.FLOAT,
+      vertices);
+
+    const maxSegments = Math.max(segments, 1);
+    const program = this.program(header.depth_bits, maxSegments);
+    gl.useProgram(program);
+    const uniform = (name) => gl.getUniformLocation(program, name);
+    gl.uniform1i(uniform('uRgba'), 0);
+    gl.uniform1i(uniform('uDepth'), 1);
+    gl.uniform1i(uniform('uCameraFrames'), 2);
+    gl.uniform1i(uniform('uTables'), 3);
+    gl.uniform1i(uniform('uVertices'), 4);
+    gl.uniform1i(uniform('uSlotsAt'), offsets[0]);
+    gl.uniform1i(uniform('uTrianglesAt'), offsets[1]);
+    gl.uniform1i(uniform('uCellOffsetsAt'), offsets[2]);
+    gl.uniform1i(uniform('uCellTrianglesAt'), offsets[3]);
+    gl.uniform1i(uniform('uCellsPerFace'), header.cells_per_face);
+    gl.uniform1i(uniform('uMapSize'), n);
+    gl.uniform1f(uniform('uMapHalfExtent'), header.map_half_extent);
+    gl.uniform1i(uniform('uSegments'), segments);
+    gl.uniform1i(uniform('uSlotCount'), slots);
+    gl.uniform1i(uniform('uDepthBits'), header.depth_bits);
+    gl.uniform1i(uniform('uSearchSteps'), SEARCH_STEPS);
+    gl.uniform3fv(uniform('uCenter'), header.center);
+    gl.uniform1f(uniform('uBoundingRadius'), header.bounding_radius);
+    gl.uniform1f(uniform('uCameraRadius'), header.camera_radius);
+    this.loaded = { header, program, uniform, maxSegments };
+  }
+
+  /// Draws the reconstruction for `camera` (camera.js) with per-segment opacity scales
+  /// (missing entries are 1). Resizes the canvas to the camera's image.
+  render(camera, segmentScales = []) {
+    if (!this.loaded) throw new Error('no light field loaded');
+    const gl = this.gl;
+    const { uniform, maxSegments } = this.loaded;
+    if (this.canvas.width !== camera.width || this.canvas.height !== camera.height) {
+      this.canvas.width = camera.width;
+      this.canvas.height = camera.height;
+    }
+    gl.viewport(0, 0, camera.width, camera.height);
+    gl.useProgram(this.loaded.program);
+    const scales = new Float32Array(maxSegments).fill(1);
+    segmentScales.slice(0, maxSegments).forEach((s, i) => { scales[i] = s; });
+    gl.uniform1fv(uniform('uScales'), scales);
+    gl.uniform1i(uniform('uPerspective'), camera.perspective ? 1 : 0);
+    gl.uniform3fv(uniform('uEye'), camera.position);
+    gl.uniform3fv(uniform('uForward'), camera.forward);
+    gl.uniform3fv(uniform('uRight'), camera.right);
+    gl.uniform3fv(uniform('uUp'), camera.up);
+    gl.uniform2f(uniform('uHalfExtent'), camera.halfWidth, camera.halfHeight);
+    gl.uniform2f(uniform('uImageSize'), camera.width, camera.height);
+    gl.bindVertexArray(this.vertexArray);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+  }
+
+  /// The canvas's RGBA bytes, rows from the top (as a PNG holds them).
+  readPixels() {
+    const gl = this.gl;
+    const { width, height } = this.canvas;
+    const bottomUp = new Uint8Array(width * height * 4);
+    gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, bottomUp);
+    const rows = new Uint8Array(bottomUp.length);
+    for (let y = 0; y < height; ++y) {
+      rows.set(bottomUp.subarray((height - 1 - y) * width * 4, (height - y) * width * 4), y * width * 4);
+    }
+    return { width, height, data: rows };
+  }
+
+  /// Resolves once the GPU has finished the frames drawn so far (for frame timing).
+  finish() {
+    const gl = this.gl;
+    const sync = gl.fenceSync(gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
+    gl.flush();
+    return new Promise((resolve) => {
+      const poll = () => {
+        const status = gl.clientWaitSync(sync, 0, 0);
+        if (status === gl.TIMEOUT_EXPIRED) {
+          setTimeout(poll, 1);
+          return;
+        }
+        gl.deleteSync(sync);
+        resolve();
+      };
+      poll();
+    });
+  }
+}
