@@ -226,11 +226,20 @@ TEST_F(ExplorerLightField, SegmentsFadeIndependently) {
     request.segment_opacity_scales = {{2, 0.5}};
     testing::expect_error_naming<InvalidArgument>([&] { explorer.render(request); },
                                                   "segment-opacity segment 2");
-    // No attenuation light field: an opacity edit cannot be made from it, and says so.
+    // No attenuation light field: an opacity edit or a recolouring cannot be made from it, and
+    // says so; auto makes them from the view's proxies instead.
     request = at(100.0, 0.0, ProxySource::lightfield);
     request.opacity_scales = {{1, 0.5}};
     testing::expect_error_naming<InvalidArgument>([&] { explorer.render(request); },
-                                                  "needs attenuation proxies");
+                                                  "need an attenuation light field");
+    request.opacity_scales.clear();
+    request.transfer_function = config_.transfer_function;
+    testing::expect_error_naming<InvalidArgument>([&] { explorer.render(request); },
+                                                  "need an attenuation light field");
+    request.source = ProxySource::automatic;
+    const ExploreFrame edited = explorer.render(request);
+    EXPECT_EQ(edited.proxy_source, ProxySource::single);
+    EXPECT_EQ(edited.light_field_share, 0.0);
 }
 
 TEST_F(ExplorerLightField, MissingCamerasAreReconstructedFromTheRestAndSaidSo) {

@@ -2,12 +2,17 @@
 //  1. over HTTP, one request in flight as the page does: per scenario the engine's time per
 //     frame (X-Insitu-Milliseconds), the round trip, and frames per second;
 //  2. in headless chromium: frames per second the page displays during a continuous orbit drag
-//     (round trip + PNG decode + display).
+//     (round trip + PNG decode + display), with WebGL disabled (server frames only);
+//  3. the same drag with WebGL2 through SwiftShader (software, the worst case): where the step
+//     has a light field, the page draws every orbit frame itself; reported with the time to the
+//     first frame after opening a step (download + upload) and the bytes transferred per step.
 //
 //   node tests/viewer/frame_rate.mjs INSITU_VIEW ARCHIVE [FRAMES]
 import { performance } from 'node:perf_hooks';
 
-import { CHROMIUM, CHROMIUM_ARGS, loadPlaywright, startServer, stopServer } from './lib.mjs';
+import {
+  CHROMIUM, CHROMIUM_ARGS, loadPlaywright, startServer, stopServer, WEBGL_ARGS,
+} from './lib.mjs';
 
 const [binary, archive, framesText] = process.argv.slice(2);
 if (!binary || !archive) {
@@ -57,29 +62,56 @@ try {
 
   // The page itself: a pointer dragging across the viewport for a few seconds.
   const { chromium } = loadPlaywright();
-  const browser = await chromium.launch({ executablePath: CHROMIUM, args: CHROMIUM_ARGS });
-  try {
-    const page = await browser.newPage({ viewport: { width: 1280, height: 900 } });
-    await page.goto(server.url);
-    await page.waitForFunction(() => window.insituViewer.frameCount > 0);
-    const box = await page.locator('#viewport').boundingBox();
-    const y = box.y + box.height / 2;
-    await page.mouse.move(box.x + 100, y);
-    await page.mouse.down();
-    const first = await page.evaluate(() => window.insituViewer.frameCount);
-    const start = performance.now();
-    const dragMs = 4000;
-    for (let i = 0; performance.now() - start < dragMs; ++i) {
-      await page.mouse.move(box.x + 100 + (i % 300), y);
-      await new Promise((resolve) => setTimeout(resolve, 8));  // a 120 Hz pointer
+  for (const [label, args] of [['server frames (WebGL off)', [...CHROMIUM_ARGS, '--disable-webgl']],
+    ['WebGL2 (SwiftShader)', WEBGL_ARGS]]) {
+    const browser = await chromium.launch({ executablePath: CHROMIUM, args });
+    try {
+      const page = await browser.newPage({ viewport: { width: 1280, height: 900 } });
+      await page.goto(server.url);
+      await page.waitForFunction(() => window.insituViewer.frameCount > 0);
+      const box = await page.locator('#viewport').boundingBox();
+      const y = box.y + box.height / 2;
+      await page.mouse.move(box.x + 100, y);
+      await page.mouse.down();
+      // The first orbit frame: in the browser, after the step's light field is in textures.
+      const opened = performance.now();
+      await page.mouse.move(box.x + 101, y);
+      await page.waitForFunction(() => window.insituViewer.displayed.options.azimuth !== undefined);
+      const firstFrameMs = performance.now() - opened;
+      const first = await page.evaluate(() => window.insituViewer.frameCount);
+      const start = performance.now();
+      const dragMs = 4000;
+      for (let i = 0; performance.now() - start < dragMs; ++i) {
+        await page.mouse.move(box.x + 100 + (i % 300), y);
+        await new Promise((resolve) => setTimeout(resolve, 8));  // a 120 Hz pointer
+      }
+      const shown = (await page.evaluate(() => window.insituViewer.frameCount)) - first;
+      const elapsed = performance.now() - start;
+      await page.mouse.up();
+      const gpu = await page.evaluate(() => {
+        const v = window.insituViewer;
+        return v.displayed.gpu ? { ms: v.displayed.milliseconds, open: v.gpu.lastOpen } : null;
+      });
+      let line = `page, orbit drag, ${label}: ${shown} frames displayed in ` +
+        `${(elapsed / 1000).toFixed(1)} s = ${((shown * 1000) / elapsed).toFixed(1)} frames/s`;
+      if (gpu) {
+        line += `; drawn in the browser, last frame ${gpu.ms.toFixed(1)} ms on the GPU; step ` +
+          `opened (download ${gpu.open.downloadMs.toFixed(0)} ms + upload ` +
+          `${gpu.open.uploadMs.toFixed(0)} ms, ${(gpu.open.bytes / 1e6).toFixed(1)} MB payload), ` +
+          `first orbit frame ${firstFrameMs.toFixed(0)} ms after the drag began`;
+      }
+      console.log(line);
+    } finally {
+      await browser.close();
     }
-    const shown = (await page.evaluate(() => window.insituViewer.frameCount)) - first;
-    const elapsed = performance.now() - start;
-    await page.mouse.up();
-    console.log(`page, orbit drag: ${shown} frames displayed in ${(elapsed / 1000).toFixed(1)} s = ` +
-      `${((shown * 1000) / elapsed).toFixed(1)} frames/s`);
-  } finally {
-    await browser.close();
+  }
+  const transfer = await fetch(`${server.url}api/lightfield?step=${step}`);
+  if (transfer.ok) {
+    const compressed = Number(transfer.headers.get('content-length')) ||
+      (await transfer.arrayBuffer()).byteLength;
+    console.log(`light field of step ${step}: ${(Number(transfer.headers.get('x-insitu-payload-bytes')) / 1e6).toFixed(1)} MB ` +
+      `payload, ${transfer.headers.get('content-encoding') || 'identity'} on the wire`);
+    void compressed;
   }
   const status = await (await fetch(server.url + 'api/status')).json();
   console.log(`server: ${status.frames_rendered} frames rendered, ${status.superseded} superseded`);

@@ -28,6 +28,9 @@ export function loadPlaywright() {
 /// Headless Debian chromium, never a downloaded browser.
 export const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
 export const CHROMIUM_ARGS = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'];
+/// WebGL2 on the CPU: ANGLE over SwiftShader, which chromium offers only when told it may.
+export const WEBGL_ARGS = ['--headless', '--no-sandbox', '--disable-dev-shm-usage',
+  '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'];
 
 /// Starts `insitu-view serve ARCHIVE --port 0` and resolves once it prints its URL.
 export function startServer(binary, archive, extraArgs = []) {

@@ -10,6 +10,7 @@ import { after, before, test } from 'node:test';
 
 import {
   CHROMIUM, decodePng, env, loadPlaywright, makeWorkDir, renderWithCli, startServer, stopServer,
+  WEBGL_ARGS,
 } from './lib.mjs';
 
 const binary = env('INSITU_VIEW');
@@ -17,9 +18,6 @@ const archive = env('ARCHIVE');
 const workDir = makeWorkDir('webgl-');
 const { chromium } = loadPlaywright();
 
-// WebGL2 on the CPU: ANGLE over SwiftShader, which chromium only offers when told it may.
-const WEBGL_ARGS = ['--headless', '--no-sandbox', '--disable-dev-shm-usage',
-  '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'];
 // Canvas against CLI on premultiplied linear RGB over black (the evaluation's measure): the GPU
 // searches and blends in float32, the reference in double, and both end in 8-bit sRGB.
 const MIN_PSNR_DB = 40;

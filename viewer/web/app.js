@@ -30,7 +30,9 @@ const state = {
   mask: false,
   playing: false,
   lightField: false,      // whether the shown step has a light field the browser can draw
+  dragging: false,        // an orbit drag moved within the last REST_MS: previews will do
 };
+const REST_MS = 150;      // a drag that has not moved for this long gets its full frame
 
 const viewer = {
   gpu: null,              // GpuFrames, or null without WebGL2
@@ -206,10 +208,12 @@ function drawnInBrowser(options) {
 function requestFrame() {
   const options = currentOptions();
   if (!options || inFlight) return;
-  if (viewer.displayed && sameOptions(viewer.displayed.options, options)) return;
+  const preview = state.dragging && drawnInBrowser(options);
+  if (viewer.displayed && sameOptions(viewer.displayed.options, options) &&
+    !(viewer.displayed.preview && !preview)) return;
   inFlight = true;
   if (drawnInBrowser(options)) {
-    drawInBrowser(options);
+    drawInBrowser(options, preview);
     return;
   }
   const sent = performance.now();
@@ -234,7 +238,8 @@ function requestFrame() {
 function frameDone() {
   inFlight = false;
   const next = currentOptions();
-  if (!viewer.displayed || !sameOptions(viewer.displayed.options, next)) requestFrame();
+  if (!viewer.displayed || !sameOptions(viewer.displayed.options, next) ||
+    (viewer.displayed.preview && !state.dragging)) requestFrame();
   else if (state.playing) schedulePlay();
 }
 
@@ -253,19 +258,22 @@ function showCanvas(canvas) {
   $('gpu-frame').hidden = !canvas;
 }
 
-function drawInBrowser(options) {
+function drawInBrowser(options, preview) {
   const entry = state.timeline[state.stepIndex];
   viewer.gpu.draw(entry.step, state.view, state.info.camera, Number(options.azimuth),
-    Number(options.elevation), [])
+    Number(options.elevation), [], preview)
     .then((timing) => {
       if (!timing) throw new Error('the step has no light field');
       showCanvas(true);
+      // A preview is smaller than the view: scaled up smoothly, not in blocks.
+      $('gpu-frame').style.imageRendering = preview ? 'auto' : '';
       if (viewer.displayed && viewer.displayed.url) URL.revokeObjectURL(viewer.displayed.url);
-      viewer.displayed = { options, gpu: true, milliseconds: timing.milliseconds, synthesised: true };
+      viewer.displayed = { options, gpu: true, preview, milliseconds: timing.milliseconds,
+        synthesised: true };
       const fps = countFrame();
       const open = viewer.gpu.lastOpen;
       $('readout').textContent =
-        `frame ${timing.milliseconds.toFixed(1)} ms (WebGL2, light field)` +
+        `frame ${timing.milliseconds.toFixed(1)} ms (WebGL2, light field${preview ? ', preview' : ''})` +
         ` · ${fps.toFixed(1)} fps · step opened in ${(open.downloadMs + open.uploadMs).toFixed(0)} ms` +
         ` (${(open.bytes / 1e6).toFixed(1)} MB)`;
       showError('');
@@ -522,8 +530,15 @@ function installOrbitDrag() {
     viewport.setPointerCapture(event.pointerId);
     viewport.classList.add('dragging');
   });
+  let rest = null;
   viewport.addEventListener('pointermove', (event) => {
     if (!drag) return;
+    state.dragging = true;
+    clearTimeout(rest);
+    rest = setTimeout(() => {
+      state.dragging = false;
+      requestFrame();
+    }, REST_MS);
     // Grab-and-turn: dragging right turns the object right (the camera moves left), dragging
     // down tips its top toward the viewer (the camera moves up).
     setOrbit(drag.azimuth - (event.clientX - drag.x) * DEGREES_PER_PIXEL,
@@ -532,6 +547,11 @@ function installOrbitDrag() {
   const end = () => {
     drag = null;
     viewport.classList.remove('dragging');
+    clearTimeout(rest);
+    if (state.dragging) {
+      state.dragging = false;
+      requestFrame();
+    }
   };
   viewport.addEventListener('pointerup', end);
   viewport.addEventListener('pointercancel', end);

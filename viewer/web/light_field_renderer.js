@@ -4,7 +4,6 @@
 // tests/viewer/webgl.test.mjs holds the two to a stated PSNR.
 
 const TABLE_WIDTH = 1024;  // rows of the 1D tables, as the shader reads them
-const SEARCH_STEPS = 64;   // LightFieldReconstructionSettings::search_steps' default
 
 async function shaderText(name) {
   const response = await fetch(name);
@@ -171,7 +170,6 @@ export class LightFieldRenderer {
     gl.uniform1i(uniform('uSegments'), segments);
     gl.uniform1i(uniform('uSlotCount'), slots);
     gl.uniform1i(uniform('uDepthBits'), header.depth_bits);
-    gl.uniform1i(uniform('uSearchSteps'), SEARCH_STEPS);
     gl.uniform3fv(uniform('uCenter'), header.center);
     gl.uniform1f(uniform('uBoundingRadius'), header.bounding_radius);
     gl.uniform1f(uniform('uCameraRadius'), header.camera_radius);
@@ -179,8 +177,9 @@ export class LightFieldRenderer {
   }
 
   /// Draws the reconstruction for `camera` (camera.js) with per-segment opacity scales
-  /// (missing entries are 1). Resizes the canvas to the camera's image.
-  render(camera, segmentScales = []) {
+  /// (missing entries are 1) and `searchSteps` of the coarse depth search (the reference's
+  /// LightFieldReconstructionSettings::search_steps). Resizes the canvas to the camera's image.
+  render(camera, segmentScales, searchSteps) {
     if (!this.loaded) throw new Error('no light field loaded');
     const gl = this.gl;
     const { uniform, maxSegments } = this.loaded;
@@ -193,6 +192,7 @@ export class LightFieldRenderer {
     const scales = new Float32Array(maxSegments).fill(1);
     segmentScales.slice(0, maxSegments).forEach((s, i) => { scales[i] = s; });
     gl.uniform1fv(uniform('uScales'), scales);
+    gl.uniform1i(uniform('uSearchSteps'), searchSteps);
     gl.uniform1i(uniform('uPerspective'), camera.perspective ? 1 : 0);
     gl.uniform3fv(uniform('uEye'), camera.position);
     gl.uniform3fv(uniform('uForward'), camera.forward);

@@ -679,6 +679,17 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
 
     const bool has_view_proxies = (single && (has_attenuation(*single) || has_layers(*single))) ||
                                   (multi && (has_attenuation(*multi) || has_layers(*multi)));
+    // Transfer-function edits and enhancement work on a_j: a light field without them shows
+    // its captured colours only. Asked for by name, it says so; auto takes the view's proxies.
+    const bool needs_attenuation = edits || request.enhancement.has_value();
+    if (light_field && needs_attenuation && !light_field->settings.attenuation) {
+        if (request.source == ProxySource::lightfield || !has_view_proxies) {
+            fail<InvalidArgument>(
+                "transfer-function edits and enhancement need an attenuation light field, and ",
+                where, " has a light field without one (\"light_field\": {\"attenuation\": true})");
+        }
+        light_field = nullptr;
+    }
     if (request.source == ProxySource::lightfield ||
         (request.source == ProxySource::automatic && light_field && !has_view_proxies)) {
         frame = light_field_frame();
