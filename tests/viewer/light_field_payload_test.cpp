@@ -2,9 +2,8 @@
 // independently of the encoder, every value must come back as the LightField holds it.
 #include "light_field_payload.hpp"
 
-#include <gtest/gtest.h>
-
 #include <Imath/half.h>
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdint>
@@ -144,21 +143,20 @@ TEST(LightFieldPayload, HoldsTheRigAndEveryPlaneExactly) {
                     if (segments > 1) {
                         for (std::size_t p = 0; p < pixels; ++p) {
                             const float expected = images.segment_depth[s].pixels[p];
-                            const float got = depth_value(segment_depth_at +
-                                                          (plane * pixels + p) * depth_bytes);
+                            const float got =
+                                depth_value(segment_depth_at + (plane * pixels + p) * depth_bytes);
                             // 16 bits: the half of the fraction, as the archive stores it.
-                            ASSERT_EQ(got, depth_bits == 8 ? expected
-                                                           : static_cast<float>(
-                                                                 Imath::half(expected)));
+                            ASSERT_EQ(got, depth_bits == 8
+                                               ? expected
+                                               : static_cast<float>(Imath::half(expected)));
                         }
                     }
                 }
                 for (std::size_t p = 0; p < pixels; ++p) {
                     const float expected = images.depth.pixels[p];
                     const float got = depth_value(depth_at + (slot * pixels + p) * depth_bytes);
-                    ASSERT_EQ(got, depth_bits == 8
-                                       ? expected
-                                       : static_cast<float>(Imath::half(expected)));
+                    ASSERT_EQ(got, depth_bits == 8 ? expected
+                                                   : static_cast<float>(Imath::half(expected)));
                 }
             }
         }
@@ -168,12 +166,12 @@ TEST(LightFieldPayload, HoldsTheRigAndEveryPlaneExactly) {
 TEST(LightFieldPayload, RefusesDepthsThatAreNotCodesAndImagesThatDoNotFit) {
     LightField not_a_code = small_light_field(1, 8);
     not_a_code.cameras[1].depth.pixels[5] = 0.3333f;
-    testing::expect_error_naming<InvalidArgument>(
-        [&] { light_field_payload(not_a_code, 0, "v"); }, "camera 7: depth 0.3333");
+    testing::expect_error_naming<InvalidArgument>([&] { light_field_payload(not_a_code, 0, "v"); },
+                                                  "camera 7: depth 0.3333");
     LightField wrong_size = small_light_field(1, 8);
     wrong_size.cameras[0].depth = Image(4, 4, 1, 0.0f);
-    testing::expect_error_naming<InvalidArgument>(
-        [&] { light_field_payload(wrong_size, 0, "v"); }, "camera 3: depth is 4x4x1");
+    testing::expect_error_naming<InvalidArgument>([&] { light_field_payload(wrong_size, 0, "v"); },
+                                                  "camera 3: depth is 4x4x1");
 }
 
 }  // namespace
