@@ -36,6 +36,19 @@ inline void store_segment(int wanted, __global float4* rgba_out, __global float*
     if ((wanted & WANT_SEGMENT_DEPTH) != 0) depth_out[index] = depth;
 }
 
+// Stores `segment` of a pixel, then the segments after it up to (not including) `until` empty:
+// those a ray passed over at once, or never reached.
+inline void store_segments(int wanted, __global float4* rgba_out, __global float* depth_out,
+                           int pixel, int pixel_count, int segment, int until, float3 colour,
+                           float transmittance, float depth) {
+    store_segment(wanted, rgba_out, depth_out, segment * pixel_count + pixel, colour, transmittance,
+                  depth);
+    for (int s = segment + 1; s < until; ++s) {
+        store_segment(wanted, rgba_out, depth_out, s * pixel_count + pixel, (float3)(0.0f), 1.0f,
+                      INFINITY);
+    }
+}
+
 __kernel void render_proxies(
     __global const float* volume, int4 dims, float4 origin_world, float4 inv_spacing,
     float4 box_lower, float4 box_upper, float4 data_offset, float4 owned_lower, float4 owned_upper,
@@ -180,15 +193,11 @@ __kernel void render_proxies(
                     }
                 }
                 if (sample_segment != segment) {
-                    store_segment(wanted, segment_rgba_out, segment_depth_out,
-                                  segment * pixel_count + pixel, segment_colour,
-                                  segment_transmittance, segment_depth);
                     // Segments passed over at once (two crossings between two samples, or two
                     // thresholds reached by one sample) stay empty.
-                    for (int s = segment + 1; s < sample_segment; ++s) {
-                        store_segment(wanted, segment_rgba_out, segment_depth_out,
-                                      s * pixel_count + pixel, (float3)(0.0f), 1.0f, INFINITY);
-                    }
+                    store_segments(wanted, segment_rgba_out, segment_depth_out, pixel, pixel_count,
+                                   segment, sample_segment, segment_colour, segment_transmittance,
+                                   segment_depth);
                     segment = sample_segment;
                     segment_colour = (float3)(0.0f);
                     segment_transmittance = 1.0f;
@@ -279,12 +288,8 @@ __kernel void render_proxies(
     }
 
     if (want_segments) {
-        store_segment(wanted, segment_rgba_out, segment_depth_out, segment * pixel_count + pixel,
-                      segment_colour, segment_transmittance, segment_depth);
-        for (int s = segment + 1; s < segment_count; ++s) {
-            store_segment(wanted, segment_rgba_out, segment_depth_out, s * pixel_count + pixel,
-                          (float3)(0.0f), 1.0f, INFINITY);
-        }
+        store_segments(wanted, segment_rgba_out, segment_depth_out, pixel, pixel_count, segment,
+                       segment_count, segment_colour, segment_transmittance, segment_depth);
         if ((wanted & WANT_FIRST_HIT_DEPTH) != 0) first_hit_out[pixel] = first_hit;
     }
     if (want_layers) {
@@ -352,6 +357,25 @@ inline void accumulate_lanes(intp contributes, floatp value, floatp weight, floa
 // its ray; each lane keeps its own sample index, so lanes skip blocks independently. The arguments
 // are render_proxies' (segment and fragment buffers unused), so the host launches either with one
 // argument list.
+// absorb() for the lanes of `composites`: premultiplied colour and T front to back, the depth
+// where the opacity first reaches `depth_threshold`, and compositing stopped at `stop_opacity`.
+inline void composite_lanes(intp composites, floatp alpha, floatp sample_red, floatp sample_green,
+                            floatp sample_blue, floatp depth, float depth_threshold,
+                            float stop_opacity, floatp* transmittance, floatp* red, floatp* green,
+                            floatp* blue, floatp* hit_depth, intp* compositing) {
+    if (!any(composites)) return;
+    const floatp a = select((floatp)0.0f, alpha, composites);
+    const floatp weight = *transmittance * a;
+    *transmittance *= 1.0f - a;
+    *red += weight * sample_red;
+    *green += weight * sample_green;
+    *blue += weight * sample_blue;
+    *hit_depth =
+        select(*hit_depth, depth,
+               composites & isinf(*hit_depth) & (1.0f - *transmittance >= depth_threshold));
+    *compositing &= ~(composites & (1.0f - *transmittance >= stop_opacity));
+}
+
 __kernel void render_proxies_packets(
     __global const float* volume, int4 dims, float4 origin_world, float4 inv_spacing,
     float4 box_lower, float4 box_upper, float4 data_offset, float4 owned_lower, float4 owned_upper,
@@ -462,17 +486,12 @@ __kernel void render_proxies_packets(
                     if (!LANE_INT(starts, lane)) continue;
                     const int2 pixel_xy = packet_pixel(gx, gy, lane);
                     const int pixel = pixel_xy.y * size.x + pixel_xy.x;
-                    const int from = LANE_INT(segment, lane);
-                    store_segment(wanted, segment_rgba_out, segment_depth_out,
-                                  from * pixel_count + pixel,
-                                  (float3)(LANE(segment_red, lane), LANE(segment_green, lane),
-                                           LANE(segment_blue, lane)),
-                                  LANE(segment_transmittance, lane), LANE(segment_depth, lane));
                     // Segments passed over at once (thresholds reached by one sample) stay empty.
-                    for (int s = from + 1; s < LANE_INT(sample_segment, lane); ++s) {
-                        store_segment(wanted, segment_rgba_out, segment_depth_out,
-                                      s * pixel_count + pixel, (float3)(0.0f), 1.0f, INFINITY);
-                    }
+                    store_segments(wanted, segment_rgba_out, segment_depth_out, pixel, pixel_count,
+                                   LANE_INT(segment, lane), LANE_INT(sample_segment, lane),
+                                   (float3)(LANE(segment_red, lane), LANE(segment_green, lane),
+                                            LANE(segment_blue, lane)),
+                                   LANE(segment_transmittance, lane), LANE(segment_depth, lane));
                 }
                 segment = select(segment, sample_segment, starts);
                 segment_red = select(segment_red, (floatp)0.0f, starts);
@@ -501,33 +520,14 @@ __kernel void render_proxies_packets(
                                  optical_depth_out);
                 accumulating &= ~(contributes & (1.0f - transmittance >= stop_opacity));
             }
-            const intp composites = usable & compositing & (alpha > 0.0f);
-            if (any(composites)) {
-                const floatp a = select((floatp)0.0f, alpha, composites);
-                const floatp weight = ray_transmittance * a;  // absorb()
-                ray_transmittance *= 1.0f - a;
-                red += weight * sample_red;
-                green += weight * sample_green;
-                blue += weight * sample_blue;
-                first_hit = select(
-                    first_hit, depth,
-                    composites & isinf(first_hit) & (1.0f - ray_transmittance >= depth_threshold));
-                compositing &= ~(composites & (1.0f - ray_transmittance >= stop_opacity));
-            }
-            const intp segment_composites = usable & compositing_segment & (alpha > 0.0f);
-            if (any(segment_composites)) {
-                const floatp a = select((floatp)0.0f, alpha, segment_composites);
-                const floatp weight = segment_transmittance * a;  // absorb()
-                segment_transmittance *= 1.0f - a;
-                segment_red += weight * sample_red;
-                segment_green += weight * sample_green;
-                segment_blue += weight * sample_blue;
-                segment_depth = select(segment_depth, depth,
-                                       segment_composites & isinf(segment_depth) &
-                                           (1.0f - segment_transmittance >= depth_threshold));
-                compositing_segment &=
-                    ~(segment_composites & (1.0f - segment_transmittance >= stop_opacity));
-            }
+            // The whole ray, then the opacity segment (none unless asked for).
+            composite_lanes(usable & compositing & (alpha > 0.0f), alpha, sample_red, sample_green,
+                            sample_blue, depth, depth_threshold, stop_opacity, &ray_transmittance,
+                            &red, &green, &blue, &first_hit, &compositing);
+            composite_lanes(usable & compositing_segment & (alpha > 0.0f), alpha, sample_red,
+                            sample_green, sample_blue, depth, depth_threshold, stop_opacity,
+                            &segment_transmittance, &segment_red, &segment_green, &segment_blue,
+                            &segment_depth, &compositing_segment);
         }
         intp done = ~accumulating & ~compositing & ~compositing_segment;
         if (opacity_segments) {
@@ -595,15 +595,11 @@ __kernel void render_proxies_packets(
             }
         }
         if (opacity_segments) {
-            const int last = LANE_INT(segment, lane);
-            store_segment(wanted, segment_rgba_out, segment_depth_out, last * pixel_count + pixel,
-                          (float3)(LANE(segment_red, lane), LANE(segment_green, lane),
-                                   LANE(segment_blue, lane)),
-                          LANE(segment_transmittance, lane), LANE(segment_depth, lane));
-            for (int s = last + 1; s < segment_count; ++s) {
-                store_segment(wanted, segment_rgba_out, segment_depth_out, s * pixel_count + pixel,
-                              (float3)(0.0f), 1.0f, INFINITY);
-            }
+            store_segments(wanted, segment_rgba_out, segment_depth_out, pixel, pixel_count,
+                           LANE_INT(segment, lane), segment_count,
+                           (float3)(LANE(segment_red, lane), LANE(segment_green, lane),
+                                    LANE(segment_blue, lane)),
+                           LANE(segment_transmittance, lane), LANE(segment_depth, lane));
         } else {
             if ((wanted & WANT_SEGMENT_RGBA) != 0) {
                 segment_rgba_out[pixel] =
