@@ -205,7 +205,7 @@ int child_capture(const fs::path& dir, bool sparse, int n, int image) {
     insitu::ProxyRequest request;
     request.depth_layers = false;
     request.intervals = renderer.choose_intervals(16, insitu::IntervalMode::uniform);
-    request.transfer_function = config.transfer_function;
+    request.transfer_function = *config.transfer_function;  // bench_config gives one
     renderer.render(insitu::Camera::orbit(config.views.front().orbit, field.bounds()), request);
 
     const insitu::Index3 dims = field.dims();

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "insitu/core/histogram.hpp"
 #include "insitu/error.hpp"
 
 namespace insitu {
@@ -34,6 +35,38 @@ void expect_error(const std::string& text, const std::vector<std::string>& parts
     }
 }
 
+TEST(InstrumentConfig, TransferFunctionAutoRoundTripsAndOtherTextIsRefused) {
+    const InstrumentConfig automatic =
+        InstrumentConfig::from_json_text(R"({"transfer_function": "auto"})");
+    EXPECT_FALSE(automatic.transfer_function.has_value());
+    EXPECT_EQ(automatic.to_json().at("transfer_function"), "auto");
+    EXPECT_FALSE(InstrumentConfig::from_json(automatic.to_json()).transfer_function.has_value());
+    const InstrumentConfig given = InstrumentConfig::from_json_text(
+        R"({"transfer_function": {"points": [[-1000, 0, 0, 1, 0], [2000, 1, 0, 0, 0.5]]}})");
+    ASSERT_TRUE(given.transfer_function.has_value());
+    EXPECT_EQ(given.transfer_function->value_min(), -1000.0);
+    EXPECT_EQ(InstrumentConfig::from_json(given.to_json()).transfer_function->to_json(),
+              given.transfer_function->to_json());
+    expect_error<InvalidArgument>(R"({"transfer_function": "automatic"})",
+                                  {"transfer_function", "automatic", "auto"});
+}
+
+TEST(DefaultTransferFunction, SpansThePercentilesAndWidensDegenerateRanges) {
+    std::vector<float> values(1000);
+    for (std::size_t i = 0; i < values.size(); ++i) values[i] = static_cast<float>(i);
+    values.back() = 1e6f;  // an outlier does not squeeze the ramp
+    const TransferFunction tf = default_transfer_function(ValueHistogram::of(values));
+    EXPECT_NEAR(tf.value_min(), 10.0, 1e6 / 256);
+    EXPECT_LT(tf.value_max(), 1e6 / 256 + 1.0);  // the 99th percentile sits in the first bin
+    EXPECT_EQ(tf.evaluate(tf.value_min()).a, 0.0f);
+    EXPECT_NEAR(tf.evaluate(tf.value_max()).a, 0.5f, 1e-6);
+
+    const TransferFunction constant =
+        default_transfer_function(ValueHistogram::of(std::vector<float>(8, 2.0f)));
+    EXPECT_EQ(constant.value_min(), 1.5);
+    EXPECT_EQ(constant.value_max(), 2.5);
+}
+
 TEST(InstrumentConfig, EmptyObjectGivesTheDocumentedDefaults) {
     std::vector<std::string> unknown;
     const InstrumentConfig config = InstrumentConfig::from_json_text("{}", &unknown);
@@ -47,16 +80,16 @@ TEST(InstrumentConfig, EmptyObjectGivesTheDocumentedDefaults) {
     EXPECT_EQ(orbit.width, 256);
     EXPECT_EQ(orbit.height, 256);
     EXPECT_EQ(config.views[0].distortion_tilt_deg, 45.0);
-    EXPECT_EQ(config.transfer_function.value_min(), 0.0);
-    EXPECT_EQ(config.transfer_function.value_max(), 1.0);
+    EXPECT_FALSE(config.transfer_function.has_value());  // "auto": from each step's data
     EXPECT_TRUE(config.training_transfer_functions.empty());
     EXPECT_FALSE(config.layers.has_value());  // "auto"
     EXPECT_EQ(config.max_auto_layers, 4);
     EXPECT_EQ(config.interval_count, 16);
     EXPECT_EQ(config.interval_mode, IntervalMode::uniform);
     EXPECT_TRUE(config.proxies.depth);
-    EXPECT_TRUE(config.proxies.distortion);
+    EXPECT_FALSE(config.proxies.distortion);  // Explorer's auto never prefers it
     EXPECT_TRUE(config.proxies.attenuation);
+    EXPECT_TRUE(config.proxies.rendering);
     EXPECT_FALSE(config.proxies.multi_attenuation);
     EXPECT_FALSE(config.proxies.optical_depth);
     EXPECT_EQ(config.step_voxels, 1.0);
@@ -202,7 +235,7 @@ TEST(InstrumentConfig, ToJsonEmitsEveryKeyAndRoundTrips) {
         EXPECT_TRUE(json.contains(key)) << key;
     }
     EXPECT_EQ(json["layers"], "auto");
-    EXPECT_EQ(json["proxies"], nlohmann::json({"depth", "distortion", "attenuation"}));
+    EXPECT_EQ(json["proxies"], nlohmann::json({"depth", "attenuation", "rendering"}));
 
     InstrumentConfig custom;
     custom.fields = {"u", "v"};
@@ -318,19 +351,23 @@ TEST(InstrumentConfig, StepBelowTheFloorIsRefusedNamingTheBound) {
 }
 
 TEST(InstrumentConfig, EstimatedSamplesPerStepFollowTheCostModel) {
-    InstrumentConfig config;  // one view; depth, distortion, attenuation; step 1
+    InstrumentConfig config;  // one view; depth, attenuation, rendering; step 1
     config.views[0].orbit.width = config.views[0].orbit.height = 512;
-    EXPECT_EQ(config.passes_per_view(), 3);  // single, multi-perspective, preview
-    EXPECT_DOUBLE_EQ(config.estimated_samples_per_step(), 512.0 * 512.0 * 3 * kWorstDiagonalVoxels);
+    EXPECT_EQ(config.passes_per_view(), 2);  // single perspective, preview (= the rendering)
+    EXPECT_DOUBLE_EQ(config.estimated_samples_per_step(), 512.0 * 512.0 * 2 * kWorstDiagonalVoxels);
     config.step_voxels = 0.5;
-    EXPECT_DOUBLE_EQ(config.estimated_samples_per_step(), 512.0 * 512.0 * 6 * kWorstDiagonalVoxels);
-    // Two training functions, fitted: a ground truth and an attenuation pass each.
-    config.training_transfer_functions = {config.transfer_function, config.transfer_function};
-    EXPECT_EQ(config.passes_per_view(), 7);
-    config.colour_model.enabled = false;  // not fitted, not kept: not rendered
+    EXPECT_DOUBLE_EQ(config.estimated_samples_per_step(), 512.0 * 512.0 * 4 * kWorstDiagonalVoxels);
+    config.proxies.distortion = true;  // the multi-perspective pass
     EXPECT_EQ(config.passes_per_view(), 3);
+    config.proxies.distortion = false;
+    // Two training functions, fitted: a ground truth and an attenuation pass each.
+    const TransferFunction ramp({{0.0, {0, 0, 1, 0}}, {1.0, {1, 0, 0, 0.5}}});
+    config.training_transfer_functions = {ramp, ramp};
+    EXPECT_EQ(config.passes_per_view(), 6);
+    config.colour_model.enabled = false;  // not fitted, not kept: not rendered
+    EXPECT_EQ(config.passes_per_view(), 2);
     config.keep_training_images = true;
-    EXPECT_EQ(config.passes_per_view(), 5);
+    EXPECT_EQ(config.passes_per_view(), 4);
     // The largest view at a 1-voxel step with the default proxies is within the ceiling.
     InstrumentConfig largest;
     largest.views[0].orbit.width = 16384;

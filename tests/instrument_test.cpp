@@ -23,12 +23,14 @@
 #include <iostream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "insitu/archive/archive.hpp"
+#include "insitu/core/histogram.hpp"
 #include "insitu/error.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 
@@ -87,9 +89,86 @@ TEST(InstrumentStatus, PrintsItsName) {
     EXPECT_EQ(text.str(), "not_selected error InstrumentOptions{rethrow_errors false, log true}");
 }
 
+// "transfer_function": "auto" (the default): each step's function spans that step's 1st-99th
+// percentiles, the archive records it with each view and the step's histogram with the step,
+// and a field in Hounsfield-like units is coloured over its own range, not clamped to [0, 1].
+TEST_F(InstrumentTest, AutoTransferFunctionSpansEachStepsPercentilesAndIsArchived) {
+    InstrumentConfig config = small_config(archive());
+    config.transfer_function.reset();
+    config.layers.reset();
+    SampledVolume scan = volume_;
+    for (float& value : scan.values) value = -1000.0f + 3000.0f * value;  // "Hounsfield"
+    {
+        Instrument instrument(config, quiet());
+        ASSERT_EQ(instrument.execute(0, 0.0, {volume_.field()}), Status::ok)
+            << instrument.last_error();
+        ASSERT_EQ(instrument.execute(1, 1.0, {scan.field()}), Status::ok)
+            << instrument.last_error();
+        ASSERT_EQ(instrument.finalize(), Status::ok) << instrument.last_error();
+    }
+    const ArchiveReader reader(archive().string());
+    EXPECT_EQ(reader.manifest().at("configuration").at("transfer_function"), "auto");
+    for (std::int64_t step : {0, 1}) {
+        const SampledVolume& volume = step == 0 ? volume_ : scan;
+        const std::optional<FieldSummaryRecord> summary = reader.field_summary(step, "f");
+        ASSERT_TRUE(summary.has_value()) << "step " << step;
+        const auto [low, high] = std::minmax_element(volume.values.begin(), volume.values.end());
+        EXPECT_EQ(summary->histogram.min, *low);
+        EXPECT_EQ(summary->histogram.max, *high);
+        ASSERT_EQ(summary->histogram.counts.size(), static_cast<std::size_t>(kValueHistogramBins));
+        EXPECT_EQ(summary->histogram.total(), static_cast<double>(volume.values.size()));
+        EXPECT_EQ(summary->nonfinite_samples, 0);
+
+        // The function is the default ramp over the step's 1st and 99th percentiles.
+        std::vector<float> sorted = volume.values;
+        std::sort(sorted.begin(), sorted.end());
+        const double p1 = sorted[sorted.size() / 100];
+        const double p99 = sorted[sorted.size() * 99 / 100];
+        const TransferFunction tf = reader.transfer_function(step, 0);
+        const double bin = (*high - *low) / kValueHistogramBins;
+        EXPECT_NEAR(tf.value_min(), p1, bin) << "step " << step;
+        EXPECT_NEAR(tf.value_max(), p99, bin) << "step " << step;
+        EXPECT_EQ(tf.to_json(), default_transfer_function(summary->histogram).to_json());
+    }
+    // Colours follow the data's units: the scan's preview is not an opaque or empty block, and
+    // it matches the first step's picture, which the same ramp over the same quantiles makes.
+    const Image first = reader.load_preview(0, 0);
+    const Image second = reader.load_preview(1, 0);
+    double alpha = 0.0;
+    double difference = 0.0;
+    for (std::size_t p = 0; p < first.pixel_count(); ++p) {
+        alpha += second.pixels[4 * p + 3];
+        for (int c = 0; c < 4; ++c) {
+            difference = std::max(
+                difference,
+                static_cast<double>(std::abs(first.pixels[4 * p + c] - second.pixels[4 * p + c])));
+        }
+    }
+    alpha /= static_cast<double>(first.pixel_count());
+    EXPECT_GT(alpha, 0.02);
+    EXPECT_LT(alpha, 0.9);
+    EXPECT_LT(difference, 0.02);  // 8-bit previews of the same picture
+}
+
+// An explicit function wins, and the histogram is stored all the same.
+TEST_F(InstrumentTest, AGivenTransferFunctionIsArchivedAsGivenWithTheStepsHistogram) {
+    const InstrumentConfig config = small_config(archive());
+    {
+        Instrument instrument(config, quiet());
+        ASSERT_EQ(instrument.execute(3, 0.0, {volume_.field()}), Status::ok)
+            << instrument.last_error();
+        ASSERT_EQ(instrument.finalize(), Status::ok);
+    }
+    const ArchiveReader reader(archive().string());
+    EXPECT_EQ(reader.transfer_function(3, 0).to_json(), config.transfer_function->to_json());
+    ASSERT_TRUE(reader.field_summary(3, "f").has_value());
+    EXPECT_FALSE(reader.field_summary(3, "other").has_value());
+}
+
 TEST_F(InstrumentTest, WritesEveryNthStepIntoAnArchiveTheReaderOpens) {
     InstrumentConfig config = small_config(archive());
     config.every = 2;
+    config.proxies.distortion = true;  // both perspectives
     Instrument instrument(config, quiet());
     const Field field = volume_.field();
     for (std::int64_t step = 0; step <= 6; ++step) {
@@ -438,7 +517,7 @@ TEST_F(InstrumentTest, SeveralFieldsGoIntoOneArchiveEachWithItsViews) {
     const InstrumentConfig stored = reader.configuration();
     EXPECT_EQ(stored.views_of("energy").size(), 2u);
     EXPECT_EQ(stored.views_of("f").size(), 1u);
-    EXPECT_EQ(stored.transfer_function_of("energy").to_json(), style.transfer_function->to_json());
+    EXPECT_EQ(stored.transfer_function_of("energy")->to_json(), style.transfer_function->to_json());
 }
 
 TEST_F(InstrumentTest, FinalizeStatesTheInSituShareOfWallTime) {

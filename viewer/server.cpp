@@ -470,7 +470,12 @@ private:
             }
             description["timeline"] = timeline;
             description["name"] = root_.filename().string();
-            description["transfer_function"] = reader.configuration().transfer_function.to_json();
+            // The editor starts from the first step's function ("auto" makes one per step;
+            // /api/step says each step's).
+            if (!steps.empty()) {
+                description["transfer_function"] =
+                    reader.transfer_function(steps.front(), 0).to_json();
+            }
             description_ = description.dump();
         }
         response.set_header("Cache-Control", "no-store");
@@ -486,24 +491,31 @@ private:
             const ArchiveReader& reader = explorer_->archive();
             const ProxyFrame frame = reader.load(key.step, key.view);
             const Camera& camera = frame.camera;
-            json info{{"step", key.step},
-                      {"view", key.view},
-                      {"time", reader.entry(key.step, key.view).time},
-                      {"size", {camera.width(), camera.height()}},
-                      {"projection", to_string(camera.projection())},
-                      {"azimuth", camera.azimuth_deg()},
-                      {"elevation", camera.elevation_deg()},
-                      {"isovalues", frame.isovalues},
-                      {"depth_layers", frame.depth_layers.size()},
-                      {"colour_model", frame.colour_model.has_value()},
-                      {"camera", camera.to_json()}};
+            json info{
+                {"step", key.step},
+                {"view", key.view},
+                {"time", reader.entry(key.step, key.view).time},
+                {"size", {camera.width(), camera.height()}},
+                {"projection", to_string(camera.projection())},
+                {"azimuth", camera.azimuth_deg()},
+                {"elevation", camera.elevation_deg()},
+                {"isovalues", frame.isovalues},
+                {"depth_layers", frame.depth_layers.size()},
+                {"colour_model", frame.colour_model.has_value()},
+                {"camera", camera.to_json()},
+                {"transfer_function", reader.transfer_function(key.step, key.view).to_json()}};
+            // The field's values at the step, for the editor's histogram (older archives: none).
+            const std::optional<FieldSummaryRecord> summary =
+                reader.field_summary(key.step, reader.entry(key.step, key.view).field);
+            if (summary) {
+                info["histogram"] = summary->histogram.to_json();
+                info["nonfinite_samples"] = summary->nonfinite_samples;
+            }
             if (frame.intervals) {
                 const IntervalSet& intervals = *frame.intervals;
                 info["intervals"] = intervals.edges();
                 info["interval_colours"] =
-                    interval_colours(reader.configuration().transfer_function_of(
-                                         reader.entry(key.step, key.view).field),
-                                     intervals);
+                    interval_colours(reader.transfer_function(key.step, key.view), intervals);
                 if (frame.attenuation.channels == intervals.count()) {
                     // A summary for the editor, not per-pixel synthesis: a_j summed over the
                     // stored image (Eq. 7), as the mean per pixel.

@@ -105,7 +105,8 @@ const std::vector<Option>& options() {
          "continued)",
          "", [](Arguments& a, V, V v) { a.out_path = v; }},
         {"--field", "NAME", false, "array (.vti) or grid (.vdb) to read",
-         "the configuration's first field", [](Arguments& a, V, V v) { a.field = v; }},
+         "the configuration's first field; neither given: the file's only array or grid",
+         [](Arguments& a, V, V v) { a.field = v; }},
         {"--raw-dims", "NX,NY,NZ", false, "samples per axis of raw inputs", "",
          [](Arguments& a, V f, V v) { a.raw_dims = parse_dims(f, v); }},
         {"--raw-type", "TYPE", false,
@@ -217,11 +218,13 @@ private:
     Clock::time_point start_;
 };
 
-// Whether the configuration file names "every" or "steps" (it has parsed already: it is JSON).
-bool configuration_sets_cadence(const std::string& path) {
+// Whether the configuration file names any of `keys` (it has parsed already: it is JSON).
+bool configuration_sets(const std::string& path, std::initializer_list<const char*> keys) {
     std::ifstream in(path);
     const nlohmann::json json = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-    return json.is_object() && (json.contains("every") || json.contains("steps"));
+    if (!json.is_object()) return false;
+    return std::any_of(keys.begin(), keys.end(),
+                       [&](const char* key) { return json.contains(key); });
 }
 
 int run(const Arguments& arguments) {
@@ -241,11 +244,17 @@ int run(const Arguments& arguments) {
     }
     // Each input is a step the user chose to capture: the simulation's default cadence (every
     // 10th step) applies only when the configuration asks for a cadence itself.
-    if (!configuration_sets_cadence(arguments.config_path)) config.every = 1;
+    if (!configuration_sets(arguments.config_path, {"every", "steps"})) config.every = 1;
 
     capture::InputOptions input_options;
     input_options.field_name = config.fields.front();
     input_options.array_name = arguments.field.empty() ? config.fields.front() : arguments.field;
+    // Neither --field nor "fields": the first file's only array or grid (its active scalars or
+    // first scalar grid where there are several), under its own name, which every later file
+    // must then hold too.
+    const bool field_from_file =
+        arguments.field.empty() && !configuration_sets(arguments.config_path, {"fields"});
+    if (field_from_file) input_options.field_name = input_options.array_name = "";
     if (arguments.raw_dims) {
         capture::RawOptions raw;
         raw.dims = *arguments.raw_dims;
@@ -284,6 +293,7 @@ int run(const Arguments& arguments) {
     std::size_t dropped = 0;
     std::size_t skipped = 0;
     std::string layers_note;
+    std::string field_note;
     // An input that cannot be used: skipped, or the end of the run (the archive keeps what the
     // Instrument already wrote: finalize drains its queue).
     const auto input_failed = [&](const std::string& why) {
@@ -311,6 +321,16 @@ int run(const Arguments& arguments) {
             input_failed(error.what());
             progress.update(i + 1);
             continue;
+        }
+        if (!instrument && field_from_file) {
+            const std::string name = loaded->field().name();
+            if (name.empty()) {
+                throw UsageError("\"" + input.path +
+                                 "\": its array has no name, which an archive's field needs");
+            }
+            config.fields = {name};
+            input_options.array_name = input_options.field_name = name;
+            field_note = ", field \"" + name + "\" (named by the first file)";
         }
         if (!instrument) {
             // Level sets: the zero crossing is a layer unless the configuration names layers.
@@ -368,7 +388,7 @@ int run(const Arguments& arguments) {
             << " of " << steps.size() << " steps archived (" << skipped << " skipped, "
             << not_selected << " not selected by the cadence, " << dropped << " dropped) in "
             << seconds << " s, " << (seconds > 0.0 ? captured / seconds : 0.0) << " steps/s"
-            << layers_note << " -> " << config.archive;
+            << field_note << layers_note << " -> " << config.archive;
     std::cout << summary.str() << "\n";
     return 0;
 }

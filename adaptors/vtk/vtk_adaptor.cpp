@@ -100,8 +100,29 @@ vtkDataArray& find_array(vtkDataSet& data_set, const ArraySelection& selection,
             return *array;
         }
     }
-    const std::string what =
-        selection.name.empty() ? std::string("active scalars") : "array \"" + selection.name + "\"";
+    // No name and no active scalars: a data set with one array means that one (a .vti written
+    // by a code that never marks its scalars active, issue 17).
+    if (selection.name.empty()) {
+        vtkDataArray* only = nullptr;
+        int arrays = 0;
+        const std::pair<vtkDataSetAttributes*, Association> places[] = {
+            {points_allowed ? data_set.GetPointData() : nullptr, Association::point},
+            {cells_allowed ? data_set.GetCellData() : nullptr, Association::cell}};
+        for (const auto& [attributes, association] : places) {
+            if (!attributes) continue;
+            for (int a = 0; a < attributes->GetNumberOfArrays(); ++a) {
+                if (vtkDataArray* array = attributes->GetArray(a)) {
+                    ++arrays;
+                    only = array;
+                    found_in = association;
+                }
+            }
+        }
+        if (arrays == 1) return *only;
+    }
+    const std::string what = selection.name.empty()
+                                 ? std::string("active scalars, and not exactly one array,")
+                                 : "array \"" + selection.name + "\"";
     fail<InvalidArgument>("VTK ", data_set.GetClassName(), ": no ", what,
                           selection.association == Association::any
                               ? std::string(" in point or cell data")

@@ -623,7 +623,7 @@ std::vector<Configuration> configuration_grid(bool smoke) {
 
 /// Ground truths of one scene at one image size, shared by every configuration of that size.
 struct Truths {
-    Image edit, rotated_15;
+    Image edit, rotated_15, stored;
     Image depth_15, depth_30;
 };
 
@@ -634,7 +634,7 @@ void section_configurations(const std::vector<const Scene*>& scenes, const Scene
             "compression,emission_single_ms,emission_multi_ms,emission_ms,instrument_ms,"
             "archive_bytes,synthesis_ms,edit_ms,edit_psnr,edit_ssim,edit_max_abs,"
             "recolour_psnr,recolour_ssim,recolour_max_abs,rotate15_psnr,rotate15_ssim,"
-            "rotate15_max_abs,depth_corr_15,depth_corr_30");
+            "rotate15_max_abs,depth_corr_15,depth_corr_30,stored_psnr,stored_recomposed_psnr");
     const std::vector<Configuration> grid = configuration_grid(options.smoke);
     const int repeats = options.smoke ? 1 : 3;
     int archive_index = 0;
@@ -654,6 +654,7 @@ void section_configurations(const std::vector<const Scene*>& scenes, const Scene
             const Camera camera = Camera::orbit(stored_view(image), bounds);
             Truths t;
             t.edit = renderer.render_ground_truth(camera, edit_tf, truth_settings()).rgba;
+            t.stored = renderer.render_ground_truth(camera, stored_tf, truth_settings()).rgba;
             const Camera at_15 = camera.reorbit(kStoredAzimuth + 15.0, kStoredElevation);
             const Camera at_30 = camera.reorbit(kStoredAzimuth + 30.0, kStoredElevation);
             t.rotated_15 = renderer.render_ground_truth(at_15, stored_tf, truth_settings()).rgba;
@@ -687,6 +688,7 @@ void section_configurations(const std::vector<const Scene*>& scenes, const Scene
             }
             config.layers = scene_layers(*scene, c.layers);
             config.interval_count = c.intervals;
+            config.proxies.distortion = true;  // measured below (off by default)
             config.proxies.multi_attenuation = true;
             config.precision = c.precision;
             config.compression = c.compression;
@@ -724,6 +726,13 @@ void section_configurations(const std::vector<const Scene*>& scenes, const Scene
                     .rgba;
             const ImageErrors recolour_err =
                 errors_of(recolour_truth, explore(recoloured, &recolour_ms));
+            // The stored view with the run's own function: the stored rendering (issue 17).
+            double stored_ms = 0;
+            const ImageErrors stored_err = errors_of(truth.stored, explore({}, &stored_ms));
+            ExploreRequest recomposed;
+            recomposed.colour = ColourSource::recompose;
+            const ImageErrors recomposed_err =
+                errors_of(truth.stored, explore(recomposed, &stored_ms));
             ExploreRequest rotated;
             rotated.azimuth_deg = kStoredAzimuth + 15.0;
             const ImageErrors rotate_err =
@@ -748,7 +757,7 @@ void section_configurations(const std::vector<const Scene*>& scenes, const Scene
                     static_cast<unsigned long long>(statistics.bytes_written), synthesis_ms,
                     edit_ms, edit_err.psnr, edit_err.ssim, edit_err.max_abs, recolour_err.psnr,
                     recolour_err.ssim, recolour_err.max_abs, rotate_err.psnr, rotate_err.ssim,
-                    rotate_err.max_abs, corr_15, corr_30);
+                    rotate_err.max_abs, corr_15, corr_30, stored_err.psnr, recomposed_err.psnr);
             fs::remove_all(config.archive);
         }
         std::printf("configurations: %s, %.1f s\n", scene->name.c_str(), ms_since(start) / 1e3);

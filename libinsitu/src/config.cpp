@@ -10,6 +10,7 @@
 #include <optional>
 #include <sstream>
 
+#include "insitu/core/histogram.hpp"
 #include "insitu/core/layers.hpp"
 #include "insitu/error.hpp"
 
@@ -140,7 +141,8 @@ constexpr Choice<bool ProxySelection::*> kProxies[] = {
     {"distortion", &ProxySelection::distortion},
     {"attenuation", &ProxySelection::attenuation},
     {"multi_attenuation", &ProxySelection::multi_attenuation},
-    {"optical_depth", &ProxySelection::optical_depth}};
+    {"optical_depth", &ProxySelection::optical_depth},
+    {"rendering", &ProxySelection::rendering}};
 
 /// "a, b or c".
 template <typename Value, std::size_t N>
@@ -425,9 +427,19 @@ const Key<InstrumentConfig> kTopLevelKeys[] = {
      [](const InstrumentConfig& config) { return write_views(config.views); }},
     {"transfer_function",
      [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
+         if (value.is_string() && value.get<std::string>() == "auto") {
+             config.transfer_function.reset();
+             return;
+         }
+         if (value.is_string()) {
+             fail<InvalidArgument>("configuration \"", key, "\": ", value.dump(),
+                                   " (expected \"auto\" or an object with \"points\")");
+         }
          config.transfer_function = parse_transfer_function(value, key, unknown);
      },
-     [](const InstrumentConfig& config) { return config.transfer_function.to_json(); }},
+     [](const InstrumentConfig& config) {
+         return config.transfer_function ? config.transfer_function->to_json() : json("auto");
+     }},
     {"training_transfer_functions",
      [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
          require_array(value, key);
@@ -859,10 +871,26 @@ const std::vector<ViewConfig>& InstrumentConfig::views_of(const std::string& fie
     return style != nullptr && style->views ? *style->views : views;
 }
 
-const TransferFunction& InstrumentConfig::transfer_function_of(const std::string& field) const {
+const std::optional<TransferFunction>& InstrumentConfig::transfer_function_of(
+    const std::string& field) const {
     const FieldStyle* style = style_of(*this, field);
-    return style != nullptr && style->transfer_function ? *style->transfer_function
+    return style != nullptr && style->transfer_function ? style->transfer_function
                                                         : transfer_function;
+}
+
+TransferFunction default_transfer_function(const ValueHistogram& histogram) {
+    double low = histogram.percentile(0.01);
+    double high = histogram.percentile(0.99);
+    if (!(high > low)) {
+        low = histogram.min;
+        high = histogram.max;
+    }
+    if (!(high > low)) {  // a constant field
+        low = histogram.min - 0.5;
+        high = histogram.min + 0.5;
+    }
+    return TransferFunction(std::vector<ControlPoint>{{low, {0, 0, 1, 0}}, {high, {1, 0, 0, 0.5}}},
+                            1.0);
 }
 
 const std::optional<std::vector<double>>& InstrumentConfig::layers_of(

@@ -20,6 +20,7 @@
 #include "insitu/archive/archive.hpp"
 #include "insitu/core/camera.hpp"
 #include "insitu/core/check.hpp"
+#include "insitu/core/histogram.hpp"
 #include "insitu/core/layers.hpp"
 #include "insitu/error.hpp"
 #include "insitu/explore/colour_model.hpp"
@@ -283,7 +284,17 @@ struct Instrument::Impl {
         std::vector<double> isovalues;
         IntervalSet intervals = IntervalSet::uniform(0.0, 1.0, 1);
         bool has_block = true;  ///< false: a rank that owns nothing of the field
+        /// The whole grid's values at this step (stored with the step, and what "auto" spans).
+        FieldSummaryRecord summary;
+        /// The configured function, or for "auto" default_transfer_function(summary.histogram).
+        TransferFunction transfer_function{std::vector<ControlPoint>{{0.0, {0, 0, 0, 0}}}};
     };
+    /// The function a field is rendered with at this step (the plan's summary is filled in).
+    TransferFunction transfer_function_for(const std::string& name,
+                                           const ValueHistogram& histogram) const {
+        const std::optional<TransferFunction>& configured = config.transfer_function_of(name);
+        return configured ? *configured : default_transfer_function(histogram);
+    }
     /// Uploads one field and chooses its layers and intervals (one process).
     FieldPlan plan_field(const Field& field, std::int64_t step);
     /// The same for this rank's block (or none) of a distributed field, agreed over the ranks.
@@ -542,10 +553,16 @@ Instrument::Impl::FieldPlan Instrument::Impl::plan_field(const Field& field, std
     FieldPlan plan;
     plan.name = field.name();
     plan.bounds = volume.bounds;
+    plan.summary.field = plan.name;
+    plan.summary.nonfinite_samples = volume.range.nonfinite_count;
+    plan.summary.histogram =
+        volume.range.empty()
+            ? ValueHistogram::of({}, 0.0, 0.0)
+            : ValueHistogram::of(volume.host_values, volume.range.min, volume.range.max);
+    plan.transfer_function = transfer_function_for(plan.name, plan.summary.histogram);
     const std::optional<std::vector<double>>& layers = config.layers_of(field.name());
-    plan.isovalues = layers ? *layers
-                            : renderer->choose_layers(config.transfer_function_of(field.name()),
-                                                      config.max_auto_layers);
+    plan.isovalues =
+        layers ? *layers : renderer->choose_layers(plan.transfer_function, config.max_auto_layers);
     plan.intervals = renderer->choose_intervals(config.interval_count, config.interval_mode);
     return plan;
 }
@@ -616,12 +633,28 @@ Instrument::Impl::FieldPlan Instrument::Impl::plan_distributed_field(
     plan.name = name;
     plan.bounds = grid.bounds;
     plan.has_block = block.has_value();
-    const std::optional<std::vector<double>>& layers = config.layers_of(name);
-    plan.isovalues =
-        layers ? *layers
-               : opacity_peaks(config.transfer_function_of(name), range, config.max_auto_layers);
     const double min = range.empty() ? 0.0 : range.min;
     const double max = range.empty() ? 0.0 : range.max;
+    // The grid's histogram: the sum of the ranks' counts of the samples each owns, over the
+    // agreed range (a rank without a block adds zeros, as every rank reduces).
+    ValueHistogram histogram = ValueHistogram::of({}, min, max);
+    failure.guard([&] {
+        if (!block) return;
+        const DeviceVolume& volume = renderer->volume();
+        histogram =
+            ValueHistogram::of(grid.owned_values(volume.host_values, volume.dims, me), min, max);
+    });
+    start = Clock::now();
+    ranks.all_reduce(histogram.counts, Reduction::sum);
+    agree(ranks, failure);
+    composite_seconds += seconds_since(start);
+    plan.summary.field = name;
+    plan.summary.histogram = std::move(histogram);
+    plan.summary.nonfinite_samples = range.nonfinite_count;
+    plan.transfer_function = transfer_function_for(name, plan.summary.histogram);
+    const std::optional<std::vector<double>>& layers = config.layers_of(name);
+    plan.isovalues =
+        layers ? *layers : opacity_peaks(plan.transfer_function, range, config.max_auto_layers);
     if (config.interval_mode == IntervalMode::uniform) {
         plan.intervals = IntervalSet::uniform(min, max, config.interval_count);
     } else {
@@ -649,7 +682,8 @@ Instrument::Impl::FieldPlan Instrument::Impl::plan_distributed_field(
 void Instrument::Impl::compute_field(const FieldPlan& plan, StepRecord& record,
                                      double& composite_seconds) {
     const std::string& name = plan.name;
-    const TransferFunction& transfer_function = config.transfer_function_of(name);
+    const TransferFunction& transfer_function = plan.transfer_function;
+    record.fields.push_back(plan.summary);
     const std::vector<double>& isovalues = plan.isovalues;
     const IntervalSet& intervals = plan.intervals;
 
@@ -751,11 +785,13 @@ void Instrument::Impl::compute_field(const FieldPlan& plan, StepRecord& record,
     const bool wants_multi = config.proxies.distortion || config.proxies.multi_attenuation;
 
     // The preview is what Cinema viewers show: the ground truth, unshaded like the proxies'
-    // emission-absorption model, at the proxies' step. Distributed, it marches on to T = 0 like
-    // the proxies: a block cannot stop at an opacity it does not know is reached in front of it.
+    // emission-absorption model, at the proxies' step. It marches on to T = 0 like the proxies:
+    // it is also the stored view's "rendering", which the Explorer returns as that view exactly
+    // (stopping at 0.99 left up to 1 % of the colour behind), and distributed, a block cannot
+    // stop at an opacity it does not know is reached in front of it.
     RenderSettings preview_settings;
     preview_settings.step_voxels = config.step_voxels;
-    if (communicator) preview_settings.early_termination_opacity = 1.0;
+    preview_settings.early_termination_opacity = 1.0;
 
     for (const ViewConfig& view : config.views_of(name)) {
         ViewRecord out;
@@ -784,6 +820,10 @@ void Instrument::Impl::compute_field(const FieldPlan& plan, StepRecord& record,
         }
         if (wants_multi) out.multi = proxies(view.orbit, view.distortion_tilt_deg, true, multi);
         out.preview = truth(camera, transfer_function, preview_settings);
+        if (config.proxies.rendering) {
+            if (!out.single) out.single = frame_shell(camera, 0.0, false, single);
+            out.single->rendering = out.preview;
+        }
         record.views.push_back(std::move(out));
     }
     if (communicator) {

@@ -27,6 +27,7 @@
 #include <iterator>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -141,6 +142,7 @@ StepRecord record(std::int64_t step, int views = 2, int width = 12, int height =
         for (float& a : view.preview.pixels) a = std::min(a, 1.0f);
         view.transfer_function = ramp(0.5f);
         if (v == 0) view.training_transfer_functions = {ramp(0.2f), ramp(0.9f)};
+        if (v == 0) view.single->rendering = view.preview;  // the stored view's exact rendering
         result.views.push_back(std::move(view));
     }
     return result;
@@ -205,6 +207,7 @@ void expect_frames_match(const ProxyFrame& expected, const ProxyFrame& actual, b
     expect_images_match(expected.mean_depth, actual.mean_depth, half, "mean depth");
     expect_images_match(expected.optical_depth, actual.optical_depth, half, "optical depth");
     expect_layers_match(expected.training, actual.training, half, "training");
+    expect_images_match(expected.rendering, actual.rendering, half, "rendering");
 }
 
 class Archive : public ::testing::Test {
@@ -294,14 +297,59 @@ TEST_F(Archive, RenderedProxiesRoundTrip) {
     view.multi = renderer.render(
         DistortionCamera::orbit(view.view.orbit, renderer.volume().bounds, 45.0), request);
     view.preview = view.single->training.at(0);
+    view.single->rendering = view.preview;
     view.transfer_function = *request.transfer_function;
     view.training_transfer_functions = {ramp(0.3f)};
-    StepRecord step{42, 4.2, "v", {view}, {}};
+    FieldSummaryRecord summary{"v", ValueHistogram::of(volume.values), 3};
+    StepRecord step{42, 4.2, "v", {view}, {}, {summary}};
 
     ArchiveWriter(config_).write(step);
     const ArchiveReader reader(archive().string());
     expect_frames_match(*view.single, reader.load(42, 0), false);
     expect_frames_match(*view.multi, reader.load(42, 0, true), false);
+    // The step's values and the view's function come back from the index.
+    const std::optional<FieldSummaryRecord> read = reader.field_summary(42, "v");
+    ASSERT_TRUE(read.has_value());
+    EXPECT_EQ(read->histogram.counts, summary.histogram.counts);
+    EXPECT_EQ(read->histogram.min, summary.histogram.min);
+    EXPECT_EQ(read->histogram.max, summary.histogram.max);
+    EXPECT_EQ(read->nonfinite_samples, 3);
+    EXPECT_EQ(reader.transfer_function(42, 0).to_json(), view.transfer_function.to_json());
+}
+
+// Archives written before steps recorded their functions and histograms: the configuration's
+// function stands in, no histogram is made up, and a broken summary costs only its step.
+TEST_F(Archive, OlderEntriesFallBackToTheConfiguredFunctionAndBrokenSummariesAreRefused) {
+    config_.transfer_function = ramp(0.7f);
+    ArchiveWriter(config_).write(record(1));
+    ArchiveWriter(config_).write(record(2));
+    const std::filesystem::path manifest_path = archive() / "manifest.json";
+    nlohmann::json manifest = nlohmann::json::parse(read_text(manifest_path));
+    for (auto& view : manifest["steps"][0]["views"]) view.erase("transfer_function");
+    manifest["steps"][1]["fields"] =
+        nlohmann::json::array({{{"field", "v"},
+                                {"nonfinite", 0},
+                                {"histogram", {{"min", 1}, {"max", 0}, {"counts", {1}}}}}});
+    write_text(manifest_path, manifest.dump());
+    std::filesystem::remove(archive() / "manifest.journal");
+
+    const ArchiveReader reader(archive().string());
+    EXPECT_EQ(reader.transfer_function(1, 0).to_json(), ramp(0.7f).to_json());
+    EXPECT_FALSE(reader.field_summary(1, "v").has_value());
+    EXPECT_EQ(reader.steps(), std::vector<std::int64_t>{1});  // step 2's reversed range
+    ASSERT_EQ(reader.diagnostics().size(), 1u);
+    EXPECT_NE(reader.diagnostics()[0].find("fields[0].histogram"), std::string::npos)
+        << reader.diagnostics()[0];
+
+    // "auto" in the configuration and no function in the entry: nothing to fall back on.
+    config_.transfer_function.reset();
+    nlohmann::json configuration = manifest["configuration"];
+    configuration["transfer_function"] = "auto";
+    manifest["configuration"] = configuration;
+    manifest["steps"].erase(1);
+    write_text(manifest_path, manifest.dump());
+    const ArchiveReader automatic(archive().string());
+    EXPECT_THROW(automatic.transfer_function(1, 0), ParseError);
 }
 
 TEST_F(Archive, HalfRoundTripIsWithinHalfPrecisionAndKeepsDepthInFloat) {
@@ -517,8 +565,8 @@ TEST_F(Archive, ManifestRecordsVersionProducerConfigurationAndChecksums) {
     EXPECT_EQ(step.at("field"), "v");
     ASSERT_EQ(step.at("views").size(), 2u);
     EXPECT_EQ(step.at("views").at(0).at("parts"),
-              nlohmann::json({"depth", "attenuation", "train0", "train1", "multi.depth",
-                              "multi.distortion", "multi.attenuation"}));
+              nlohmann::json({"depth", "attenuation", "train0", "train1", "rendering",
+                              "multi.depth", "multi.distortion", "multi.attenuation"}));
     std::size_t files = 0;
     for (const auto& view : step.at("views")) {
         for (const auto& file : view.at("files")) {

@@ -37,6 +37,11 @@ file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/insitu_capture_config.json [=[
 ]=])
 set(capture_config ${CMAKE_CURRENT_BINARY_DIR}/insitu_capture_config.json)
 file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/insitu_capture_bad_config.json [=[{"every": 0}]=])
+# Names neither a field nor a transfer function: the file's only array, coloured from its values.
+file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/insitu_capture_unnamed_config.json [=[
+{"views": [{"size": [24, 24]}], "intervals": {"count": 4}}
+]=])
+set(unnamed_config --config ${CMAKE_CURRENT_BINARY_DIR}/insitu_capture_unnamed_config.json)
 
 # capture_case(NAME EXIT status STDOUT|STDERR text [FILES names... [COUNT n]] ARGS arguments...):
 # runs insitu-capture with ARGS in the output folder and expects the exit status and the text in
@@ -138,6 +143,12 @@ if(TARGET insitu_vtk)
          ${capture_in}/points_1.vti)
   capture_case(truncated_vti_skipped_named EXIT 0 STDERR "skipped: \"${capture_in}/truncated.vti\": VTK could not read it"
     ARGS ${config} --on-error skip ${capture_in}/truncated.vti ${capture_in}/points_1.vti)
+  # Its only array, not marked as the active scalars, captured without naming it (issue 17).
+  capture_case(vti_only_array EXIT 0 STDOUT "2 of 2 steps archived (0 skipped, 0 not selected by the cadence, 0 dropped) in"
+    FILES proxies/step000001_view0.exr
+    ARGS ${unnamed_config} ${capture_in}/points_0.vti ${capture_in}/points_1.vti)
+  capture_case(vti_only_array_named EXIT 0 STDOUT "field \"density\" (named by the first file)"
+    ARGS ${unnamed_config} ${capture_in}/points_0.vti)
   capture_case(missing_array EXIT 2 STDERR "no array \"pressure\" in point or cell data"
     ARGS ${config} --field pressure ${capture_in}/points_0.vti)
 endif()
@@ -149,6 +160,9 @@ if(TARGET insitu_openvdb)
   capture_case(vdb_level_set EXIT 0 STDOUT "layers at the level set's zero crossing"
     FILES proxies/step000000_view0.exr
     ARGS ${config} --field surface ${capture_in}/sphere.vdb)
+  capture_case(vdb_only_grid EXIT 0 STDOUT "field \"surface\" (named by the first file), layers"
+    FILES proxies/step000000_view0.exr
+    ARGS ${unnamed_config} ${capture_in}/sphere.vdb)
   capture_case(vdb_missing_grid EXIT 2 STDERR "no grid named \"temperature\" (grids: density"
     ARGS ${config} --field temperature ${capture_in}/fog_0.vdb)
   capture_case(not_a_vdb_skipped EXIT 0 STDOUT "1 of 2 steps archived (1 skipped"

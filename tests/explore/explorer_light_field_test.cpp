@@ -123,7 +123,7 @@ TEST_F(ExplorerLightField, ANewViewFromTheLightFieldIsCloseToTheGroundTruth) {
         EXPECT_EQ(frame.light_field_share, 1.0);
         EXPECT_EQ(frame.colour_source, ColourSource::captured);
         EXPECT_TRUE(frame.synthesised_view);
-        const Image expected = truth(azimuth, elevation, config_.transfer_function);
+        const Image expected = truth(azimuth, elevation, *config_.transfer_function);
         const double psnr = evaluation::psnr_db(expected, frame.colour);
         std::printf("light field, azimuth %.0f elevation %.0f: PSNR %.1f dB\n", azimuth, elevation,
                     psnr);
@@ -140,7 +140,7 @@ TEST_F(ExplorerLightField, ANewViewFromTheLightFieldIsCloseToTheGroundTruth) {
 TEST_F(ExplorerLightField, AutoFusesPerPixelAndKeepsWhatTheLightFieldTrusts) {
     write_step();
     Explorer explorer(config_.archive);
-    const Image expected = truth(120.0, -25.0, config_.transfer_function);
+    const Image expected = truth(120.0, -25.0, *config_.transfer_function);
     const ExploreFrame single = explorer.render(at(120.0, -25.0, ProxySource::single));
     const ExploreFrame fused = explorer.render(at(120.0, -25.0, ProxySource::automatic));
     const ExploreFrame light_field = explorer.render(at(120.0, -25.0, ProxySource::lightfield));
@@ -169,7 +169,7 @@ TEST_F(ExplorerLightField, OpacityEditsGoThroughTheAttenuationLightField) {
     write_step();
     Explorer explorer(config_.archive);
     // Fade the translucent shell (low values), keep the core.
-    std::vector<ControlPoint> points = config_.transfer_function.rows().front().points;
+    std::vector<ControlPoint> points = config_.transfer_function->rows().front().points;
     points[1].rgba.a = 0.05f;
     const TransferFunction edited(points, 1.0);
     ExploreRequest request = at(200.0, 10.0, ProxySource::lightfield);
@@ -177,7 +177,7 @@ TEST_F(ExplorerLightField, OpacityEditsGoThroughTheAttenuationLightField) {
     const ExploreFrame frame = explorer.render(request);
     EXPECT_EQ(frame.colour_source, ColourSource::recompose);
     const Image expected = truth(200.0, 10.0, edited);
-    const Image unedited = truth(200.0, 10.0, config_.transfer_function);
+    const Image unedited = truth(200.0, 10.0, *config_.transfer_function);
     const double psnr = evaluation::psnr_db(expected, frame.colour);
     std::printf("opacity edit from the light field: %.1f dB (unedited truth %.1f dB)\n", psnr,
                 evaluation::psnr_db(unedited, frame.colour));
@@ -198,9 +198,9 @@ TEST_F(ExplorerLightField, ArchivesWithOnlyALightFieldRenderEveryView) {
     // exactly the one the Instrument used.
     const Camera expected_camera = Camera::orbit(config_.views[0].orbit, renderer_.volume().bounds);
     EXPECT_NEAR(glm::distance(frame.camera.position(), expected_camera.position()), 0.0, 1e-9);
-    EXPECT_GT(evaluation::psnr_db(truth(30.0, 20.0, config_.transfer_function), frame.colour),
+    EXPECT_GT(evaluation::psnr_db(truth(30.0, 20.0, *config_.transfer_function), frame.colour),
               27.0);
-    EXPECT_GT(evaluation::psnr_db(truth(300.0, -40.0, config_.transfer_function),
+    EXPECT_GT(evaluation::psnr_db(truth(300.0, -40.0, *config_.transfer_function),
                                   explorer.render(at(300.0, -40.0, ProxySource::automatic)).colour),
               27.0);
 }
@@ -233,7 +233,7 @@ TEST_F(ExplorerLightField, SegmentsFadeIndependently) {
     testing::expect_error_naming<InvalidArgument>([&] { explorer.render(request); },
                                                   "need an attenuation light field");
     request.opacity_scales.clear();
-    request.transfer_function = config_.transfer_function;
+    request.transfer_function = *config_.transfer_function;
     testing::expect_error_naming<InvalidArgument>([&] { explorer.render(request); },
                                                   "need an attenuation light field");
     request.source = ProxySource::automatic;
@@ -260,7 +260,7 @@ TEST_F(ExplorerLightField, MissingCamerasAreReconstructedFromTheRestAndSaidSo) {
         view.view = config_.views[0];
         view.single = reader.load(1, 0);
         view.preview = reader.load_preview(1, 0);
-        view.transfer_function = config_.transfer_function;
+        view.transfer_function = *config_.transfer_function;
         record.views.push_back(std::move(view));
         LightField partial = reader.load_light_field(1, "f");
         std::vector<LightFieldImages> kept;

@@ -13,9 +13,11 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "insitu/archive/archive.hpp"
 #include "insitu/instrument.hpp"
 #include "insitu/mpi.hpp"
 #include "insitu/parallel/communicator.hpp"
@@ -70,8 +72,13 @@ SampledVolume field_at(int step) {
     return volume;
 }
 
+constexpr const char* kGivenFunction =
+    R"({"points": [[0.0, 0.1, 0.2, 0.9, 0.0], [0.4, 0.9, 0.6, 0.1, 0.3],
+                   [1.5, 1.0, 1.0, 1.0, 0.9]]})";
+
 std::string configuration(const std::string& archive, const std::string& layers,
-                          const std::string& interval_mode) {
+                          const std::string& interval_mode,
+                          const std::string& transfer_function = kGivenFunction) {
     return R"({"archive": ")" + archive +
            R"(", "fields": ["f"], "on_existing": "replace", "every": 1,
         "views": [{"azimuth": 30, "elevation": 20, "camera": "perspective", "size": [48, 40]},
@@ -80,8 +87,8 @@ std::string configuration(const std::string& archive, const std::string& layers,
            layers + R"(, "intervals": {"count": 6, "mode": ")" + interval_mode + R"("},
         "proxies": ["depth", "distortion", "attenuation", "optical_depth", "multi_attenuation"],
         "precision": "float",
-        "transfer_function": {"points": [[0.0, 0.1, 0.2, 0.9, 0.0], [0.4, 0.9, 0.6, 0.1, 0.3],
-                                          [1.5, 1.0, 1.0, 1.0, 0.9]]},
+        "transfer_function": )" +
+           transfer_function + R"(,
         "training_transfer_functions": [
             {"points": [[0.0, 1.0, 0.0, 0.0, 0.0], [1.5, 0.0, 0.0, 1.0, 0.8]]}]})";
 }
@@ -107,8 +114,8 @@ std::vector<Field> views_of(const std::vector<VolumeBlock>& blocks) {
 // Runs three steps distributed over `parts`, then (rank 0) the same steps in one process, and
 // compares the archives.
 void expect_same_archive_as_one_process(const std::string& name, Index3 parts,
-                                        const std::string& layers,
-                                        const std::string& interval_mode) {
+                                        const std::string& layers, const std::string& interval_mode,
+                                        const std::string& transfer_function = kGivenFunction) {
     const std::string directory = shared_directory(name);
     const std::string distributed = directory + "/ranks.cdb";
     const std::string reference = directory + "/one.cdb";
@@ -116,7 +123,8 @@ void expect_same_archive_as_one_process(const std::string& name, Index3 parts,
     options.rethrow_errors = true;
     {
         auto instrument = mpi::instrument_from_json_text(
-            configuration(distributed, layers, interval_mode), MPI_COMM_WORLD, options);
+            configuration(distributed, layers, interval_mode, transfer_function), MPI_COMM_WORLD,
+            options);
         for (int step = 0; step < 3; ++step) {
             const SampledVolume volume = field_at(step);
             const std::vector<VolumeBlock> blocks = my_blocks(volume, parts);
@@ -132,8 +140,9 @@ void expect_same_archive_as_one_process(const std::string& name, Index3 parts,
         InstrumentOptions one = options;
         one.communicator = single_process_communicator();
         one.log = false;
-        Instrument instrument(
-            InstrumentConfig::from_json_text(configuration(reference, layers, interval_mode)), one);
+        Instrument instrument(InstrumentConfig::from_json_text(configuration(
+                                  reference, layers, interval_mode, transfer_function)),
+                              one);
         for (int step = 0; step < 3; ++step) {
             const SampledVolume volume = field_at(step);
             EXPECT_EQ(instrument.execute(step, 0.5 * step, {volume.field()}), Status::ok);
@@ -150,6 +159,22 @@ void expect_same_archive_as_one_process(const std::string& name, Index3 parts,
         EXPECT_TRUE(same) << comparison;
         // 3 steps x 2 views x (single, multi, preview)
         EXPECT_EQ(comparison.frames.size(), 18u);
+        // The histograms summed over the ranks are the one process's, and so are the functions
+        // ("auto" spans their percentiles).
+        const ArchiveReader single(reference);
+        const ArchiveReader ranks(distributed);
+        for (const std::int64_t step : single.steps()) {
+            const auto expected = single.field_summary(step, "f");
+            const auto actual = ranks.field_summary(step, "f");
+            ASSERT_TRUE(expected && actual) << "step " << step;
+            EXPECT_EQ(expected->histogram.counts, actual->histogram.counts) << "step " << step;
+            EXPECT_EQ(expected->histogram.total(), 37.0 * 33 * 30) << "step " << step;
+            for (int view = 0; view < 2; ++view) {
+                EXPECT_EQ(single.transfer_function(step, view).to_json(),
+                          ranks.transfer_function(step, view).to_json())
+                    << "step " << step << " view " << view;
+            }
+        }
     }
     EXPECT_TRUE(on_every_rank(same));
 }
@@ -163,6 +188,12 @@ TEST(InstrumentMpi, GridWithAutoLayersAndHistogramIntervals) {
     MPI_Dims_create(world_size(), 3, dims);
     expect_same_archive_as_one_process("grid", {dims[0], dims[1], dims[2]}, "\"auto\"",
                                        "histogram");
+}
+
+// "transfer_function": "auto": every rank colours by the percentiles of the whole grid.
+TEST(InstrumentMpi, SlabsWithTheFunctionFromTheData) {
+    expect_same_archive_as_one_process("auto_function", {world_size(), 1, 1}, "\"auto\"", "uniform",
+                                       "\"auto\"");
 }
 
 // One rank fewer blocks than ranks (at 1 rank: one block): the last rank owns nothing.

@@ -88,6 +88,16 @@ test('the page walks through steps, orbit, opacity, colour, AO and the mask', as
   assert.deepEqual(frame.options, { step: String(steps[0]), view: '0' });
   assertMatchesCli(frame);
 
+  // The editor draws the field's histogram, stored in situ per step: every sample of the
+  // 32^3 grid counted once, in 256 bins over the step's range.
+  const first = await (await fetch(`${server.url}api/step?step=${steps[0]}&view=0`)).json();
+  assert.equal(first.histogram.counts.length, 256);
+  assert.equal(first.histogram.counts.reduce((a, b) => a + b, 0), 32 * 32 * 32);
+  assert.ok(first.histogram.min < first.histogram.max, 'the reaction has begun: values vary');
+  assert.deepEqual(first.transfer_function, archiveInfo.transfer_function,
+    'a run with a given function stores it with every step');
+  assert.equal(await page.locator('#tf-histogram').getAttribute('data-bins'), '256');
+
   // Timestep slider: one step right shows the next timestep, a different picture.
   await page.focus('#step');
   let before = frame;

@@ -71,7 +71,9 @@ function short(x) {
 // ---------------------------------------------------------------------------------------------
 // Transfer functions (DESIGN.md JSON: {"points": [[value, r, g, b, a], ...], "unit_length": u}).
 
+/// The function the current step's view was made with ("auto" archives make one per step).
 function storedTf() {
+  if (state.info && state.info.transfer_function) return state.info.transfer_function;
   return state.archive ? state.archive.transfer_function : null;
 }
 function baseTf() {
@@ -587,6 +589,36 @@ function intervalColour(j) {
     : [0.5, 0.5, 0.5];
 }
 
+/// The field's values at the step (ValueHistogram, stored in situ): the samples per bin on a log
+/// scale, as a grey silhouette under the interval bars, so that handles can be put where the
+/// data is. Bins outside the intervals' range [lo, hi] are left out.
+function drawHistogram(chart, histogram, x, lo, hi, top, bottom) {
+  if (!histogram || !histogram.counts || !histogram.counts.length) return;
+  const bins = histogram.counts.length;
+  const width = (histogram.max - histogram.min) / bins;
+  const peak = Math.log1p(Math.max(...histogram.counts));
+  if (!(peak > 0)) return;
+  const y = (count) => bottom - (Math.log1p(count) / peak) * (bottom - top);
+  const corners = [];
+  for (let b = 0; b < bins; ++b) {
+    const v0 = Math.max(lo, histogram.min + b * width);
+    const v1 = Math.min(hi, histogram.min + (b + 1) * width);
+    if (width > 0 && v1 < v0) continue;
+    corners.push(`${x(v0).toFixed(1)},${y(histogram.counts[b]).toFixed(1)}`,
+      `${x(width > 0 ? v1 : v0).toFixed(1)},${y(histogram.counts[b]).toFixed(1)}`);
+  }
+  if (!corners.length) return;
+  const first = corners[0].split(',')[0];
+  const last = corners[corners.length - 1].split(',')[0];
+  const path = svg('path', {
+    id: 'tf-histogram', d: `M${first},${bottom} L${corners.join(' L')} L${last},${bottom} Z`,
+    fill: '#5b6472', opacity: 0.55, 'data-bins': bins,
+  }, chart);
+  const total = histogram.counts.reduce((a, b) => a + b, 0);
+  svg('title', {}, path).textContent =
+    `values at this step: ${total} samples in [${short(histogram.min)}, ${short(histogram.max)}], ${bins} bins (log scale)`;
+}
+
 function drawTfEditor() {
   const chart = $('tf-chart');
   chart.replaceChildren();
@@ -606,6 +638,7 @@ function drawTfEditor() {
   const hi = edges[count];
   const x = (v) => 6 + ((v - lo) / (hi - lo || 1)) * (w - 12);
   const scaleY = (s) => bottom - (s / MAX_OPACITY_SCALE) * (bottom - top);
+  drawHistogram(chart, info.histogram, x, lo, hi, top, bottom);
   const attenuation = info.mean_attenuation || new Array(count).fill(0);
   const largest = Math.max(...attenuation, 1e-12);
   for (let j = 0; j < count; ++j) {

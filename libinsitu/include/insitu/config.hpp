@@ -5,10 +5,11 @@
 // {"fields": ["v"],
 //  "views": [{"azimuth": 30, "elevation": 20, "camera": "perspective", "fov": 30,
 //             "size": [512, 512], "distortion_tilt": 45}],
-//  "transfer_function": {"points": [[0.0, 0, 0, 1, 0], [1.0, 1, 0, 0, 0.5]], "unit_length": 1.0},
+//  "transfer_function": "auto" | {"points": [[0.0, 0, 0, 1, 0], [1.0, 1, 0, 0, 0.5]],
+//                                 "unit_length": 1.0},
 //  "training_transfer_functions": [],
 //  "layers": "auto", "intervals": {"count": 16, "mode": "uniform"},
-//  "proxies": ["depth", "distortion", "attenuation"], "step": 1.0, "every": 10,
+//  "proxies": ["depth", "attenuation", "rendering"], "step": 1.0, "every": 10,
 //  "archive": "run.cdb", "precision": "half", "compression": "zip",
 //  "writer": {"queue": 4, "when_full": "block"},
 //  "colour_model": {"clusters": 24, "enabled": true},
@@ -59,12 +60,21 @@ enum class WhenFull { block, drop };           ///< writer policy when its queue
 
 /// Proxies a run emits ("proxies" list). "multi_attenuation" without "distortion" still makes a
 /// multi-perspective frame, holding only the attenuation proxies.
+/// Defaults pay for themselves (issue 17): a kind is on by default only where the Explorer's
+/// default ("auto") reconstructs better with it. The multi-perspective pass is off: "auto"
+/// synthesises new views from the single-perspective proxies, which bench/RESULTS.md ("Depth
+/// correlation by proxy source") measures ahead of the distortion camera's at 15 and 30 degrees
+/// (0.976 / 0.970 against 0.907 / 0.938 at the default tilt), so it cost one of a default
+/// step's three passes, and bytes, for frames only "source": "multi" shows.
 struct ProxySelection {
     bool depth = true;               ///< "depth": single-perspective depth layers
-    bool distortion = true;          ///< "distortion": multi-perspective depth + distortion layers
+    bool distortion = false;         ///< "distortion": multi-perspective depth + distortion layers
     bool attenuation = true;         ///< "attenuation": a_j and mean depth, single perspective
     bool multi_attenuation = false;  ///< "multi_attenuation": the same from the distortion camera
     bool optical_depth = false;      ///< "optical_depth": tau_j as well
+    /// "rendering": the stored view's ground truth with the run's function in half RGBA (the
+    /// preview costs that pass anyway), so the Explorer returns that view exactly (issue 17).
+    bool rendering = true;
 };
 
 /// "colour_model": the in-situ fit of seed 000 §6.2 (insitu/explore/colour_model.hpp).
@@ -117,6 +127,13 @@ struct PlannedView {
 };
 
 struct InstrumentConfig;
+struct ValueHistogram;
+
+/// The function "transfer_function": "auto" uses: a blue-to-red ramp from transparent at
+/// `low` to half opaque at `high`, which are the field's 1st and 99th percentiles at the step
+/// (widened to the histogram's whole range, then by +-0.5, where they coincide), so that the
+/// tails of outliers do not squeeze the colours of the bulk (seed 000's CT head, issue 17).
+TransferFunction default_transfer_function(const ValueHistogram& histogram);
 
 /// The known key nearest to the last component of an unknown key's dotted path, at the same
 /// level of the configuration ("evry" -> "every", "views[0].azimut" -> "azimuth"); empty when
@@ -137,10 +154,13 @@ struct InstrumentConfig {
     std::vector<std::string> fields{"v"};
     std::map<std::string, FieldStyle> field_styles;  ///< by field name; none by default
     std::vector<ViewConfig> views{ViewConfig{}};
-    /// "transfer_function"; default: a blue-to-red ramp, transparent at the range's minimum,
-    /// over [0, 1] (set it to the data's units).
-    TransferFunction transfer_function{
-        std::vector<ControlPoint>{{0.0, {0, 0, 1, 0}}, {1.0, {1, 0, 0, 0.5}}}, 1.0};
+    /// "transfer_function": a function in the data's units, or "auto" (nullopt, the default):
+    /// at every archived step, default_transfer_function() over the 1st to 99th percentiles of
+    /// the field's values at that step (its ValueHistogram), stored with the step like any
+    /// other. Per step, so that a field whose range grows (a reaction front, a CT scan in
+    /// Hounsfield units) is never an opaque block or empty; colours then mean the step's
+    /// percentiles, not fixed values: give a function to compare steps by colour.
+    std::optional<TransferFunction> transfer_function;
     std::vector<TransferFunction> training_transfer_functions;  ///< default none
     /// "layers": explicit isovalues, or "auto" (empty here) = opacity peaks, at most max_layers.
     std::optional<std::vector<double>> layers;           ///< nullopt = "auto"
@@ -172,7 +192,8 @@ struct InstrumentConfig {
     /// The views of `field` (its own, or the top-level ones), its transfer function, its layers,
     /// and whether the training transfer functions apply to it (it uses the top-level function).
     const std::vector<ViewConfig>& views_of(const std::string& field) const;
-    const TransferFunction& transfer_function_of(const std::string& field) const;
+    /// The field's own function, else the top-level one; nullopt: "auto", from the data.
+    const std::optional<TransferFunction>& transfer_function_of(const std::string& field) const;
     const std::optional<std::vector<double>>& layers_of(const std::string& field) const;
     bool trains(const std::string& field) const;
     /// Every archived view, in archive order (see PlannedView).

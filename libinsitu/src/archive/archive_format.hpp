@@ -7,6 +7,7 @@
 //   part "depth"              depth.layer0 .. depth.layer<K-1>                        FLOAT
 //   part "attenuation"        attenuation.a00 .., attenuation.zmean00 .., attenuation.tau00 ..
 //   part "train<k>"           train<k>.R, .G, .B, .A  (a training rendering, premultiplied)
+//   part "rendering"          rendering.R, .G, .B, .A (the run's own function, premultiplied)
 //   part "model"              model.table: the colour model of seed 000 §6.2 as an image of
 //                             (4 L + 3) x K pixels, one row per cluster: a0 (L), c0 (RGB),
 //                             J (3 x L, row-major by colour component)                  FLOAT
@@ -66,6 +67,7 @@ inline constexpr const char* kDistortionPart = "distortion";  // only ever as "m
 inline constexpr const char* kAttenuationPart = "attenuation";
 inline constexpr const char* kTrainingPartPrefix = "train";
 inline constexpr const char* kModelPart = "model";
+inline constexpr const char* kRenderingPart = "rendering";  // single perspective only
 
 // Channel suffixes.
 inline constexpr const char* kLayerChannel = ".layer";
@@ -100,6 +102,11 @@ inline constexpr const char* kModelFunctionsAttribute =
     "libinsitu.model_training_transfer_functions";
 inline constexpr const char* kModelLayout =
     "one row per cluster: a0[0..L-1], c0 R G B, J row-major 3 x L (R row, G row, B row)";
+
+/// The step entry's per-field summaries (manifest.hpp): {"field", "histogram", "nonfinite"}.
+inline constexpr const char* kFieldsKey = "fields";
+/// A view entry's transfer function: the one its proxies and preview were made with.
+inline constexpr const char* kViewTransferFunctionKey = "transfer_function";
 
 // Light fields (the table above).
 /// The step entry's list of light-field files in manifest.json and the journal.

@@ -200,6 +200,37 @@ ArchivedView ArchiveReader::entry(std::int64_t step, int view) const {
     return result;
 }
 
+TransferFunction ArchiveReader::transfer_function(std::int64_t step, int view) const {
+    const af::ViewEntry found = af::find_view(*manifest_, path_, step, view);
+    const auto recorded = found.view->find(af::kViewTransferFunctionKey);
+    // Checked when the index was read (manifest.cpp): a recorded function parses.
+    if (recorded != found.view->end()) return TransferFunction::from_json(*recorded);
+    const std::string field = entry(step, view).field;
+    const InstrumentConfig config = configuration();
+    const std::optional<TransferFunction>& configured = config.transfer_function_of(field);
+    if (!configured) {
+        fail<ParseError>("archive \"", path_, "\": step ", step, " view ", view,
+                         " records no transfer function and the configuration's is \"auto\"");
+    }
+    return *configured;
+}
+
+std::optional<FieldSummaryRecord> ArchiveReader::field_summary(std::int64_t step,
+                                                               const std::string& field) const {
+    const nlohmann::json& step_entry = af::find_step(*manifest_, path_, step);
+    const auto summaries = step_entry.find(af::kFieldsKey);
+    if (summaries == step_entry.end()) return std::nullopt;
+    for (const nlohmann::json& summary : *summaries) {
+        if (summary.at("field").get<std::string>() != field) continue;
+        FieldSummaryRecord out;
+        out.field = field;
+        out.histogram = ValueHistogram::from_json(summary.at("histogram"), "histogram");
+        out.nonfinite_samples = summary.at("nonfinite").get<std::int64_t>();
+        return out;
+    }
+    return std::nullopt;
+}
+
 ProxyFrame ArchiveReader::load(std::int64_t step, int view, bool multi_perspective) const {
     const af::ViewEntry found = af::find_view(*manifest_, path_, step, view);
     if (view_file(*found.view, af::kProxyKind).empty()) {

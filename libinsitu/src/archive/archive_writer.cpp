@@ -289,6 +289,7 @@ StepWriteResult ArchiveWriter::write(const StepRecord& record) {
                  {"phi", view.view.orbit.azimuth_deg},
                  {"theta", view.view.orbit.elevation_deg},
                  {"parts", parts},
+                 {af::kViewTransferFunctionKey, view.transfer_function.to_json()},
                  {"files", std::move(files)}});
         }
         if (!record.light_fields.empty()) {
@@ -305,6 +306,15 @@ StepWriteResult ArchiveWriter::write(const StepRecord& record) {
                 const LightFieldRig& rig = light_field.light_field.rig;
                 entries.push_back(af::light_field_entry(light_field.field, result.files.back(),
                                                         rig.camera_count(), rig.map_size()));
+            }
+        }
+        if (!record.fields.empty()) {
+            nlohmann::json& summaries = step_entry[af::kFieldsKey];
+            summaries = nlohmann::json::array();
+            for (const FieldSummaryRecord& summary : record.fields) {
+                summaries.push_back({{"field", summary.field},
+                                     {"histogram", summary.histogram.to_json()},
+                                     {"nonfinite", summary.nonfinite_samples}});
             }
         }
         // The entry must read back before anything names it (issue 19).

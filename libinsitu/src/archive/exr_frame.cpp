@@ -153,6 +153,18 @@ std::vector<PartSource> frame_parts(const ProxyFrame& frame, const ViewRecord& v
         }
         parts.push_back(std::move(part));
     }
+    if (!frame.rendering.pixels.empty()) {
+        if (frame.rendering.channels != 4 || multi) {
+            fail<InvalidArgument>(where, ": the stored rendering has ", frame.rendering.channels,
+                                  " channels (expected RGBA, single perspective only)");
+        }
+        PartSource part{kRenderingPart, {}, nullptr};
+        for (int c = 0; c < 4; ++c) {
+            part.channels.push_back(
+                {std::string(kRenderingPart) + kRgbaChannels[c], &frame.rendering, c, compact});
+        }
+        parts.push_back(std::move(part));
+    }
     if (frame.colour_model) {
         const ColourModel& model = *frame.colour_model;
         if (interval_count >= 0 && model.intervals() != interval_count) {
@@ -466,9 +478,10 @@ void read_attenuation(Imf::InputPart& part, ProxyFrame& frame, const PartContext
     }
 }
 
-Image read_training(Imf::InputPart& part, const PartContext& where) {
+/// An RGBA part: a training rendering or the stored one.
+Image read_rgba(Imf::InputPart& part, const PartContext& where) {
     std::vector<std::string> names;
-    for (const char* suffix : kTrainingChannels) {
+    for (const char* suffix : kRgbaChannels) {
         names.push_back(where.part + suffix);
         if (!part.header().channels().findChannel(names.back())) {
             where.error("no channel \"" + names.back() + "\"");
@@ -713,7 +726,10 @@ ProxyFrame decode_frame(const std::vector<char>& bytes, const std::string& path,
                 read_attenuation(part, frame, where);
             } else if (base.rfind(kTrainingPartPrefix, 0) == 0 &&
                        base == kTrainingPartPrefix + std::to_string(frame.training.size())) {
-                frame.training.push_back(read_training(part, where));
+                frame.training.push_back(read_rgba(part, where));
+            } else if (base == kRenderingPart && !multi_perspective &&
+                       frame.rendering.pixels.empty()) {
+                frame.rendering = read_rgba(part, where);
             } else if (base == kModelPart && !frame.colour_model) {
                 frame.colour_model = read_model(part, where);
             } else {

@@ -10,7 +10,9 @@
 #include "archive/archive_format.hpp"
 #include "archive/atomic_file.hpp"
 #include "insitu/archive/step_record.hpp"
+#include "insitu/core/histogram.hpp"
 #include "insitu/core/light_field.hpp"
+#include "insitu/core/transfer_function.hpp"
 #include "insitu/error.hpp"
 
 namespace insitu::archive_format {
@@ -119,6 +121,30 @@ void check_light_field_entries(const nlohmann::json& step, const std::string& fi
     }
 }
 
+/// The optional per-field summaries of a step entry: one per field, each a valid histogram.
+void check_field_summaries(const nlohmann::json& step, const std::string& file,
+                           const std::string& where) {
+    if (!step.contains(kFieldsKey)) return;  // archives written before summaries
+    const auto& entries = require(step, kFieldsKey, Expect::array, file, where);
+    std::set<std::string> fields_seen;
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+        const std::string entry_where = where + "." + kFieldsKey + "[" + std::to_string(i) + "]";
+        const auto& field = require(entries[i], "field", Expect::string, file, entry_where);
+        if (!fields_seen.insert(field.get<std::string>()).second) {
+            fail<ParseError>("\"", file, "\": ", entry_where, ": field ", field.dump(),
+                             " is repeated");
+        }
+        require(entries[i], "nonfinite", Expect::count, file, entry_where);
+        try {
+            ValueHistogram::from_json(
+                require(entries[i], "histogram", Expect::object, file, entry_where),
+                entry_where + ".histogram");
+        } catch (const ParseError& error) {
+            fail<ParseError>("\"", file, "\": ", error.what());
+        }
+    }
+}
+
 }  // namespace
 
 nlohmann::json empty_manifest() {
@@ -148,6 +174,16 @@ void check_step_entry(const nlohmann::json& step, const std::string& file,
         require(view, "theta", Expect::number, file, view_where);
         // Optional: archives written before several fields per run name only the step's field.
         if (view.contains("field")) require(view, "field", Expect::string, file, view_where);
+        if (view.contains(kViewTransferFunctionKey)) {
+            const auto& tf =
+                require(view, kViewTransferFunctionKey, Expect::object, file, view_where);
+            try {
+                TransferFunction::from_json(tf);
+            } catch (const Error& error) {
+                fail<ParseError>("\"", file, "\": ", view_where, ".", kViewTransferFunctionKey,
+                                 ": ", error.what());
+            }
+        }
         for (const auto& part : require(view, "parts", Expect::array, file, view_where)) {
             if (!part.is_string()) {
                 fail<ParseError>("\"", file, "\": ", view_where, ".parts: ", part.dump(),
@@ -173,6 +209,7 @@ void check_step_entry(const nlohmann::json& step, const std::string& file,
         }
     }
     check_light_field_entries(step, file, where);
+    check_field_summaries(step, file, where);
 }
 
 namespace {

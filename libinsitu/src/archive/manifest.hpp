@@ -3,10 +3,15 @@
 //   {"schema_version": 1, "producer": "libinsitu X.Y.Z", "configuration": {...},
 //    "previous_configurations": [...]   (only when a restarted run changed it)
 //    "steps": [{"step", "time", "field",
-//               "views": [{"view", "phi", "theta", "parts": [...],
+//               "views": [{"view", "phi", "theta", "parts": [...], "transfer_function",
 //                          "files": [{"kind", "path", "bytes", "crc32"}, ...]}],
-//               "light_fields": [{"field", "file", "bytes", "crc32", "cameras", "map_size"}]}]}
+//               "light_fields": [{"field", "file", "bytes", "crc32", "cameras", "map_size"}],
 //                   (only on steps with light fields; "cameras" and "map_size" are the rig's)
+//               "fields": [{"field", "histogram": {"min", "max", "counts"}, "nonfinite"}]}]}
+//                   (the values of each field at the step, core/histogram.hpp; "fields" and a
+//                   view's "transfer_function", the one it was made with, are absent from
+//                   archives written before they were, and readers fall back to the
+//                   configuration's function)
 //    "malformed_steps": [{"entry", "problem"}]   (only when a writer set entries aside)
 // Steps are kept sorted; each view lists one proxy_exr and one preview_png file (in a step with
 // light fields a view may list only its preview: "proxies" none, the light field stands in).

@@ -28,6 +28,8 @@ std::string to_string(ColourSource source) {
             return "recompose";
         case ColourSource::captured:
             return "captured";
+        case ColourSource::stored:
+            return "stored";
     }
     return "unknown";
 }
@@ -558,10 +560,17 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
     frame.synthesised_view = !same_view;
     const Camera& target = frame.camera;
 
-    // The run's function for the field this view shows (fields may carry their own).
-    const TransferFunction stored_tf = archive_->configuration().transfer_function_of(field);
+    // The function this step's view was made with (the run's, or "auto"'s from this step's data).
+    const TransferFunction stored_tf = archive_->transfer_function(request.step, request.view);
     const TransferFunction& shown_tf =
         request.transfer_function ? *request.transfer_function : stored_tf;
+    // A page or script that sends the stored function back unchanged, or scales by 1, asks
+    // for no edit.
+    const bool scales_opacity =
+        std::any_of(request.opacity_scales.begin(), request.opacity_scales.end(),
+                    [](const std::pair<int, double>& scale) { return scale.second != 1.0; });
+    const bool shows_stored_tf =
+        !request.transfer_function || request.transfer_function->to_json() == stored_tf.to_json();
 
     // The light field's frame: reconstructed, then steps 4-7 as for any proxies.
     const bool edits = request.transfer_function.has_value() || !request.opacity_scales.empty();
@@ -632,6 +641,15 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
                                : ProxySource::single;
         FrameBasis basis;
         basis.confidence = Image(target.width(), target.height(), 1, 1.0f);
+        // The stored view with the run's own function, unedited: the rendering the Instrument
+        // kept is that view exactly (to half precision), where recomposing it from intervals
+        // treats each interval's colour as constant (38.8 dB on a CT head, issue 17). Lighting
+        // and enhancement still apply to it as factors; asked for "recompose" or "model", the
+        // frame is recomposed as asked.
+        const bool stored_rendering = same_view && single && single->rendering.channels == 4 &&
+                                      shows_stored_tf && !scales_opacity &&
+                                      request.colour == ColourSource::automatic;
+        if (stored_rendering) basis.colour = single->rendering;
         if (attenuation_source && attenuation_source == single && same_view) {
             basis.attenuation = single->attenuation;
             basis.mean_depth = single->mean_depth;
@@ -658,6 +676,18 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
             if (confidence) *confidence = std::move(synthesised.confidence);
             return std::move(synthesised.depth);
         };
+        if (stored_rendering) {
+            basis.front_depth = [&target_layers, &device]() {
+                const std::vector<Image> layers = target_layers(nullptr);
+                return layers.empty() ? Image() : FrontSurface(device, layers).depth();
+            };
+            ExploreRequest unedited = request;
+            unedited.transfer_function.reset();  // it is the stored one
+            unedited.opacity_scales.clear();     // all 1
+            finish_frame(std::move(basis), unedited, stored_tf, stored_tf, where, device, out);
+            out.colour_source = ColourSource::stored;
+            return out;
+        }
         if (!attenuation_source) {
             // Surfaces only: the front-most layer in its isovalue's colour; the layers are the
             // picture, so their mask is the frame's.

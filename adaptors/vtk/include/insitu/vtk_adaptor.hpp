@@ -64,7 +64,8 @@ inline constexpr double kUniformSpacingTolerance = 1e-6;
 
 /// Which array to adapt.
 struct ArraySelection {
-    /// Array name; empty: the active scalars of the point data, else of the cell data.
+    /// Array name; empty: the active scalars of the point data, else of the cell data, else the
+    /// data set's only array (point or cell data, where `association` allows).
     std::string name;
     /// Where to look; `any` looks in the point data first, then in the cell data.
     Association association = Association::any;

@@ -5,11 +5,13 @@
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
+#include <optional>
 #include <set>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "insitu/archive/step_record.hpp"
 #include "insitu/config.hpp"
 #include "insitu/core/image.hpp"
 #include "insitu/render/light_field_capture.hpp"
@@ -81,6 +83,17 @@ public:
     std::vector<std::int64_t> steps() const;
     int view_count() const;
     ArchivedView entry(std::int64_t step, int view) const;
+
+    /// The transfer function (step, view) was made with: the one its entry records, or, for an
+    /// archive written before entries recorded it, the configuration's for its field (ParseError
+    /// when that is "auto" too, which such archives cannot hold). Step or view not listed:
+    /// InvalidArgument.
+    TransferFunction transfer_function(std::int64_t step, int view) const;
+    /// The values of `field` at `step`: range, histogram and NaN/Inf count (nullopt for archives
+    /// written before steps recorded them, or a field the step does not show). A step not
+    /// listed: InvalidArgument.
+    std::optional<FieldSummaryRecord> field_summary(std::int64_t step,
+                                                    const std::string& field) const;
 
     /// Loads the single- or multi-perspective proxies of (step, view) from its EXR, lazily (only
     /// this file is read), the colour model (ProxyFrame::colour_model) included when stored.

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "insitu/config.hpp"
+#include "insitu/core/histogram.hpp"
 #include "insitu/core/image.hpp"
 #include "insitu/render/light_field_capture.hpp"
 #include "insitu/render/proxy_renderer.hpp"
@@ -28,6 +29,14 @@ struct ViewRecord {
     std::vector<TransferFunction> training_transfer_functions;
 };
 
+/// One field's values at one timestep (the whole grid's, in a distributed run): what the
+/// manifest stores under the step's "fields" for readers such as the viewer's editor.
+struct FieldSummaryRecord {
+    std::string field;
+    ValueHistogram histogram;  ///< range and kValueHistogramBins counts of the finite samples
+    std::int64_t nonfinite_samples = 0;
+};
+
 /// One field's light field at one timestep (written as one multi-part EXR, a part per camera).
 struct LightFieldRecord {
     std::string field;
@@ -40,6 +49,7 @@ struct StepRecord {
     std::string field;  ///< the first field's name (each view names its own, ViewRecord::field)
     std::vector<ViewRecord> views;
     std::vector<LightFieldRecord> light_fields;  ///< one per field, when "light_field" is set
+    std::vector<FieldSummaryRecord> fields;      ///< one per visualised field, in "fields" order
 };
 
 }  // namespace insitu

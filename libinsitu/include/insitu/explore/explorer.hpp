@@ -42,8 +42,10 @@
 
 namespace insitu {
 
-/// "captured" is never asked for: it reports a frame whose colour is the light field's own RGBA.
-enum class ColourSource { automatic, model, recompose, captured };
+/// "captured" and "stored" are never asked for: they report a frame whose colour is the light
+/// field's own RGBA, or the rendering the run stored of its own view and transfer function
+/// (ProxyFrame::rendering), which "auto" shows for that view unedited.
+enum class ColourSource { automatic, model, recompose, captured, stored };
 std::string to_string(ColourSource source);
 /// "auto" | "model" | "recompose"; InvalidArgument names other text.
 ColourSource parse_colour_source(const std::string& text);

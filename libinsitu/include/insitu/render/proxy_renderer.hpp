@@ -98,6 +98,9 @@ struct ProxyFrame {
     std::vector<Image> segment_depth;      ///< 1 channel each, one per segment
     Image first_hit_depth;                 ///< 1 channel
     std::vector<Image> training;           ///< RGBA each
+    /// RGBA, premultiplied: the ground truth of the run's own transfer function in this camera
+    /// (the preview, before its 8-bit PNG), single perspective only ("rendering" proxy).
+    Image rendering;
     /// A block's pass only (a region set, see ProxyRenderer::set_region): per pixel the
     /// fragment record that partial frames composite by (insitu/parallel/compositing.hpp).
     Image fragment;

@@ -1,0 +1,106 @@
+#include "insitu/core/histogram.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+#include "insitu/error.hpp"
+
+namespace insitu {
+
+ValueHistogram ValueHistogram::of(const std::vector<float>& values, double min, double max,
+                                  int bins) {
+    if (bins < 1) fail<InvalidArgument>("histogram bins = ", bins, " (must be at least 1)");
+    if (!std::isfinite(min) || !std::isfinite(max) || max < min) {
+        fail<InvalidArgument>("histogram range [", min, ", ", max, "] (must be finite, min <= max)");
+    }
+    ValueHistogram histogram;
+    histogram.min = min;
+    histogram.max = max;
+    histogram.counts.assign(static_cast<std::size_t>(bins), 0.0);
+    // Halves, so that a range as wide as double's (a float field over +-3e38 is not) cannot
+    // overflow the width.
+    const double half_width = 0.5 * max - 0.5 * min;
+    const double scale = half_width > 0.0 ? 0.5 * bins / half_width : 0.0;
+    const int last = bins - 1;
+    for (float value : values) {
+        if (!std::isfinite(value)) continue;
+        const double position = (static_cast<double>(value) - min) * scale;
+        // Clamped before the cast: a value outside [min, max] belongs to an end bin.
+        const double clamped = std::clamp(position, 0.0, static_cast<double>(last));
+        histogram.counts[static_cast<std::size_t>(clamped)] += 1.0;
+    }
+    return histogram;
+}
+
+ValueHistogram ValueHistogram::of(const std::vector<float>& values, int bins) {
+    double low = std::numeric_limits<double>::infinity();
+    double high = -low;
+    for (float value : values) {
+        if (!std::isfinite(value)) continue;
+        low = std::min(low, static_cast<double>(value));
+        high = std::max(high, static_cast<double>(value));
+    }
+    if (low > high) low = high = 0.0;  // no finite sample
+    return of(values, low, high, bins);
+}
+
+double ValueHistogram::total() const {
+    double sum = 0.0;
+    for (double count : counts) sum += count;
+    return sum;
+}
+
+double ValueHistogram::percentile(double fraction) const {
+    if (!(fraction >= 0.0 && fraction <= 1.0)) {
+        fail<InvalidArgument>("percentile fraction ", fraction, " (must be in [0, 1])");
+    }
+    const double samples = total();
+    if (samples <= 0.0 || counts.empty() || max <= min) return min;
+    const double wanted = fraction * samples;
+    const double bin_width = (max - min) / static_cast<double>(counts.size());
+    double below = 0.0;
+    for (std::size_t b = 0; b < counts.size(); ++b) {
+        if (counts[b] > 0.0 && below + counts[b] >= wanted) {
+            const double within = std::clamp((wanted - below) / counts[b], 0.0, 1.0);
+            return min + (static_cast<double>(b) + within) * bin_width;
+        }
+        below += counts[b];
+    }
+    return max;
+}
+
+nlohmann::json ValueHistogram::to_json() const {
+    nlohmann::json bins = nlohmann::json::array();
+    for (double count : counts) bins.push_back(static_cast<std::uint64_t>(count));
+    return {{"min", min}, {"max", max}, {"counts", std::move(bins)}};
+}
+
+ValueHistogram ValueHistogram::from_json(const nlohmann::json& json, const std::string& where) {
+    const auto number = [&](const char* key) {
+        if (!json.is_object() || !json.contains(key) || !json.at(key).is_number() ||
+            !std::isfinite(json.at(key).get<double>())) {
+            fail<ParseError>(where, ".", key, ": missing or not a finite number");
+        }
+        return json.at(key).get<double>();
+    };
+    ValueHistogram histogram;
+    histogram.min = number("min");
+    histogram.max = number("max");
+    if (histogram.max < histogram.min) {
+        fail<ParseError>(where, ": range [", histogram.min, ", ", histogram.max, "] is reversed");
+    }
+    if (!json.contains("counts") || !json.at("counts").is_array() || json.at("counts").empty()) {
+        fail<ParseError>(where, ".counts: missing or not a non-empty array");
+    }
+    for (const nlohmann::json& count : json.at("counts")) {
+        if (!count.is_number() || !std::isfinite(count.get<double>()) || count.get<double>() < 0) {
+            fail<ParseError>(where, ".counts: ", count.dump(), " is not a count");
+        }
+        histogram.counts.push_back(count.get<double>());
+    }
+    return histogram;
+}
+
+}  // namespace insitu
