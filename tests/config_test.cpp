@@ -145,6 +145,7 @@ TEST(InstrumentConfig, ExplicitLayersAndProxyListReplaceTheDefaults) {
     EXPECT_FALSE(config.proxies.depth);
     EXPECT_FALSE(config.proxies.distortion);
     EXPECT_FALSE(config.proxies.attenuation);
+    EXPECT_FALSE(config.proxies.rendering);  // on by default, off unless listed
     EXPECT_TRUE(config.proxies.multi_attenuation);
 }
 

@@ -474,7 +474,7 @@ const Key<InstrumentConfig> kTopLevelKeys[] = {
      [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
          require_array(value, key);
          // A given list replaces the default one: only what it names is emitted.
-         config.proxies = ProxySelection{false, false, false, false, false};
+         for (const auto& proxy : kProxies) config.proxies.*proxy.value = false;
          for (std::size_t i = 0; i < value.size(); ++i) {
              config.proxies.*choose(value[i], element_key(key, i), kProxies) = true;
          }

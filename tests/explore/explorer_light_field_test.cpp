@@ -187,7 +187,7 @@ TEST_F(ExplorerLightField, OpacityEditsGoThroughTheAttenuationLightField) {
 }
 
 TEST_F(ExplorerLightField, ArchivesWithOnlyALightFieldRenderEveryView) {
-    config_.proxies = ProxySelection{false, false, false, false, false};
+    config_.proxies = ProxySelection{false, false, false, false, false, false};
     write_step();
     Explorer explorer(config_.archive);
     ExploreRequest stored;

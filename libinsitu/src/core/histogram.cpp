@@ -13,7 +13,8 @@ ValueHistogram ValueHistogram::of(const std::vector<float>& values, double min, 
                                   int bins) {
     if (bins < 1) fail<InvalidArgument>("histogram bins = ", bins, " (must be at least 1)");
     if (!std::isfinite(min) || !std::isfinite(max) || max < min) {
-        fail<InvalidArgument>("histogram range [", min, ", ", max, "] (must be finite, min <= max)");
+        fail<InvalidArgument>("histogram range [", min, ", ", max,
+                              "] (must be finite, min <= max)");
     }
     ValueHistogram histogram;
     histogram.min = min;
