@@ -92,6 +92,39 @@ set_tests_properties(viewer.webgl PROPERTIES
                      ENVIRONMENT "INSITU_VIEW=$<TARGET_FILE:insitu-view>;ARCHIVE=${viewer_lf_archive};WORK_DIR=${viewer_work}"
                      TIMEOUT 180)
 
+# Per-segment fades (issue 15): the same run with its light field split at opacity 0.5 into two
+# segments, depth in half floats; segments.test.mjs moves the page's faders and compares the
+# canvas with `insitu-view render --source lightfield --segment-opacity`, checks the refusals of
+# bad segment-opacity values, and that the faders are hidden for the archives above (no light
+# field; one segment).
+set(viewer_lf_segments_archive ${viewer_work}/viewer_lf_segments.cdb)
+set(viewer_lf_segments_config ${CMAKE_CURRENT_BINARY_DIR}/viewer_lf_segments_config.json)
+file(WRITE ${viewer_lf_segments_config} [=[
+{"fields": ["v"],
+ "views": [{"azimuth": 30, "elevation": 20, "size": [160, 160]}],
+ "transfer_function": {"points": [[0.0, 0.1, 0.25, 0.75, 0.0], [0.12, 0.1, 0.25, 0.75, 0.0],
+                                  [0.2, 0.15, 0.55, 0.9, 0.04], [0.28, 0.35, 0.85, 0.7, 0.1],
+                                  [0.36, 0.95, 0.8, 0.3, 0.22], [0.45, 1.0, 0.4, 0.15, 0.4]],
+                       "unit_length": 1.0},
+ "intervals": {"count": 8},
+ "light_field": {"cameras": 42, "size": 128, "attenuation": false, "segments": [0.5],
+                 "depth_bits": 16},
+ "every": 300}
+]=])
+add_test(NAME viewer.setup_lf_segments_archive
+         COMMAND gray-scott --size 40 --steps 600 --config ${viewer_lf_segments_config}
+                 --out ${viewer_lf_segments_archive})
+set_tests_properties(viewer.setup_lf_segments_archive PROPERTIES
+                     FIXTURES_REQUIRED viewer_work FIXTURES_SETUP viewer_lf_segments_archive
+                     TIMEOUT 120)
+add_test(NAME viewer.segments
+         COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/segments.test.mjs
+         WORKING_DIRECTORY ${viewer_tests_dir})
+set_tests_properties(viewer.segments PROPERTIES
+                     FIXTURES_REQUIRED "viewer_archive;viewer_lf_archive;viewer_lf_segments_archive"
+                     ENVIRONMENT "INSITU_VIEW=$<TARGET_FILE:insitu-view>;ARCHIVE=${viewer_lf_segments_archive};ARCHIVE_ONE_SEGMENT=${viewer_lf_archive};ARCHIVE_NO_LIGHT_FIELD=${viewer_archive};WORK_DIR=${viewer_work}"
+                     TIMEOUT 180)
+
 # serve's command line: exit 2 and one line on stderr for bad arguments or archives.
 function(viewer_serve_case name exit_status stream text)
   string(JOIN "|" command $<TARGET_FILE:insitu-view> serve ${ARGN})

@@ -35,6 +35,7 @@
 #include "arguments.hpp"
 #include "cli.hpp"
 #include "explore_options.hpp"
+#include "insitu/config.hpp"
 #include "insitu/core/image.hpp"
 #include "insitu/error.hpp"
 #include "insitu/explore/explorer.hpp"
@@ -530,10 +531,60 @@ private:
                     info["mean_attenuation"] = sums;
                 }
             }
+            // How many faders the page shows (0: the step has no light field of the field).
+            info["light_field_segments"] = light_field_segments_locked(key);
             if (step_infos_.size() >= kMaxStepInfos) step_infos_.clear();
             found = step_infos_.emplace(key, info.dump()).first;
         }
         response.set_content(found->second, "application/json");
+    }
+
+    /// Segments of the light field of the field that (step, view) shows (0 without one), from
+    /// the configuration's light-field settings; only the "layers" rule, whose count is the
+    /// step's isovalues, reads the light field's headers (and one camera). Cached per (step,
+    /// view): a listed step's files never change. Caller holds engine_mutex_, the step listed.
+    int light_field_segments_locked(const StepKey& key) {
+        const auto cached = segment_counts_.find(key);
+        if (cached != segment_counts_.end()) return cached->second;
+        const ArchiveReader& reader = explorer_->archive();
+        const std::string field = reader.entry(key.step, key.view).field;
+        int count = 0;
+        for (const ArchivedLightField& stored : reader.light_fields(key.step)) {
+            if (stored.field != field) continue;
+            const std::optional<LightFieldSettings> settings = reader.configuration().light_field;
+            if (settings && settings->segments == SegmentRule::opacity) {
+                count = static_cast<int>(settings->opacity_thresholds.size()) + 1;
+            } else if (settings && settings->segments == SegmentRule::whole_ray) {
+                count = 1;
+            } else {
+                require_inside(stored.exr_path);
+                count = reader.load_light_field(key.step, field, {0}).segment_count();
+            }
+        }
+        if (segment_counts_.size() >= kMaxStepInfos) segment_counts_.clear();
+        segment_counts_[key] = count;
+        return count;
+    }
+
+    /// 400 for a segment-opacity naming a segment the step's light field lacks, whichever
+    /// proxies the frame is then made from (Explorer checks them only when it uses the light
+    /// field), so a page never sends faders that silently do nothing.
+    void check_segments(const ExploreRequest& request, const Options& options) {
+        if (request.segment_opacity_scales.empty()) return;
+        std::lock_guard<std::mutex> lock(engine_mutex_);
+        require_listed_locked(request.step, request.view);
+        const int count = light_field_segments_locked({request.step, request.view});
+        for (const auto& [segment, factor] : request.segment_opacity_scales) {
+            if (segment < count) continue;
+            const std::string text = options.at("segment-opacity");
+            throw HttpError(
+                400,
+                "segment-opacity = \"" + text + "\": segment " + std::to_string(segment) +
+                    (count == 0 ? " (step " + std::to_string(request.step) + " view " +
+                                      std::to_string(request.view) + " has no light field)"
+                                : " is out of range (the light field has " + std::to_string(count) +
+                                      " segments: 0.." + std::to_string(count - 1) + ")"));
+        }
     }
 
     /// The light field of the field that (step, view) shows, as light_field_payload encodes it
@@ -639,6 +690,7 @@ private:
         const auto [options, session] = options_of(request);
         const ExploreRequest explore = request_from_options(options);
         check_limits(explore);
+        check_segments(explore, options);
         const std::string options_text = canonical_text(options);
 
         if (mask) {
@@ -756,6 +808,7 @@ private:
     std::optional<std::string> description_;
     std::map<StepKey, std::string> step_infos_;
     std::map<StepKey, std::string> trust_;
+    std::map<StepKey, int> segment_counts_;
     /// (ETag, (payload, its gzip)), oldest first.
     std::vector<std::pair<std::string, std::pair<std::string, std::string>>> light_field_payloads_;
     FrameScheduler scheduler_;

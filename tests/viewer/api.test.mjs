@@ -69,6 +69,12 @@ test('the page and its scripts are served from the binary', async () => {
   }
 });
 
+test('a step without a light field has no segments: the page shows no faders', async () => {
+  const info = await (await fetch(`${server.url}api/step?step=${steps[0]}`)).json();
+  assert.equal(info.light_field_segments, 0);
+  assert.match(await (await fetch(server.url)).text(), /<fieldset id="segments" hidden>/);
+});
+
 test('absurd or malformed parameters are 4xx with a JSON error, and logged', async () => {
   const first = steps[0];
   const tenLights = new Array(9).fill('30,20').join(';');
@@ -89,6 +95,8 @@ test('absurd or malformed parameters are 4xx with a JSON error, and logged', asy
     [`api/frame?step=${first}&opacity-scale=0%3D-1`, 400],
     [`api/frame?step=${first}&opacity-scale=63%3D2`, 400],      // interval the archive lacks
     [`api/frame?step=${first}&opacity-scale=garbage`, 400],
+    [`api/frame?step=${first}&segment-opacity=0%3D0.5`, 400],   // no light field, no segments
+    [`api/frame?step=${first}&segment-opacity=0%3D-1`, 400],
     [`api/frame?step=${first}&tf=%7B%22points%22%3A`, 400],     // truncated JSON
     [`api/frame?step=${first}&tf=%7B%22points%22%3A%5B%5D%7D`, 400],  // no points
     [`api/frame?step=${first}&tf=%2Fetc%2Fpasswd`, 400],        // a path is not a TF

@@ -5,6 +5,7 @@
 // in flight; a control moved meanwhile is drawn once that one is done (the server also
 // coalesces, per session).
 import { GpuFrames } from './gpu_frames.js';
+import { segmentOpacityOption, showSegmentFaders } from './segment_faders.js';
 
 const DEGREES_PER_PIXEL = 0.4;  // orbit drag: degrees of azimuth/elevation per CSS pixel
 const MAX_OPACITY_SCALE = 4;    // top of the opacity-handle axis
@@ -25,6 +26,7 @@ const state = {
   elevation: null,
   scales: [],             // opacity scale per interval (1 = unchanged)
   colours: [],            // per interval: null or an edited linear RGB triple
+  segmentScales: [],      // opacity factor per light-field segment (1 = unchanged)
   baseTf: null,           // a loaded TF (JSON object) or null = the archive's own
   colourSource: 'auto',
   mask: false,
@@ -173,6 +175,14 @@ function currentOptions() {
   if ($('enhance-on').checked) {
     options.enhance = `${$('enhance-lambda').value},${$('enhance-gamma').value}`;
   }
+  const segments = segmentOpacityOption(state.segmentScales);
+  if (segments) {
+    options['segment-opacity'] = segments;
+    // Only the light field has segments: "auto" makes the stored view (and, for a light field
+    // without attenuation, every frame with edits or enhancement) from the view's proxies,
+    // where faders do nothing. Without those the light field can make every frame: asked for.
+    if (!options.tf && !options['opacity-scale'] && !options.enhance) options.source = 'lightfield';
+  }
   return options;
 }
 
@@ -263,7 +273,7 @@ function showCanvas(canvas) {
 function drawInBrowser(options, preview) {
   const entry = state.timeline[state.stepIndex];
   viewer.gpu.draw(entry.step, state.view, state.info.camera, Number(options.azimuth),
-    Number(options.elevation), [], preview)
+    Number(options.elevation), state.segmentScales.slice(), preview)
     .then((timing) => {
       if (!timing) throw new Error('the step has no light field');
       showCanvas(true);
@@ -406,6 +416,11 @@ async function stepChanged() {
     state.colours = new Array(count).fill(null);
   }
   state.info = info;
+  // Faders for a light field captured in segments; the same run keeps its segments, and the
+  // factors set, from step to step.
+  const segments = info.light_field_segments || 0;
+  if (segments !== state.segmentScales.length) state.segmentScales = new Array(segments).fill(1);
+  showSegmentFaders($('segments'), state.segmentScales, requestFrame);
   drawTfEditor();
   syncOrbitInputs();
   requestFrame();
