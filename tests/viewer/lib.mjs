@@ -170,3 +170,28 @@ export function makeWorkDir(prefix) {
   if (!existsSync(base)) throw new Error(`WORK_DIR ${base} does not exist`);
   return mkdtempSync(path.join(base, prefix));
 }
+
+function srgbToLinear(byte) {
+  const x = byte / 255;
+  return x <= 0.04045 ? x / 12.92 : Math.pow((x + 0.055) / 1.055, 2.4);
+}
+
+/// PSNR (dB) of two straight-alpha 8-bit sRGB RGBA images (decodePng's) on premultiplied linear
+/// RGB over black, the evaluation's measure.
+export function psnrPremultiplied(a, b) {
+  if (a.width !== b.width || a.height !== b.height) {
+    throw new Error(`images of ${a.width}x${a.height} and ${b.width}x${b.height} pixels`);
+  }
+  let sum = 0;
+  const pixels = a.width * a.height;
+  for (let p = 0; p < pixels; ++p) {
+    const alphaA = a.data[4 * p + 3] / 255;
+    const alphaB = b.data[4 * p + 3] / 255;
+    for (let c = 0; c < 3; ++c) {
+      const d = srgbToLinear(a.data[4 * p + c]) * alphaA - srgbToLinear(b.data[4 * p + c]) * alphaB;
+      sum += d * d;
+    }
+  }
+  const mse = sum / (3 * pixels);
+  return mse > 0 ? 10 * Math.log10(1 / mse) : Infinity;
+}

@@ -12,8 +12,8 @@ import assert from 'node:assert/strict';
 import { after, before, test } from 'node:test';
 
 import {
-  CHROMIUM, decodePng, differingSamples, env, loadPlaywright, makeWorkDir, renderWithCli,
-  startServer, stopServer, WEBGL_ARGS,
+  CHROMIUM, decodePng, differingSamples, env, loadPlaywright, makeWorkDir, psnrPremultiplied,
+  renderWithCli, startServer, stopServer, WEBGL_ARGS,
 } from './lib.mjs';
 
 const binary = env('INSITU_VIEW');
@@ -94,29 +94,6 @@ async function serverPixels(page) {
     return btoa(text);
   });
   return decodePng(Buffer.from(base64, 'base64'));
-}
-
-function srgbToLinear(byte) {
-  const x = byte / 255;
-  return x <= 0.04045 ? x / 12.92 : Math.pow((x + 0.055) / 1.055, 2.4);
-}
-
-/// PSNR (dB) of two straight-alpha 8-bit sRGB RGBA images on premultiplied linear RGB.
-function psnrPremultiplied(a, b) {
-  assert.equal(a.width, b.width);
-  assert.equal(a.height, b.height);
-  let sum = 0;
-  const pixels = a.width * a.height;
-  for (let p = 0; p < pixels; ++p) {
-    const alphaA = a.data[4 * p + 3] / 255;
-    const alphaB = b.data[4 * p + 3] / 255;
-    for (let c = 0; c < 3; ++c) {
-      const d = srgbToLinear(a.data[4 * p + c]) * alphaA - srgbToLinear(b.data[4 * p + c]) * alphaB;
-      sum += d * d;
-    }
-  }
-  const mse = sum / (3 * pixels);
-  return mse > 0 ? 10 * Math.log10(1 / mse) : Infinity;
 }
 
 test('segment faders fade the WebGL2 frame as insitu-view render --segment-opacity does', async () => {
