@@ -90,6 +90,7 @@ TEST(InstrumentConfig, EmptyObjectGivesTheDocumentedDefaults) {
     EXPECT_FALSE(config.proxies.distortion);  // Explorer's auto never prefers it
     EXPECT_TRUE(config.proxies.attenuation);
     EXPECT_TRUE(config.proxies.rendering);
+    EXPECT_TRUE(config.proxies.interleaving);  // the edit trust reads it
     EXPECT_FALSE(config.proxies.multi_attenuation);
     EXPECT_FALSE(config.proxies.optical_depth);
     EXPECT_EQ(config.step_voxels, 1.0);
@@ -146,6 +147,7 @@ TEST(InstrumentConfig, ExplicitLayersAndProxyListReplaceTheDefaults) {
     EXPECT_FALSE(config.proxies.distortion);
     EXPECT_FALSE(config.proxies.attenuation);
     EXPECT_FALSE(config.proxies.rendering);  // on by default, off unless listed
+    EXPECT_FALSE(config.proxies.interleaving);
     EXPECT_TRUE(config.proxies.multi_attenuation);
 }
 
@@ -236,7 +238,8 @@ TEST(InstrumentConfig, ToJsonEmitsEveryKeyAndRoundTrips) {
         EXPECT_TRUE(json.contains(key)) << key;
     }
     EXPECT_EQ(json["layers"], "auto");
-    EXPECT_EQ(json["proxies"], nlohmann::json({"depth", "attenuation", "rendering"}));
+    EXPECT_EQ(json["proxies"],
+              nlohmann::json({"depth", "attenuation", "rendering", "interleaving"}));
 
     InstrumentConfig custom;
     custom.fields = {"u", "v"};

@@ -132,6 +132,22 @@ def light_field_goals(rows, met):
     return out
 
 
+def edit_trust_goals(scale, occlusion, met):
+    """The goal row of the edit trust (issue 17): over the failure sweeps, the worst row's share of
+    wrong pixels flagged (rows where any went wrong) and of right ones flagged."""
+    rows = [r for r in scale + occlusion if r.get("good_flagged_fraction")]
+    if not rows:
+        return []
+    wrong = [r for r in rows if num(r, "high_error_fraction") > 0.0]
+    worst_flagged = min((num(r, "flagged_fraction") for r in wrong), default=1.0)
+    worst_good = max(num(r, "good_flagged_fraction") for r in rows)
+    return [["trust for edits < 0.5: share of wrong pixels (error > 0.1) flagged, worst sweep row / of "
+             "right ones flagged, worst row (failure sweeps: opacity scale, occlusion; model and "
+             "recomposition)", "≥ 80 % / ≤ 10 %",
+             "%.0f %% / %.0f %%" % (100 * worst_flagged, 100 * worst_good),
+             met(worst_flagged >= 0.8 and worst_good <= 0.1)]]
+
+
 def chart_light_fields(d, rows):
     """Light fields (seed 001 Table 1 on our scenes) beside the single-view proxies and their
     per-pixel fusion, all from the same random views: accuracy against bytes, error against
@@ -441,7 +457,8 @@ def write_markdown(d, path, prefix, elapsed):
                  ["stored view with the run's own function, default configuration, half: the stored "
                   "rendering (recomposed from the intervals), dB", "≥ 60 dB", stored_text or "n/a",
                   met(stored_worst >= 60)],
-             ] + light_field_goals(read(d, "light_fields"), met)), ""]
+             ] + edit_trust_goals(scale, occlusion, met) + light_field_goals(read(d, "light_fields"), met)),
+             ""]
     lines += ["Depth correlation by proxy source (%s; the goal rows above use the single-perspective "
               "proxies, which Explorer prefers; tilt 45° is the configuration default and the paper's "
               "Eq. 1):" % rot_scene, "",
@@ -519,16 +536,21 @@ def write_markdown(d, path, prefix, elapsed):
                           "%.1f×" % (int(r["volume_n"]) ** 3 * 4 / num(r, "bytes"))] for r in meas]), ""]
 
     lines += ["## Where the methods fail", "", "![failures](%sfailures.png)" % prefix, ""]
+    def good(r):
+        return "%.2f" % num(r, "good_flagged_fraction") if r.get("good_flagged_fraction") else "n/a"
     body = [[r["scale"], "yes" if r["in_training_range"] == "1" else "no", r["method"], "%.1f" % num(r, "psnr"),
-             "%.3f" % num(r, "high_error_fraction"), "%.2f" % num(r, "flagged_fraction")] for r in scale]
-    lines += ["Opacity scaled on every interval (pixels off by > 0.1 of full scale, and the fraction the "
-              "confidence mask flagged; at the stored view the explorer's mask is 1 everywhere):", "",
-              table(["scale", "in training range", "method", "PSNR dB", "high-error px", "flagged"], body), ""]
+             "%.3f" % num(r, "high_error_fraction"), "%.2f" % num(r, "flagged_fraction"), good(r)] for r in scale]
+    lines += ["Opacity scaled on every interval (pixels off by > 0.1 of full scale; the share of them the "
+              "edit's trust flags, trust < 0.5, and the share of right pixels it flags among those either "
+              "image covers; insitu/explore/transfer_function_edit.hpp):", "",
+              table(["scale", "in training range", "method", "PSNR dB", "high-error px", "flagged",
+                     "right px flagged"], body), ""]
     body = [[r["training"].replace("_", " "), r["method"], "%.1f" % num(r, "psnr"), "%.3f" % num(r, "high_error_fraction"),
-             "%.2f" % num(r, "flagged_fraction")] for r in occlusion]
+             "%.2f" % num(r, "flagged_fraction"), good(r)] for r in occlusion]
     lines += ["A feature occluded in every training image (nested shells, the outer one opaque in all "
               "training functions, then faded by the edit):", "",
-              table(["training images", "method", "PSNR dB", "high-error px", "flagged"], body), ""]
+              table(["training images", "method", "PSNR dB", "high-error px", "flagged", "right px flagged"],
+                    body), ""]
     rot_rows = [r for r in rotation if r["scene"] == rot_scene and r["source"] == "multi45"
                 and float(r["angle_deg"]) in (15.0, 30.0, 60.0, 90.0)]
     body = [[r["angle_deg"], "%.4f" % num(r, "depth_corr"), "%.3f" % num(r, "depth_high_error_fraction"),
@@ -600,10 +622,12 @@ def meaning(configs, primary, c15, c30, edit_min, rotation, rot_scene, occlusion
     occ = lookup(occlusion, training="inner_occluded", method="model")
     far = [r for r in scale if r["method"] == "model" and r["in_training_range"] == "0"]
     worst_far = min(num(r, "psnr") for r in far) if far else float("nan")
-    s3 = ("Colour-model failures are silent: a feature hidden in every training image drops the model to %.1f dB "
-          "and opacity scaled far outside the training range to %.1f dB, with no pixel flagged, because "
-          "nothing but the view-synthesis mask carries a confidence." % (
-              num(occ, "psnr") if occ else float("nan"), worst_far))
+    s3 = ("Colour-model failures are no longer silent: a feature hidden in every training image drops the "
+          "model to %.1f dB and opacity scaled far outside the training range to %.1f dB, and the edit's "
+          "trust flags %.0f %% and %.0f %% of the pixels that went wrong there." % (
+              num(occ, "psnr") if occ else float("nan"), worst_far,
+              100 * num(occ, "flagged_fraction") if occ else float("nan"),
+              100 * min((num(r, "flagged_fraction") for r in far), default=float("nan"))))
     return " ".join([s1, s2, s3])
 
 

@@ -358,8 +358,10 @@ ColourSetup colour_setup(ProxyRenderer& renderer, const Scene& scene, int image,
     setup.stored_tf = make_tf(scene, stored);
     ProxyRequest request = proxy_request(scene, setup.stored_tf, intervals, 1);
     request.depth_layers = false;
+    request.interleaving = true;  // what the edit trust reads, as the Instrument stores it
     setup.intervals = *request.intervals;
     setup.frame = renderer.render(setup.camera, request);
+    request.interleaving = false;
     for (const TfSpec& spec : training) {
         const TransferFunction tf = make_tf(scene, spec);
         request.transfer_function = tf;
@@ -386,6 +388,45 @@ ColourModel fit_model(const ColourSetup& setup, int training, int clusters) {
 Image edited_attenuation(const ColourSetup& setup, const TransferFunction& edited) {
     const std::vector<double> scales = opacity_scales(setup.stored_tf, edited, setup.intervals);
     return estimate_attenuation(setup.frame.attenuation, setup.frame.mean_depth, nullptr, scales);
+}
+
+/// The trust the Explorer gives an edit of the stored view (transfer_function_edit.hpp), for
+/// the recomposition and, with `model_prediction`, for the colour model's prediction.
+Image edit_trust(const ColourSetup& setup, const TransferFunction& edited, const Image& a_edited,
+                 const Image& recomposed, const Image* model_prediction) {
+    EditTrustInputs trust;
+    trust.attenuation = &setup.frame.attenuation;
+    trust.mean_depth = &setup.frame.mean_depth;
+    trust.interleaving = &setup.frame.interleaving;
+    trust.edited_attenuation = &a_edited;
+    trust.scales = opacity_scales(setup.stored_tf, edited, setup.intervals);
+    trust.colours = interval_colours(edited, setup.intervals);
+    trust.colour_spread = interval_colour_spread(edited, setup.intervals);
+    trust.attenuation_resolution = kFloatAttenuationResolution;  // frames straight from the pass
+    Image error = edit_error(trust);
+    if (model_prediction) add_model_departure(error, *model_prediction, recomposed);
+    return edit_confidence(error);
+}
+
+/// Columns high_error_fraction, flagged_fraction, good_flagged_fraction of an edit's mask: a
+/// pixel is flagged where the trust is below 1/2, right pixels are counted where either image
+/// covers anything.
+constexpr const char* kEditMaskColumns =
+    "high_error_fraction,flagged_fraction,good_flagged_fraction";
+struct EditOutcome {
+    ImageErrors errors;
+    MaskCoverage mask;
+};
+/// The errors of the model's or the recomposition's colour for an edit, and its trust's mask.
+EditOutcome judge_edit(const ColourSetup& setup, const TransferFunction& edited, const Image& truth,
+                       const Image& a_edited, const Image& by_model, const Image& by_recompose,
+                       bool model_used) {
+    const Image& predicted = model_used ? by_model : by_recompose;
+    const Image trust =
+        edit_trust(setup, edited, a_edited, by_recompose, model_used ? &by_model : nullptr);
+    const std::vector<char> covered = covered_pixels(truth, predicted);
+    return {errors_of(truth, predicted), mask_coverage(pixel_errors_rgb(truth, predicted), trust,
+                                                       kColourErrorThreshold, 0.5, &covered)};
 }
 
 void section_colour(const Scene& scene, const Options& options, int image) {
@@ -463,15 +504,13 @@ void section_colour(const Scene& scene, const Options& options, int image) {
     // range (the training functions span scales 0.2..1 per band).
     {
         Csv csv(fs::path(options.out) / "opacity_scale.csv",
-                "scene,scale,in_training_range,method,psnr,ssim,max_abs,high_error_fraction,"
-                "flagged_fraction");
+                std::string("scene,scale,in_training_range,method,psnr,ssim,max_abs,") +
+                    kEditMaskColumns);
         const ColourModel model = fit_model(setup, 3, 24);
         const std::vector<double> scales =
             options.smoke
                 ? std::vector<double>{1.0 / 16, 1.0, 16.0}
                 : std::vector<double>{1.0 / 64, 1.0 / 16, 1.0 / 4, 0.5, 1.0, 2.0, 4.0, 16.0, 64.0};
-        // The stored view has no synthesis mask: the explorer's confidence is 1 everywhere.
-        const Image confidence(image, image, 1, 1.0f);
         for (const double s : scales) {
             TfSpec spec;
             spec.scale = s;
@@ -481,14 +520,13 @@ void section_colour(const Scene& scene, const Options& options, int image) {
             const Image a = edited_attenuation(setup, edited);
             const Image by_model = model.predict(a);
             const Image by_recompose = recolour(a, interval_colours(edited, setup.intervals));
-            for (const auto& [method, predicted] :
-                 {std::pair<const char*, const Image*>{"model", &by_model},
-                  {"recompose", &by_recompose}}) {
-                const ImageErrors err = errors_of(truth, *predicted);
-                const MaskCoverage mask = mask_coverage(pixel_errors_rgb(truth, *predicted),
-                                                        confidence, kColourErrorThreshold);
-                csv.row(scene.name, s, (s >= 0.2 && s <= 1.0) ? 1 : 0, method, err.psnr, err.ssim,
-                        err.max_abs, mask.high_error_fraction(), mask.flagged_fraction());
+            for (const bool model_used : {true, false}) {
+                const auto [err, mask] =
+                    judge_edit(setup, edited, truth, a, by_model, by_recompose, model_used);
+                csv.row(scene.name, s, (s >= 0.2 && s <= 1.0) ? 1 : 0,
+                        model_used ? "model" : "recompose", err.psnr, err.ssim, err.max_abs,
+                        mask.high_error_fraction(), mask.flagged_fraction(),
+                        mask.good_flagged_fraction());
             }
         }
     }
@@ -553,7 +591,7 @@ void section_occlusion(const Options& options, int size, int image) {
     edit.low_scale = 0.3;
     const TransferFunction edited = make_tf(scene, edit);
     Csv csv(fs::path(options.out) / "occlusion.csv",
-            "training,method,psnr,ssim,max_abs,high_error_fraction,flagged_fraction");
+            std::string("training,method,psnr,ssim,max_abs,") + kEditMaskColumns);
     for (const bool occluded : {true, false}) {
         const ColourSetup setup =
             colour_setup(renderer, scene, image, 16, occluded ? occluding : training_specs(3));
@@ -562,16 +600,13 @@ void section_occlusion(const Options& options, int size, int image) {
         const Image a = edited_attenuation(setup, edited);
         const Image by_model = fit_model(setup, 3, 24).predict(a);
         const Image by_recompose = recolour(a, interval_colours(edited, setup.intervals));
-        // The stored view has no synthesis mask: the explorer's confidence is 1 everywhere.
-        const Image confidence(image, image, 1, 1.0f);
-        for (const auto& [method, predicted] :
-             {std::pair<const char*, const Image*>{"model", &by_model},
-              {"recompose", &by_recompose}}) {
-            const ImageErrors err = errors_of(truth, *predicted);
-            const MaskCoverage mask = mask_coverage(pixel_errors_rgb(truth, *predicted), confidence,
-                                                    kColourErrorThreshold);
-            csv.row(occluded ? "inner_occluded" : "inner_visible", method, err.psnr, err.ssim,
-                    err.max_abs, mask.high_error_fraction(), mask.flagged_fraction());
+        for (const bool model_used : {true, false}) {
+            const auto [err, mask] =
+                judge_edit(setup, edited, truth, a, by_model, by_recompose, model_used);
+            csv.row(occluded ? "inner_occluded" : "inner_visible",
+                    model_used ? "model" : "recompose", err.psnr, err.ssim, err.max_abs,
+                    mask.high_error_fraction(), mask.flagged_fraction(),
+                    mask.good_flagged_fraction());
         }
     }
     std::printf("occlusion: done\n");

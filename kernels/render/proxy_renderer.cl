@@ -49,20 +49,23 @@ inline void store_segments(int wanted, __global float4* rgba_out, __global float
     }
 }
 
-__kernel void render_proxies(
-    __global const float* volume, int4 dims, float4 origin_world, float4 inv_spacing,
-    float4 box_lower, float4 box_upper, float4 data_offset, float4 owned_lower, float4 owned_upper,
-    __global const float4* tf_table, int2 tf_bins, float4 tf_domain, float4 cam_position,
-    float4 cam_forward, float4 cam_right, float4 cam_up, float4 cam_half_extent, int2 size,
-    float4 march, int wanted, int layer_count, __global const float* isovalues, int interval_count,
-    float uniform_interval_scale, __global const float* interval_edges, __global float* depth_out,
-    __global float* distortion_out,
-    __global float* attenuation_out,  // always given when accumulating
-    __global float* mean_depth_out, __global float* optical_depth_out, int segment_rule,
-    int segment_count, __global const float* segment_thresholds, float depth_threshold,
-    __global float4* segment_rgba_out, __global float* segment_depth_out,
-    __global float* first_hit_out, __global const uchar* skippable_blocks, int4 block_counts,
-    int block_size, __global float* fragment_out) {
+__kernel void render_proxies(__global const float* volume, int4 dims, float4 origin_world,
+                             float4 inv_spacing, float4 box_lower, float4 box_upper,
+                             float4 data_offset, float4 owned_lower, float4 owned_upper,
+                             __global const float4* tf_table, int2 tf_bins, float4 tf_domain,
+                             float4 cam_position, float4 cam_forward, float4 cam_right,
+                             float4 cam_up, float4 cam_half_extent, int2 size, float4 march,
+                             int wanted, int layer_count, __global const float* isovalues,
+                             int interval_count, float uniform_interval_scale,
+                             __global const float* interval_edges, __global float* depth_out,
+                             __global float* distortion_out,
+                             __global float* attenuation_out,  // always given when accumulating
+                             __global float* mean_depth_out, __global float* optical_depth_out,
+                             __global float* interleaving_out, int segment_rule, int segment_count,
+                             __global const float* segment_thresholds, float depth_threshold,
+                             __global float4* segment_rgba_out, __global float* segment_depth_out,
+                             __global float* first_hit_out, __global const uchar* skippable_blocks,
+                             int4 block_counts, int block_size, __global float* fragment_out) {
     const int x = get_global_id(0);
     const int y = get_global_id(1);
     if (x >= size.x || y >= size.y) return;
@@ -94,6 +97,7 @@ __kernel void render_proxies(
     const bool want_attenuation = (wanted & WANT_ATTENUATION) != 0;
     const bool want_mean_depth = (wanted & WANT_MEAN_DEPTH) != 0;
     const bool want_optical_depth = (wanted & WANT_OPTICAL_DEPTH) != 0;
+    const bool want_interleaving = (wanted & WANT_INTERLEAVING) != 0;
     const bool want_segments =
         (wanted & (WANT_SEGMENT_RGBA | WANT_SEGMENT_DEPTH | WANT_FIRST_HIT_DEPTH)) != 0;
     // Segments split at the layers' crossings need them found even where depth layers are not
@@ -105,7 +109,16 @@ __kernel void render_proxies(
     for (int l = 0; l < layer_count; ++l) layer_t[l] = INFINITY;
     int layers_found = 0;
     // Mean and optical depth need the same accumulation, even when a_j is not stored.
-    const bool accumulate = want_attenuation || want_mean_depth || want_optical_depth;
+    const bool accumulate =
+        want_attenuation || want_mean_depth || want_optical_depth || want_interleaving;
+    // Interleaving: the interval of the last sample that contributed; how many times a
+    // contributing sample fell in an interval that already holds light but is not that one (the
+    // ray left the interval and came back), and the light of those re-entered runs. Scalars
+    // only: a_j > 0 says "seen before".
+    int last_interval = -1;
+    bool reentering = false;
+    float reentries = 0.0f;
+    float reentered = 0.0f;
     __global float* attenuation = attenuation_out + pixel * interval_count;
     __global float* weighted_depth = mean_depth_out + pixel * interval_count;
     __global float* optical_depth = optical_depth_out + pixel * interval_count;
@@ -218,7 +231,13 @@ __kernel void render_proxies(
                             ? clamp((int)((value - interval_edges[0]) * uniform_interval_scale), 0,
                                     interval_count - 1)
                             : interval_of(interval_edges, interval_count, value);
+                    if (j != last_interval) {
+                        reentering = attenuation[j] > 0.0f;
+                        if (reentering) reentries += 1.0f;
+                        last_interval = j;
+                    }
                     const float weight = absorb(&transmittance, alpha);  // seed 000 Eq. 7
+                    if (reentering) reentered += weight;
                     attenuation[j] += weight;
                     if (want_mean_depth) weighted_depth[j] += weight * sample_depth(&ray, t);
                     if (want_optical_depth) {
@@ -307,6 +326,7 @@ __kernel void render_proxies(
                 attenuation[j] > 0.0f ? weighted_depth[j] / attenuation[j] : INFINITY;
         }
     }
+    if (want_interleaving) vstore2((float2)(reentries, reentered), pixel, interleaving_out);
     if (partial) {
         __global float* fragment = fragment_out + pixel * FRAGMENT_CHANNELS;
         fragment[0] = (float)fragment_first;
@@ -321,6 +341,14 @@ __kernel void render_proxies(
     }
 }
 
+// render_proxies' interleaving state, per lane of a packet.
+typedef struct {
+    intp last_interval;
+    intp reentering;
+    floatp reentries;
+    floatp reentered;
+} PacketInterleaving;
+
 // Adds one sample's contribution to the interleaved per-interval outputs of the lanes in
 // `contributes`, one lane at a time (a lane's interval is data-dependent, and its pixel's
 // intervals share one or two cache lines, as in render_proxies).
@@ -329,7 +357,7 @@ inline void accumulate_lanes(intp contributes, floatp value, floatp weight, floa
                              float uniform_interval_scale, __global const float* interval_edges,
                              bool want_mean_depth, bool want_optical_depth,
                              __global float* attenuation_out, __global float* mean_depth_out,
-                             __global float* optical_depth_out) {
+                             __global float* optical_depth_out, PacketInterleaving* interleaving) {
     for (int lane = 0; lane < PACKET_LANES; ++lane) {
         if (!LANE_INT(contributes, lane)) continue;
         const int2 pixel_xy = packet_pixel(gx, gy, lane);
@@ -340,7 +368,15 @@ inline void accumulate_lanes(intp contributes, floatp value, floatp weight, floa
                                   interval_count - 1)
                           : interval_of(interval_edges, interval_count, v);
         const int index = pixel * interval_count + j;
+        // Interleaving, as render_proxies counts it.
+        if (j != LANE_INT(interleaving->last_interval, lane)) {
+            const bool reentering = attenuation_out[index] > 0.0f;
+            LANE_INT(interleaving->reentering, lane) = reentering ? -1 : 0;
+            if (reentering) LANE(interleaving->reentries, lane) += 1.0f;
+            LANE_INT(interleaving->last_interval, lane) = j;
+        }
         const float w = LANE(weight, lane);
+        if (LANE_INT(interleaving->reentering, lane)) LANE(interleaving->reentered, lane) += w;
         attenuation_out[index] += w;
         if (want_mean_depth) mean_depth_out[index] += w * LANE(depth, lane);
         if (want_optical_depth) {
@@ -384,8 +420,8 @@ __kernel void render_proxies_packets(
     float4 march, int wanted, int layer_count, __global const float* isovalues, int interval_count,
     float uniform_interval_scale, __global const float* interval_edges, __global float* depth_out,
     __global float* distortion_out, __global float* attenuation_out, __global float* mean_depth_out,
-    __global float* optical_depth_out, int segment_rule, int segment_count,
-    __global const float* segment_thresholds, float depth_threshold,
+    __global float* optical_depth_out, __global float* interleaving_out, int segment_rule,
+    int segment_count, __global const float* segment_thresholds, float depth_threshold,
     __global float4* segment_rgba_out, __global float* segment_depth_out,
     __global float* first_hit_out, __global const uchar* skippable_blocks, int4 block_counts,
     int block_size, __global float* fragment_out) {
@@ -400,8 +436,9 @@ __kernel void render_proxies_packets(
     const bool want_layers = (wanted & WANT_DEPTH) != 0 && layer_count > 0;
     const bool want_mean_depth = (wanted & WANT_MEAN_DEPTH) != 0;
     const bool want_optical_depth = (wanted & WANT_OPTICAL_DEPTH) != 0;
-    const bool accumulate =
-        (wanted & WANT_ATTENUATION) != 0 || want_mean_depth || want_optical_depth;
+    const bool want_interleaving = (wanted & WANT_INTERLEAVING) != 0;
+    const bool accumulate = (wanted & WANT_ATTENUATION) != 0 || want_mean_depth ||
+                            want_optical_depth || want_interleaving;
     // Segments here are the whole ray or opacity thresholds (the host sends layer segments to
     // render_proxies). The whole ray is one segment composited from T = 1, the ray itself, so
     // its depth is the first hit; opacity segments are composited on their own beside the ray,
@@ -432,6 +469,7 @@ __kernel void render_proxies_packets(
     intp layers_found = 0;
     floatp transmittance = 1.0f;
     intp accumulating = accumulate ? (intp)(-1) : (intp)(0);
+    PacketInterleaving interleaving = {(intp)(-1), (intp)(0), (floatp)(0.0f), (floatp)(0.0f)};
     intp compositing = want_segments ? (intp)(-1) : (intp)(0);
     floatp red = 0.0f, green = 0.0f, blue = 0.0f, ray_transmittance = 1.0f;
     floatp first_hit = INFINITY;
@@ -517,7 +555,7 @@ __kernel void render_proxies_packets(
                 accumulate_lanes(contributes, value, weight, depth, a, gx, gy, size, interval_count,
                                  uniform_interval_scale, interval_edges, want_mean_depth,
                                  want_optical_depth, attenuation_out, mean_depth_out,
-                                 optical_depth_out);
+                                 optical_depth_out, &interleaving);
                 accumulating &= ~(contributes & (1.0f - transmittance >= stop_opacity));
             }
             // The whole ray, then the opacity segment (none unless asked for).
@@ -610,6 +648,11 @@ __kernel void render_proxies_packets(
                 segment_depth_out[pixel] = LANE(first_hit, lane);
         }
         if ((wanted & WANT_FIRST_HIT_DEPTH) != 0) first_hit_out[pixel] = LANE(first_hit, lane);
+        if (want_interleaving) {
+            vstore2(
+                (float2)(LANE(interleaving.reentries, lane), LANE(interleaving.reentered, lane)),
+                pixel, interleaving_out);
+        }
         if (want_mean_depth) {
             const int base = pixel * interval_count;
             for (int j = 0; j < interval_count; ++j) {

@@ -142,7 +142,8 @@ constexpr Choice<bool ProxySelection::*> kProxies[] = {
     {"attenuation", &ProxySelection::attenuation},
     {"multi_attenuation", &ProxySelection::multi_attenuation},
     {"optical_depth", &ProxySelection::optical_depth},
-    {"rendering", &ProxySelection::rendering}};
+    {"rendering", &ProxySelection::rendering},
+    {"interleaving", &ProxySelection::interleaving}};
 
 /// "a, b or c".
 template <typename Value, std::size_t N>

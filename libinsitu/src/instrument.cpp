@@ -725,6 +725,10 @@ void Instrument::Impl::compute_field(const FieldPlan& plan, StepRecord& record,
         }
         ProxyRequest march = request;
         march.training_transfer_functions.clear();
+        // A block cannot count re-entries of intervals the ray met in front of it (see
+        // ProxyRequest::interleaving): distributed archives carry no interleaving, and the
+        // Explorer's edit trust then goes without that term.
+        march.interleaving = false;
         std::optional<ProxyFrame> partial;
         if (plan.has_block) {
             failure.guard([&] {
@@ -758,6 +762,7 @@ void Instrument::Impl::compute_field(const FieldPlan& plan, StepRecord& record,
     single.attenuation = config.proxies.attenuation;
     single.mean_depth = config.proxies.attenuation;
     single.optical_depth = config.proxies.optical_depth;
+    single.interleaving = config.proxies.attenuation && config.proxies.interleaving;
     // The colour model maps the stored attenuation to colour, so it is fitted only where that
     // attenuation is stored. Training renderings are rendered when the model or the archive
     // needs them, and stored only on request ("keep_training_images").

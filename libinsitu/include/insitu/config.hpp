@@ -76,6 +76,12 @@ struct ProxySelection {
     /// "rendering": the stored view's ground truth with the run's function in half RGBA (the
     /// preview costs that pass anyway), so the Explorer returns that view exactly (issue 17).
     bool rendering = true;
+    /// "interleaving" (with "attenuation"): per pixel, how many times the ray re-entered an
+    /// interval it had left, one channel counted in the attenuation pass (no pass of its own).
+    /// Opacity edits are exact where it is 0 and approximate elsewhere, so the Explorer's trust
+    /// for edits reads it (issue 17; bench/RESULTS.md "Trust for transfer-function edits").
+    /// Not written by distributed runs: a block cannot count what the ray met in front of it.
+    bool interleaving = true;
 };
 
 /// "colour_model": the in-situ fit of seed 000 §6.2 (insitu/explore/colour_model.hpp).

@@ -5,7 +5,9 @@
 // One multi-part OpenEXR file per step and view. Every channel name starts with its part's name,
 // so names stay unique even when a tool flattens the parts into one channel list:
 //   part "depth"              depth.layer0 .. depth.layer<K-1>                        FLOAT
-//   part "attenuation"        attenuation.a00 .., attenuation.zmean00 .., attenuation.tau00 ..
+//   part "attenuation"        attenuation.a00 .., attenuation.zmean00 .., attenuation.tau00 ..,
+//                             attenuation.reentries, .reentered (interleaving, when present:
+//                             re-entries per pixel and the attenuation they added)
 //   part "train<k>"           train<k>.R, .G, .B, .A  (a training rendering, premultiplied)
 //   part "rendering"          rendering.R, .G, .B, .A (the run's own function, premultiplied)
 //   part "model"              model.table: the colour model of seed 000 §6.2 as an image of
@@ -14,8 +16,8 @@
 //   part "multi.depth"        multi.depth.layer0 ..       distortion camera (seed 000 §4.1) FLOAT
 //   part "multi.distortion"   multi.distortion.layer0 ..  ds of Eq. 2, world units          FLOAT
 //   part "multi.attenuation"  multi.attenuation.a00 .., .zmean00 .., .tau00 ..
-// Attenuation, mean depth, optical depth and training channels are HALF or FLOAT as the
-// configuration's "precision" says. Only parts with images are written. The model part carries
+// Attenuation, mean depth, optical depth, interleaving and training channels are HALF or FLOAT as
+// the configuration's "precision" says. Only parts with images are written. The model part carries
 // libinsitu.model_intervals (L), libinsitu.model_clusters (K), libinsitu.model_layout (the row
 // layout in words) and libinsitu.model_training_transfer_functions (the functions it was
 // fitted on, JSON); it is written whenever the frame has a model, kept training images or not.
@@ -74,6 +76,8 @@ inline constexpr const char* kLayerChannel = ".layer";
 inline constexpr const char* kAttenuationChannel = ".a";
 inline constexpr const char* kMeanDepthChannel = ".zmean";
 inline constexpr const char* kOpticalDepthChannel = ".tau";
+inline constexpr const char* kReentriesChannel = ".reentries";  // interleaving, one per part
+inline constexpr const char* kReenteredChannel = ".reentered";
 inline constexpr const char* kRgbaChannels[4] = {".R", ".G", ".B", ".A"};
 inline constexpr const char* const (&kTrainingChannels)[4] = kRgbaChannels;
 inline constexpr const char* kModelChannel = ".table";

@@ -135,6 +135,20 @@ std::vector<PartSource> frame_parts(const ProxyFrame& frame, const ViewRecord& v
         interval_count = image.channels;
         add_channels(attenuation, image, interval_suffixes[i], compact);
     }
+    if (!frame.interleaving.pixels.empty()) {
+        // Beside the intervals it describes: a count (HALF holds integers to 2048 exactly) and
+        // an attenuation.
+        if (frame.interleaving.channels != 2 || attenuation.channels.empty()) {
+            fail<InvalidArgument>(where, ": interleaving has ", frame.interleaving.channels,
+                                  " channels",
+                                  attenuation.channels.empty() ? " and no attenuation" : "",
+                                  " (expected 2 beside the attenuation proxies)");
+        }
+        attenuation.channels.push_back(
+            {attenuation.name + kReentriesChannel, &frame.interleaving, 0, compact});
+        attenuation.channels.push_back(
+            {attenuation.name + kReenteredChannel, &frame.interleaving, 1, compact});
+    }
     if (!attenuation.channels.empty()) parts.push_back(std::move(attenuation));
 
     for (std::size_t t = 0; t < frame.training.size(); ++t) {
@@ -469,6 +483,14 @@ void read_attenuation(Imf::InputPart& part, ProxyFrame& frame, const PartContext
     if (intervals == 0) {
         where.error("no channel \"" + interval_channel(where.part, suffixes[0], 0) + "\"");
     }
+    const std::string reentries = where.part + kReentriesChannel;
+    const std::string reentered = where.part + kReenteredChannel;
+    const bool has_interleaving = channels.findChannel(reentries) != nullptr;
+    if (has_interleaving) {
+        if (!channels.findChannel(reentered)) where.error("\"" + reentered + "\" missing");
+        names.push_back(reentries);
+        names.push_back(reentered);
+    }
     const Image all = read_channels(part, names, where);
     int first = 0;
     for (int i = 0; i < 3; ++i) {
@@ -476,6 +498,7 @@ void read_attenuation(Imf::InputPart& part, ProxyFrame& frame, const PartContext
         *targets[i] = channel_range(all, first, counts[i]);
         first += counts[i];
     }
+    if (has_interleaving) frame.interleaving = channel_range(all, first, 2);
 }
 
 /// An RGBA part: a training rendering or the stored one.
@@ -692,9 +715,9 @@ ProxyFrame decode_frame(const std::vector<char>& bytes, const std::string& path,
     try {
         check_headers(bytes, path, [&limits](const std::string& part) {
             // The model is a (4 L + 3) x K table (archive_format.hpp); every other part is an
-            // image of the view, with at most attenuation, mean depth and optical depth: three
-            // channels per interval.
-            constexpr long long kMaxChannels = 3ll * kMaxIntervals;
+            // image of the view, with at most attenuation, mean depth and optical depth (three
+            // channels per interval) and the two interleaving channels.
+            constexpr long long kMaxChannels = 3ll * kMaxIntervals + 2;
             if (part == kModelPart) {
                 return PartLimits{4ll * kMaxIntervals + 3, kMaxColourModelClusters, kMaxChannels,
                                   "the largest model"};

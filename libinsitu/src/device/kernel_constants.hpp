@@ -24,6 +24,10 @@ constexpr int kWantFirstHitDepth = 128;
 /// A block's partial image in a distributed run: the fragment record of each pixel
 /// (insitu/parallel/compositing.hpp), from which partial images composite exactly.
 constexpr int kWantFragment = 256;
+/// Per pixel, how many times the ray re-entered an interval it had already left (the
+/// "interleaving" proxy: where it is 0, every interval is one contiguous run and opacity edits
+/// are exact; insitu/explore/transfer_function_edit.hpp).
+constexpr int kWantInterleaving = 512;
 /// Floats per pixel of that record (kernels/render/proxy_renderer.cl writes them).
 constexpr int kFragmentChannels = 9;
 
@@ -47,7 +51,7 @@ struct KernelConstant {
 
 /// Every constant passed to the kernels. Private arrays are sized by the MAX_* limits, so they
 /// bound each work-item's private memory.
-inline constexpr std::array<KernelConstant, 17> kKernelConstants{{
+inline constexpr std::array<KernelConstant, 18> kKernelConstants{{
     {"MAX_LAYERS", kMaxLayers},        // depth layers per pass (layer_t[] in the proxy kernel)
     {"MAX_INTERVALS", kMaxIntervals},  // intensity intervals (a[] in colour model, edits)
     {"MAX_LIGHTS", kMaxLights},        // lights per relighting call (half_vectors[])
@@ -60,6 +64,7 @@ inline constexpr std::array<KernelConstant, 17> kKernelConstants{{
     {"WANT_SEGMENT_DEPTH", kWantSegmentDepth},
     {"WANT_FIRST_HIT_DEPTH", kWantFirstHitDepth},
     {"WANT_FRAGMENT", kWantFragment},
+    {"WANT_INTERLEAVING", kWantInterleaving},
     {"FRAGMENT_CHANNELS", kFragmentChannels},
     {"SEGMENTS_WHOLE_RAY", kSegmentsWholeRay},
     {"SEGMENTS_LAYERS", kSegmentsLayers},
@@ -74,8 +79,8 @@ static_assert(kMaxLights >= 1 && kMaxLights <= 64, "half_vectors[] is a private 
 // The wanted bits must be distinct powers of two.
 static_assert((kWantDepth | kWantDistortion | kWantAttenuation | kWantMeanDepth |
                kWantOpticalDepth | kWantSegmentRgba | kWantSegmentDepth | kWantFirstHitDepth |
-               kWantFragment) == 511,
-              "wanted bits are the nine distinct low bits");
+               kWantFragment | kWantInterleaving) == 1023,
+              "wanted bits are the ten distinct low bits");
 static_assert(kSegmentsWholeRay != kSegmentsLayers && kSegmentsLayers != kSegmentsOpacity &&
                   kSegmentsWholeRay != kSegmentsOpacity,
               "the kernel tells the segment rules apart by these values");

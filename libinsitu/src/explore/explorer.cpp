@@ -325,6 +325,11 @@ namespace {
 struct FrameBasis {
     Image attenuation, mean_depth;  ///< empty: no attenuation
     const Image* optical_depth = nullptr;
+    /// The stored view's interleaving counts; null for synthesised views (not re-projected) and
+    /// archives without them: the edit trust then leaves that term out.
+    const Image* interleaving = nullptr;
+    /// How exactly the archive stores a_j (EditTrustInputs::attenuation_resolution).
+    double attenuation_resolution = kHalfAttenuationResolution;
     const IntervalSet* intervals = nullptr;  ///< with attenuation
     const ColourModel* model = nullptr;      ///< the view's colour model, when stored
     Image colour;                            ///< the frame's own colour; empty: recompose
@@ -391,6 +396,8 @@ void finish_frame(FrameBasis basis, const ExploreRequest& request,
         for (std::size_t j = 0; j < scales.size(); ++j) scales[j] *= explicit_scales[j];
         const bool opacity_edited =
             std::any_of(scales.begin(), scales.end(), [](double s) { return s != 1.0; });
+        // The trust of an edit compares the edited attenuation with the stored one.
+        const Image stored_attenuation = edits ? basis.attenuation : Image();
         if (opacity_edited) {
             frame.opacity_scales = scales;
             basis.attenuation = estimate_attenuation(basis.attenuation, basis.mean_depth,
@@ -416,8 +423,28 @@ void finish_frame(FrameBasis basis, const ExploreRequest& request,
                                   " intervals, the attenuation proxies ", interval_count);
         }
         frame.colour_source = use_model ? ColourSource::model : ColourSource::recompose;
-        frame.colour = use_model ? model->predict(basis.attenuation, device)
-                                 : recolour(basis.attenuation, colours, device);
+        const Image recomposed = recolour(basis.attenuation, colours, device);
+        frame.colour = use_model ? model->predict(basis.attenuation, device) : recomposed;
+        if (edits) {
+            // Trust for the edit (transfer_function_edit.hpp), on top of the view's own mask.
+            EditTrustInputs trust;
+            trust.attenuation = &stored_attenuation;
+            trust.mean_depth = &basis.mean_depth;
+            trust.optical_depth = basis.optical_depth;
+            trust.interleaving = basis.interleaving;
+            trust.edited_attenuation = opacity_edited ? &basis.attenuation : nullptr;
+            trust.scales = scales;
+            trust.colours = colours;
+            trust.colour_spread = interval_colour_spread(shown_tf, intervals);
+            trust.attenuation_resolution = basis.attenuation_resolution;
+            Image error = edit_error(trust);
+            if (use_model) add_model_departure(error, frame.colour, recomposed);
+            const Image confidence = edit_confidence(error);
+            for (std::size_t p = 0; p < confidence.pixels.size(); ++p) {
+                frame.confidence.pixels[p] =
+                    std::min(frame.confidence.pixels[p], confidence.pixels[p]);
+            }
+        }
     } else {
         if (request.transfer_function && !has_attenuation && !basis.colour_follows_edits) {
             fail<InvalidArgument>("a transfer-function edit needs attenuation proxies, and ", where,
@@ -572,6 +599,10 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
     const bool shows_stored_tf =
         !request.transfer_function || request.transfer_function->to_json() == stored_tf.to_json();
 
+    const double attenuation_resolution =
+        archive_->configuration().precision == StoragePrecision::half ? kHalfAttenuationResolution
+                                                                      : kFloatAttenuationResolution;
+
     // The light field's frame: reconstructed, then steps 4-7 as for any proxies.
     const bool edits = request.transfer_function.has_value() || !request.opacity_scales.empty();
     auto light_field_frame = [&]() {
@@ -591,6 +622,7 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
         out.light_field_share = 1.0;
         out.missing_cameras = reconstruction->missing_cameras;
         FrameBasis basis;
+        basis.attenuation_resolution = attenuation_resolution;
         if (reconstruction->attenuation.channels > 0) {
             basis.attenuation = reconstruction->attenuation;
             basis.mean_depth = reconstruction->mean_depth;
@@ -640,6 +672,7 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
                                ? ProxySource::multi
                                : ProxySource::single;
         FrameBasis basis;
+        basis.attenuation_resolution = attenuation_resolution;
         basis.confidence = Image(target.width(), target.height(), 1, 1.0f);
         // The stored view with the run's own function, unedited: the rendering the Instrument
         // kept is that view exactly (to half precision), where recomposing it from intervals
@@ -654,6 +687,7 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
             basis.attenuation = single->attenuation;
             basis.mean_depth = single->mean_depth;
             if (single->optical_depth.channels > 0) basis.optical_depth = &single->optical_depth;
+            if (single->interleaving.channels == 2) basis.interleaving = &single->interleaving;
         } else if (attenuation_source) {
             SynthesisedAttenuation synthesised =
                 synthesise_attenuation(*attenuation_source, target, request.synthesis, device);

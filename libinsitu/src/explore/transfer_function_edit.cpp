@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "device/device_image.hpp"
 #include "insitu/error.hpp"
@@ -192,6 +193,204 @@ Image estimate_attenuation(const Image& attenuation, const Image& mean_depth,
                            static_cast<cl_int>(intervals), static_cast<cl_uint>(pixels),
                            scale_buffer, output.buffer());
     return output.download(device, "estimate_attenuation: edited attenuation");
+}
+
+std::vector<float> interval_colour_spread(const TransferFunction& tf,
+                                          const IntervalSet& intervals) {
+    require_1d(tf, "interval_colour_spread");
+    const std::vector<float> colours = interval_colours(tf, intervals);
+    const std::vector<double>& edges = intervals.edges();
+    std::vector<float> spread;
+    spread.reserve(static_cast<std::size_t>(intervals.count()));
+    for (int j = 0; j < intervals.count(); ++j) {
+        const std::vector<double> points = breakpoints(tf, edges[j], edges[j + 1]);
+        // Where the opacity is 0 on a whole piece its colour never reaches a pixel; a piece with
+        // some opacity counts both of its ends (linear pieces: the extremes are at the ends).
+        float worst = 0.0f;
+        auto consider = [&](double value) {
+            const glm::vec4 rgba = tf.evaluate(value);
+            for (int c = 0; c < 3; ++c) {
+                worst = std::max(worst, std::abs(rgba[c] - colours[3 * j + c]));
+            }
+        };
+        for (std::size_t p = 0; p + 1 < points.size(); ++p) {
+            const bool visible = tf.evaluate(points[p]).a > 0.0f ||
+                                 tf.evaluate(points[p + 1]).a > 0.0f ||
+                                 tf.evaluate(0.5 * (points[p] + points[p + 1])).a > 0.0f;
+            if (!visible) continue;
+            consider(points[p]);
+            consider(points[p + 1]);
+        }
+        spread.push_back(worst);
+    }
+    return spread;
+}
+
+namespace {
+
+void check_trust_image(const Image* image, const Image& reference, int channels, const char* what) {
+    if (!image) return;
+    if (image->width != reference.width || image->height != reference.height ||
+        image->channels != channels || image->pixels.size() != reference.pixel_count() * channels) {
+        fail<InvalidArgument>("edit_error: ", what, " is ", image->width, "x", image->height, "x",
+                              image->channels, ", expected ", reference.width, "x",
+                              reference.height, "x", channels);
+    }
+}
+
+/// estimate_attenuation's walk over the intervals in the order [first, last) of (depth, index)
+/// pairs, recomposed with `colours` into rgb: the edit's colour if the ray met the intervals
+/// in that order, one run each.
+template <typename Iterator>
+void recompose_in_order(const float* a, const float* tau, const std::vector<double>& scales,
+                        const std::vector<float>& colours, Iterator first, Iterator last,
+                        double* rgb) {
+    rgb[0] = rgb[1] = rgb[2] = 0.0;
+    double transmittance = 1.0, edited_transmittance = 1.0;
+    for (Iterator entry = first; entry != last; ++entry) {
+        const int j = entry->second;
+        double t = 1.0;
+        if (tau) {
+            t = std::exp(-std::max(0.0, double(tau[j])));
+        } else if (transmittance > 0.0) {
+            const double behind = transmittance - a[j];
+            t = behind > kFloatAttenuationResolution ? std::clamp(behind / transmittance, 0.0, 1.0)
+                                                     : 0.0;
+        }
+        const double edited = scales[j] > 0.0 ? std::pow(t, scales[j]) : 1.0;
+        const double a_edited = edited_transmittance * (1.0 - edited);
+        for (int c = 0; c < 3; ++c) rgb[c] += a_edited * colours[3 * j + c];
+        transmittance *= t;
+        edited_transmittance *= edited;
+    }
+}
+
+}  // namespace
+
+Image edit_error(const EditTrustInputs& inputs) {
+    if (!inputs.attenuation || !inputs.mean_depth) {
+        fail<InvalidArgument>("edit_error: attenuation and mean depth are required");
+    }
+    const Image& stored = *inputs.attenuation;
+    check_intervals(stored, "edit_error");
+    const int intervals = stored.channels;
+    const auto L = static_cast<std::size_t>(intervals);
+    check_trust_image(inputs.mean_depth, stored, intervals, "mean depth");
+    check_trust_image(inputs.optical_depth, stored, intervals, "optical depth");
+    check_trust_image(inputs.edited_attenuation, stored, intervals, "edited attenuation");
+    check_trust_image(inputs.interleaving, stored, 2, "interleaving");
+    const std::vector<double> scales =
+        inputs.scales.empty() ? std::vector<double>(L, 1.0) : inputs.scales;
+    if (scales.size() != L || inputs.colours.size() != 3 * L ||
+        (!inputs.colour_spread.empty() && inputs.colour_spread.size() != L)) {
+        fail<InvalidArgument>("edit_error: ", scales.size(), " scales, ", inputs.colours.size(),
+                              " colour values and ", inputs.colour_spread.size(), " spreads for ",
+                              intervals, " intervals (expected ", intervals, ", ", 3 * intervals,
+                              " and ", intervals, ")");
+    }
+    const bool unrecoverable = std::any_of(
+        scales.begin(), scales.end(), [](double s) { return s >= kUnrecoverableOpacityScale; });
+    const Image& edited = inputs.edited_attenuation ? *inputs.edited_attenuation : stored;
+    const double resolution = inputs.attenuation_resolution;
+
+    Image error(stored.width, stored.height, 1);
+    if (unrecoverable) {
+        std::fill(error.pixels.begin(), error.pixels.end(), 1.0f);
+        return error;
+    }
+    std::vector<std::pair<float, int>> order;
+    order.reserve(L);
+    for (std::size_t p = 0; p < stored.pixel_count(); ++p) {
+        const float* a = &stored.pixels[p * L];
+        const float* a_edited = &edited.pixels[p * L];
+        const float* z = &inputs.mean_depth->pixels[p * L];
+        const float* tau = inputs.optical_depth ? &inputs.optical_depth->pixels[p * L] : nullptr;
+        // Front to back by mean depth, as estimate_attenuation walks them (ties by index).
+        order.clear();
+        for (std::size_t j = 0; j < L; ++j) {
+            if (a[j] > 0.0f) order.emplace_back(std::isnan(z[j]) ? INFINITY : z[j], int(j));
+        }
+        std::stable_sort(order.begin(), order.end(),
+                         [](const auto& x, const auto& y) { return x.first < y.first; });
+
+        double total = 0.0;
+        // Precision, and the recolouring spread.
+        double transmittance = 1.0, edited_transmittance = 1.0;
+        for (const auto& [depth, j] : order) {
+            (void)depth;
+            const double s = scales[j];
+            double t = 1.0, uncertainty = 0.0;
+            if (tau) {
+                const double optical = std::max(0.0, double(tau[j]));
+                t = std::exp(-optical);
+                uncertainty = t * optical * resolution;
+            } else if (transmittance > 0.0) {
+                const double behind = transmittance - a[j];
+                t = behind > kFloatAttenuationResolution
+                        ? std::clamp(behind / transmittance, 0.0, 1.0)
+                        : 0.0;
+                uncertainty = resolution / transmittance;
+            }
+            if (s > 0.0 && uncertainty > 0.0) {
+                const double high = std::min(1.0, t + uncertainty);
+                total += edited_transmittance * std::abs(std::pow(high, s) - std::pow(t, s));
+            }
+            transmittance *= t;
+            edited_transmittance *= s > 0.0 ? std::pow(t, s) : 1.0;
+        }
+        for (std::size_t j = 0; j < L; ++j) {
+            if (!inputs.colour_spread.empty()) total += a_edited[j] * inputs.colour_spread[j];
+        }
+        // Interleaving: where the ray re-entered intervals, the one-run-per-interval order the
+        // estimator assumed holds only for the light of first runs. The estimate in the reverse
+        // order (nearest last) is the other extreme; the light of the re-entered runs, as a
+        // share of the pixel's, says how far towards it the truth may lie. 0 without an opacity
+        // edit: both orders then return a itself.
+        const float* interleaving =
+            inputs.interleaving ? &inputs.interleaving->pixels[2 * p] : nullptr;
+        if (interleaving && interleaving[0] > 0.0f && order.size() > 1) {
+            double light = 0.0;
+            for (std::size_t j = 0; j < L; ++j) light += a[j];
+            const double share = light > 0.0 ? std::min(1.0, interleaving[1] / light) : 0.0;
+            double forward[3], backward[3];
+            recompose_in_order(a, tau, scales, inputs.colours, order.begin(), order.end(), forward);
+            recompose_in_order(a, tau, scales, inputs.colours, order.rbegin(), order.rend(),
+                               backward);
+            double worst = 0.0;
+            for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(forward[c] - backward[c]));
+            total += share * worst;
+        }
+        error.pixels[p] = static_cast<float>(total);
+    }
+    return error;
+}
+
+void add_model_departure(Image& error, const Image& predicted, const Image& recomposed) {
+    if (predicted.pixel_count() != error.pixel_count() ||
+        recomposed.pixel_count() != error.pixel_count() || predicted.channels < 3 ||
+        recomposed.channels < 3 || error.channels != 1) {
+        fail<InvalidArgument>("add_model_departure: images of ", predicted.pixel_count(), ", ",
+                              recomposed.pixel_count(), " and ", error.pixel_count(),
+                              " pixels (expected one size, RGB(A) and 1 channel)");
+    }
+    for (std::size_t p = 0; p < error.pixel_count(); ++p) {
+        float worst = 0.0f;
+        for (int c = 0; c < 3; ++c) {
+            worst = std::max(worst, std::abs(predicted.pixels[p * predicted.channels + c] -
+                                             recomposed.pixels[p * recomposed.channels + c]));
+        }
+        error.pixels[p] += worst;
+    }
+}
+
+Image edit_confidence(const Image& error) {
+    Image confidence(error.width, error.height, 1);
+    for (std::size_t p = 0; p < error.pixel_count(); ++p) {
+        const double e = error.pixels[p * error.channels];
+        confidence.pixels[p] = static_cast<float>(
+            std::isnan(e) ? 0.0 : std::clamp(1.0 - e / (2.0 * kEditErrorTolerance), 0.0, 1.0));
+    }
+    return confidence;
 }
 
 }  // namespace insitu

@@ -23,7 +23,8 @@ using detail::to_float4;
 namespace {
 
 bool accumulates(const ProxyRequest& request) {
-    return request.attenuation || request.mean_depth || request.optical_depth;
+    return request.attenuation || request.mean_depth || request.optical_depth ||
+           request.interleaving;
 }
 
 bool wants_segments(const ProxyRequest& request) {
@@ -110,8 +111,8 @@ int segment_count(const ProxyRequest& request) {
 struct ProxyRenderer::DeviceState {
     cl::Kernel kernel, packet_kernel;  // one ray per work-item; ray packets
     detail::DeviceMemory table, isovalues, edges, thresholds, depth_out, distortion_out,
-        attenuation_out, mean_depth_out, optical_depth_out, segment_rgba_out, segment_depth_out,
-        first_hit_out, skippable, fragment_out, block_ranges_out;
+        attenuation_out, mean_depth_out, optical_depth_out, interleaving_out, segment_rgba_out,
+        segment_depth_out, first_hit_out, skippable, fragment_out, block_ranges_out;
     cl::Kernel block_ranges;  ///< kernels/render/empty_space.cl
     /// Block ranges of the uploaded volume, rescanned when its generation changes.
     detail::BlockRanges blocks;
@@ -201,8 +202,16 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     if (request.segment_rgba) wanted |= detail::kWantSegmentRgba;
     if (request.segment_depth) wanted |= detail::kWantSegmentDepth;
     if (request.first_hit_depth) wanted |= detail::kWantFirstHitDepth;
+    if (request.interleaving) wanted |= detail::kWantInterleaving;
     const bool partial = volume.region.has_value();
     if (partial) {
+        // A block sees its own part of each ray: a run that the block's neighbour interrupts
+        // is not a re-entry it can count.
+        if (request.interleaving) {
+            fail<InvalidArgument>(
+                "interleaving counts are not composited across blocks: a block of a distributed "
+                "run cannot know which intervals the ray met in front of it");
+        }
         // A segment's and the first hit's opacity thresholds depend on the opacity in front of
         // the block, which a block does not know.
         if (want_segments) {
@@ -237,6 +246,7 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
         output(state_->mean_depth_out, request.mean_depth, interval_count);
     const cl::Buffer optical_depth_out =
         output(state_->optical_depth_out, request.optical_depth, interval_count);
+    const cl::Buffer interleaving_out = output(state_->interleaving_out, request.interleaving, 2);
     const cl::Buffer segment_rgba_out =
         output(state_->segment_rgba_out, request.segment_rgba, 4 * segments);
     const cl::Buffer segment_depth_out =
@@ -330,8 +340,8 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
         detail::camera_args(camera), detail::image_size(camera), march, static_cast<cl_int>(wanted),
         static_cast<cl_int>(layer_count), isovalue_buffer, static_cast<cl_int>(interval_count),
         static_cast<cl_float>(uniform_scale), edge_buffer, depth_out, distortion_out,
-        attenuation_out, mean_depth_out, optical_depth_out, static_cast<cl_int>(request.segments),
-        static_cast<cl_int>(segments), threshold_buffer,
+        attenuation_out, mean_depth_out, optical_depth_out, interleaving_out,
+        static_cast<cl_int>(request.segments), static_cast<cl_int>(segments), threshold_buffer,
         static_cast<cl_float>(request.first_hit_threshold), segment_rgba_out, segment_depth_out,
         first_hit_out, skippable_buffer, block_counts, block_voxels, fragment_out);
 
@@ -368,6 +378,12 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
         fetch(segment_depth_out, segments, "segment depth");
         frame.segment_depth = planes_to_images(planar, width, height, segments);
     }
+    if (request.interleaving) {
+        frame.interleaving = Image(width, height, 2);
+        device_->opencl().download(interleaving_out, frame.interleaving.pixels.data(),
+                                   frame.interleaving.pixels.size() * sizeof(float),
+                                   "interleaving");
+    }
     if (request.first_hit_depth) {
         frame.first_hit_depth = Image(width, height, 1);
         device_->opencl().download(first_hit_out, frame.first_hit_depth.pixels.data(),
@@ -387,6 +403,7 @@ std::ostream& operator<<(std::ostream& out, const ProxyRequest& request) {
     if (request.attenuation) out << "attenuation, ";
     if (request.mean_depth) out << "mean depth, ";
     if (request.optical_depth) out << "optical depth, ";
+    if (request.interleaving) out << "interleaving, ";
     if (wants_segments(request)) {
         out << segment_count(request) << " segments (" << to_string(request.segments);
         if (request.segments == SegmentRule::opacity) {
@@ -425,6 +442,7 @@ std::ostream& operator<<(std::ostream& out, const ProxyFrame& frame) {
     image("attenuation", frame.attenuation);
     image("mean depth", frame.mean_depth);
     image("optical depth", frame.optical_depth);
+    image("interleaving", frame.interleaving);
     images("segment RGBA", frame.segment_rgba);
     images("segment depth", frame.segment_depth);
     image("first-hit depth", frame.first_hit_depth);

@@ -68,4 +68,66 @@ Image estimate_attenuation(const Image& attenuation, const Image& mean_depth,
                            const Image* optical_depth, const std::vector<double>& scales,
                            ComputeDevice& device = *ComputeDevice::shared());
 
+/// Trust for transfer-function edits (issue 17): a per-pixel estimate of how far an edited frame
+/// can be from the ground truth, from what the proxies know. Each term bounds one way the edit
+/// can go wrong; the estimate is their sum, in premultiplied colour (max over RGB, full scale 1).
+struct EditTrustInputs {
+    const Image* attenuation = nullptr;    ///< stored a_j (L channels), required
+    const Image* mean_depth = nullptr;     ///< L channels, required (orders the intervals)
+    const Image* optical_depth = nullptr;  ///< may be null (then t_j is inferred from a_j)
+    /// ProxyFrame::interleaving (2 channels); null = unknown, and its term is left out.
+    const Image* interleaving = nullptr;
+    const Image* edited_attenuation = nullptr;  ///< a'_j; null = no opacity edit (a' = a)
+    std::vector<double> scales;                 ///< s_j as applied; empty = all 1
+    /// Interval colours the frame is recomposed with (interval_colours of the shown function),
+    /// and how far that function's colour strays inside each interval (interval_colour_spread).
+    std::vector<float> colours;
+    std::vector<float> colour_spread;
+    /// Absolute error of a stored a_j: kHalfAttenuationResolution for half archives,
+    /// kFloatAttenuationResolution for float ones and frames straight from the renderer.
+    double attenuation_resolution = 0.0;
+};
+/// Half rounds a_j in [0.5, 1) by up to 2^-12; T = 1 - sum_j a_j adds a few such roundings.
+inline constexpr double kHalfAttenuationResolution = 1.0 / 2048.0;
+inline constexpr double kFloatAttenuationResolution = 1e-6;  // EDIT_OPAQUE_LIGHT
+
+/// Per interval, the largest deviation (max over RGB) of `tf`'s colour from interval j's
+/// emission colour (interval_colours) over the values in j where the opacity is > 0: the most a
+/// pixel's own mix of values in j can differ from the constant colour recolouring assumes. 0 for
+/// colours constant per interval. Exact for the piecewise-linear function (its extremes lie at
+/// breakpoints and ends). InvalidArgument for 2D functions.
+std::vector<float> interval_colour_spread(const TransferFunction& tf, const IntervalSet& intervals);
+
+/// The error estimate of recomposing the edit, per pixel (1 channel), the sum of:
+///  * precision: walking the intervals front to back as estimate_attenuation does, interval j's
+///    transmittance t_j is known to within d_j = resolution / T (T in front of it; with optical
+///    depth, t_j tau_j resolution); the edit can then be off by T'(|(t_j + d_j)^s_j - t_j^s_j|),
+///    T' the edited transmittance in front. Large where s < 1 thins a front that was opaque in
+///    the store: what lay behind it was never recorded (t = 0 shows as "opaque", 1e-8^(1/64) =
+///    0.75);
+///  * interleaving: where the ray re-entered an interval (interleaving > 0) the estimator's
+///    one-run-per-interval order is wrong, and the edit's change sum_j |a'_j - a_j| can land in
+///    the wrong intervals: weighted by the spread of the present intervals' colours when every
+///    present interval has the same scale (the total opacity is then still exact), else by
+///    their largest colour component;
+///  * recolouring: sum_j a'_j spread_j (the colour inside each interval is not constant);
+///  * an interval the stored function left transparent and the edit does not
+///    (kUnrecoverableOpacityScale): 1 everywhere, since the proxies never saw those values.
+/// InvalidArgument names an input of the wrong size.
+Image edit_error(const EditTrustInputs& inputs);
+
+/// error += |predicted - recomposed| (max over RGB): a colour-model prediction is at most that
+/// far from the recomposition, and the recomposition within edit_error of the truth. The
+/// model's own extrapolation (edits outside its training range, attenuation unlike any cluster)
+/// shows up as its departure from the model-free recomposition.
+void add_model_departure(Image& error, const Image& predicted, const Image& recomposed);
+
+/// The error estimate a pixel may have and still count as right: the evaluation's "wrong" pixel
+/// is off by more than 0.1 (bench/evaluation/evaluate.cpp, kColourErrorThreshold).
+inline constexpr double kEditErrorTolerance = 0.1;
+
+/// Confidence in [0, 1] from the estimate: 1 - error / (2 kEditErrorTolerance), clamped, so it
+/// falls below 1/2 exactly where the estimate exceeds the tolerance.
+Image edit_confidence(const Image& error);
+
 }  // namespace insitu

@@ -45,6 +45,10 @@ struct ProxyRequest {
     bool attenuation = true;
     bool mean_depth = true;
     bool optical_depth = false;
+    /// Per pixel, how many times the ray re-entered an interval it had already left
+    /// (ProxyFrame::interleaving); needs intervals, and is refused for a block of a distributed
+    /// run (a block cannot know what the ray met in front of it).
+    bool interleaving = false;
     /// Per segment of each ray, RGBA (premultiplied) and first-hit depth; the whole ray's
     /// first-hit depth. Each needs the transfer function.
     bool segment_rgba = false;
@@ -94,10 +98,16 @@ struct ProxyFrame {
     Image attenuation;                     ///< L channels
     Image mean_depth;                      ///< L channels
     Image optical_depth;                   ///< L channels
-    std::vector<Image> segment_rgba;       ///< RGBA each, one per segment, front first
-    std::vector<Image> segment_depth;      ///< 1 channel each, one per segment
-    Image first_hit_depth;                 ///< 1 channel
-    std::vector<Image> training;           ///< RGBA each
+    /// 2 channels: how many times the ray's contributing samples (opacity > 0) re-entered an
+    /// interval that already held light after another interval's (a run j, k, j counts 1), and
+    /// the attenuation those re-entered runs added (part of sum_j a_j). Where the count is 0
+    /// every interval is one contiguous run along the ray, the case in which opacity edits are
+    /// exact (estimate_attenuation); the edit's trust reads both.
+    Image interleaving;
+    std::vector<Image> segment_rgba;   ///< RGBA each, one per segment, front first
+    std::vector<Image> segment_depth;  ///< 1 channel each, one per segment
+    Image first_hit_depth;             ///< 1 channel
+    std::vector<Image> training;       ///< RGBA each
     /// RGBA, premultiplied: the ground truth of the run's own transfer function in this camera
     /// (the preview, before its 8-bit PNG), single perspective only ("rendering" proxy).
     Image rendering;

@@ -221,8 +221,10 @@ inline std::vector<double> pixel_errors_depth(const Image& a, const Image& b) {
 
 struct MaskCoverage {
     std::int64_t high_error_pixels = 0;  ///< pixels with error > threshold
-    std::int64_t flagged = 0;            ///< of those, pixels with confidence < 1
+    std::int64_t flagged = 0;            ///< of those, pixels the mask flags
     std::int64_t pixels = 0;             ///< all pixels
+    std::int64_t good_pixels = 0;        ///< counted pixels with error <= threshold
+    std::int64_t good_flagged = 0;       ///< of those, pixels the mask flags
     /// flagged / high_error_pixels; 1 when no pixel went wrong (nothing needed flagging).
     double flagged_fraction() const {
         return high_error_pixels == 0 ? 1.0 : static_cast<double>(flagged) / high_error_pixels;
@@ -230,23 +232,48 @@ struct MaskCoverage {
     double high_error_fraction() const {
         return pixels == 0 ? 0.0 : static_cast<double>(high_error_pixels) / pixels;
     }
+    /// good_flagged / good_pixels: the mask's false alarms; 0 without good pixels.
+    double good_flagged_fraction() const {
+        return good_pixels == 0 ? 0.0 : static_cast<double>(good_flagged) / good_pixels;
+    }
 };
 
-/// How much of what went wrong (error > threshold) the 1-channel confidence mask flagged.
+/// How much of what went wrong (error > threshold) the 1-channel confidence mask flagged, a
+/// pixel being flagged where its confidence is below `flag_below`, and how many right pixels it
+/// flagged too: those where `counted` is nonzero (all when null; e.g. the pixels either image
+/// covers, so that empty background does not dilute the false alarms).
 inline MaskCoverage mask_coverage(const std::vector<double>& errors, const Image& confidence,
-                                  double threshold) {
-    if (confidence.pixel_count() != errors.size() || confidence.channels < 1) {
+                                  double threshold, double flag_below = 1.0,
+                                  const std::vector<char>* counted = nullptr) {
+    if (confidence.pixel_count() != errors.size() || confidence.channels < 1 ||
+        (counted && counted->size() != errors.size())) {
         fail<InvalidArgument>("mask_coverage: ", errors.size(), " errors and a ", confidence.width,
                               "x", confidence.height, "x", confidence.channels, " mask");
     }
     MaskCoverage coverage;
     coverage.pixels = static_cast<std::int64_t>(errors.size());
     for (std::size_t p = 0; p < errors.size(); ++p) {
-        if (!(errors[p] > threshold) && !std::isnan(errors[p])) continue;
+        const bool flagged = confidence.pixels[p * confidence.channels] < flag_below;
+        if (!(errors[p] > threshold) && !std::isnan(errors[p])) {
+            if (counted && !(*counted)[p]) continue;
+            ++coverage.good_pixels;
+            if (flagged) ++coverage.good_flagged;
+            continue;
+        }
         ++coverage.high_error_pixels;
-        if (confidence.pixels[p * confidence.channels] < 1.0f) ++coverage.flagged;
+        if (flagged) ++coverage.flagged;
     }
     return coverage;
+}
+
+/// The pixels either of two RGBA images covers (alpha above 1e-3).
+inline std::vector<char> covered_pixels(const Image& a, const Image& b) {
+    require_same_size(a, b, 4, "covered_pixels");
+    std::vector<char> covered(a.pixel_count());
+    for (std::size_t p = 0; p < covered.size(); ++p) {
+        covered[p] = a.pixels[p * a.channels + 3] > 1e-3f || b.pixels[p * b.channels + 3] > 1e-3f;
+    }
+    return covered;
 }
 
 }  // namespace insitu::evaluation
