@@ -547,4 +547,46 @@ TEST(InstrumentConfig, BadFieldEntriesAreNamed) {
     EXPECT_THAT(unknown, ElementsAre("fields[0].colour"));
 }
 
+TEST(InstrumentConfig, BudgetParsesValidatesAndRoundTrips) {
+    const InstrumentConfig config = InstrumentConfig::from_json_text(
+        R"({"budget": {"psnr_db": 40, "bytes_per_step": 8e6, "check_every": 5}})", nullptr);
+    ASSERT_TRUE(config.budget.has_value());
+    EXPECT_EQ(config.budget->psnr_db, 40.0);
+    EXPECT_EQ(config.budget->bytes_per_step, 8e6);
+    EXPECT_FALSE(config.budget->ms_per_step.has_value());
+    EXPECT_EQ(config.budget->check_every, 5);
+    EXPECT_TRUE(config.budget->chooses_intervals);  // "intervals" not given
+    const InstrumentConfig again = InstrumentConfig::from_json(config.to_json(), nullptr);
+    ASSERT_TRUE(again.budget.has_value());
+    EXPECT_EQ(again.budget->psnr_db, 40.0);
+    EXPECT_TRUE(again.budget->chooses_intervals);
+    EXPECT_FALSE(InstrumentConfig{}.to_json().contains("budget"));
+
+    // Explicit settings win, unless "choose" says otherwise.
+    EXPECT_FALSE(InstrumentConfig::from_json_text(
+                     R"({"intervals": {"count": 8}, "budget": {"psnr_db": 40}})", nullptr)
+                     .budget->chooses_intervals);
+    EXPECT_TRUE(InstrumentConfig::from_json_text(
+                    R"({"intervals": {"count": 8}, "budget": {"choose": ["intervals"]}})", nullptr)
+                    .budget->chooses_intervals);
+
+    for (const auto& [text, named] : std::vector<std::pair<std::string, std::string>>{
+             {R"({"budget": {"psnr_db": -3}})", "budget.psnr_db"},
+             {R"({"budget": {"bytes_per_step": 0}})", "budget.bytes_per_step"},
+             {R"({"budget": {"ms_per_step": -1}})", "budget.ms_per_step"},
+             {R"({"budget": {"check_every": 0}})", "budget.check_every"},
+             {R"({"budget": {"choose": ["layers"]}})", "budget.choose[0]"}}) {
+        try {
+            InstrumentConfig::from_json_text(text, nullptr);
+            ADD_FAILURE() << text << " was accepted";
+        } catch (const Error& error) {
+            EXPECT_THAT(error.what(), HasSubstr(named)) << text;
+        }
+    }
+    std::vector<std::string> unknown;
+    InstrumentConfig::from_json_text(R"({"budget": {"psnr_d": 40}})", &unknown);
+    EXPECT_THAT(unknown, ElementsAre("budget.psnr_d"));
+    EXPECT_EQ(suggest_key("budget.psnr_d"), "psnr_db");
+}
+
 }  // namespace insitu

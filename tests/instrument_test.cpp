@@ -539,6 +539,75 @@ TEST_F(InstrumentTest, FinalizeStatesTheInSituShareOfWallTime) {
     EXPECT_THAT(log, HasSubstr("between calls"));
 }
 
+// "budget": the Instrument measures each interval count and mode on the stored view (a
+// held-out edit against its ground truth, the view's bytes and pass time), archives with the
+// cheapest that meets the budget, records the choice per step and re-checks every
+// "check_every" archived steps.
+TEST_F(InstrumentTest, AnErrorBudgetChoosesTheCheapestIntervalsThatMeetIt) {
+    const auto run = [&](const fs::path& path, BudgetConfig budget,
+                         std::optional<int> given_intervals, std::string* log) {
+        InstrumentConfig config = small_config(path, 48);
+        if (given_intervals) config.interval_count = *given_intervals;
+        budget.chooses_intervals = !given_intervals;
+        config.budget = budget;
+        InstrumentOptions options;
+        options.log = log != nullptr;
+        if (log) ::testing::internal::CaptureStderr();
+        {
+            Instrument instrument(config, options);
+            for (std::int64_t step = 0; step < 5; ++step) {
+                EXPECT_EQ(instrument.execute(step, 0.1 * step, {volume_.field()}), Status::ok);
+            }
+            EXPECT_EQ(instrument.finalize(), Status::ok);
+        }
+        if (log) *log = ::testing::internal::GetCapturedStderr();
+        return ArchiveReader(path.string());
+    };
+
+    // Any PSNR a candidate reaches: the fewest bytes win, and 4 intervals store the least.
+    BudgetConfig easy;
+    easy.psnr_db = 1.0;
+    easy.check_every = 2;
+    std::string log;
+    const ArchiveReader cheap = run(directory_ / "cheap.cdb", easy, std::nullopt, &log);
+    for (std::int64_t step = 0; step < 5; ++step) {
+        const std::vector<BudgetRecord> choice = cheap.budget(step);
+        ASSERT_EQ(choice.size(), 1u) << "step " << step;
+        EXPECT_EQ(choice[0].field, "f");
+        EXPECT_EQ(choice[0].intervals, 4) << "step " << step;
+        EXPECT_TRUE(choice[0].met);
+        EXPECT_GT(choice[0].bytes, 0.0);
+        EXPECT_GT(choice[0].milliseconds, 0.0);
+        EXPECT_EQ(choice[0].checked, step % 2 == 0) << "step " << step;  // steps 0, 2, 4
+        EXPECT_EQ(cheap.load(step, 0).intervals->count(), 4) << "step " << step;
+    }
+    EXPECT_THAT(log, HasSubstr("budget: field \"f\" 4 "));
+    EXPECT_THAT(log, HasSubstr("3 check(s)"));
+    EXPECT_THAT(log, HasSubstr(", met"));
+
+    // A PSNR no candidate reaches: the most accurate one, said not to meet it.
+    BudgetConfig strict;
+    strict.psnr_db = 199.0;
+    const ArchiveReader best = run(directory_ / "best.cdb", strict, std::nullopt, &log);
+    const BudgetRecord most_accurate = best.budget(0).at(0);
+    EXPECT_FALSE(most_accurate.met);
+    EXPECT_GT(most_accurate.psnr_db, cheap.budget(0).at(0).psnr_db);
+    EXPECT_THAT(log, HasSubstr("NOT met"));
+
+    // A byte limit below every candidate: the cheapest, not met.
+    BudgetConfig tiny;
+    tiny.bytes_per_step = 10.0;
+    const BudgetRecord cheapest =
+        run(directory_ / "tiny.cdb", tiny, std::nullopt, nullptr).budget(0).at(0);
+    EXPECT_FALSE(cheapest.met);
+    EXPECT_EQ(cheapest.intervals, 4);
+
+    // Explicit settings win: the given intervals are measured and kept.
+    const ArchiveReader given = run(directory_ / "given.cdb", easy, 16, nullptr);
+    EXPECT_EQ(given.budget(0).at(0).intervals, 16);
+    EXPECT_EQ(given.load(0, 0).intervals->count(), 16);
+}
+
 TEST_F(InstrumentTest, MissingFieldIsAnErrorNamingIt) {
     Instrument instrument(small_config(archive(), 16), quiet());
     SampledVolume other = small_volume(8);

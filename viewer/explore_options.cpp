@@ -40,13 +40,16 @@ std::int64_t integer(const std::string& key, const std::string& text) {
     return value;
 }
 
-/// "J=S,J=S": interval index and opacity factor.
+/// "J=S,J=S": interval (opacity-scale) or segment (segment-opacity) index and opacity factor.
 std::vector<std::pair<int, double>> parse_scales(const std::string& key, const std::string& text) {
+    const bool segments = key == "segment-opacity";
+    const char* what = segments ? "segment" : "interval";
     std::vector<std::pair<int, double>> scales;
     for (const std::string& item : split(text, ',')) {
         const auto equals = item.find('=');
         if (equals == std::string::npos) {
-            fail<InvalidArgument>(key, " = \"", text, "\": \"", item, "\" is not INTERVAL=SCALE");
+            fail<InvalidArgument>(key, " = \"", text, "\": \"", item, "\" is not ",
+                                  segments ? "SEGMENT" : "INTERVAL", "=SCALE");
         }
         const std::int64_t index = integer(key, item.substr(0, equals));
         const double factor = number(key, item.substr(equals + 1), text);
@@ -54,7 +57,7 @@ std::vector<std::pair<int, double>> parse_scales(const std::string& key, const s
             fail<InvalidArgument>(key, " = \"", text, "\": scale ", factor, " is negative");
         }
         if (index < 0 || index > kMaxIntervals) {
-            fail<InvalidArgument>(key, " = \"", text, "\": interval ", index, " is out of range");
+            fail<InvalidArgument>(key, " = \"", text, "\": ", what, " ", index, " is out of range");
         }
         scales.emplace_back(static_cast<int>(index), factor);
     }

@@ -26,6 +26,8 @@
 #include <vector>
 
 #include "arguments.hpp"
+#include "gray_scott_simulation.hpp"
+#include "gray_scott_volume.hpp"
 #include "insitu/archive/archive.hpp"
 #include "insitu/explore/colour_model.hpp"
 #include "insitu/explore/explorer.hpp"
@@ -57,15 +59,16 @@ struct RawInput {
 struct Options {
     std::string out;
     bool smoke = false;
-    std::set<std::string> sections{"rotation",       "curvature", "colour",
-                                   "configurations", "storage",   "light_fields"};
+    std::set<std::string> sections{"rotation", "curvature",    "colour", "configurations",
+                                   "storage",  "light_fields", "budget"};
     std::vector<RawInput> raw;
 };
 
 [[noreturn]] void usage_error(const std::string& message) {
     std::fprintf(stderr,
                  "insitu_evaluate: %s\nusage: insitu_evaluate --out DIR [--smoke] "
-                 "[--sections rotation,curvature,colour,configurations,storage,light_fields] "
+                 "[--sections rotation,curvature,colour,configurations,storage,light_fields,"
+                 "budget] "
                  "[--raw PATH:NXxNYxNZ:TYPE ...]\n",
                  message.c_str());
     std::exit(2);
@@ -610,6 +613,98 @@ void section_occlusion(const Options& options, int size, int image) {
         }
     }
     std::printf("occlusion: done\n");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The error budget over a Gray-Scott run (issue 17): per archived step, the PSNR asked, what the
+// budget chose and measured in situ, and what the archive achieves, measured here on the same
+// held-out edit (the run's function with every opacity halved) through the Explorer against the
+// ground truth; the fixed default (16 uniform intervals) beside it.
+
+void section_budget(const Options& options, const fs::path& scratch) {
+    const auto start = std::chrono::steady_clock::now();
+    const int size = options.smoke ? 32 : 64;
+    const int image = options.smoke ? 64 : 256;
+    const int steps = options.smoke ? 120 : 1200;
+    const int every = options.smoke ? 40 : 100;
+    Csv csv(fs::path(options.out) / "budget.csv",
+            "run,asked_psnr_db,step,intervals,mode,checked,met,measured_psnr_db,"
+            "achieved_psnr_db,bytes,ms");
+    struct Run {
+        std::string name;
+        std::optional<double> psnr_db;
+    };
+    const std::vector<Run> runs = {
+        {"default", std::nullopt}, {"budget_30", 30.0}, {"budget_40", 40.0}, {"budget_50", 50.0}};
+    for (const Run& run : runs) {
+        const fs::path archive = scratch / ("budget_" + run.name + ".cdb");
+        fs::remove_all(archive);
+        InstrumentConfig config;
+        config.fields = {"v"};
+        config.views[0].orbit = stored_view(image);
+        config.every = every;
+        config.archive = archive.string();
+        if (run.psnr_db) {
+            BudgetConfig budget;
+            budget.psnr_db = run.psnr_db;
+            budget.check_every = 3;
+            config.budget = budget;
+        }
+        InstrumentOptions instrument_options;
+        instrument_options.log = false;
+        instrument_options.rethrow_errors = true;
+        gray_scott::Parameters parameters;
+        parameters.size = size;
+        gray_scott::Simulation simulation(parameters);
+        std::vector<std::pair<std::int64_t, SampledVolume>> archived;
+        {
+            Instrument instrument(config, instrument_options);
+            for (int step = 1; step <= steps; ++step) {
+                simulation.step();
+                if (!instrument.selects(step)) continue;
+                SampledVolume volume = bench::gray_scott_volume(simulation);
+                instrument.execute(step, step, {volume.field()});
+                archived.emplace_back(step, std::move(volume));
+            }
+            instrument.finalize();
+        }
+        Explorer explorer(archive.string());
+        ProxyRenderer renderer;
+        for (const auto& [step, volume] : archived) {
+            renderer.upload(volume.field());
+            const TransferFunction stored = explorer.archive().transfer_function(step, 0);
+            std::vector<ControlPoint> points = stored.rows().front().points;
+            for (ControlPoint& point : points) {
+                point.rgba.a = 1.0f - std::sqrt(std::max(0.0f, 1.0f - point.rgba.a));
+            }
+            const TransferFunction held_out(points, stored.unit_length());
+            ExploreRequest request;
+            request.step = step;
+            request.transfer_function = held_out;
+            request.colour = ColourSource::recompose;
+            const ExploreFrame frame = explorer.render(request);
+            RenderSettings settings;
+            settings.early_termination_opacity = 1.0;
+            const Image truth = renderer.render_ground_truth(frame.camera, held_out, settings).rgba;
+            const double achieved = psnr_db(truth, frame.colour);
+            const std::vector<BudgetRecord> choice = explorer.archive().budget(step);
+            const ArchivedView files = explorer.archive().entry(step, 0);
+            const std::uintmax_t bytes =
+                fs::file_size(files.exr_path) + fs::file_size(files.preview_path);
+            const int intervals = explorer.archive().load(step, 0).intervals->count();
+            if (choice.empty()) {
+                csv.row(run.name, "", step, intervals, "uniform", 0, 1, "", achieved,
+                        static_cast<double>(bytes), "");
+            } else {
+                const BudgetRecord& c = choice.front();
+                csv.row(run.name, *run.psnr_db, step, c.intervals, to_string(c.interval_mode),
+                        c.checked ? 1 : 0, c.met ? 1 : 0, c.psnr_db, achieved,
+                        static_cast<double>(bytes), c.milliseconds);
+            }
+        }
+    }
+    std::printf("budget: %zu runs of Gray-Scott %d^3, %d steps, %.1f s\n", runs.size(), size, steps,
+                ms_since(start) / 1e3);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1229,6 +1324,7 @@ int main(int argc, char** argv) {
             section_configurations(all, primary, options, scratch);
         }
         if (options.sections.count("storage")) section_storage(options, scratch);
+        if (options.sections.count("budget")) section_budget(options, scratch);
         if (options.sections.count("light_fields")) {
             // The issue's goal scenes: Gray-Scott and Marschner-Lobb.
             section_light_fields({&primary, &analytic[2]}, options, scratch, image);

@@ -314,6 +314,47 @@ const Key<ColourModelConfig> kColourModelKeys[] = {
      [](const ColourModelConfig& model) { return json(model.enabled); }},
 };
 
+// "budget": {"psnr_db", "bytes_per_step", "ms_per_step", "check_every", "choose"}.
+constexpr Choice<int> kBudgetChoices[] = {{"intervals", 0}};
+const Key<BudgetConfig> kBudgetKeys[] = {
+    {"psnr_db",
+     [](const json& value, const std::string& key, BudgetConfig& budget, Unknown&) {
+         budget.psnr_db = number(value, key);
+     },
+     [](const BudgetConfig& budget) { return budget.psnr_db ? json(*budget.psnr_db) : json(); }},
+    {"bytes_per_step",
+     [](const json& value, const std::string& key, BudgetConfig& budget, Unknown&) {
+         budget.bytes_per_step = number(value, key);
+     },
+     [](const BudgetConfig& budget) {
+         return budget.bytes_per_step ? json(*budget.bytes_per_step) : json();
+     }},
+    {"ms_per_step",
+     [](const json& value, const std::string& key, BudgetConfig& budget, Unknown&) {
+         budget.ms_per_step = number(value, key);
+     },
+     [](const BudgetConfig& budget) {
+         return budget.ms_per_step ? json(*budget.ms_per_step) : json();
+     }},
+    {"check_every",
+     [](const json& value, const std::string& key, BudgetConfig& budget, Unknown&) {
+         budget.check_every = small_integer(value, key);
+     },
+     [](const BudgetConfig& budget) { return json(budget.check_every); }},
+    {"choose",
+     [](const json& value, const std::string& key, BudgetConfig& budget, Unknown&) {
+         require_array(value, key);
+         budget.chooses_intervals = false;
+         for (std::size_t i = 0; i < value.size(); ++i) {
+             (void)choose(value[i], element_key(key, i), kBudgetChoices);
+             budget.chooses_intervals = true;
+         }
+     },
+     [](const BudgetConfig& budget) {
+         return budget.chooses_intervals ? json::array({"intervals"}) : json::array();
+     }},
+};
+
 std::vector<ViewConfig> parse_views(const json& value, const std::string& key, Unknown& unknown) {
     require_array(value, key);
     std::vector<ViewConfig> views;
@@ -557,6 +598,15 @@ const Key<InstrumentConfig> kTopLevelKeys[] = {
      [](const InstrumentConfig& config) {
          return config.light_field ? config.light_field->to_json() : json();
      }},
+    {"budget",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
+         BudgetConfig budget;
+         parse_object(value, key, kBudgetKeys, budget, unknown);
+         config.budget = budget;
+     },
+     [](const InstrumentConfig& config) {
+         return config.budget ? write_object(*config.budget, kBudgetKeys) : json();
+     }},
 };
 
 // The key names of each object of the configuration, by the name of the key that holds the
@@ -576,6 +626,7 @@ std::vector<std::string> known_keys_under(const std::string& parent) {
     if (parent == "writer") return names_of(kWriterKeys);
     if (parent == "colour_model") return names_of(kColourModelKeys);
     if (parent == "light_field") return LightFieldSettings::keys();
+    if (parent == "budget") return names_of(kBudgetKeys);
     if (parent == "transfer_function" || parent == "training_transfer_functions") {
         return {kTransferFunctionKeys.begin(), kTransferFunctionKeys.end()};
     }
@@ -673,6 +724,11 @@ InstrumentConfig InstrumentConfig::from_json(const nlohmann::json& document,
     Unknown unknown;
     InstrumentConfig config;
     parse_object(document, "", kTopLevelKeys, config, unknown);
+    // Explicit settings win over the budget: given "intervals" are kept unless "choose" says
+    // otherwise.
+    if (config.budget && document.contains("intervals") && !document["budget"].contains("choose")) {
+        config.budget->chooses_intervals = false;
+    }
     config.validate();
     if (unknown_keys != nullptr) {
         unknown_keys->insert(unknown_keys->end(), unknown.begin(), unknown.end());
@@ -806,6 +862,34 @@ void InstrumentConfig::validate() const {
                      "expected none, rle, zips, zip, piz, pxr24 or b44");
     }
     if (writer_queue < 1) out_of_range("writer.queue", text_of(writer_queue), "must be >= 1");
+    if (budget) {
+        if (budget->psnr_db && !(*budget->psnr_db > 0.0 && *budget->psnr_db <= 200.0)) {
+            out_of_range("budget.psnr_db", text_of(*budget->psnr_db), "dB, must be in (0, 200]");
+        }
+        if (budget->bytes_per_step &&
+            !(*budget->bytes_per_step > 0.0 && std::isfinite(*budget->bytes_per_step))) {
+            out_of_range("budget.bytes_per_step", text_of(*budget->bytes_per_step),
+                         "bytes, must be finite and > 0");
+        }
+        if (budget->ms_per_step &&
+            !(*budget->ms_per_step > 0.0 && std::isfinite(*budget->ms_per_step))) {
+            out_of_range("budget.ms_per_step", text_of(*budget->ms_per_step),
+                         "milliseconds, must be finite and > 0");
+        }
+        if (budget->check_every < 1) {
+            out_of_range("budget.check_every", text_of(budget->check_every), "must be >= 1");
+        }
+        // Its held-out edit scales opacity per interval, which a 2D function does not have.
+        bool two_d = transfer_function && transfer_function->is_2d();
+        for (const auto& entry : field_styles) {
+            two_d = two_d ||
+                    (entry.second.transfer_function && entry.second.transfer_function->is_2d());
+        }
+        if (two_d) {
+            out_of_range("budget", "{...}",
+                         "measures opacity edits per interval, which needs 1D transfer functions");
+        }
+    }
     if (colour_model.clusters < 1 || colour_model.clusters > kMaxColourModelClusters) {
         out_of_range("colour_model.clusters", text_of(colour_model.clusters), "must be in [1, ",
                      kMaxColourModelClusters, "]");

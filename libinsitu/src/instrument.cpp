@@ -10,12 +10,14 @@
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
 
+#include "archive/exr_frame.hpp"
 #include "archive/writer_thread.hpp"
 #include "insitu/archive/archive.hpp"
 #include "insitu/core/camera.hpp"
@@ -24,6 +26,7 @@
 #include "insitu/core/layers.hpp"
 #include "insitu/error.hpp"
 #include "insitu/explore/colour_model.hpp"
+#include "insitu/explore/transfer_function_edit.hpp"
 #include "insitu/parallel/compositing.hpp"
 #include "insitu/parallel/decomposition.hpp"
 #include "insitu/render/distortion_camera.hpp"
@@ -288,7 +291,49 @@ struct Instrument::Impl {
         FieldSummaryRecord summary;
         /// The configured function, or for "auto" default_transfer_function(summary.histogram).
         TransferFunction transfer_function{std::vector<ControlPoint>{{0.0, {0, 0, 0, 0}}}};
+        /// With a "budget": what it archives the field with at this step.
+        std::optional<BudgetRecord> budget;
     };
+    /// The error budget's state of one field: its choice, the check that made it, and the
+    /// field's 1st-99th percentiles then (a range that drifts is checked again at once).
+    struct BudgetState {
+        BudgetRecord choice;
+        std::int64_t archived_since_check = 0;
+        double low = 0.0, high = 0.0;
+        int checks = 0;
+    };
+    std::map<std::string, BudgetState> budget_state;
+    /// The budget's choice for the field of `plan` at this step (checking when one is due),
+    /// applied to the plan's intervals where the budget chooses them.
+    BudgetRecord apply_budget(FieldPlan& plan);
+    /// Measures every candidate on the field's first view and picks the cheapest that meets
+    /// the budget (see BudgetConfig).
+    BudgetRecord check_budget(const FieldPlan& plan) const;
+    /// "budget: field "v" 8 uniform intervals (3 checks, last: 41.2 dB >= 40, ...)".
+    std::string budget_summary() const {
+        const BudgetConfig& budget = *config.budget;
+        std::ostringstream out;
+        out << std::fixed << std::setprecision(1) << "budget: ";
+        if (budget_state.empty()) out << "no step checked";
+        const double share = 1.0 / static_cast<double>(config.fields.size());
+        const char* separator = "";
+        for (const auto& [field, state] : budget_state) {
+            const BudgetRecord& c = state.choice;
+            out << separator << "field \"" << field << "\" " << c.intervals << " "
+                << to_string(c.interval_mode) << " intervals"
+                << (budget.chooses_intervals ? " chosen" : " (given)") << " at " << state.checks
+                << " check(s); last measured " << c.psnr_db << " dB";
+            if (budget.psnr_db) out << " (asked >= " << *budget.psnr_db << ")";
+            out << ", " << c.bytes / 1e6 << " MB";
+            if (budget.bytes_per_step)
+                out << " (<= " << share * *budget.bytes_per_step / 1e6 << ")";
+            out << ", " << c.milliseconds << " ms per step";
+            if (budget.ms_per_step) out << " (<= " << share * *budget.ms_per_step << ")";
+            out << (c.met ? ", met" : ", NOT met: the closest candidate");
+            separator = "; ";
+        }
+        return out.str();
+    }
     /// The function a field is rendered with at this step (the plan's summary is filled in).
     TransferFunction transfer_function_for(const std::string& name,
                                            const ValueHistogram& histogram) const {
@@ -339,6 +384,12 @@ void Instrument::Impl::open_distributed(InstrumentConfig distributed_config) {
     LocalFailure failure;
     failure.guard([&] {
         distributed_config.validate();
+        if (distributed_config.budget) {
+            fail<InvalidArgument>(
+                "\"budget\": an error budget is measured against a ground truth of the whole "
+                "field, which one process of a distributed run does not hold; give the settings "
+                "themselves, or measure them in a run without a communicator");
+        }
         if (distributed_config.light_field) {
             fail<InvalidArgument>(
                 "\"light_field\": light fields are not composited across ranks (their segments "
@@ -564,7 +615,145 @@ Instrument::Impl::FieldPlan Instrument::Impl::plan_field(const Field& field, std
     plan.isovalues =
         layers ? *layers : renderer->choose_layers(plan.transfer_function, config.max_auto_layers);
     plan.intervals = renderer->choose_intervals(config.interval_count, config.interval_mode);
+    if (config.budget) plan.budget = apply_budget(plan);
     return plan;
+}
+
+namespace {
+
+/// The budget's held-out edit: the run's function with every control point's opacity halved
+/// in extinction, a' = 1 - (1 - a)^0.5 (the law opacity edits follow), colours kept.
+TransferFunction halved_opacity(const TransferFunction& tf) {
+    std::vector<ControlPoint> points = tf.rows().front().points;
+    for (ControlPoint& point : points) {
+        point.rgba.a = 1.0f - std::sqrt(std::max(0.0f, 1.0f - point.rgba.a));
+    }
+    return TransferFunction(points, tf.unit_length());
+}
+
+}  // namespace
+
+BudgetRecord Instrument::Impl::apply_budget(FieldPlan& plan) {
+    const BudgetConfig& budget = *config.budget;
+    const auto [found, fresh] = budget_state.try_emplace(plan.name);
+    BudgetState& state = found->second;
+    const double low = plan.summary.histogram.percentile(0.01);
+    const double high = plan.summary.histogram.percentile(0.99);
+    const double width = std::max(state.high - state.low, 1e-30);
+    const bool drifted = !fresh && (std::abs(low - state.low) > 0.25 * width ||
+                                    std::abs(high - state.high) > 0.25 * width);
+    const bool due = fresh || drifted || state.archived_since_check >= budget.check_every;
+    if (due) {
+        state.choice = check_budget(plan);
+        state.low = low;
+        state.high = high;
+        state.archived_since_check = 0;
+        ++state.checks;
+    }
+    ++state.archived_since_check;
+    BudgetRecord choice = state.choice;
+    choice.checked = due;
+    if (budget.chooses_intervals) {
+        plan.intervals = renderer->choose_intervals(choice.intervals, choice.interval_mode);
+    }
+    return choice;
+}
+
+BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
+    const BudgetConfig& budget = *config.budget;
+    const std::vector<ViewConfig>& views = config.views_of(plan.name);
+    const ViewConfig& view = views.front();
+    const Camera camera = Camera::orbit(view.orbit, plan.bounds);
+    const double view_count = static_cast<double>(views.size());
+    // The fields share the step's bytes and time evenly.
+    const double share = 1.0 / static_cast<double>(config.fields.size());
+    const TransferFunction held_out = halved_opacity(plan.transfer_function);
+    RenderSettings truth_settings;
+    truth_settings.step_voxels = config.step_voxels;
+    truth_settings.early_termination_opacity = 1.0;
+    const auto truth_start = Clock::now();
+    const Image truth = renderer->render_ground_truth(camera, held_out, truth_settings).rgba;
+    // The step's preview (the stored view's rendering) is one such pass per view.
+    const double preview_ms = 1e3 * seconds_since(truth_start);
+
+    std::vector<std::pair<int, IntervalMode>> candidates;
+    if (budget.chooses_intervals) {
+        for (const int count : kBudgetIntervalCounts) {
+            for (const IntervalMode mode :
+                 {IntervalMode::uniform, IntervalMode::histogram_equalized}) {
+                candidates.emplace_back(count, mode);
+            }
+        }
+    } else {
+        candidates.emplace_back(config.interval_count, config.interval_mode);
+    }
+    std::vector<BudgetRecord> measured;
+    for (const auto& [count, mode] : candidates) {
+        BudgetRecord candidate;
+        candidate.field = plan.name;
+        candidate.intervals = count;
+        candidate.interval_mode = mode;
+        // The single-perspective pass as compute_field makes it, with these intervals.
+        ProxyRequest request;
+        request.isovalues = plan.isovalues;
+        request.intervals = renderer->choose_intervals(count, mode);
+        request.transfer_function = plan.transfer_function;
+        request.march.step_voxels = config.step_voxels;
+        request.depth_layers = config.proxies.depth;
+        request.interleaving = config.proxies.interleaving;
+        const auto start = Clock::now();
+        ProxyFrame frame = renderer->render(camera, request);
+        const double pass_ms = 1e3 * seconds_since(start);
+        const std::vector<double> scales =
+            opacity_scales(plan.transfer_function, held_out, *request.intervals);
+        const Image edited =
+            estimate_attenuation(frame.attenuation, frame.mean_depth, nullptr, scales);
+        candidate.psnr_db =
+            psnr_rgb_db(truth, recolour(edited, interval_colours(held_out, *request.intervals)));
+        // Bytes as the writer stores the view (the rendering is the preview's size).
+        if (config.proxies.rendering) frame.rendering = truth;
+        StepRecord record;
+        record.field = plan.name;
+        ViewRecord view_record;
+        view_record.field = plan.name;
+        view_record.view = view;
+        view_record.transfer_function = plan.transfer_function;
+        view_record.single = std::move(frame);
+        const archive_format::EncodedView encoded = archive_format::encode_view(
+            record, view_record, config.precision, config.compression, "budget check");
+        candidate.bytes = view_count * static_cast<double>(encoded.bytes.size());
+        candidate.milliseconds = view_count * (pass_ms + preview_ms);
+        measured.push_back(candidate);
+    }
+    const auto affordable = [&](const BudgetRecord& c) {
+        return (!budget.bytes_per_step || c.bytes <= share * *budget.bytes_per_step) &&
+               (!budget.ms_per_step || c.milliseconds <= share * *budget.ms_per_step);
+    };
+    const auto accurate = [&](const BudgetRecord& c) {
+        return !budget.psnr_db || c.psnr_db >= *budget.psnr_db;
+    };
+    // The cheapest (bytes, then time) that meets every limit; else the most accurate one
+    // affordable; else the cheapest.
+    const auto cheaper = [](const BudgetRecord& a, const BudgetRecord& b) {
+        return a.bytes < b.bytes || (a.bytes == b.bytes && a.milliseconds < b.milliseconds);
+    };
+    const BudgetRecord* chosen = nullptr;
+    for (const BudgetRecord& c : measured) {
+        if (affordable(c) && accurate(c) && (!chosen || cheaper(c, *chosen))) chosen = &c;
+    }
+    if (!chosen) {
+        for (const BudgetRecord& c : measured) {
+            if (affordable(c) && (!chosen || c.psnr_db > chosen->psnr_db)) chosen = &c;
+        }
+    }
+    if (!chosen) {
+        for (const BudgetRecord& c : measured) {
+            if (!chosen || cheaper(c, *chosen)) chosen = &c;
+        }
+    }
+    BudgetRecord choice = *chosen;
+    choice.met = affordable(choice) && accurate(choice);
+    return choice;
 }
 
 Instrument::Impl::FieldPlan Instrument::Impl::plan_distributed_field(
@@ -684,6 +873,7 @@ void Instrument::Impl::compute_field(const FieldPlan& plan, StepRecord& record,
     const std::string& name = plan.name;
     const TransferFunction& transfer_function = plan.transfer_function;
     record.fields.push_back(plan.summary);
+    if (plan.budget) record.budget.push_back(*plan.budget);
     const std::vector<double>& isovalues = plan.isovalues;
     const IntervalSet& intervals = plan.intervals;
 
@@ -961,6 +1151,7 @@ Status Instrument::Impl::finalize() {
                     << statistics.simulation_seconds << " s between calls; writer "
                     << statistics.write_seconds << " s on its own thread)";
         }
+        if (config.budget) summary << "; " << budget_summary();
         if (!first_error.empty()) summary << "; first error: " << first_error;
         if (!last_error.empty() && last_error != first_error) {
             summary << "; last error: " << last_error;

@@ -248,6 +248,36 @@ TEST_F(ExplorerTest, OpacityEditsAreBoundedAndZeroOpacityIsTransparent) {
     }
 }
 
+TEST_F(ExplorerTest, EditsCarryTheirTrustAndTheStoredViewIsTrustedThroughout) {
+    write_steps({1});
+    Explorer explorer(config_.archive);
+    ExploreRequest request;
+    request.step = 1;
+    const ExploreFrame stored = explorer.render(request);
+    for (const float c : stored.confidence.pixels) ASSERT_EQ(c, 1.0f);
+
+    // Far denser: each blob's rays rise through the intervals and fall back through them, so
+    // the order of the runs decides where the light lands, and the archive's interleaving
+    // counts (on by default) say so; empty pixels stay trusted.
+    ExploreRequest denser = request;
+    for (int j = 0; j < kIntervals; ++j) denser.opacity_scales.emplace_back(j, 1000.0);
+    const ExploreFrame frame = explorer.render(denser);
+    std::size_t distrusted = 0, covered = 0;
+    for (std::size_t p = 0; p < frame.confidence.pixel_count(); ++p) {
+        const float c = frame.confidence.pixels[p];
+        ASSERT_GE(c, 0.0f);
+        ASSERT_LE(c, 1.0f);
+        if (stored.colour.pixels[4 * p + 3] == 0.0f) {
+            EXPECT_EQ(c, 1.0f) << "pixel " << p;
+            continue;
+        }
+        ++covered;
+        distrusted += c < 0.5f;
+    }
+    EXPECT_GT(distrusted, 0u);
+    EXPECT_LT(distrusted, covered);
+}
+
 TEST_F(ExplorerTest, ANewViewIsSynthesisedWithAConfidenceMask) {
     write_steps({1});
     Explorer explorer(config_.archive);
@@ -469,6 +499,16 @@ TEST(ExploreOptions, MalformedValuesNameKeyAndValue) {
             request_from_options({{"opacity-scale", "1=-1"}});
         },
         "negative");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"segment-opacity", "-1=0.5"}});
+        },
+        "segment -1 is out of range");
+    testing::expect_error_naming<InvalidArgument>(
+        [] {
+            request_from_options({{"segment-opacity", "2"}});
+        },
+        "SEGMENT=SCALE");
     testing::expect_error_naming<InvalidArgument>(
         [] {
             request_from_options({{"light", "10"}});

@@ -9,12 +9,15 @@
 //                                 "unit_length": 1.0},
 //  "training_transfer_functions": [],
 //  "layers": "auto", "intervals": {"count": 16, "mode": "uniform"},
-//  "proxies": ["depth", "attenuation", "rendering"], "step": 1.0, "every": 10,
+//  "proxies": ["depth", "attenuation", "rendering", "interleaving"], "step": 1.0,
+//  "every": 10,
 //  "archive": "run.cdb", "precision": "half", "compression": "zip",
 //  "writer": {"queue": 4, "when_full": "block"},
 //  "colour_model": {"clusters": 24, "enabled": true},
 //  "light_field": {"cameras": 42, "size": 256, "segments": "layers", "attenuation": true,
-//                  "depth_bits": 8, "depth_threshold": 0.3}}
+//                  "depth_bits": 8, "depth_threshold": 0.3},
+//  "budget": {"psnr_db": 40, "bytes_per_step": 8e6, "ms_per_step": 500, "check_every": 10,
+//             "choose": ["intervals"]}}
 //
 // Every key is optional; defaults are listed on the members below. Unknown keys (at any level)
 // are collected by name, not silently ignored: an Instrument refuses them unless "strict" is
@@ -79,7 +82,9 @@ struct ProxySelection {
     /// "interleaving" (with "attenuation"): per pixel, how many times the ray re-entered an
     /// interval it had left, one channel counted in the attenuation pass (no pass of its own).
     /// Opacity edits are exact where it is 0 and approximate elsewhere, so the Explorer's trust
-    /// for edits reads it (issue 17; bench/RESULTS.md "Trust for transfer-function edits").
+    /// for edits reads it (issue 17; bench/RESULTS.md, "Where the methods fail"). Measured on
+    /// Gray-Scott 128^3, 100 steps at 256^2: 4.8 % of the archive's bytes, and proxies per
+    /// archived step 77-83 ms with it against 79-88 ms without (no measurable time).
     /// Not written by distributed runs: a block cannot count what the ray met in front of it.
     bool interleaving = true;
 };
@@ -89,6 +94,36 @@ struct ColourModelConfig {
     int clusters = 24;    ///< "clusters": K, in [1, kMaxColourModelClusters]
     bool enabled = true;  ///< "enabled": fit when training transfer functions are given
 };
+
+/// "budget": what a step may cost and how accurate its proxies must be; the Instrument measures
+/// candidate configurations in situ and archives with the cheapest that meets it (fewest bytes,
+/// then least time), else the most accurate affordable one, else the cheapest (issue 17). Any
+/// subset of the three limits; with several fields each gets an even share of bytes and time.
+/// The bytes and time are the field's views' single-perspective proxies, rendering and preview
+/// (the multi-perspective, training and light-field passes come on top). Distributed runs
+/// refuse it (its ground truth needs the whole field on one process).
+struct BudgetConfig {
+    /// "psnr_db": the least PSNR of a held-out edit of the stored view (the run's function
+    /// with every opacity halved, a' = 1 - (1 - a)^0.5), recomposed from the candidate's
+    /// attenuation proxies, against the ground truth of that function; in (0, 200].
+    std::optional<double> psnr_db;
+    std::optional<double> bytes_per_step;  ///< "bytes_per_step": a step's archived bytes, > 0
+    std::optional<double> ms_per_step;     ///< "ms_per_step": a step's passes' time, > 0
+    /// "check_every": archived steps between two checks, >= 1. A check costs a ground-truth
+    /// pass and one proxy pass per candidate (kBudgetCandidates) for each field's first view,
+    /// so 10 keeps it under a tenth of a default run's passes; a field whose 1st-99th
+    /// percentile range moved by more than a quarter of its width since the last check is
+    /// checked at once (a reaction front, a shock), whatever the count.
+    int check_every = 10;
+    /// "choose": what the budget may choose. Today the intervals (count and mode), which are
+    /// what the recomposition's accuracy and the archive's bytes turn on; by default chosen
+    /// unless the configuration sets "intervals" itself (explicit settings win).
+    bool chooses_intervals = true;
+};
+
+/// Interval counts and modes a budget check measures: L in {4, 8, 16, 32}, uniform and
+/// histogram-equalised.
+inline constexpr int kBudgetIntervalCounts[] = {4, 8, 16, 32};
 
 /// Largest K a configuration may ask for (the fit's cost grows with K, and K rows are stored).
 constexpr int kMaxColourModelClusters = 1024;
@@ -195,6 +230,8 @@ struct InstrumentConfig {
     /// "light_field": per step and field, a light field (seed 001) from an icosphere of cameras
     /// (insitu/core/light_field.hpp), captured in the proxy pass; none by default.
     std::optional<LightFieldSettings> light_field;
+    /// "budget": none by default (the settings above, as given, are what runs).
+    std::optional<BudgetConfig> budget;
 
     /// The views of `field` (its own, or the top-level ones), its transfer function, its layers,
     /// and whether the training transfer functions apply to it (it uses the top-level function).

@@ -109,6 +109,8 @@ inline constexpr const char* kModelLayout =
 
 /// The step entry's per-field summaries (manifest.hpp): {"field", "histogram", "nonfinite"}.
 inline constexpr const char* kFieldsKey = "fields";
+/// Step entries of runs with an error budget: what it chose per field (BudgetRecord).
+inline constexpr const char* kBudgetKey = "budget";
 /// A view entry's transfer function: the one its proxies and preview were made with.
 inline constexpr const char* kViewTransferFunctionKey = "transfer_function";
 

@@ -215,6 +215,15 @@ TransferFunction ArchiveReader::transfer_function(std::int64_t step, int view) c
     return *configured;
 }
 
+std::vector<BudgetRecord> ArchiveReader::budget(std::int64_t step) const {
+    const nlohmann::json& step_entry = af::find_step(*manifest_, path_, step);
+    std::vector<BudgetRecord> choices;
+    const auto entries = step_entry.find(af::kBudgetKey);
+    if (entries == step_entry.end()) return choices;
+    for (const nlohmann::json& entry : *entries) choices.push_back(af::budget_from_entry(entry));
+    return choices;
+}
+
 std::optional<FieldSummaryRecord> ArchiveReader::field_summary(std::int64_t step,
                                                                const std::string& field) const {
     const nlohmann::json& step_entry = af::find_step(*manifest_, path_, step);

@@ -317,6 +317,12 @@ StepWriteResult ArchiveWriter::write(const StepRecord& record) {
                                      {"nonfinite", summary.nonfinite_samples}});
             }
         }
+        if (!record.budget.empty()) {
+            nlohmann::json& budget = step_entry[af::kBudgetKey];
+            budget = nlohmann::json::array();
+            for (const BudgetRecord& choice : record.budget)
+                budget.push_back(af::budget_entry(choice));
+        }
         // The entry must read back before anything names it (issue 19).
         try {
             af::check_step_entry(step_entry, (archive / af::kJournalFile).string(), "new entry");

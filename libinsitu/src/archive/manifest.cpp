@@ -145,7 +145,49 @@ void check_field_summaries(const nlohmann::json& step, const std::string& file,
     }
 }
 
+/// The optional budget choices of a step entry (budget_entry's form).
+void check_budget_entries(const nlohmann::json& step, const std::string& file,
+                          const std::string& where) {
+    if (!step.contains(kBudgetKey)) return;
+    const auto& entries = require(step, kBudgetKey, Expect::array, file, where);
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+        const std::string entry_where = where + "." + kBudgetKey + "[" + std::to_string(i) + "]";
+        try {
+            budget_from_entry(entries[i]);
+        } catch (const std::exception& error) {
+            fail<ParseError>("\"", file, "\": ", entry_where, ": ", error.what());
+        }
+    }
+}
+
 }  // namespace
+
+nlohmann::json budget_entry(const BudgetRecord& choice) {
+    return {{"field", choice.field},
+            {"intervals", choice.intervals},
+            {"mode", to_string(choice.interval_mode)},
+            {"checked", choice.checked},
+            {"met", choice.met},
+            {"psnr_db", choice.psnr_db},
+            {"bytes", choice.bytes},
+            {"ms", choice.milliseconds}};
+}
+
+BudgetRecord budget_from_entry(const nlohmann::json& entry) {
+    BudgetRecord choice;
+    choice.field = entry.at("field").get<std::string>();
+    choice.intervals = entry.at("intervals").get<int>();
+    if (choice.intervals < 1 || choice.intervals > kMaxIntervals) {
+        fail<ParseError>("intervals ", choice.intervals, " is outside [1, ", kMaxIntervals, "]");
+    }
+    choice.interval_mode = parse_interval_mode(entry.at("mode").get<std::string>());
+    choice.checked = entry.at("checked").get<bool>();
+    choice.met = entry.at("met").get<bool>();
+    choice.psnr_db = entry.at("psnr_db").get<double>();
+    choice.bytes = entry.at("bytes").get<double>();
+    choice.milliseconds = entry.at("ms").get<double>();
+    return choice;
+}
 
 nlohmann::json empty_manifest() {
     return {{"schema_version", kArchiveSchemaVersion}, {"steps", nlohmann::json::array()}};
@@ -210,6 +252,7 @@ void check_step_entry(const nlohmann::json& step, const std::string& file,
     }
     check_light_field_entries(step, file, where);
     check_field_summaries(step, file, where);
+    check_budget_entries(step, file, where);
 }
 
 namespace {

@@ -40,6 +40,11 @@ inline constexpr const char* kMalformedKey = "malformed_steps";
 /// A manifest with no steps.
 nlohmann::json empty_manifest();
 
+/// One field's budget choice as the step entry's "budget" list holds it, and back (ParseError
+/// or nlohmann's exceptions for an entry of the wrong form: check_step_entry names it).
+nlohmann::json budget_entry(const BudgetRecord& choice);
+BudgetRecord budget_from_entry(const nlohmann::json& entry);
+
 /// Checks one step entry: required keys and their types (numbers finite), safe relative paths,
 /// no repeated views; the optional light-field list likewise (no repeated field, a camera count
 /// and map size a light field can have). ParseError naming `file`, `where` and the key.

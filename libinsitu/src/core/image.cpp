@@ -25,6 +25,29 @@ Image::Image(int width_pixels, int height_pixels, int channel_count, float fill)
     pixels.assign(pixel_count() * static_cast<std::size_t>(channels), fill);
 }
 
+double mse_rgb(const Image& a, const Image& b) {
+    if (a.width != b.width || a.height != b.height || a.channels < 3 || b.channels < 3) {
+        fail<InvalidArgument>("mse_rgb: images ", a.width, "x", a.height, "x", a.channels, " and ",
+                              b.width, "x", b.height, "x", b.channels,
+                              " (need equal sizes, >= 3 channels)");
+    }
+    double sum = 0.0;
+    for (std::size_t p = 0; p < a.pixel_count(); ++p) {
+        for (int c = 0; c < 3; ++c) {
+            const double d =
+                static_cast<double>(a.pixels[p * a.channels + c]) - b.pixels[p * b.channels + c];
+            sum += d * d;
+        }
+    }
+    return sum / (3.0 * static_cast<double>(a.pixel_count()));
+}
+
+double psnr_rgb_db(const Image& a, const Image& b) {
+    const double mse = mse_rgb(a, b);
+    if (std::isnan(mse)) return mse;
+    return std::min(100.0, -10.0 * std::log10(std::max(mse, 1e-10)));
+}
+
 std::ostream& operator<<(std::ostream& out, const Image& image) {
     out << "Image " << image.width << "x" << image.height << "x" << image.channels;
     float low = std::numeric_limits<float>::infinity();

@@ -89,6 +89,9 @@ public:
     /// when that is "auto" too, which such archives cannot hold). Step or view not listed:
     /// InvalidArgument.
     TransferFunction transfer_function(std::int64_t step, int view) const;
+    /// What the run's error budget archived each field of `step` with (empty: no budget, or
+    /// an archive written before budgets); InvalidArgument for a step the archive lacks.
+    std::vector<BudgetRecord> budget(std::int64_t step) const;
     /// The values of `field` at `step`: range, histogram and NaN/Inf count (nullopt for archives
     /// written before steps recorded them, or a field the step does not show). A step not
     /// listed: InvalidArgument.

@@ -37,6 +37,19 @@ struct FieldSummaryRecord {
     std::int64_t nonfinite_samples = 0;
 };
 
+/// What an error budget ("budget", insitu/config.hpp) archived one field with at one timestep,
+/// and what it measured at the check that chose it: the manifest's step entry "budget".
+struct BudgetRecord {
+    std::string field;
+    int intervals = 0;
+    IntervalMode interval_mode = IntervalMode::uniform;
+    bool checked = false;       ///< measured at this step; otherwise the last check's choice, kept
+    bool met = false;           ///< the choice met every limit the budget gives
+    double psnr_db = 0.0;       ///< the held-out edit's PSNR with the choice, at its check
+    double bytes = 0.0;         ///< the field's views' archived bytes per step, at its check
+    double milliseconds = 0.0;  ///< the field's views' passes per step, at its check
+};
+
 /// One field's light field at one timestep (written as one multi-part EXR, a part per camera).
 struct LightFieldRecord {
     std::string field;
@@ -50,6 +63,7 @@ struct StepRecord {
     std::vector<ViewRecord> views;
     std::vector<LightFieldRecord> light_fields;  ///< one per field, when "light_field" is set
     std::vector<FieldSummaryRecord> fields;      ///< one per visualised field, in "fields" order
+    std::vector<BudgetRecord> budget;            ///< one per field, with a "budget" only
 };
 
 }  // namespace insitu

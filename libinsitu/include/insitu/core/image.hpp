@@ -35,6 +35,14 @@ private:
 /// comparison says what it compared.
 std::ostream& operator<<(std::ostream& out, const Image& image);
 
+/// Mean squared error over the premultiplied RGB of two images composited over black (the first
+/// three channels of each); InvalidArgument unless both have one size and >= 3 channels.
+double mse_rgb(const Image& a, const Image& b);
+/// PSNR in dB, peak 1, of mse_rgb (floored at 1e-10, so at most 100 dB); NaN when either image
+/// holds a NaN (garbage must not read as a perfect match). What the evaluation reports and an
+/// error budget measures in situ.
+double psnr_rgb_db(const Image& a, const Image& b);
+
 /// Linear -> sRGB transfer curve for one component in [0, 1] (IEC 61966-2-1).
 float linear_to_srgb(float linear);
 

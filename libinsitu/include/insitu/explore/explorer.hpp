@@ -13,7 +13,8 @@
 //  4. opacity edits: per-interval scales (from an edited transfer function and/or explicit
 //     scales) turn a into a' (estimate_attenuation);
 //  5. colour: the fitted colour model (Eq. 8, 10) when the archive has one and the colours are
-//     unchanged, else exact recomposition sum_j c_j a'_j (recolour);
+//     unchanged, else exact recomposition sum_j c_j a'_j (recolour); an edited frame's
+//     confidence is also at most the edit's trust (edit_confidence, transfer_function_edit.hpp);
 //  6. lighting: per-pixel factor from the per-interval mean depths (light_volume, §6.5), and
 //     ambient occlusion (Eq. 5) from the front-most depth layer;
 //  7. depth-aware enhancement (Eq. 11).

@@ -7,6 +7,9 @@
 //    a (and mean depth, and optical depth when stored); the estimator is documented at its
 //    definition and measured against the ground truth in tests/transfer_function_edit_test.cpp.
 // Both work per pixel on the compute device (kernels/explore/transfer_function_edit.cl).
+//  * Trust: edit_error() estimates, per pixel, how far an edited frame can be from the truth
+//    from what the proxies know (the interleaving proxy among them), on the host; the Explorer
+//    folds edit_confidence() of it into every edited frame's confidence.
 #include <vector>
 
 #include "insitu/core/image.hpp"

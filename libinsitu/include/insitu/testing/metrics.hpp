@@ -38,30 +38,19 @@ inline void require_same_size(const Image& a, const Image& b, int min_channels, 
     }
 }
 
-/// Mean squared error over the premultiplied RGB of two RGBA images (composited over black).
-inline double mse_rgb(const Image& a, const Image& b) {
-    require_same_size(a, b, 3, "mse_rgb");
-    double sum = 0.0;
-    for (std::size_t p = 0; p < a.pixel_count(); ++p) {
-        for (int c = 0; c < 3; ++c) {
-            const double d =
-                static_cast<double>(a.pixels[p * a.channels + c]) - b.pixels[p * b.channels + c];
-            sum += d * d;
-        }
-    }
-    return sum / (3.0 * static_cast<double>(a.pixel_count()));
-}
+/// Mean squared error over the premultiplied RGB of two RGBA images (composited over black):
+/// the core's definition (insitu/core/image.hpp), which an error budget measures in situ.
+using insitu::mse_rgb;
 
 /// Sum of squared differences over premultiplied RGB (seed 000 Fig. 13's "SSD").
 inline double ssd_rgb(const Image& a, const Image& b) {
     return mse_rgb(a, b) * 3.0 * static_cast<double>(a.pixel_count());
 }
 
-/// NaN when either image holds a NaN (garbage must not read as a perfect match).
+/// NaN when either image holds a NaN (garbage must not read as a perfect match); at most
+/// kPsnrCapDb.
 inline double psnr_db(const Image& a, const Image& b) {
-    const double mse = mse_rgb(a, b);
-    if (std::isnan(mse)) return mse;
-    return std::min(kPsnrCapDb, -10.0 * std::log10(std::max(mse, 1e-10)));
+    return psnr_rgb_db(a, b);
 }
 
 /// PSNR in dB of premultiplied RGB against `truth`, peak 1, over the pixels either image covers

@@ -1,0 +1,157 @@
+// Frames: at most one in flight; a control moved meanwhile is drawn once that one is done (the
+// server also coalesces, per session). Orbit views of a step with a light field are drawn here
+// by WebGL2 (gpu_frames.js); every other frame is the server's exploration engine's PNG. The
+// confidence overlay is the engine's mask of the frame shown.
+import { $, FPS_WINDOW_MS, errorText, session, showError, state, viewer } from './page.js';
+import { currentOptions, sameOptions } from './explore_options.js';
+import { schedulePlay } from './timeline.js';
+
+let inFlight = false;
+
+// Whether the browser draws this frame: an orbit view (the stored view is the archive's own
+// proxies, exact) of a step with a light field, without what only the server's engine does
+// (transfer-function edits, lighting, enhancement).
+export function drawnInBrowser(options) {
+  return Boolean(viewer.gpu && $('gpu-toggle').checked && state.lightField && state.info &&
+    state.info.camera && options.azimuth !== undefined && !options.tf &&
+    !options['opacity-scale'] && !options.light && !options.ao && !options.enhance);
+}
+
+export function requestFrame() {
+  const options = currentOptions();
+  if (!options || inFlight) return;
+  const preview = state.dragging && drawnInBrowser(options);
+  // The same options drawn the same way (toggling "draw in the browser" redraws them).
+  if (viewer.displayed && sameOptions(viewer.displayed.options, options) &&
+    !(viewer.displayed.preview && !preview) &&
+    Boolean(viewer.displayed.gpu) === drawnInBrowser(options)) return;
+  inFlight = true;
+  if (drawnInBrowser(options)) {
+    drawInBrowser(options, preview);
+    return;
+  }
+  const sent = performance.now();
+  const body = new URLSearchParams({ ...options, session });
+  fetch('api/frame', { method: 'POST', body })
+    .then(async (response) => {
+      if (response.status === 409) return;  // a newer request of ours replaced it
+      if (!response.ok) {
+        showError(await errorText(response));
+        // Do not ask again for what was refused: remember it as displayed.
+        if (viewer.displayed) viewer.displayed.options = options;
+        return;
+      }
+      const png = new Uint8Array(await response.arrayBuffer());
+      await display(options, png, response.headers, performance.now() - sent);
+      showError('');
+    })
+    .catch((error) => showError(String(error)))
+    .finally(frameDone);
+}
+
+function frameDone() {
+  inFlight = false;
+  const next = currentOptions();
+  if (!viewer.displayed || !sameOptions(viewer.displayed.options, next) ||
+    (viewer.displayed.preview && !state.dragging)) requestFrame();
+  else if (state.playing) schedulePlay();
+}
+
+// Frames per second over the last FPS_WINDOW_MS, counting this one.
+function countFrame() {
+  viewer.frameCount += 1;
+  const now = performance.now();
+  viewer.frameTimes.push(now);
+  while (viewer.frameTimes.length && viewer.frameTimes[0] < now - FPS_WINDOW_MS) viewer.frameTimes.shift();
+  return viewer.frameTimes.length > 1
+    ? (viewer.frameTimes.length - 1) * 1000 / (now - viewer.frameTimes[0]) : 0;
+}
+
+function showCanvas(canvas) {
+  $('frame').hidden = canvas;
+  $('gpu-frame').hidden = !canvas;
+}
+
+function drawInBrowser(options, preview) {
+  const entry = state.timeline[state.stepIndex];
+  viewer.gpu.draw(entry.step, state.view, state.info.camera, Number(options.azimuth),
+    Number(options.elevation), state.segmentScales.slice(), preview)
+    .then((timing) => {
+      if (!timing) throw new Error('the step has no light field');
+      showCanvas(true);
+      // A preview is smaller than the view: scaled up smoothly, not in blocks.
+      $('gpu-frame').style.imageRendering = preview ? 'auto' : '';
+      if (viewer.displayed && viewer.displayed.url) URL.revokeObjectURL(viewer.displayed.url);
+      viewer.displayed = { options, gpu: true, preview, milliseconds: timing.milliseconds,
+        synthesised: true };
+      const fps = countFrame();
+      const open = viewer.gpu.lastOpen;
+      $('readout').textContent =
+        `frame ${timing.milliseconds.toFixed(1)} ms (WebGL2, light field${preview ? ', preview' : ''})` +
+        ` · ${fps.toFixed(1)} fps · step opened in ${(open.downloadMs + open.uploadMs).toFixed(0)} ms` +
+        ` (${(open.bytes / 1e6).toFixed(1)} MB)`;
+      showError('');
+      return updateMask();
+    })
+    .catch((error) => showError(String(error)))
+    .finally(frameDone);
+}
+
+async function display(options, png, headers, roundTripMs) {
+  const url = URL.createObjectURL(new Blob([png], { type: 'image/png' }));
+  const image = $('frame');
+  await new Promise((resolve, reject) => {
+    image.onload = resolve;
+    image.onerror = () => reject(new Error('the frame is not a readable PNG'));
+    image.src = url;
+  });
+  if (viewer.displayed && viewer.displayed.url) URL.revokeObjectURL(viewer.displayed.url);
+  showCanvas(false);
+  const header = (name) => headers.get(name);
+  viewer.displayed = {
+    options,
+    png,
+    url,
+    milliseconds: Number(header('X-Insitu-Milliseconds')),
+    encodeMilliseconds: Number(header('X-Insitu-Encode-Milliseconds')),
+    confidence: Number(header('X-Insitu-Confidence')),
+    colourSource: header('X-Insitu-Colour-Source'),
+    synthesised: header('X-Insitu-Synthesised') === '1',
+  };
+  const fps = countFrame();
+  const d = viewer.displayed;
+  $('readout').textContent =
+    `frame ${d.milliseconds.toFixed(1)} ms (engine) + ${d.encodeMilliseconds.toFixed(1)} ms (PNG)` +
+    ` · ${roundTripMs.toFixed(1)} ms (round trip)` +
+    ` · ${fps.toFixed(1)} fps · mean confidence ${d.confidence.toFixed(3)}` +
+    ` · colour ${d.colourSource}${d.synthesised ? ' · synthesised view' : ' · stored view'}`;
+  await updateMask();
+}
+
+export async function updateMask() {
+  const canvas = $('mask-overlay');
+  canvas.hidden = !state.mask;
+  if (!state.mask || !viewer.displayed) return;
+  const options = viewer.displayed.options;
+  // A frame drawn here is the light field's: its confidence is the light field's too.
+  const source = viewer.displayed.gpu ? { source: 'lightfield' } : {};
+  const response = await fetch('api/mask',
+    { method: 'POST', body: new URLSearchParams({ ...options, ...source, session }) });
+  if (!response.ok || !sameOptions(options, viewer.displayed.options)) return;
+  const bitmap = await createImageBitmap(await response.blob());
+  canvas.width = bitmap.width;
+  canvas.height = bitmap.height;
+  const context = canvas.getContext('2d', { willReadFrequently: true });
+  context.drawImage(bitmap, 0, 0);
+  // Untrusted pixels in red, as opaque as they are untrusted; trusted ones clear.
+  const pixels = context.getImageData(0, 0, canvas.width, canvas.height);
+  for (let i = 0; i < pixels.data.length; i += 4) {
+    const untrusted = 255 - pixels.data[i];
+    pixels.data[i] = 255;
+    pixels.data[i + 1] = 40;
+    pixels.data[i + 2] = 40;
+    pixels.data[i + 3] = Math.round(untrusted * 0.7);
+  }
+  context.putImageData(pixels, 0, 0);
+  viewer.maskCount = (viewer.maskCount || 0) + 1;
+}

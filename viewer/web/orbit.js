@@ -1,0 +1,162 @@
+// Orbit: the drag and the angle inputs, and the trusted range around the stored view
+// (/api/trust), drawn as a map of offsets.
+import { $, DEGREES_PER_PIXEL, REST_MS, getJson, state, svg } from './page.js';
+import { requestFrame } from './frames.js';
+
+let trust = null;
+let trustKey = null;
+
+export function storedAngles() {
+  return state.info ? [state.info.azimuth, state.info.elevation] : [0, 0];
+}
+
+function normaliseAzimuth(degrees) {
+  let a = ((degrees + 180) % 360 + 360) % 360 - 180;
+  if (a === -180) a = 180;
+  return a;
+}
+
+export function setOrbit(azimuth, elevation) {
+  state.azimuth = normaliseAzimuth(azimuth);
+  state.elevation = Math.max(-89, Math.min(89, elevation));
+  syncOrbitInputs();
+  requestFrame();
+}
+
+export function syncOrbitInputs() {
+  const [az, el] = storedAngles();
+  $('azimuth').value = (state.azimuth ?? az).toFixed(2);
+  $('elevation').value = (state.elevation ?? el).toFixed(2);
+  drawTrustMap();
+}
+
+export async function requestTrust() {
+  const entry = state.timeline[state.stepIndex];
+  const key = `${entry.step}:${state.view}`;
+  if (trustKey === key) return;
+  trustKey = key;
+  trust = null;
+  $('trust-label').textContent = 'trusted range: measuring…';
+  drawTrustMap();
+  try {
+    const result = await getJson(`api/trust?step=${entry.step}&view=${state.view}`);
+    if (trustKey !== key) return;
+    trust = result;
+    const [a0, a1] = trust.trusted_offsets.azimuth;
+    const [e0, e1] = trust.trusted_offsets.elevation;
+    const range = (lo, hi) => `${lo}…${hi > 0 ? '+' : ''}${hi}°`;
+    $('trust-label').textContent =
+      `trusted (mean confidence ≥ ${trust.threshold}): azimuth ${range(a0, a1)}, ` +
+      `elevation ${range(e0, e1)} around the stored view`;
+  } catch (error) {
+    if (trustKey === key) {
+      trustKey = null;
+      $('trust-label').textContent = `trusted range: ${error.message}`;
+    }
+  }
+  drawTrustMap();
+}
+
+/// Orbit offsets from the stored view: +-90 deg azimuth across, +-90 deg elevation up and down.
+export function drawTrustMap() {
+  const map = $('trust-map');
+  const w = Number(map.getAttribute('width'));
+  const h = Number(map.getAttribute('height'));
+  const x = (offset) => w / 2 + (offset / 90) * (w / 2 - 8);
+  const y = (offset) => h / 2 - (offset / 90) * (h / 2 - 8);
+  map.replaceChildren();
+  svg('line', { x1: x(-90), x2: x(90), y1: y(0), y2: y(0), stroke: '#444' }, map);
+  svg('line', { x1: x(0), x2: x(0), y1: y(-90), y2: y(90), stroke: '#444' }, map);
+  if (trust) {
+    const [a0, a1] = trust.trusted_offsets.azimuth;
+    const [e0, e1] = trust.trusted_offsets.elevation;
+    svg('rect', {
+      id: 'trusted-range', x: x(a0), y: y(e1), width: x(a1) - x(a0), height: y(e0) - y(e1),
+      fill: 'rgba(108,180,255,0.25)', stroke: '#6cb4ff',
+    }, map);
+  }
+  if (trust) {
+    // Each probed offset, green where its mean confidence reached the threshold, red where not.
+    for (const sample of trust.samples) {
+      const along = sample.axis === 'azimuth';
+      const dot = svg('circle', {
+        cx: x(along ? sample.offset : 0), cy: y(along ? 0 : sample.offset), r: 2.5,
+        fill: sample.mean_confidence >= trust.threshold ? '#7ee787' : '#ff6b6b',
+      }, map);
+      svg('title', {}, dot).textContent =
+        `${sample.axis} ${sample.offset > 0 ? '+' : ''}${sample.offset}°: mean confidence ` +
+        sample.mean_confidence.toFixed(3);
+    }
+  }
+  const [az, el] = storedAngles();
+  const da = normaliseAzimuth((state.azimuth ?? az) - az);
+  const de = (state.elevation ?? el) - el;
+  const inside = !trust || (da >= trust.trusted_offsets.azimuth[0] - 1e-9 &&
+    da <= trust.trusted_offsets.azimuth[1] + 1e-9 && de >= trust.trusted_offsets.elevation[0] - 1e-9 &&
+    de <= trust.trusted_offsets.elevation[1] + 1e-9);
+  svg('circle', {
+    cx: x(Math.max(-90, Math.min(90, da))), cy: y(Math.max(-90, Math.min(90, de))), r: 4,
+    fill: inside ? '#7ee787' : '#ffae57',
+  }, map);
+  const label = svg('text', { x: 4, y: h - 4, fill: '#8a92a0', 'font-size': 10 }, map);
+  label.textContent = `Δaz ${da.toFixed(1)}°  Δel ${de.toFixed(1)}°`;
+}
+
+export function installOrbitDrag() {
+  const viewport = $('viewport');
+  let drag = null;
+  viewport.addEventListener('pointerdown', (event) => {
+    if (!state.info) return;
+    const [az, el] = storedAngles();
+    drag = { x: event.clientX, y: event.clientY, azimuth: state.azimuth ?? az,
+      elevation: state.elevation ?? el };
+    viewport.setPointerCapture(event.pointerId);
+    viewport.classList.add('dragging');
+  });
+  let rest = null;
+  viewport.addEventListener('pointermove', (event) => {
+    if (!drag) return;
+    state.dragging = true;
+    clearTimeout(rest);
+    rest = setTimeout(() => {
+      state.dragging = false;
+      requestFrame();
+    }, REST_MS);
+    // Grab-and-turn: dragging right turns the object right (the camera moves left), dragging
+    // down tips its top toward the viewer (the camera moves up).
+    setOrbit(drag.azimuth - (event.clientX - drag.x) * DEGREES_PER_PIXEL,
+      drag.elevation + (event.clientY - drag.y) * DEGREES_PER_PIXEL);
+  });
+  const end = () => {
+    drag = null;
+    viewport.classList.remove('dragging');
+    clearTimeout(rest);
+    if (state.dragging) {
+      state.dragging = false;
+      requestFrame();
+    }
+  };
+  viewport.addEventListener('pointerup', end);
+  viewport.addEventListener('pointercancel', end);
+  viewport.addEventListener('dblclick', resetView);
+  for (const id of ['azimuth', 'elevation']) {
+    $(id).addEventListener('change', () => {
+      const az = Number($('azimuth').value);
+      const el = Number($('elevation').value);
+      if (Number.isFinite(az) && Number.isFinite(el)) setOrbit(az, el);
+    });
+  }
+}
+
+export function resetView() {
+  state.azimuth = null;
+  state.elevation = null;
+  syncOrbitInputs();
+  requestFrame();
+}
+
+
+/// Another view's range is measured anew.
+export function forgetTrust() {
+  trustKey = null;
+}

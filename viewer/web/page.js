@@ -1,0 +1,74 @@
+// What every module of insitu-view's page shares: the page's state (the controls as the
+// request's parts), the object tests read (window.insituViewer), the constants of its controls,
+// and small DOM and fetch helpers.
+
+export const DEGREES_PER_PIXEL = 0.4;  // orbit drag: degrees of azimuth/elevation per CSS pixel
+export const MAX_OPACITY_SCALE = 4;    // top of the opacity-handle axis
+export const ARCHIVE_POLL_MS = 3000;   // how often new timesteps of a running simulation are looked for
+export const PLAY_INTERVAL_MS = 250;   // at most four timesteps per second while playing
+export const FPS_WINDOW_MS = 2000;     // frames per second averaged over this window
+export const REST_MS = 150;      // a drag that has not moved for this long gets its full frame
+
+export const $ = (id) => document.getElementById(id);
+export const session = 'page-' + Math.random().toString(36).slice(2, 12);
+
+export const state = {
+  archive: null,          // /api/archive
+  timeline: [],           // [{step, time}]
+  stepIndex: 0,
+  view: 0,
+  info: null,             // /api/step of the shown step
+  azimuth: null,          // orbit angles; null = the stored view
+  elevation: null,
+  scales: [],             // opacity scale per interval (1 = unchanged)
+  colours: [],            // per interval: null or an edited linear RGB triple
+  segmentScales: [],      // opacity factor per light-field segment (1 = unchanged)
+  baseTf: null,           // a loaded TF (JSON object) or null = the archive's own
+  colourSource: 'auto',
+  mask: false,
+  playing: false,
+  lightField: false,      // whether the shown step has a light field the browser can draw
+  dragging: false,        // an orbit drag moved within the last REST_MS: previews will do
+};
+export const viewer = {
+  gpu: null,              // GpuFrames, or null without WebGL2
+  frameCount: 0,
+  degreesPerPixel: DEGREES_PER_PIXEL,
+  displayed: null,        // {options, png: Uint8Array, url, headers}
+  frameTimes: [],
+  options: null,          // () => the current explore options (app.js sets it)
+  // The browser-drawn frame's RGBA bytes (tests compare them with `insitu-view render`).
+  gpuPixels: () => viewer.gpu.renderer.readPixels(),
+};
+window.insituViewer = viewer;
+
+export function short(x) {
+  return Number(x.toPrecision(6)).toString();
+}
+
+export function showError(message) {
+  $('error').hidden = !message;
+  $('error').textContent = message || '';
+}
+
+export async function errorText(response) {
+  try {
+    return (await response.json()).error;
+  } catch (e) {
+    return `${response.status} ${response.statusText}`;
+  }
+}
+
+export async function getJson(url) {
+  const response = await fetch(url, { cache: 'no-store' });
+  if (!response.ok) throw new Error(await errorText(response));
+  return response.json();
+}
+
+export function svg(tag, attributes, parent) {
+  const element = document.createElementNS('http://www.w3.org/2000/svg', tag);
+  for (const [k, v] of Object.entries(attributes)) element.setAttribute(k, v);
+  if (parent) parent.appendChild(element);
+  return element;
+}
+

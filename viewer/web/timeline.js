@@ -1,0 +1,91 @@
+// Timesteps: the archive's index (polled, so a running simulation's new steps appear), the
+// step shown and its intervals, light field and faders, and playing through the steps.
+import { $, PLAY_INTERVAL_MS, getJson, short, showError, state, viewer } from './page.js';
+import { showSegmentFaders } from './segment_faders.js';
+import { requestFrame } from './frames.js';
+import { drawTfEditor } from './tf_editor.js';
+import { requestTrust, syncOrbitInputs } from './orbit.js';
+
+export async function loadArchive() {
+  const archive = await getJson('api/archive');
+  const grew = state.archive && archive.timeline.length !== state.timeline.length;
+  state.archive = archive;
+  state.timeline = archive.timeline;
+  $('archive-name').textContent = archive.name;
+  const slider = $('step');
+  const atEnd = state.stepIndex === Number(slider.max);
+  slider.max = Math.max(0, state.timeline.length - 1);
+  if (grew && atEnd && !state.playing) {
+    // Following a running simulation: stay on the newest step.
+    state.stepIndex = state.timeline.length - 1;
+    slider.value = state.stepIndex;
+    await stepChanged();
+  }
+  const select = $('view-select');
+  if (select.options.length !== archive.view_count) {
+    select.replaceChildren(...Array.from({ length: archive.view_count }, (_, v) => {
+      const option = document.createElement('option');
+      option.value = option.textContent = String(v);
+      return option;
+    }));
+    select.value = String(state.view);
+  }
+  updateStepLabel();
+}
+
+function updateStepLabel() {
+  const entry = state.timeline[state.stepIndex];
+  $('step-label').textContent = entry
+    ? `step ${entry.step} · t = ${short(entry.time)} · ${state.stepIndex + 1}/${state.timeline.length}`
+    : 'no steps yet';
+}
+
+export async function stepChanged() {
+  updateStepLabel();
+  const entry = state.timeline[state.stepIndex];
+  if (!entry) return;
+  const info = await getJson(`api/step?step=${entry.step}&view=${state.view}`);
+  let lightField = false;
+  if (viewer.gpu) {
+    lightField = await viewer.gpu.has(entry.step, state.view).catch(() => false);
+    const next = state.timeline[state.stepIndex + 1];
+    if (lightField && next) viewer.gpu.prefetch(next.step, state.view);
+  }
+  if (state.timeline[state.stepIndex] !== entry) return;  // the slider moved on meanwhile
+  state.lightField = lightField;
+  const count = info.intervals ? info.intervals.length - 1 : 0;
+  if (count !== state.scales.length) {
+    state.scales = new Array(count).fill(1);
+    state.colours = new Array(count).fill(null);
+  }
+  state.info = info;
+  // Faders for a light field captured in segments; the same run keeps its segments, and the
+  // factors set, from step to step.
+  const segments = info.light_field_segments || 0;
+  if (segments !== state.segmentScales.length) state.segmentScales = new Array(segments).fill(1);
+  showSegmentFaders($('segments'), state.segmentScales, requestFrame);
+  drawTfEditor();
+  syncOrbitInputs();
+  requestFrame();
+  if (!state.playing) requestTrust();
+}
+
+let playTimer = null;
+
+export function schedulePlay() {
+  if (playTimer) return;
+  playTimer = setTimeout(() => {
+    playTimer = null;
+    if (!state.playing || !state.timeline.length) return;
+    state.stepIndex = (state.stepIndex + 1) % state.timeline.length;
+    $('step').value = state.stepIndex;
+    stepChanged().catch((error) => showError(error.message));
+  }, PLAY_INTERVAL_MS);
+}
+
+export function setPlaying(playing) {
+  state.playing = playing;
+  $('play').textContent = playing ? '❚❚' : '▶';
+  if (playing) schedulePlay();
+  else requestTrust();
+}
