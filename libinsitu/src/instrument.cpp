@@ -295,11 +295,11 @@ struct Instrument::Impl {
         std::optional<BudgetRecord> budget;
     };
     /// The error budget's state of one field: its choice, the check that made it, and the
-    /// field's 1st-99th percentiles then (a range that drifts is checked again at once).
+    /// field's histogram then (values that move are checked again at once).
     struct BudgetState {
         BudgetRecord choice;
         std::int64_t archived_since_check = 0;
-        double low = 0.0, high = 0.0;
+        ValueHistogram histogram;
         int checks = 0;
     };
     std::map<std::string, BudgetState> budget_state;
@@ -637,16 +637,12 @@ BudgetRecord Instrument::Impl::apply_budget(FieldPlan& plan) {
     const BudgetConfig& budget = *config.budget;
     const auto [found, fresh] = budget_state.try_emplace(plan.name);
     BudgetState& state = found->second;
-    const double low = plan.summary.histogram.percentile(0.01);
-    const double high = plan.summary.histogram.percentile(0.99);
-    const double width = std::max(state.high - state.low, 1e-30);
-    const bool drifted = !fresh && (std::abs(low - state.low) > 0.25 * width ||
-                                    std::abs(high - state.high) > 0.25 * width);
-    const bool due = fresh || drifted || state.archived_since_check >= budget.check_every;
+    const bool moved =
+        !fresh && histogram_distance(state.histogram, plan.summary.histogram) > kBudgetMovedShare;
+    const bool due = fresh || moved || state.archived_since_check >= budget.check_every;
     if (due) {
         state.choice = check_budget(plan);
-        state.low = low;
-        state.high = high;
+        state.histogram = plan.summary.histogram;
         state.archived_since_check = 0;
         ++state.checks;
     }
@@ -687,8 +683,22 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
     } else {
         candidates.emplace_back(config.interval_count, config.interval_mode);
     }
+    const auto affordable = [&](const BudgetRecord& c) {
+        return (!budget.bytes_per_step || c.bytes <= share * *budget.bytes_per_step) &&
+               (!budget.ms_per_step || c.milliseconds <= share * *budget.ms_per_step);
+    };
+    const auto accurate = [&](const BudgetRecord& c) {
+        return !budget.psnr_db || c.psnr_db >= *budget.psnr_db;
+    };
     std::vector<BudgetRecord> measured;
     for (const auto& [count, mode] : candidates) {
+        // Bytes and time grow with the count: past a count that met an accuracy budget (both
+        // modes measured), larger ones can only cost more. An easy budget costs two passes.
+        if (budget.psnr_db && !measured.empty() && measured.back().intervals != count &&
+            std::any_of(measured.begin(), measured.end(),
+                        [&](const BudgetRecord& c) { return affordable(c) && accurate(c); })) {
+            break;
+        }
         BudgetRecord candidate;
         candidate.field = plan.name;
         candidate.intervals = count;
@@ -725,21 +735,16 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
         candidate.milliseconds = view_count * (pass_ms + preview_ms);
         measured.push_back(candidate);
     }
-    const auto affordable = [&](const BudgetRecord& c) {
-        return (!budget.bytes_per_step || c.bytes <= share * *budget.bytes_per_step) &&
-               (!budget.ms_per_step || c.milliseconds <= share * *budget.ms_per_step);
-    };
-    const auto accurate = [&](const BudgetRecord& c) {
-        return !budget.psnr_db || c.psnr_db >= *budget.psnr_db;
-    };
-    // The cheapest (bytes, then time) that meets every limit; else the most accurate one
-    // affordable; else the cheapest.
+    // With an accuracy asked: the cheapest (bytes, then time) that meets every limit. Else (or
+    // without one: only cost limits) the most accurate one affordable; else the cheapest.
     const auto cheaper = [](const BudgetRecord& a, const BudgetRecord& b) {
         return a.bytes < b.bytes || (a.bytes == b.bytes && a.milliseconds < b.milliseconds);
     };
     const BudgetRecord* chosen = nullptr;
     for (const BudgetRecord& c : measured) {
-        if (affordable(c) && accurate(c) && (!chosen || cheaper(c, *chosen))) chosen = &c;
+        if (budget.psnr_db && affordable(c) && accurate(c) && (!chosen || cheaper(c, *chosen))) {
+            chosen = &c;
+        }
     }
     if (!chosen) {
         for (const BudgetRecord& c : measured) {

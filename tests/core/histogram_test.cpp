@@ -117,5 +117,21 @@ TEST(ValueHistogram, RefusesBadBinsAndRangesByValue) {
     EXPECT_THROW(histogram.percentile(1.5), InvalidArgument);
 }
 
+TEST(HistogramDistance, IsTheShareOfSamplesThatMoved) {
+    std::vector<float> values;
+    for (int i = 0; i < 1000; ++i) values.push_back(static_cast<float>(i) / 1000.0f);
+    const ValueHistogram uniform = ValueHistogram::of(values);
+    EXPECT_NEAR(histogram_distance(uniform, uniform), 0.0, 1e-12);
+    // A tenth of the samples moved to the top: a tenth (to the coarse bins' rounding).
+    std::vector<float> moved = values;
+    for (int i = 0; i < 100; ++i) moved[static_cast<std::size_t>(i)] = 0.999f;
+    EXPECT_NEAR(histogram_distance(uniform, ValueHistogram::of(moved)), 0.1, 0.02);
+    // Disjoint ranges: everything moved.
+    std::vector<float> shifted;
+    for (const float v : values) shifted.push_back(v + 5.0f);
+    EXPECT_NEAR(histogram_distance(uniform, ValueHistogram::of(shifted)), 1.0, 1e-9);
+    EXPECT_EQ(histogram_distance(uniform, ValueHistogram::of(std::vector<float>{})), 0.0);
+}
+
 }  // namespace
 }  // namespace insitu

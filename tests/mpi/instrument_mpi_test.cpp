@@ -324,6 +324,21 @@ TEST(InstrumentMpi, RefusesLightFields) {
     }
 }
 
+// An error budget is measured against the whole field's ground truth on one process: refused
+// on every rank, at construction, naming the key.
+TEST(InstrumentMpi, RefusesAnErrorBudget) {
+    const std::string directory = shared_directory("budget");
+    std::string config = configuration(directory + "/budget.cdb", "[0.35]", "uniform");
+    config.insert(config.size() - 1, R"(, "budget": {"psnr_db": 40})");
+    try {
+        mpi::instrument_from_json_text(config, MPI_COMM_WORLD);
+        ADD_FAILURE() << "a distributed instrument took a budget";
+    } catch (const InvalidArgument& error) {
+        EXPECT_NE(std::string(error.what()).find("rank 0: \"budget\""), std::string::npos)
+            << error.what();
+    }
+}
+
 }  // namespace
 }  // namespace insitu
 

@@ -97,7 +97,9 @@ struct ColourModelConfig {
 
 /// "budget": what a step may cost and how accurate its proxies must be; the Instrument measures
 /// candidate configurations in situ and archives with the cheapest that meets it (fewest bytes,
-/// then least time), else the most accurate affordable one, else the cheapest (issue 17). Any
+/// then least time), else the most accurate affordable one, else the cheapest (issue 17); with
+/// cost limits only, the most accurate affordable one. Candidates are measured in increasing
+/// interval count, stopping after the first count that meets an accuracy asked. Any
 /// subset of the three limits; with several fields each gets an even share of bytes and time.
 /// The bytes and time are the field's views' single-perspective proxies, rendering and preview
 /// (the multi-perspective, training and light-field passes come on top). Distributed runs
@@ -110,10 +112,10 @@ struct BudgetConfig {
     std::optional<double> bytes_per_step;  ///< "bytes_per_step": a step's archived bytes, > 0
     std::optional<double> ms_per_step;     ///< "ms_per_step": a step's passes' time, > 0
     /// "check_every": archived steps between two checks, >= 1. A check costs a ground-truth
-    /// pass and one proxy pass per candidate (kBudgetCandidates) for each field's first view,
-    /// so 10 keeps it under a tenth of a default run's passes; a field whose 1st-99th
-    /// percentile range moved by more than a quarter of its width since the last check is
-    /// checked at once (a reaction front, a shock), whatever the count.
+    /// pass and one proxy pass per candidate (kBudgetIntervalCounts x 2 modes) for each field's
+    /// first view; a field more than kBudgetMovedShare of whose values moved since the last
+    /// check (histogram_distance: a reaction front spreading, a shock) is checked at once,
+    /// whatever the count.
     int check_every = 10;
     /// "choose": what the budget may choose. Today the intervals (count and mode), which are
     /// what the recomposition's accuracy and the archive's bytes turn on; by default chosen
@@ -124,6 +126,9 @@ struct BudgetConfig {
 /// Interval counts and modes a budget check measures: L in {4, 8, 16, 32}, uniform and
 /// histogram-equalised.
 inline constexpr int kBudgetIntervalCounts[] = {4, 8, 16, 32};
+/// Share of a field's samples whose values may move (histogram_distance) before the budget is
+/// checked again ahead of "check_every".
+inline constexpr double kBudgetMovedShare = 0.1;
 
 /// Largest K a configuration may ask for (the fit's cost grows with K, and K rows are stored).
 constexpr int kMaxColourModelClusters = 1024;

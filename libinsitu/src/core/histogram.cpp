@@ -72,6 +72,43 @@ double ValueHistogram::percentile(double fraction) const {
     return max;
 }
 
+double histogram_distance(const ValueHistogram& a, const ValueHistogram& b) {
+    const double total_a = a.total(), total_b = b.total();
+    if (!(total_a > 0.0) || !(total_b > 0.0)) return 0.0;
+    const double low = std::min(a.min, b.min);
+    const double high = std::max(a.max, b.max);
+    std::vector<double> p(kHistogramDistanceBins, 0.0), q(kHistogramDistanceBins, 0.0);
+    // Each bin's samples spread evenly over its width, shared among the coarse bins it overlaps
+    // (a constant field's, a point mass, into the one holding its value).
+    const double coarse_width = (high - low) / kHistogramDistanceBins;
+    const auto coarse_of = [&](double value) {
+        return std::clamp(coarse_width > 0.0 ? static_cast<int>((value - low) / coarse_width) : 0,
+                          0, kHistogramDistanceBins - 1);
+    };
+    const auto spread = [&](const ValueHistogram& h, double total, std::vector<double>& out) {
+        const double width = (h.max - h.min) / static_cast<double>(h.counts.size());
+        for (std::size_t bin = 0; bin < h.counts.size(); ++bin) {
+            const double share = h.counts[bin] / total;
+            const double from = h.min + static_cast<double>(bin) * width;
+            const double to = from + width;
+            if (!(width > 0.0) || !(coarse_width > 0.0)) {
+                out[static_cast<std::size_t>(coarse_of(from))] += share;
+                continue;
+            }
+            for (int c = coarse_of(from); c <= coarse_of(to); ++c) {
+                const double lo = std::max(from, low + c * coarse_width);
+                const double hi = std::min(to, low + (c + 1) * coarse_width);
+                if (hi > lo) out[static_cast<std::size_t>(c)] += share * (hi - lo) / width;
+            }
+        }
+    };
+    spread(a, total_a, p);
+    spread(b, total_b, q);
+    double l1 = 0.0;
+    for (int bin = 0; bin < kHistogramDistanceBins; ++bin) l1 += std::abs(p[bin] - q[bin]);
+    return std::min(1.0, 0.5 * l1);
+}
+
 nlohmann::json ValueHistogram::to_json() const {
     nlohmann::json bins = nlohmann::json::array();
     for (double count : counts) bins.push_back(static_cast<std::uint64_t>(count));

@@ -43,4 +43,12 @@ struct ValueHistogram {
     static ValueHistogram from_json(const nlohmann::json& json, const std::string& where);
 };
 
+/// The share of the samples whose values moved between two histograms, in [0, 1]: half the L1
+/// distance of the two as distributions on kHistogramDistanceBins bins over the union of their
+/// ranges (each bin's count at its centre). 0 for equal distributions, 1 for disjoint ones; 0
+/// when either has no samples. An error budget re-checks a field whose distance from its last
+/// check exceeds a tenth (BudgetConfig).
+double histogram_distance(const ValueHistogram& a, const ValueHistogram& b);
+constexpr int kHistogramDistanceBins = 64;
+
 }  // namespace insitu
