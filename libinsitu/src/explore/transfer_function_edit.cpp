@@ -238,6 +238,16 @@ void check_trust_image(const Image* image, const Image& reference, int channels,
     }
 }
 
+/// Interval j's transmittance t_j as estimate_attenuation infers it (its definition, step 2), T
+/// the stored transmittance in front of it; `tau` may be null.
+double inferred_transmittance(double a_j, double transmittance, const float* tau, int j) {
+    if (tau) return std::exp(-std::max(0.0, double(tau[j])));
+    if (!(transmittance > 0.0)) return 1.0;
+    const double behind = transmittance - a_j;
+    return behind > kFloatAttenuationResolution ? std::clamp(behind / transmittance, 0.0, 1.0)
+                                                : 0.0;
+}
+
 /// estimate_attenuation's walk over the intervals in the order [first, last) of (depth, index)
 /// pairs, recomposed with `colours` into rgb: the edit's colour if the ray met the intervals
 /// in that order, one run each.
@@ -249,14 +259,7 @@ void recompose_in_order(const float* a, const float* tau, const std::vector<doub
     double transmittance = 1.0, edited_transmittance = 1.0;
     for (Iterator entry = first; entry != last; ++entry) {
         const int j = entry->second;
-        double t = 1.0;
-        if (tau) {
-            t = std::exp(-std::max(0.0, double(tau[j])));
-        } else if (transmittance > 0.0) {
-            const double behind = transmittance - a[j];
-            t = behind > kFloatAttenuationResolution ? std::clamp(behind / transmittance, 0.0, 1.0)
-                                                     : 0.0;
-        }
+        const double t = inferred_transmittance(a[j], transmittance, tau, j);
         const double edited = scales[j] > 0.0 ? std::pow(t, scales[j]) : 1.0;
         const double a_edited = edited_transmittance * (1.0 - edited);
         for (int c = 0; c < 3; ++c) rgb[c] += a_edited * colours[3 * j + c];
@@ -319,16 +322,12 @@ Image edit_error(const EditTrustInputs& inputs) {
         for (const auto& [depth, j] : order) {
             (void)depth;
             const double s = scales[j];
-            double t = 1.0, uncertainty = 0.0;
+            const double t = inferred_transmittance(a[j], transmittance, tau, j);
+            // Stored tau is known relatively, a_j absolutely (so t_j to within res / T).
+            double uncertainty = 0.0;
             if (tau) {
-                const double optical = std::max(0.0, double(tau[j]));
-                t = std::exp(-optical);
-                uncertainty = t * optical * resolution;
+                uncertainty = t * std::max(0.0, double(tau[j])) * resolution;
             } else if (transmittance > 0.0) {
-                const double behind = transmittance - a[j];
-                t = behind > kFloatAttenuationResolution
-                        ? std::clamp(behind / transmittance, 0.0, 1.0)
-                        : 0.0;
                 uncertainty = resolution / transmittance;
             }
             if (s > 0.0 && uncertainty > 0.0) {
