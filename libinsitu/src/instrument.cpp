@@ -614,7 +614,10 @@ Instrument::Impl::FieldPlan Instrument::Impl::plan_field(const Field& field, std
     const std::optional<std::vector<double>>& layers = config.layers_of(field.name());
     plan.isovalues =
         layers ? *layers : renderer->choose_layers(plan.transfer_function, config.max_auto_layers);
-    plan.intervals = renderer->choose_intervals(config.interval_count, config.interval_mode);
+    // A budget that chooses the intervals sets them itself (apply_budget).
+    if (!config.budget || !config.budget->chooses_intervals) {
+        plan.intervals = renderer->choose_intervals(config.interval_count, config.interval_mode);
+    }
     if (config.budget) plan.budget = apply_budget(plan);
     return plan;
 }

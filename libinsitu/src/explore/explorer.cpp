@@ -291,6 +291,22 @@ void Explorer::refresh() {
     std::lock_guard<std::mutex> lock(mutex_);
     // Steps are immutable once the manifest names them, so the cached frames stay valid.
     archive_ = std::make_unique<ArchiveReader>(path_);
+    attenuation_resolution_.reset();
+}
+
+double Explorer::stored_attenuation_resolution() {
+    if (!attenuation_resolution_) {
+        // Half, the coarser, where the configuration cannot be read: the trust then errs on the
+        // side of flagging.
+        StoragePrecision precision = StoragePrecision::half;
+        try {
+            precision = archive_->configuration().precision;
+        } catch (const ParseError&) {
+        }
+        attenuation_resolution_ = precision == StoragePrecision::half ? kHalfAttenuationResolution
+                                                                      : kFloatAttenuationResolution;
+    }
+    return *attenuation_resolution_;
 }
 
 const Explorer::CachedStep& Explorer::load(std::int64_t step, int view) {
@@ -396,11 +412,12 @@ void finish_frame(FrameBasis basis, const ExploreRequest& request,
         for (std::size_t j = 0; j < scales.size(); ++j) scales[j] *= explicit_scales[j];
         const bool opacity_edited =
             std::any_of(scales.begin(), scales.end(), [](double s) { return s != 1.0; });
-        // The trust of an edit compares the edited attenuation with the stored one.
-        const Image stored_attenuation = edits ? basis.attenuation : Image();
+        // The trust of an edit compares the edited attenuation with the stored one, kept here.
+        Image stored_attenuation;
         if (opacity_edited) {
             frame.opacity_scales = scales;
-            basis.attenuation = estimate_attenuation(basis.attenuation, basis.mean_depth,
+            stored_attenuation = std::move(basis.attenuation);
+            basis.attenuation = estimate_attenuation(stored_attenuation, basis.mean_depth,
                                                      basis.optical_depth, scales, device);
         }
 
@@ -423,12 +440,12 @@ void finish_frame(FrameBasis basis, const ExploreRequest& request,
                                   " intervals, the attenuation proxies ", interval_count);
         }
         frame.colour_source = use_model ? ColourSource::model : ColourSource::recompose;
-        const Image recomposed = recolour(basis.attenuation, colours, device);
-        frame.colour = use_model ? model->predict(basis.attenuation, device) : recomposed;
+        frame.colour = use_model ? model->predict(basis.attenuation, device)
+                                 : recolour(basis.attenuation, colours, device);
         if (edits) {
             // Trust for the edit (transfer_function_edit.hpp), on top of the view's own mask.
             EditTrustInputs trust;
-            trust.attenuation = &stored_attenuation;
+            trust.attenuation = opacity_edited ? &stored_attenuation : &basis.attenuation;
             trust.mean_depth = &basis.mean_depth;
             trust.optical_depth = basis.optical_depth;
             trust.interleaving = basis.interleaving;
@@ -438,7 +455,10 @@ void finish_frame(FrameBasis basis, const ExploreRequest& request,
             trust.colour_spread = interval_colour_spread(shown_tf, intervals);
             trust.attenuation_resolution = basis.attenuation_resolution;
             Image error = edit_error(trust);
-            if (use_model) add_model_departure(error, frame.colour, recomposed);
+            if (use_model) {
+                add_model_departure(error, frame.colour,
+                                    recolour(basis.attenuation, colours, device));
+            }
             const Image confidence = edit_confidence(error);
             for (std::size_t p = 0; p < confidence.pixels.size(); ++p) {
                 frame.confidence.pixels[p] =
@@ -599,12 +619,11 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
     const bool shows_stored_tf =
         !request.transfer_function || request.transfer_function->to_json() == stored_tf.to_json();
 
-    const double attenuation_resolution =
-        archive_->configuration().precision == StoragePrecision::half ? kHalfAttenuationResolution
-                                                                      : kFloatAttenuationResolution;
-
     // The light field's frame: reconstructed, then steps 4-7 as for any proxies.
     const bool edits = request.transfer_function.has_value() || !request.opacity_scales.empty();
+    // Only an edit's trust reads it (FrameBasis::attenuation_resolution).
+    const double attenuation_resolution =
+        edits ? stored_attenuation_resolution() : kHalfAttenuationResolution;
     auto light_field_frame = [&]() {
         light_field =
             load_light_field(request.step, field, cameras_facing(light_field->rig, target));

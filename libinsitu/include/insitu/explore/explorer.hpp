@@ -143,6 +143,10 @@ private:
         LightField light_field;
     };
     std::optional<CachedLightField> light_field_cache_;
+    /// How exactly the archive stores a_j, by its "precision" (EditTrustInputs); read once per
+    /// refresh, on the first edit.
+    double stored_attenuation_resolution();
+    std::optional<double> attenuation_resolution_;
 
     std::string path_;
     std::shared_ptr<ComputeDevice> device_;
