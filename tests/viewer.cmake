@@ -92,6 +92,17 @@ set_tests_properties(viewer.webgl PROPERTIES
                      ENVIRONMENT "INSITU_VIEW=$<TARGET_FILE:insitu-view>;ARCHIVE=${viewer_lf_archive};WORK_DIR=${viewer_work}"
                      TIMEOUT 180)
 
+# The stored view drawn by the page from its single-perspective proxies (/api/proxies,
+# /api/recipe): proxies.test.mjs edits, relights, occludes, enhances and changes the step on the
+# same archive, comparing the canvas with `insitu-view render` each time.
+add_test(NAME viewer.proxies
+         COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/proxies.test.mjs
+         WORKING_DIRECTORY ${viewer_tests_dir})
+set_tests_properties(viewer.proxies PROPERTIES
+                     FIXTURES_REQUIRED viewer_lf_archive
+                     ENVIRONMENT "INSITU_VIEW=$<TARGET_FILE:insitu-view>;ARCHIVE=${viewer_lf_archive};WORK_DIR=${viewer_work}"
+                     TIMEOUT 180)
+
 # Per-segment fades (issue 15): the same run with its light field split at opacity 0.5 into two
 # segments, depth in half floats; segments.test.mjs moves the page's faders and compares the
 # canvas with `insitu-view render --source lightfield --segment-opacity`, checks the refusals of

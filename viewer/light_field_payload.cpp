@@ -9,6 +9,7 @@
 
 #include "insitu/core/check.hpp"
 #include "insitu/error.hpp"
+#include "payload_header.hpp"
 
 namespace insitu::viewer {
 namespace {
@@ -131,15 +132,7 @@ std::string light_field_payload(const LightField& light_field, std::int64_t step
                         {"depth", rgba_bytes},
                         {"segment_depth", segments > 1 ? rgba_bytes + first_hit_bytes : 0},
                         {"depth_type", depth_bits == 8 ? "uint8 code" : "half"}}}};
-    std::string text = header.dump();
-    text.resize((text.size() + 7) / 8 * 8, ' ');
-
-    std::string out = "insituLF";
-    const std::uint32_t version = kLightFieldPayloadVersion;
-    const auto header_bytes = static_cast<std::uint32_t>(text.size());
-    out.append(reinterpret_cast<const char*>(&version), 4);
-    out.append(reinterpret_cast<const char*>(&header_bytes), 4);
-    out += text;
+    std::string out = payload_opening("insituLF", kLightFieldPayloadVersion, header);
     const std::size_t data_start = out.size();
     out.reserve(data_start + rgba_bytes + first_hit_bytes * (segments > 1 ? segments + 1 : 1));
     for (const LightFieldImages& images : light_field.cameras) {

@@ -42,6 +42,7 @@
 #include "insitu/explore/transfer_function_edit.hpp"
 #include "insitu/explore/trust.hpp"
 #include "light_field_payload.hpp"
+#include "proxy_payload.hpp"
 
 namespace insitu::viewer {
 
@@ -87,8 +88,8 @@ constexpr int kReadTimeoutSeconds = 5;
 constexpr int kWriteTimeoutSeconds = 10;
 constexpr int kKeepAliveTimeoutSeconds = 2;
 constexpr std::size_t kMaxStepInfos = 64;
-/// Light-field payloads kept in memory: the step shown and the ones a scrubbing page prefetches.
-constexpr std::size_t kMaxLightFieldPayloads = 4;
+/// Payloads (light fields, proxies) kept in memory: the steps shown and those a page prefetches.
+constexpr std::size_t kMaxPayloads = 8;
 
 /// Content type of a page file, from its name's extension.
 std::string web_content_type(const std::string& name) {
@@ -265,9 +266,13 @@ public:
         server.Get("/api/archive", guarded([this](const auto& r, auto& s) { archive(r, s); }));
         server.Get("/api/lightfield",
                    guarded([this](const auto& r, auto& s) { light_field(r, s); }));
+        server.Get("/api/proxies", guarded([this](const auto& r, auto& s) { proxies(r, s); }));
         server.Get("/api/step", guarded([this](const auto& r, auto& s) { step_info(r, s); }));
         server.Get("/api/trust", guarded([this](const auto& r, auto& s) { trust(r, s); }));
         server.Get("/api/status", guarded([this](const auto& r, auto& s) { status(r, s); }));
+        const auto recipe_handler = guarded([this](const auto& r, auto& s) { frame_recipe(r, s); });
+        server.Get("/api/recipe", recipe_handler);
+        server.Post("/api/recipe", recipe_handler);
         for (const bool mask : {false, true}) {
             const char* route = mask ? "/api/mask" : "/api/frame";
             const auto handler =
@@ -588,9 +593,7 @@ private:
     }
 
     /// The light field of the field that (step, view) shows, as light_field_payload encodes it
-    /// for the page's WebGL2 renderer: gzip-compressed when the client accepts it, with an ETag
-    /// (the file's modification time and size: a step's files never change once listed) so that
-    /// a revisited step costs a 304. The last few payloads stay in memory for a scrubbing page.
+    /// for the page's WebGL2 renderer (send_payload: gzip, ETag, a few kept in memory).
     void light_field(const httplib::Request& request, httplib::Response& response) {
         const StepKey key = step_key(request);
         std::lock_guard<std::mutex> lock(engine_mutex_);
@@ -605,26 +608,63 @@ private:
                                      " has no light field of field \"" + field + "\"");
         }
         require_inside(stored->exr_path);
-        const auto [modified, size] = stamp_of(stored->exr_path);
-        const std::string etag = "\"lf" + std::to_string(kLightFieldPayloadVersion) + "-" +
-                                 std::to_string(key.step) + "-" + std::to_string(modified) + "-" +
-                                 std::to_string(size) + "\"";
+        send_payload(request, response,
+                     payload_etag("lf", kLightFieldPayloadVersion, key, stored->exr_path), [&] {
+                         return light_field_payload(reader.load_light_field(key.step, field),
+                                                    key.step, field);
+                     });
+    }
+
+    /// The stored view's single-perspective proxies of (step, view), as proxy_payload encodes
+    /// them for the page's WebGL2 renderer; sent as light_field() sends its payload. 404 where
+    /// the view has no single-perspective attenuation proxies (the page then asks for frames).
+    void proxies(const httplib::Request& request, httplib::Response& response) {
+        const StepKey key = step_key(request);
+        std::lock_guard<std::mutex> lock(engine_mutex_);
+        const ArchiveReader& reader = explorer_->archive();
+        const ArchivedView entry = reader.entry(key.step, key.view);
+        const std::string where =
+            "step " + std::to_string(key.step) + " view " + std::to_string(key.view);
+        if (entry.exr_path.empty()) throw HttpError(404, where + " has no proxies");
+        require_inside(entry.exr_path);
+        send_payload(request, response,
+                     payload_etag("px", kProxyPayloadVersion, key, entry.exr_path), [&] {
+                         const ProxyFrame frame = reader.load(key.step, key.view);
+                         if (frame.attenuation.channels < 1) {
+                             throw HttpError(404, where + " has no attenuation proxies");
+                         }
+                         return proxy_payload(frame, key.step, key.view, entry.field);
+                     });
+    }
+
+    /// A payload's ETag: its kind and format version, the step, and the file's modification time
+    /// and size (a step's files never change once listed).
+    static std::string payload_etag(const char* kind, std::uint32_t version, const StepKey& key,
+                                    const fs::path& file) {
+        const auto [modified, size] = stamp_of(file);
+        return "\"" + std::string(kind) + std::to_string(version) + "-" + std::to_string(key.step) +
+               "-" + std::to_string(key.view) + "-" + std::to_string(modified) + "-" +
+               std::to_string(size) + "\"";
+    }
+
+    /// Sends a binary payload: gzip-compressed when the client accepts it, a 304 when the client
+    /// holds `etag` already; the last few payloads stay in memory for a scrubbing page. Caller
+    /// holds the engine lock (`make` reads the archive).
+    void send_payload(const httplib::Request& request, httplib::Response& response,
+                      const std::string& etag, const std::function<std::string()>& make) {
         response.set_header("ETag", etag);
         response.set_header("Cache-Control", "no-cache");
         if (request.get_header_value("If-None-Match") == etag) {
             response.status = 304;
             return;
         }
-        auto cached = std::find_if(light_field_payloads_.begin(), light_field_payloads_.end(),
+        auto cached = std::find_if(payloads_.begin(), payloads_.end(),
                                    [&](const auto& entry) { return entry.first == etag; });
-        if (cached == light_field_payloads_.end()) {
-            const std::string payload =
-                light_field_payload(reader.load_light_field(key.step, field), key.step, field);
-            if (light_field_payloads_.size() >= kMaxLightFieldPayloads) {
-                light_field_payloads_.erase(light_field_payloads_.begin());
-            }
-            light_field_payloads_.emplace_back(etag, std::pair{payload, gzip(payload)});
-            cached = std::prev(light_field_payloads_.end());
+        if (cached == payloads_.end()) {
+            const std::string payload = make();
+            if (payloads_.size() >= kMaxPayloads) payloads_.erase(payloads_.begin());
+            payloads_.emplace_back(etag, std::pair{payload, gzip(payload)});
+            cached = std::prev(payloads_.end());
         }
         const auto& [raw, compressed] = cached->second;
         response.set_header("X-Insitu-Payload-Bytes", std::to_string(raw.size()));
@@ -684,6 +724,55 @@ private:
         require_listed_locked(request.step, request.view);
         require_files_inside(request.step, request.view);
         return explorer_->render(request);
+    }
+
+    /// What the page needs besides /api/proxies to draw the frame these options ask for itself
+    /// (Explorer::recipe), as JSON; the same options and refusals as /api/frame.
+    void frame_recipe(const httplib::Request& request, httplib::Response& response) {
+        const auto [options, session] = options_of(request);
+        const ExploreRequest explore = request_from_options(options);
+        check_limits(explore);
+        check_segments(explore, options);
+        FrameRecipe recipe;
+        {
+            std::lock_guard<std::mutex> lock(engine_mutex_);
+            require_listed_locked(explore.step, explore.view);
+            require_files_inside(explore.step, explore.view);
+            recipe = explorer_->recipe(explore);
+        }
+        const auto rgb = [](const glm::dvec3& v, double scale) {
+            return nlohmann::json::array({scale * v.x, scale * v.y, scale * v.z});
+        };
+        nlohmann::json body{{"drawable", recipe.drawable},
+                            {"why_not", recipe.why_not},
+                            {"stored_rendering", recipe.stored_rendering},
+                            {"opacity_edited", recipe.opacity_edited},
+                            {"opacity_scales", recipe.opacity_scales},
+                            {"colours", recipe.colours},
+                            {"colour_source", to_string(recipe.colour_source)}};
+        if (recipe.lighting) {
+            nlohmann::json lights = nlohmann::json::array();
+            for (const Light& light : recipe.lighting->lights) {
+                lights.push_back({{"direction", rgb(light.direction_world, 1.0)},
+                                  {"diffuse", rgb(light.colour, light.diffuse)},
+                                  {"specular", rgb(light.colour, light.specular)},
+                                  {"shininess", light.shininess}});
+            }
+            body["lighting"] = {{"ambient", recipe.lighting->ambient}, {"lights", lights}};
+        }
+        if (recipe.ambient_occlusion) {
+            const OcclusionTerms& ao = *recipe.ambient_occlusion;
+            body["ambient_occlusion"] = {{"radius", ao.radius_pixels},
+                                         {"strength", ao.strength},
+                                         {"inverse_depth_scale", ao.inverse_depth_scale},
+                                         {"inverse_neighbours", ao.inverse_neighbours}};
+        }
+        if (recipe.enhancement) {
+            body["enhancement"] = {{"lambda", recipe.enhancement->lambda},
+                                   {"gamma", recipe.enhancement->gamma}};
+        }
+        response.set_header("Cache-Control", "no-store");
+        response.set_content(body.dump(), "application/json");
     }
 
     void frame(const httplib::Request& request, httplib::Response& response, bool mask) {
@@ -809,8 +898,8 @@ private:
     std::map<StepKey, std::string> step_infos_;
     std::map<StepKey, std::string> trust_;
     std::map<StepKey, int> segment_counts_;
-    /// (ETag, (payload, its gzip)), oldest first.
-    std::vector<std::pair<std::string, std::pair<std::string, std::string>>> light_field_payloads_;
+    /// (ETag, (payload, its gzip)), oldest first: light fields and proxies.
+    std::vector<std::pair<std::string, std::pair<std::string, std::string>>> payloads_;
     FrameScheduler scheduler_;
     std::mutex masks_mutex_;
     /// Per session, the options and confidence of its last frame, for the overlay.

@@ -408,6 +408,64 @@ TEST_F(ExplorerTest, BadRequestsNameWhatIsWrong) {
                                                   "has no colour model");
 }
 
+// The recipe a client draws the stored view from holds the terms render() applied: the same
+// scales, the colours of the shown function, the stored rendering where render() shows it; and
+// says what it cannot draw.
+TEST_F(ExplorerTest, TheRecipeHoldsTheTermsRenderApplies) {
+    write_steps({1});
+    Explorer explorer(config_.archive);
+    ExploreRequest plain;
+    plain.step = 1;
+    const FrameRecipe stored = explorer.recipe(plain);
+    EXPECT_TRUE(stored.drawable) << stored.why_not;
+    EXPECT_TRUE(stored.stored_rendering);
+    EXPECT_EQ(stored.colour_source, ColourSource::stored);
+    EXPECT_EQ(explorer.render(plain).colour_source, ColourSource::stored);
+    EXPECT_EQ(stored.opacity_scales, std::vector<double>(kIntervals, 1.0));
+
+    ExploreRequest edited = plain;
+    const TransferFunction tf = *config_.transfer_function;
+    std::vector<ControlPoint> points = tf.rows().front().points;
+    for (ControlPoint& point : points) point.rgba = glm::vec4(1.0f, 0.5f, 0.0f, point.rgba.a);
+    edited.transfer_function = TransferFunction(points, tf.unit_length());
+    edited.opacity_scales = {{3, 0.25}};
+    edited.lighting = LightingSettings{};
+    edited.lighting->lights.front().direction_world = glm::dvec3(0.0);  // a headlight
+    edited.ambient_occlusion = AmbientOcclusionSettings{};
+    const FrameRecipe recipe = explorer.recipe(edited);
+    const ExploreFrame frame = explorer.render(edited);
+    EXPECT_TRUE(recipe.drawable) << recipe.why_not;
+    EXPECT_FALSE(recipe.stored_rendering);
+    EXPECT_TRUE(recipe.opacity_edited);
+    EXPECT_EQ(recipe.opacity_scales, frame.opacity_scales);
+    EXPECT_EQ(recipe.opacity_scales[3], 0.25);
+    EXPECT_EQ(recipe.colour_source, frame.colour_source);
+    ASSERT_EQ(recipe.colours.size(), 3u * kIntervals);
+    for (int j = 1; j < kIntervals; ++j) {  // every interval is orange now
+        EXPECT_NEAR(recipe.colours[3 * j], 1.0f, 1e-6f) << j;
+        EXPECT_NEAR(recipe.colours[3 * j + 1], 0.5f, 1e-6f) << j;
+    }
+    ASSERT_TRUE(recipe.lighting.has_value());
+    EXPECT_EQ(recipe.lighting->lights.front().direction_world, glm::dvec3(0.0))
+        << "a headlight stays for the client to aim";
+    ASSERT_TRUE(recipe.ambient_occlusion.has_value());
+    EXPECT_EQ(recipe.ambient_occlusion->radius_pixels, 8);
+    EXPECT_GT(recipe.ambient_occlusion->inverse_neighbours, 0.0);
+
+    ExploreRequest orbit = plain;
+    orbit.azimuth_deg = 50.0;
+    const FrameRecipe synthesised = explorer.recipe(orbit);
+    EXPECT_FALSE(synthesised.drawable);
+    EXPECT_THAT(synthesised.why_not, HasSubstr("synthesised view"));
+    ExploreRequest multi = plain;
+    multi.source = ProxySource::multi;
+    EXPECT_FALSE(explorer.recipe(multi).drawable);
+    ExploreRequest bad = plain;
+    bad.opacity_scales = {{kIntervals, 0.5}};
+    testing::expect_error_naming<InvalidArgument>([&] { explorer.recipe(bad); },
+                                                  "opacity-scale interval 6");
+}
+
 TEST_F(ExplorerTest, StepsWrittenLaterAppearAfterRefresh) {
     write_steps({1});
     Explorer explorer(config_.archive);

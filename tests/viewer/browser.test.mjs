@@ -3,7 +3,8 @@
 // opacity, recolour an interval, toggle ambient occlusion and the confidence overlay, save the
 // edited transfer function and load it back. After each action the displayed frame must have
 // changed as the action implies and its pixels must equal the PNG `insitu-view render` writes
-// for the same options.
+// for the same options. The page draws nothing itself here (?gpu=off): these are the server's
+// frames.
 //
 //   INSITU_VIEW=build/viewer/insitu-view ARCHIVE=viewer.cdb WORK_DIR=dir node browser.test.mjs
 import assert from 'node:assert/strict';
@@ -83,7 +84,9 @@ test('the page walks through steps, orbit, opacity, colour, AO and the mask', as
   const steps = archiveInfo.timeline.map((entry) => entry.step);
   assert.ok(steps.length >= 2, 'the fixture archive holds at least two steps');
 
-  await page.goto(server.url);
+  // The server's frames, which equal the CLI's exactly (proxies.test.mjs and webgl.test.mjs
+  // cover the frames the browser draws).
+  await page.goto(`${server.url}?gpu=off`);
   let frame = await settledFrame(0);
   assert.deepEqual(frame.options, { step: String(steps[0]), view: '0' });
   assertMatchesCli(frame);

@@ -66,6 +66,10 @@ async function start() {
   installOrbitDrag();
   viewer.gpu = await GpuFrames.create($('gpu-frame'));
   $('gpu-toggle').disabled = !viewer.gpu;
+  // ?gpu=off opens the page with the server's frames only (to compare, or on a slow GPU).
+  if (new URLSearchParams(window.location.search).get('gpu') === 'off') {
+    $('gpu-toggle').checked = false;
+  }
   $('gpu-toggle').addEventListener('change', requestFrame);
   try {
     await loadArchive();

@@ -1,35 +1,81 @@
 // Frames: at most one in flight; a control moved meanwhile is drawn once that one is done (the
-// server also coalesces, per session). Orbit views of a step with a light field are drawn here
-// by WebGL2 (gpu_frames.js); every other frame is the server's exploration engine's PNG. The
-// confidence overlay is the engine's mask of the frame shown.
+// server also coalesces, per session). Orbit views of a step with a light field, and the stored
+// view where its recipe allows (/api/recipe), are drawn here by WebGL2 (gpu_frames.js); every
+// other frame is the server's exploration engine's PNG. The confidence overlay is the engine's
+// mask of the frame shown.
 import { $, FPS_WINDOW_MS, errorText, session, showError, state, viewer } from './page.js';
 import { currentOptions, sameOptions } from './explore_options.js';
 import { schedulePlay } from './timeline.js';
 
 let inFlight = false;
 
-// Whether the browser draws this frame: an orbit view (the stored view is the archive's own
-// proxies, exact) of a step with a light field, without what only the server's engine does
-// (transfer-function edits, lighting, enhancement).
+// Whether the browser draws this frame from the light field: an orbit view (the stored view is
+// the archive's own proxies, exact) of a step with a light field, without what only the server's
+// engine does (transfer-function edits, lighting, enhancement).
 export function drawnInBrowser(options) {
   return Boolean(viewer.gpu && $('gpu-toggle').checked && state.lightField && state.info &&
-    state.info.camera && options.azimuth !== undefined && !options.tf &&
+    state.info.camera && options.azimuth !== undefined && !atStoredView(options) && !options.tf &&
     !options['opacity-scale'] && !options.light && !options.ao && !options.enhance);
+}
+
+// Angles equal up to a turn and rounding, as the engine's same_angle.
+function sameAngle(a, b) {
+  const difference = ((a - b) % 360 + 540) % 360 - 180;
+  return Math.abs(difference) < 1e-9;
+}
+
+function atStoredView(options) {
+  return options.azimuth === undefined || Boolean(state.info && state.info.camera &&
+    sameAngle(Number(options.azimuth), state.info.camera.azimuth) &&
+    sameAngle(Number(options.elevation), state.info.camera.elevation));
+}
+
+// Whether the browser may draw this frame from the stored view's proxies; the frame's recipe
+// then says whether it does (the colour model, for one, is the server's).
+function storedViewInBrowser(options) {
+  return Boolean(viewer.gpu && viewer.gpu.proxyRenderer && $('gpu-toggle').checked &&
+    state.info && state.info.camera && atStoredView(options));
+}
+
+const recipes = new Map();  // options JSON -> Promise of the recipe
+const KEPT_RECIPES = 32;
+
+function recipeFor(options) {
+  const key = JSON.stringify(options);
+  if (!recipes.has(key)) {
+    recipes.set(key, fetch('api/recipe', { method: 'POST', body: new URLSearchParams(options) })
+      .then(async (response) => {
+        if (!response.ok) throw new Error(await errorText(response));
+        return response.json();
+      })
+      .catch((error) => {
+        recipes.delete(key);
+        throw error;
+      }));
+    while (recipes.size > KEPT_RECIPES) recipes.delete(recipes.keys().next().value);
+  }
+  return recipes.get(key);
 }
 
 export function requestFrame() {
   const options = currentOptions();
   if (!options || inFlight) return;
   const preview = state.dragging && drawnInBrowser(options);
+  const inBrowser = drawnInBrowser(options) || storedViewInBrowser(options);
   // The same options drawn the same way (toggling "draw in the browser" redraws them).
   if (viewer.displayed && sameOptions(viewer.displayed.options, options) &&
-    !(viewer.displayed.preview && !preview) &&
-    Boolean(viewer.displayed.gpu) === drawnInBrowser(options)) return;
+    !(viewer.displayed.preview && !preview) && Boolean(viewer.displayed.gpu) === inBrowser) return;
   inFlight = true;
   if (drawnInBrowser(options)) {
     drawInBrowser(options, preview);
-    return;
+  } else if (storedViewInBrowser(options)) {
+    drawStoredView(options);
+  } else {
+    serverFrame(options);
   }
+}
+
+function serverFrame(options) {
   const sent = performance.now();
   const body = new URLSearchParams({ ...options, session });
   fetch('api/frame', { method: 'POST', body })
@@ -47,6 +93,35 @@ export function requestFrame() {
     })
     .catch((error) => showError(String(error)))
     .finally(frameDone);
+}
+
+// The stored view from its proxies, where the recipe allows; else (or when the server refuses
+// the options: it says why in the frame's answer) the server's frame.
+async function drawStoredView(options) {
+  const entry = state.timeline[state.stepIndex];
+  let recipe = null;
+  try {
+    recipe = await recipeFor(options);
+  } catch (error) {
+    serverFrame(options);
+    return;
+  }
+  if (!recipe.drawable) {
+    serverFrame(options);
+    return;
+  }
+  viewer.gpu.drawStoredView(entry.step, state.view, recipe)
+    .then((timing) => {
+      if (!timing) {
+        serverFrame(options);
+        return null;
+      }
+      return showGpuFrame(options, timing, 'stored view', recipe.colour_source).then(frameDone);
+    })
+    .catch((error) => {
+      showError(String(error));
+      frameDone();
+    });
 }
 
 function frameDone() {
@@ -78,23 +153,29 @@ function drawInBrowser(options, preview) {
     Number(options.elevation), state.segmentScales.slice(), preview)
     .then((timing) => {
       if (!timing) throw new Error('the step has no light field');
-      showCanvas(true);
-      // A preview is smaller than the view: scaled up smoothly, not in blocks.
-      $('gpu-frame').style.imageRendering = preview ? 'auto' : '';
-      if (viewer.displayed && viewer.displayed.url) URL.revokeObjectURL(viewer.displayed.url);
-      viewer.displayed = { options, gpu: true, preview, milliseconds: timing.milliseconds,
-        synthesised: true };
-      const fps = countFrame();
-      const open = viewer.gpu.lastOpen;
-      $('readout').textContent =
-        `frame ${timing.milliseconds.toFixed(1)} ms (WebGL2, light field${preview ? ', preview' : ''})` +
-        ` · ${fps.toFixed(1)} fps · step opened in ${(open.downloadMs + open.uploadMs).toFixed(0)} ms` +
-        ` (${(open.bytes / 1e6).toFixed(1)} MB)`;
-      showError('');
-      return updateMask();
+      return showGpuFrame(options, timing, 'light field', 'captured');
     })
     .catch((error) => showError(String(error)))
     .finally(frameDone);
+}
+
+// Shows the canvas the GPU just drew (`what`: light field or stored view).
+function showGpuFrame(options, timing, what, colourSource) {
+  const preview = timing.preview;
+  showCanvas(true);
+  // A preview is smaller than the view: scaled up smoothly, not in blocks.
+  $('gpu-frame').style.imageRendering = preview ? 'auto' : '';
+  if (viewer.displayed && viewer.displayed.url) URL.revokeObjectURL(viewer.displayed.url);
+  viewer.displayed = { options, gpu: true, drawnFrom: what, preview,
+    milliseconds: timing.milliseconds, synthesised: what === 'light field', colourSource };
+  const fps = countFrame();
+  const open = viewer.gpu.lastOpen;
+  $('readout').textContent =
+    `frame ${timing.milliseconds.toFixed(1)} ms (WebGL2, ${what}${preview ? ', preview' : ''})` +
+    ` · ${fps.toFixed(1)} fps · step opened in ${(open.downloadMs + open.uploadMs).toFixed(0)} ms` +
+    ` (${(open.bytes / 1e6).toFixed(1)} MB)` + ` · colour ${colourSource}`;
+  showError('');
+  return updateMask();
 }
 
 async function display(options, png, headers, roundTripMs) {
@@ -133,8 +214,9 @@ export async function updateMask() {
   canvas.hidden = !state.mask;
   if (!state.mask || !viewer.displayed) return;
   const options = viewer.displayed.options;
-  // A frame drawn here is the light field's: its confidence is the light field's too.
-  const source = viewer.displayed.gpu ? { source: 'lightfield' } : {};
+  // A frame drawn here from the light field has the light field's confidence; one of the stored
+  // view has the engine's (its edits' trust included).
+  const source = viewer.displayed.drawnFrom === 'light field' ? { source: 'lightfield' } : {};
   const response = await fetch('api/mask',
     { method: 'POST', body: new URLSearchParams({ ...options, ...source, session }) });
   if (!response.ok || !sameOptions(options, viewer.displayed.options)) return;

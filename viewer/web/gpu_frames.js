@@ -1,13 +1,19 @@
-// Frames drawn in the browser: the light field of the shown step, downloaded once per step (the
-// next step prefetched while the user scrubs), uploaded once, then drawn by WebGL2 for every
-// orbit angle (light_field_renderer.js). What it can draw is what reconstruct_light_field gives
-// without edits: the light field's own colours, per-segment opacity fades; everything else
-// (transfer-function edits, relighting, enhancement, the stored view's exact proxies) stays with
-// the server's frames.
+// Frames drawn in the browser, from what the data server sends once per step (the next step
+// prefetched while the user scrubs) and the GPU keeps:
+//  * orbit views from the step's light field (light_field_renderer.js): what
+//    reconstruct_light_field gives without edits, the light field's own colours and
+//    per-segment opacity fades;
+//  * the stored view from its single-perspective proxies (proxy_renderer.js), with recolouring,
+//    opacity edits, relighting, ambient occlusion and enhancement, as the frame's recipe
+//    (/api/recipe) says.
+// Everything else (orbit views from single-view proxies, the colour model, edits through a light
+// field) stays with the server's frames.
 
 import { reorbit } from './camera.js';
 import { fetchLightField } from './light_field_data.js';
 import { LightFieldRenderer, webgl2Available } from './light_field_renderer.js';
+import { fetchProxies } from './proxy_data.js';
+import { ProxyRenderer } from './proxy_renderer.js';
 
 const KEPT_STEPS = 3;  // light fields kept parsed: the shown step and the ones around it
 // While the user drags, frames are previews: at most PREVIEW_SIDE pixels a side (the image
@@ -23,39 +29,69 @@ export class GpuFrames {
   /// null when this browser has no WebGL2 (the page then uses the server's frames only).
   static async create(canvas) {
     if (!webgl2Available()) return null;
+    let lightFields;
     try {
-      return new GpuFrames(await LightFieldRenderer.create(canvas));
+      lightFields = await LightFieldRenderer.create(canvas);
     } catch (error) {
       console.warn(`drawing in the browser is off: ${error.message}`);
       return null;
     }
+    let proxies = null;
+    try {
+      proxies = await ProxyRenderer.create(canvas);
+    } catch (error) {
+      console.warn(`the stored view is drawn by the server: ${error.message}`);
+    }
+    return new GpuFrames(lightFields, proxies);
   }
 
-  constructor(renderer) {
+  constructor(renderer, proxyRenderer) {
     this.renderer = renderer;
+    this.proxyRenderer = proxyRenderer;  // null: stored views are the server's
     this.cache = new Map();  // "step/view" -> Promise of {lightField, downloadMs} (or null)
+    this.proxyCache = new Map();  // "step/view" -> Promise of {proxies, downloadMs} (or null)
     this.uploaded = null;    // key of the light field on the GPU
+    this.uploadedProxies = null;  // key of the proxies on the GPU
     this.lastOpen = null;    // {key, downloadMs, uploadMs, bytes}
   }
 
-  lightField(step, view) {
-    const key = `${step}/${view}`;
-    if (!this.cache.has(key)) {
-      const started = performance.now();
-      this.cache.set(key, fetchLightField(step, view)
-        .then((lightField) => ({ lightField, downloadMs: performance.now() - started }))
-        .catch((error) => {
-          this.cache.delete(key);
-          throw error;
-        }));
-      while (this.cache.size > KEPT_STEPS) this.cache.delete(this.cache.keys().next().value);
-    }
-    return this.cache.get(key);
+  /// The parsed proxies of (step, view) with their download time; null without attenuation.
+  proxies(step, view) {
+    return cached(this.proxyCache, `${step}/${view}`, () => fetchProxies(step, view))
+      .then(({ value, downloadMs }) => ({ proxies: value, downloadMs }));
   }
 
-  /// Starts downloading a step's light field ahead of need.
+  /// Draws the stored view of (step, view) with `recipe` (/api/recipe, drawable). Resolves to
+  /// the frame's timing, or null when the view has no attenuation proxies.
+  async drawStoredView(step, view, recipe) {
+    const key = `${step}/${view}`;
+    const { proxies, downloadMs } = await this.proxies(step, view);
+    if (!proxies) return null;
+    let uploadMs = 0;
+    if (this.uploadedProxies !== key) {
+      const started = performance.now();
+      this.proxyRenderer.load(proxies);
+      await this.proxyRenderer.finish();
+      uploadMs = performance.now() - started;
+      this.uploadedProxies = key;
+      this.lastOpen = { key, downloadMs, uploadMs, bytes: proxies.bytes };
+    }
+    const started = performance.now();
+    this.proxyRenderer.render(recipe, proxies.header.camera);
+    await this.proxyRenderer.finish();
+    return { milliseconds: performance.now() - started, uploadMs, preview: false };
+  }
+
+  lightField(step, view) {
+    return cached(this.cache, `${step}/${view}`, () => fetchLightField(step, view))
+      .then(({ value, downloadMs }) => ({ lightField: value, downloadMs }));
+  }
+
+  /// Starts downloading a step's light field (and its stored view's proxies, where they are
+  /// drawn here) ahead of need.
   prefetch(step, view) {
     this.lightField(step, view).catch(() => {});
+    if (this.proxyRenderer) this.proxies(step, view).catch(() => {});
   }
 
   /// Whether (step, view) has a light field (downloads it if needed).
@@ -92,4 +128,20 @@ export class GpuFrames {
     await this.renderer.finish();
     return { milliseconds: performance.now() - started, uploadMs, preview };
   }
+}
+
+/// The promise `load()` gives for `key`, kept in `cache` with its download time (the last
+/// KEPT_STEPS keys); a failure is forgotten, so the next call tries again.
+function cached(cache, key, load) {
+  if (!cache.has(key)) {
+    const started = performance.now();
+    cache.set(key, load()
+      .then((value) => ({ value, downloadMs: performance.now() - started }))
+      .catch((error) => {
+        cache.delete(key);
+        throw error;
+      }));
+    while (cache.size > KEPT_STEPS) cache.delete(cache.keys().next().value);
+  }
+  return cache.get(key);
 }

@@ -12,7 +12,7 @@
 //     centre unless it recorded a surface there (one the ray passes by: it holds nothing);
 //  3. per segment, the cameras that hold something of the ray blend with renormalised weights;
 //     segments composite front to back, segment s with its opacity scaled: A' = 1 - (1 - A)^k.
-// The JS side prepends #version, MAX_SEGMENTS and, for 8-bit depth, DEPTH_CODES.
+// The JS side prepends #version, MAX_SEGMENTS, for 8-bit depth DEPTH_CODES, and srgb.glsl.
 precision highp float;
 precision highp int;
 precision highp sampler2D;
@@ -202,12 +202,6 @@ void camerasAround(vec3 direction, out ivec3 cameras, out vec3 weights) {
   }
   weights = max(weights, vec3(0.0));
   weights /= weights.x + weights.y + weights.z;
-}
-
-// IEC 61966-2-1, as insitu::linear_to_srgb.
-vec3 linearToSrgb(vec3 linear) {
-  vec3 x = clamp(linear, 0.0, 1.0);
-  return mix(1.055 * pow(x, vec3(1.0 / 2.4)) - 0.055, 12.92 * x, lessThanEqual(x, vec3(0.0031308)));
 }
 
 // Where the line origin + t direction meets the sphere: (entry, exit), or entry > exit for none.

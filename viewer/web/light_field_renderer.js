@@ -3,36 +3,21 @@
 // light_field.frag.glsl for the target camera (camera.js). The C++ Explorer stays the reference;
 // tests/viewer/webgl.test.mjs holds the two to a stated PSNR.
 
+import {
+  buildProgram, frameContext, gpuFinished, readCanvas, shaderText, TextureSet,
+} from './webgl.js';
+
+export { webgl2Available } from './webgl.js';
+
 const TABLE_WIDTH = 1024;  // rows of the 1D tables, as the shader reads them
-
-async function shaderText(name) {
-  const response = await fetch(name);
-  if (!response.ok) throw new Error(`${name}: ${response.status}`);
-  return response.text();
-}
-
-/// Whether this browser gives a WebGL2 context with what the renderer needs.
-export function webgl2Available() {
-  try {
-    const canvas = document.createElement('canvas');
-    return Boolean(canvas.getContext('webgl2'));
-  } catch (e) {
-    return false;
-  }
-}
 
 export class LightFieldRenderer {
   /// `canvas`: the element drawn into. Throws when WebGL2 is missing.
   static async create(canvas) {
-    const gl = canvas.getContext('webgl2', {
-      premultipliedAlpha: false,   // the frame's alpha is straight, as in the PNG frames
-      preserveDrawingBuffer: true,  // the tests and "save PNG" read the canvas back
-      antialias: false,
-    });
-    if (!gl) throw new Error('WebGL2 is not available');
-    const [vertex, fragment] = await Promise.all(
-      [shaderText('fullscreen.vert.glsl'), shaderText('light_field.frag.glsl')]);
-    return new LightFieldRenderer(canvas, gl, vertex, fragment);
+    const gl = frameContext(canvas);
+    const [vertex, srgb, fragment] = await Promise.all([shaderText('fullscreen.vert.glsl'),
+      shaderText('srgb.glsl'), shaderText('light_field.frag.glsl')]);
+    return new LightFieldRenderer(canvas, gl, vertex, srgb + fragment);
   }
 
   constructor(canvas, gl, vertexSource, fragmentSource) {
@@ -41,7 +26,7 @@ export class LightFieldRenderer {
     this.vertexSource = vertexSource;
     this.fragmentSource = fragmentSource;
     this.programs = new Map();  // by "depth bits/max segments"
-    this.textures = [];
+    this.textures = new TextureSet(gl);
     this.loaded = null;          // {header, program, uniforms}
     this.vertexArray = gl.createVertexArray();
   }
@@ -49,46 +34,20 @@ export class LightFieldRenderer {
   program(depthBits, maxSegments) {
     const key = `${depthBits}/${maxSegments}`;
     if (this.programs.has(key)) return this.programs.get(key);
-    const gl = this.gl;
     const prefix = `#version 300 es\n#define MAX_SEGMENTS ${maxSegments}\n` +
       (depthBits === 8 ? '#define DEPTH_CODES\n' : '');
-    const compile = (type, source) => {
-      const shader = gl.createShader(type);
-      gl.shaderSource(shader, prefix + source);
-      gl.compileShader(shader);
-      if (!gl.getShaderParameter(shader, gl.COMPILE_STATUS)) {
-        throw new Error(`shader: ${gl.getShaderInfoLog(shader)}`);
-      }
-      return shader;
-    };
-    const program = gl.createProgram();
-    gl.attachShader(program, compile(gl.VERTEX_SHADER, this.vertexSource));
-    gl.attachShader(program, compile(gl.FRAGMENT_SHADER, this.fragmentSource));
-    gl.linkProgram(program);
-    if (!gl.getProgramParameter(program, gl.LINK_STATUS)) {
-      throw new Error(`shader link: ${gl.getProgramInfoLog(program)}`);
-    }
+    const program = buildProgram(this.gl, prefix, this.vertexSource, this.fragmentSource);
     this.programs.set(key, program);
     return program;
   }
 
   release() {
-    for (const texture of this.textures) this.gl.deleteTexture(texture);
-    this.textures = [];
+    this.textures.release();
     this.loaded = null;
   }
 
   texture(unit, target) {
-    const gl = this.gl;
-    const texture = gl.createTexture();
-    gl.activeTexture(gl.TEXTURE0 + unit);
-    gl.bindTexture(target, texture);
-    gl.texParameteri(target, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
-    gl.texParameteri(target, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
-    gl.texParameteri(target, gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE);
-    gl.texParameteri(target, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
-    this.textures.push(texture);
-    return texture;
+    return this.textures.add(unit, target);
   }
 
   /// Uploads a parsed light field (parseLightField). Throws when it needs more texture layers
@@ -187,6 +146,10 @@ export class LightFieldRenderer {
       this.canvas.width = camera.width;
       this.canvas.height = camera.height;
     }
+    // The canvas's context is shared with the proxy renderer: take back the units and the
+    // default framebuffer.
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    this.textures.bind();
     gl.viewport(0, 0, camera.width, camera.height);
     gl.useProgram(this.loaded.program);
     const scales = new Float32Array(maxSegments).fill(1);
@@ -206,33 +169,11 @@ export class LightFieldRenderer {
 
   /// The canvas's RGBA bytes, rows from the top (as a PNG holds them).
   readPixels() {
-    const gl = this.gl;
-    const { width, height } = this.canvas;
-    const bottomUp = new Uint8Array(width * height * 4);
-    gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, bottomUp);
-    const rows = new Uint8Array(bottomUp.length);
-    for (let y = 0; y < height; ++y) {
-      rows.set(bottomUp.subarray((height - 1 - y) * width * 4, (height - y) * width * 4), y * width * 4);
-    }
-    return { width, height, data: rows };
+    return readCanvas(this.gl, this.canvas);
   }
 
   /// Resolves once the GPU has finished the frames drawn so far (for frame timing).
   finish() {
-    const gl = this.gl;
-    const sync = gl.fenceSync(gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
-    gl.flush();
-    return new Promise((resolve) => {
-      const poll = () => {
-        const status = gl.clientWaitSync(sync, 0, 0);
-        if (status === gl.TIMEOUT_EXPIRED) {
-          setTimeout(poll, 1);
-          return;
-        }
-        gl.deleteSync(sync);
-        resolve();
-      };
-      poll();
-    });
+    return gpuFinished(this.gl);
   }
 }

@@ -72,3 +72,26 @@ export function svg(tag, attributes, parent) {
   return element;
 }
 
+
+/// A binary payload of the data server (light fields, proxies) as an ArrayBuffer; null where the
+/// step has none (404). Revalidated with the server's ETag (`no-cache`), so a revisited step is a
+/// 304. Other failures throw, naming `what` and the server's error.
+export async function fetchPayload(url, what) {
+  const response = await fetch(url, { cache: 'no-cache' });
+  if (response.status === 404) return null;
+  if (!response.ok) throw new Error(`${what}: ${await errorText(response)}`);
+  return response.arrayBuffer();
+}
+
+/// The opening every payload shares (viewer/payload_header.hpp): checks magic and version and
+/// returns {header (the parsed JSON), start (the byte offset of the planes)}.
+export function readPayloadHeader(buffer, magic, version, what) {
+  const bytes = new Uint8Array(buffer);
+  if (String.fromCharCode(...bytes.subarray(0, 8)) !== magic) throw new Error(`not a ${what}`);
+  const view = new DataView(buffer);
+  const found = view.getUint32(8, true);
+  if (found !== version) throw new Error(`${what} version ${found}, expected ${version}`);
+  const headerBytes = view.getUint32(12, true);
+  const header = JSON.parse(new TextDecoder().decode(bytes.subarray(16, 16 + headerBytes)));
+  return { header, start: 16 + headerBytes };
+}

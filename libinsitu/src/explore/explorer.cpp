@@ -375,6 +375,69 @@ std::vector<double> checked_scales(const std::vector<std::pair<int, double>>& re
     return scales;
 }
 
+/// Steps 4-5's choices for a frame with attenuation over `intervals` (render() and recipe()
+/// make them alike): the scales applied, the interval colours, whether the colour model predicts.
+struct EditPlan {
+    std::vector<double> scales;
+    bool opacity_edited = false;
+    std::vector<float> colours;
+    bool use_model = false;
+};
+
+EditPlan plan_edit(const ExploreRequest& request, const TransferFunction& stored_tf,
+                   const TransferFunction& shown_tf, const IntervalSet& intervals,
+                   const ColourModel* model, const std::string& where) {
+    const int interval_count = intervals.count();
+    EditPlan plan;
+    // 4. Opacity edits.
+    plan.scales.assign(static_cast<std::size_t>(interval_count), 1.0);
+    if (request.transfer_function) {
+        plan.scales = opacity_scales(stored_tf, *request.transfer_function, intervals);
+    }
+    const std::vector<double> explicit_scales =
+        checked_scales(request.opacity_scales, interval_count, "opacity-scale interval",
+                       "opacity-scale of interval", "intervals");
+    for (std::size_t j = 0; j < plan.scales.size(); ++j) plan.scales[j] *= explicit_scales[j];
+    plan.opacity_edited =
+        std::any_of(plan.scales.begin(), plan.scales.end(), [](double s) { return s != 1.0; });
+    // 5. Colour. The model learnt how the stored colours composite (Eq. 8); it cannot know
+    // other colours, and without an opacity edit recomposition is exact for colours constant
+    // per interval, so "auto" uses it only for opacity edits of the same colours.
+    plan.colours = interval_colours(shown_tf, intervals);
+    const bool colours_changed = request.transfer_function &&
+                                 !same_colours(stored_tf, *request.transfer_function, intervals);
+    if (request.colour == ColourSource::model && model == nullptr) {
+        fail<InvalidArgument>("colour = model, but ", where, " has no colour model");
+    }
+    plan.use_model = request.colour == ColourSource::model ||
+                     (request.colour == ColourSource::automatic && model != nullptr &&
+                      plan.opacity_edited && !colours_changed);
+    if (plan.use_model && model->intervals() != interval_count) {
+        fail<InvalidArgument>("the colour model has ", model->intervals(),
+                              " intervals, the attenuation proxies ", interval_count);
+    }
+    return plan;
+}
+
+// A page or script that sends the stored function back unchanged, or scales by 1, asks for no
+// edit.
+bool scales_any_opacity(const ExploreRequest& request) {
+    return std::any_of(request.opacity_scales.begin(), request.opacity_scales.end(),
+                       [](const std::pair<int, double>& scale) { return scale.second != 1.0; });
+}
+bool asks_stored_tf(const ExploreRequest& request, const TransferFunction& stored_tf) {
+    return !request.transfer_function ||
+           request.transfer_function->to_json() == stored_tf.to_json();
+}
+
+/// Whether a frame of the stored view shows the rendering the Instrument kept: the run's own
+/// function, unedited, colour left to "auto" (see proxies_frame in Explorer::render).
+bool shows_stored_rendering(const ProxyFrame& single, bool shows_stored_tf, bool scales_opacity,
+                            const ExploreRequest& request) {
+    return single.rendering.channels == 4 && shows_stored_tf && !scales_opacity &&
+           request.colour == ColourSource::automatic;
+}
+
 /// Steps 4-7 of explorer.hpp on `basis`, into `frame` (colour, confidence, opacity scales).
 void finish_frame(FrameBasis basis, const ExploreRequest& request,
                   const TransferFunction& stored_tf, const TransferFunction& shown_tf,
@@ -399,19 +462,13 @@ void finish_frame(FrameBasis basis, const ExploreRequest& request,
     }
 
     if (has_attenuation && (edits || basis.colour.pixels.empty())) {
-        const IntervalSet& intervals = *basis.intervals;
-        const int interval_count = intervals.count();
-        // 4. Opacity edits.
-        std::vector<double> scales(static_cast<std::size_t>(interval_count), 1.0);
-        if (request.transfer_function) {
-            scales = opacity_scales(stored_tf, *request.transfer_function, intervals);
-        }
-        const std::vector<double> explicit_scales =
-            checked_scales(request.opacity_scales, interval_count, "opacity-scale interval",
-                           "opacity-scale of interval", "intervals");
-        for (std::size_t j = 0; j < scales.size(); ++j) scales[j] *= explicit_scales[j];
-        const bool opacity_edited =
-            std::any_of(scales.begin(), scales.end(), [](double s) { return s != 1.0; });
+        const EditPlan plan =
+            plan_edit(request, stored_tf, shown_tf, *basis.intervals, basis.model, where);
+        const std::vector<double>& scales = plan.scales;
+        const bool opacity_edited = plan.opacity_edited;
+        const std::vector<float>& colours = plan.colours;
+        const bool use_model = plan.use_model;
+        const ColourModel* model = basis.model;
         // The trust of an edit compares the edited attenuation with the stored one, kept here.
         Image stored_attenuation;
         if (opacity_edited) {
@@ -419,25 +476,6 @@ void finish_frame(FrameBasis basis, const ExploreRequest& request,
             stored_attenuation = std::move(basis.attenuation);
             basis.attenuation = estimate_attenuation(stored_attenuation, basis.mean_depth,
                                                      basis.optical_depth, scales, device);
-        }
-
-        // 5. Colour. The model learnt how the stored colours composite (Eq. 8); it cannot know
-        // other colours, and without an opacity edit recomposition is exact for colours
-        // constant per interval, so "auto" uses it only for opacity edits of the same colours.
-        const std::vector<float> colours = interval_colours(shown_tf, intervals);
-        const bool colours_changed =
-            request.transfer_function &&
-            !same_colours(stored_tf, *request.transfer_function, intervals);
-        const ColourModel* model = basis.model;
-        if (request.colour == ColourSource::model && model == nullptr) {
-            fail<InvalidArgument>("colour = model, but ", where, " has no colour model");
-        }
-        const bool use_model = request.colour == ColourSource::model ||
-                               (request.colour == ColourSource::automatic && model != nullptr &&
-                                opacity_edited && !colours_changed);
-        if (use_model && model->intervals() != interval_count) {
-            fail<InvalidArgument>("the colour model has ", model->intervals(),
-                                  " intervals, the attenuation proxies ", interval_count);
         }
         frame.colour_source = use_model ? ColourSource::model : ColourSource::recompose;
         frame.colour = use_model ? model->predict(basis.attenuation, device)
@@ -452,7 +490,7 @@ void finish_frame(FrameBasis basis, const ExploreRequest& request,
             trust.edited_attenuation = opacity_edited ? &basis.attenuation : nullptr;
             trust.scales = scales;
             trust.colours = colours;
-            trust.colour_spread = interval_colour_spread(shown_tf, intervals);
+            trust.colour_spread = interval_colour_spread(shown_tf, *basis.intervals);
             trust.attenuation_resolution = basis.attenuation_resolution;
             Image error = edit_error(trust);
             if (use_model) {
@@ -611,13 +649,8 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
     const TransferFunction stored_tf = archive_->transfer_function(request.step, request.view);
     const TransferFunction& shown_tf =
         request.transfer_function ? *request.transfer_function : stored_tf;
-    // A page or script that sends the stored function back unchanged, or scales by 1, asks
-    // for no edit.
-    const bool scales_opacity =
-        std::any_of(request.opacity_scales.begin(), request.opacity_scales.end(),
-                    [](const std::pair<int, double>& scale) { return scale.second != 1.0; });
-    const bool shows_stored_tf =
-        !request.transfer_function || request.transfer_function->to_json() == stored_tf.to_json();
+    const bool scales_opacity = scales_any_opacity(request);
+    const bool shows_stored_tf = asks_stored_tf(request, stored_tf);
 
     // The light field's frame: reconstructed, then steps 4-7 as for any proxies.
     const bool edits = request.transfer_function.has_value() || !request.opacity_scales.empty();
@@ -698,9 +731,9 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
         // treats each interval's colour as constant (38.8 dB on a CT head, issue 17). Lighting
         // and enhancement still apply to it as factors; asked for "recompose" or "model", the
         // frame is recomposed as asked.
-        const bool stored_rendering = same_view && single && single->rendering.channels == 4 &&
-                                      shows_stored_tf && !scales_opacity &&
-                                      request.colour == ColourSource::automatic;
+        const bool stored_rendering =
+            same_view && single &&
+            shows_stored_rendering(*single, shows_stored_tf, scales_opacity, request);
         if (stored_rendering) basis.colour = single->rendering;
         if (attenuation_source && attenuation_source == single && same_view) {
             basis.attenuation = single->attenuation;
@@ -815,6 +848,76 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
     frame.milliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return frame;
+}
+
+FrameRecipe Explorer::recipe(const ExploreRequest& request) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const CachedStep& cached = load(request.step, request.view);
+    const std::string where = "step " + std::to_string(request.step) + " view " +
+                              std::to_string(request.view) + " of \"" + path_ + "\"";
+    FrameRecipe recipe;
+    const ProxyFrame* single = cached.single ? &*cached.single : nullptr;
+    if (!single || !has_attenuation(*single)) {
+        recipe.why_not = where + " has no single-perspective attenuation proxies";
+        return recipe;
+    }
+    if (request.source == ProxySource::multi || request.source == ProxySource::lightfield) {
+        recipe.why_not = "source = " + to_string(request.source);
+        return recipe;
+    }
+    const Camera& stored = single->camera;
+    if (!same_angle(request.azimuth_deg.value_or(stored.azimuth_deg()), stored.azimuth_deg()) ||
+        !same_angle(request.elevation_deg.value_or(stored.elevation_deg()),
+                    stored.elevation_deg())) {
+        recipe.why_not = "a synthesised view (not the stored view's angles)";
+        return recipe;
+    }
+    // The rest as Explorer::render's proxies_frame and finish_frame decide it at the stored view.
+    const TransferFunction stored_tf = archive_->transfer_function(request.step, request.view);
+    const TransferFunction& shown_tf =
+        request.transfer_function ? *request.transfer_function : stored_tf;
+    recipe.stored_rendering = shows_stored_rendering(*single, asks_stored_tf(request, stored_tf),
+                                                     scales_any_opacity(request), request);
+    const ColourModel* model = single->colour_model ? &*single->colour_model : nullptr;
+    if (recipe.stored_rendering) {
+        recipe.opacity_scales.assign(static_cast<std::size_t>(single->intervals->count()), 1.0);
+        recipe.colour_source = ColourSource::stored;
+    } else {
+        EditPlan plan = plan_edit(request, stored_tf, shown_tf, *single->intervals, model, where);
+        if (plan.use_model) {
+            recipe.why_not = "the colour model predicts this frame's colours";
+            return recipe;
+        }
+        recipe.opacity_scales = std::move(plan.scales);
+        recipe.opacity_edited = plan.opacity_edited;
+        recipe.colours = std::move(plan.colours);
+        recipe.colour_source = ColourSource::recompose;
+    }
+    if (request.lighting) {
+        // Checked as render() checks it, with the headlights pointed at the stored camera.
+        LightingSettings aimed = *request.lighting;
+        for (Light& light : aimed.lights) {
+            if (light.direction_world == glm::dvec3(0.0)) light.direction_world = -stored.forward();
+        }
+        validate(aimed);
+        recipe.lighting = request.lighting;
+        for (Light& light : recipe.lighting->lights) {
+            // Headlights stay (0, 0, 0): the client points them at its camera.
+            if (light.direction_world != glm::dvec3(0.0)) {
+                light.direction_world = glm::normalize(light.direction_world);
+            }
+        }
+    }
+    if (request.ambient_occlusion) {
+        if (single->depth_layers.empty()) {
+            fail<InvalidArgument>("ambient occlusion needs depth (layers or a light field), and ",
+                                  where, " has none");
+        }
+        recipe.ambient_occlusion = occlusion_terms(*request.ambient_occlusion, stored);
+    }
+    recipe.enhancement = request.enhancement;
+    recipe.drawable = true;
+    return recipe;
 }
 
 std::ostream& operator<<(std::ostream& out, const ExploreRequest& request) {

@@ -144,10 +144,10 @@ Image shade(const Image& base_colour, const Image& normals, const Camera& camera
     return colour_device.download(device, "shaded colour");
 }
 
-Image ambient_occlusion(const Image& depth, const Camera& camera,
-                        const AmbientOcclusionSettings& settings, ComputeDevice& device) {
-    check_image(depth, "depth", 1, camera);
+OcclusionTerms occlusion_terms(const AmbientOcclusionSettings& settings, const Camera& camera) {
     validate(settings);
+    OcclusionTerms terms;
+    terms.radius_pixels = settings.radius_pixels;
     const int radius = settings.radius_pixels;
     int neighbours = 0;  // the disc of Eq. 5 without its centre
     for (int dy = -radius; dy <= radius; ++dy) {
@@ -155,9 +155,19 @@ Image ambient_occlusion(const Image& depth, const Camera& camera,
             if ((dx != 0 || dy != 0) && dx * dx + dy * dy <= radius * radius) ++neighbours;
         }
     }
+    terms.strength = settings.strength;
+    terms.inverse_depth_scale = 1.0 / depth_scale_world(settings, camera);
+    terms.inverse_neighbours = neighbours > 0 ? 1.0 / neighbours : 0.0;
+    return terms;
+}
+
+Image ambient_occlusion(const Image& depth, const Camera& camera,
+                        const AmbientOcclusionSettings& settings, ComputeDevice& device) {
+    check_image(depth, "depth", 1, camera);
+    const OcclusionTerms terms = occlusion_terms(settings, camera);
+    const int radius = terms.radius_pixels;
     const cl_float4 occlusion =
-        to_float4(settings.strength, 1.0 / depth_scale_world(settings, camera),
-                  neighbours > 0 ? 1.0 / neighbours : 0.0, 0.0);
+        to_float4(terms.strength, terms.inverse_depth_scale, terms.inverse_neighbours, 0.0);
     DeviceImage depth_device;
     DeviceImage occlusion_device;
     depth_device.upload(device, depth, "depth");

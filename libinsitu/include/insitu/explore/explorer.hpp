@@ -106,6 +106,30 @@ struct ExploreFrame {
     double milliseconds = 0.0;  ///< wall time of render(), archive reads included
 };
 
+/// What a client that draws frames itself (the web viewer's WebGL2 renderer) needs besides the
+/// view's stored single-perspective proxies to make, per pixel, the frame render() makes from
+/// them at the stored view: the terms render() derives from the request once per frame. The
+/// pixels then follow explorer.hpp's steps 4-7 with these terms (the shaders in viewer/web/).
+struct FrameRecipe {
+    /// Whether the frame is one of the stored view's single-perspective proxies with attenuation
+    /// and a colour the terms below determine; else `why_not` says what the client cannot
+    /// draw (another source, a synthesised view, the colour model) and the client asks for the
+    /// frame instead.
+    bool drawable = false;
+    std::string why_not;
+    /// The stored rendering is the colour (the run's own function, unedited; steps 4-5 skipped).
+    bool stored_rendering = false;
+    std::vector<double> opacity_scales;  ///< s_j as estimate_attenuation applies them; all 1: none
+    bool opacity_edited = false;         ///< some s_j != 1
+    std::vector<float> colours;          ///< L RGB triples of the shown function (recolour)
+    ColourSource colour_source = ColourSource::recompose;  ///< stored or recompose, as drawn
+    /// Lights as the kernels take them (relighting.cl illuminate): direction toward the light,
+    /// normalised, or (0, 0, 0) for a headlight (the client puts -forward of its camera there).
+    std::optional<LightingSettings> lighting;
+    std::optional<OcclusionTerms> ambient_occlusion;
+    std::optional<EnhancementSettings> enhancement;
+};
+
 /// A summary of an archive for `insitu-view info` and the viewer's API.
 nlohmann::json describe_archive(const ArchiveReader& archive);
 
@@ -123,6 +147,10 @@ public:
     /// index out of range, a negative or non-finite scale, or a model requested that the
     /// archive does not hold. Thread-safe (one frame at a time).
     ExploreFrame render(const ExploreRequest& request);
+
+    /// The terms of the frame render(request) would make, for a client that draws it itself
+    /// (FrameRecipe). Raises what render() raises for the same request's edits and settings.
+    FrameRecipe recipe(const ExploreRequest& request);
 
 private:
     struct CachedStep {

@@ -91,6 +91,17 @@ Image ambient_occlusion(const Image& depth, const Camera& camera,
                         const AmbientOcclusionSettings& settings = {},
                         ComputeDevice& device = *ComputeDevice::shared());
 
+/// The constants of Eq. 5 as ambient_occlusion() applies them for `camera`: strength, 1 / depth
+/// scale (world units; the default scale resolved), 1 / N (the disc's pixels without its centre;
+/// 0 for radius 0). Clients that evaluate Eq. 5 themselves (the web viewer's shaders) use these.
+struct OcclusionTerms {
+    int radius_pixels = 0;
+    double strength = 0.0;
+    double inverse_depth_scale = 0.0;
+    double inverse_neighbours = 0.0;
+};
+OcclusionTerms occlusion_terms(const AmbientOcclusionSettings& settings, const Camera& camera);
+
 /// Baseline (Luft et al., unsharp masking of the depth buffer): with blur = Gaussian
 /// (sigma = radius / 2) over the (2 radius + 1)^2 square of pixels with depth,
 ///   result = 1 - clamp(strength max(0, Z(p) - blur(p)) / depth_scale, 0, 1),

@@ -1,0 +1,90 @@
+// Opacity edits of the stored view's attenuation proxies, per pixel: a' = estimate_attenuation
+// (libinsitu/include/insitu/explore/transfer_function_edit.hpp states the estimator;
+// kernels/explore/transfer_function_edit.cl is the reference this follows step for step).
+// Writes a'_j of intervals uFirst .. uFirst + 15 into four RGBA32F layers (interval j at layer
+// j / 4, component j % 4); without an edit (uCopy) a'_j = a_j exactly, as the Explorer then
+// leaves a alone. The JS side prepends #version and MAX_INTERVALS.
+precision highp float;
+precision highp int;
+precision highp sampler2DArray;
+
+uniform sampler2DArray uAttenuation;   // layer j: a_j
+uniform sampler2DArray uMeanDepth;     // layer j: mean depth of interval j, +inf where a_j = 0
+uniform sampler2DArray uOpticalDepth;  // layer j: tau_j, where stored (uHasOpticalDepth)
+uniform bool uHasOpticalDepth;
+uniform bool uCopy;
+uniform int uIntervals;
+uniform int uFirst;
+uniform float uScales[MAX_INTERVALS];
+
+layout(location = 0) out vec4 out0;
+layout(location = 1) out vec4 out1;
+layout(location = 2) out vec4 out2;
+layout(location = 3) out vec4 out3;
+
+// Light left behind a run below which the run counts as opaque (EDIT_OPAQUE_LIGHT).
+const float kOpaqueLight = 1e-6;
+
+void main() {
+  // FBO passes keep the image's rows: texel row y is image row y.
+  ivec2 pixel = ivec2(gl_FragCoord.xy);
+  float a[MAX_INTERVALS];
+  float edited[MAX_INTERVALS];
+  for (int j = 0; j < uIntervals; ++j) {
+    a[j] = texelFetch(uAttenuation, ivec3(pixel, j), 0).r;
+    edited[j] = uCopy ? a[j] : 0.0;
+  }
+  if (!uCopy) {
+    // 1. The intervals that recorded anything, front to back by mean depth (insertion sort; a
+    // tie keeps index order, as only a strictly nearer depth moves an entry).
+    int order[MAX_INTERVALS];
+    float depth[MAX_INTERVALS];
+    int count = 0;
+    for (int j = 0; j < uIntervals; ++j) {
+      if (!(a[j] > 0.0)) continue;
+      float z = texelFetch(uMeanDepth, ivec3(pixel, j), 0).r;
+      float key = isnan(z) ? uintBitsToFloat(0x7f800000u) : z;
+      int at = count++;
+      while (at > 0 && depth[at - 1] > key) {
+        order[at] = order[at - 1];
+        depth[at] = depth[at - 1];
+        --at;
+      }
+      order[at] = j;
+      depth[at] = key;
+    }
+    // 2-4. t_j from the walk (or tau_j), t_j' = t_j^s_j, a_j' = T' (1 - t_j').
+    float transmittance = 1.0;
+    float editedTransmittance = 1.0;
+    for (int i = 0; i < count; ++i) {
+      int j = order[i];
+      float t;
+      if (uHasOpticalDepth) {
+        t = exp(-max(texelFetch(uOpticalDepth, ivec3(pixel, j), 0).r, 0.0));
+      } else if (transmittance > 0.0) {
+        float behind = transmittance - a[j];
+        t = behind > kOpaqueLight ? clamp(behind / transmittance, 0.0, 1.0) : 0.0;
+      } else {
+        t = 1.0;
+      }
+      float s = uScales[j];
+      // exp2(s log2 t) as the reference writes t^s; log2(0) is undefined in GLSL, and t = 0
+      // gives 0 there (exp2(-inf)).
+      float tEdited = s > 0.0 ? (t > 0.0 ? exp2(s * log2(t)) : 0.0) : 1.0;
+      edited[j] = editedTransmittance * (1.0 - tEdited);
+      transmittance *= t;
+      editedTransmittance *= tEdited;
+    }
+  }
+  vec4 outputs[4];
+  for (int k = 0; k < 4; ++k) {
+    for (int c = 0; c < 4; ++c) {
+      int j = uFirst + 4 * k + c;
+      outputs[k][c] = j < uIntervals ? edited[j] : 0.0;
+    }
+  }
+  out0 = outputs[0];
+  out1 = outputs[1];
+  out2 = outputs[2];
+  out3 = outputs[3];
+}

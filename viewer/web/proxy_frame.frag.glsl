@@ -1,0 +1,267 @@
+// The stored view's frame from its single-perspective proxies, per pixel: Explorer::render's
+// steps 5-7 (libinsitu/include/insitu/explore/explorer.hpp) as the reference kernels compute
+// them, with the frame's terms from /api/recipe (FrameRecipe):
+//  5. colour: the stored rendering, or sum_j c_j a'_j (recolour, transfer_function_edit.cl);
+//  6. lighting: colour.rgb *= lit.rgb / lit.a, lit = light_volume of a' with white interval
+//     colours (relighting.cl, normals from each interval's mean depth), then ambient occlusion
+//     (Eq. 5, relighting.cl ambient_occlusion) of the front-most layer;
+//  7. depth-aware enhancement (Eq. 11, enhancement.cl) on the gradients of a'.
+// a' comes from proxy_edit.frag.glsl. The JS side prepends #version, MAX_INTERVALS, MAX_LIGHTS
+// and srgb.glsl.
+precision highp float;
+precision highp int;
+precision highp sampler2D;
+precision highp sampler2DArray;
+
+uniform sampler2DArray uEdited;     // layer g: a'_j of intervals 4g .. 4g + 3
+uniform sampler2DArray uMeanDepth;  // layer j: mean depth of interval j
+uniform sampler2D uRendering;       // the stored rendering, RGBA premultiplied
+uniform sampler2D uFrontDepth;      // front-most layer depth (front_depth.frag.glsl)
+uniform int uIntervals;
+uniform bool uStoredRendering;
+uniform vec3 uColours[MAX_INTERVALS];
+// The camera as camera_axes() packs it: forward, right, up, and (half width, half height,
+// 1 for perspective / 0 for orthographic).
+uniform vec3 uForward;
+uniform vec3 uRight;
+uniform vec3 uUp;
+uniform vec3 uHalfExtent;
+uniform ivec2 uImageSize;
+uniform bool uLighting;
+uniform float uAmbient;
+uniform int uLightCount;
+// Three per light: (unit direction toward it, shininess), (diffuse colour, 0), (specular, 0).
+uniform vec4 uLights[3 * MAX_LIGHTS];
+uniform bool uOcclusion;
+uniform int uOcclusionRadius;
+uniform vec3 uOcclusionTerms;  // strength, 1 / depth scale, 1 / neighbour count
+uniform bool uEnhance;
+uniform vec2 uEnhanceLaw;      // lambda, gamma
+
+out vec4 outColour;
+
+const float kInfinity = uintBitsToFloat(0x7f800000u);
+
+float editedAttenuation(ivec2 p, int j) {
+  return texelFetch(uEdited, ivec3(p, j / 4), 0)[j % 4];
+}
+
+bool inside(ivec2 p) {
+  return p.x >= 0 && p.y >= 0 && p.x < uImageSize.x && p.y < uImageSize.y;
+}
+
+// --- relighting.cl: pixel frames, finite differences and silhouettes ---
+struct PixelFrame {
+  vec3 ray, stepX, stepY, rayCrossY, xCrossRay, xCrossY, view;
+  float jumpPerDepth, jumpConstant;
+  bool perspective;
+};
+
+PixelFrame pixelFrame(ivec2 p) {
+  PixelFrame f;
+  f.perspective = uHalfExtent.z != 0.0;
+  vec2 size = vec2(uImageSize);
+  vec2 uv = vec2((2.0 * (float(p.x) + 0.5) / size.x - 1.0) * uHalfExtent.x,
+                 (1.0 - 2.0 * (float(p.y) + 0.5) / size.y) * uHalfExtent.y);
+  f.stepX = (2.0 * uHalfExtent.x / size.x) * uRight;
+  f.stepY = (-2.0 * uHalfExtent.y / size.y) * uUp;
+  f.ray = uForward;
+  if (f.perspective) f.ray += uv.x * uRight + uv.y * uUp;
+  f.rayCrossY = cross(f.ray, f.stepY);
+  f.xCrossRay = cross(f.stepX, f.ray);
+  f.xCrossY = cross(f.stepX, f.stepY);
+  f.view = -f.ray * inversesqrt(dot(f.ray, f.ray));
+  float twoFootprints = 4.0 * uHalfExtent.y / size.y;
+  f.jumpPerDepth = f.perspective ? twoFootprints : 0.0;
+  f.jumpConstant = f.perspective ? 0.0 : twoFootprints;
+  return f;
+}
+
+const int kCentral = 0;
+const int kForward = 1;
+const int kBackward = -1;
+const int kNone = 2;
+
+bool finite(float x) {
+  return !isinf(x) && !isnan(x);
+}
+
+int differenceKind(float before, float centre, float after, float jump) {
+  bool hasBefore = finite(before);
+  bool hasAfter = finite(after);
+  if (!hasBefore && !hasAfter) return kNone;
+  if (!hasBefore) return kForward;
+  if (!hasAfter) return kBackward;
+  float stepBefore = abs(centre - before);
+  float stepAfter = abs(after - centre);
+  if (stepAfter > 2.0 * stepBefore + jump) return kBackward;
+  if (stepBefore > 2.0 * stepAfter + jump) return kForward;
+  return kCentral;
+}
+
+float difference(int kind, float before, float centre, float after) {
+  if (kind == kCentral) return 0.5 * (after - before);
+  if (kind == kForward) return after - centre;
+  if (kind == kBackward) return centre - before;
+  return 0.0;
+}
+
+vec2 tangentTerms(int kind, float before, float centre, float after, bool perspective) {
+  if (kind == kCentral) return vec2(after - before, perspective ? after + before : 2.0);
+  if (kind == kForward) return vec2(after - centre, perspective ? after : 1.0);
+  return vec2(centre - before, perspective ? before : 1.0);
+}
+
+float meanDepth(ivec2 p, int j) {
+  return inside(p) ? texelFetch(uMeanDepth, ivec3(p, j), 0).r : kInfinity;
+}
+
+// depth_normal on interval j's mean depth.
+vec3 depthNormal(ivec2 p, int j, PixelFrame f) {
+  float z = meanDepth(p, j);
+  if (!finite(z)) return vec3(0.0);
+  float zLeft = meanDepth(p + ivec2(-1, 0), j);
+  float zRight = meanDepth(p + ivec2(1, 0), j);
+  float zAbove = meanDepth(p + ivec2(0, -1), j);
+  float zBelow = meanDepth(p + ivec2(0, 1), j);
+  float jump = f.jumpConstant + f.jumpPerDepth * z;
+  int kindX = differenceKind(zLeft, z, zRight, jump);
+  int kindY = differenceKind(zAbove, z, zBelow, jump);
+  vec3 normal = f.view;
+  if (kindX != kNone && kindY != kNone) {
+    vec2 tx = tangentTerms(kindX, zLeft, z, zRight, f.perspective);
+    vec2 ty = tangentTerms(kindY, zAbove, z, zBelow, f.perspective);
+    normal = (tx.x * ty.y) * f.rayCrossY + (tx.y * ty.x) * f.xCrossRay + (tx.y * ty.y) * f.xCrossY;
+  } else if (kindX != kNone || kindY != kNone) {
+    bool alongX = kindX != kNone;
+    vec2 terms = alongX ? tangentTerms(kindX, zLeft, z, zRight, f.perspective)
+                        : tangentTerms(kindY, zAbove, z, zBelow, f.perspective);
+    vec3 t = terms.x * f.ray + terms.y * (alongX ? f.stepX : f.stepY);
+    normal = f.view - (dot(f.view, t) / dot(t, t)) * t;
+  }
+  float lengthSquared = dot(normal, normal);
+  if (!(lengthSquared > 0.0) || !finite(lengthSquared)) return f.view;
+  normal *= inversesqrt(lengthSquared);
+  return dot(normal, f.view) < 0.0 ? -normal : normal;
+}
+
+float specularLobe(float nDotH, float shininess) {
+  if (nDotH <= 0.0) return shininess == 0.0 ? 1.0 : 0.0;
+  return exp2(shininess * log2(min(nDotH, 1.0)));
+}
+
+// light_volume of a' with white interval colours: (rgb, alpha).
+vec4 lightVolume(ivec2 p) {
+  PixelFrame f = pixelFrame(p);
+  vec3 halfVectors[MAX_LIGHTS];
+  for (int k = 0; k < uLightCount; ++k) {
+    vec3 h = uLights[3 * k].xyz + f.view;
+    float lengthSquared = dot(h, h);
+    halfVectors[k] = lengthSquared > 0.0 ? h * inversesqrt(lengthSquared) : f.view;
+  }
+  vec3 rgb = vec3(0.0);
+  float alpha = 0.0;
+  for (int j = 0; j < uIntervals; ++j) {
+    float a = editedAttenuation(p, j);
+    vec3 n = a != 0.0 ? depthNormal(p, j, f) : vec3(0.0);
+    alpha += a;
+    rgb += a * (dot(n, n) > 0.0 ? uAmbient : 1.0);
+    for (int k = 0; k < uLightCount; ++k) {
+      float nDotL = dot(n, uLights[3 * k].xyz);
+      if (!(nDotL > 0.0)) continue;
+      rgb += a * nDotL * uLights[3 * k + 1].xyz;
+      rgb += a * specularLobe(dot(n, halfVectors[k]), uLights[3 * k].w) * uLights[3 * k + 2].xyz;
+    }
+  }
+  return vec4(rgb, alpha);
+}
+
+// --- relighting.cl ambient_occlusion (Eq. 5) on the front depth ---
+float frontDepth(ivec2 p) {
+  return inside(p) ? texelFetch(uFrontDepth, p, 0).r : kInfinity;
+}
+
+float tangentPlaneQuantity(float depth, bool perspective) {
+  return perspective ? 1.0 / depth : depth;
+}
+
+float occlusion(ivec2 p) {
+  float z = frontDepth(p);
+  int radius = uOcclusionRadius;
+  if (!finite(z) || radius == 0) return 1.0;
+  bool perspective = uHalfExtent.z != 0.0;
+  float zLeft = frontDepth(p + ivec2(-1, 0));
+  float zRight = frontDepth(p + ivec2(1, 0));
+  float zAbove = frontDepth(p + ivec2(0, -1));
+  float zBelow = frontDepth(p + ivec2(0, 1));
+  float jump = 4.0 * uHalfExtent.y / float(uImageSize.y) * (perspective ? z : 1.0);
+  float w = tangentPlaneQuantity(z, perspective);
+  float dwdx = difference(differenceKind(zLeft, z, zRight, jump),
+                          tangentPlaneQuantity(zLeft, perspective), w,
+                          tangentPlaneQuantity(zRight, perspective));
+  float dwdy = difference(differenceKind(zAbove, z, zBelow, jump),
+                          tangentPlaneQuantity(zAbove, perspective), w,
+                          tangentPlaneQuantity(zBelow, perspective));
+  int radiusSquared = radius * radius;
+  int yBegin = max(p.y - radius, 0);
+  int yEnd = min(p.y + radius, uImageSize.y - 1);
+  float sum = 0.0;
+  for (int qy = yBegin; qy <= yEnd; ++qy) {
+    int dy = qy - p.y;
+    int reach = int(sqrt(float(radiusSquared - dy * dy) + 0.5));
+    int xBegin = max(p.x - reach, 0);
+    int xEnd = min(p.x + reach, uImageSize.x - 1);
+    for (int qx = xBegin; qx <= xEnd; ++qx) {
+      int dx = qx - p.x;
+      float zq = texelFetch(uFrontDepth, ivec2(qx, qy), 0).r;
+      if (!finite(zq)) continue;
+      float wPlane = w + dwdx * float(dx) + dwdy * float(dy);
+      float zPlane = perspective ? (wPlane > 0.0 ? 1.0 / wPlane : kInfinity) : wPlane;
+      // TANGENT_PLANE_ROUNDING: shortfalls within float rounding of the depth are not occlusion.
+      float rounding = 1e-5 * float(1 + abs(dx) + abs(dy)) * max(abs(z), abs(zq));
+      float inFront = zPlane - zq - rounding;
+      if (inFront > 0.0) sum += min(inFront * uOcclusionTerms.y, 1.0);
+    }
+  }
+  return 1.0 - clamp(uOcclusionTerms.x * sum * uOcclusionTerms.z, 0.0, 1.0);
+}
+
+// --- enhancement.cl: the gradients of a' (central, one-sided at the border) ---
+float gradientSum(ivec2 p) {
+  int x0 = max(p.x - 1, 0), x1 = min(p.x + 1, uImageSize.x - 1);
+  int y0 = max(p.y - 1, 0), y1 = min(p.y + 1, uImageSize.y - 1);
+  float inverseX = x1 > x0 ? 1.0 / float(x1 - x0) : 0.0;
+  float inverseY = y1 > y0 ? 1.0 / float(y1 - y0) : 0.0;
+  float sum = 0.0;
+  for (int j = 0; j < uIntervals; ++j) {
+    float gx = (editedAttenuation(ivec2(x1, p.y), j) - editedAttenuation(ivec2(x0, p.y), j)) *
+               inverseX;
+    float gy = (editedAttenuation(ivec2(p.x, y1), j) - editedAttenuation(ivec2(p.x, y0), j)) *
+               inverseY;
+    sum += gx * gx + gy * gy;
+  }
+  return sum;
+}
+
+void main() {
+  // The canvas's rows run up; the image's run down.
+  ivec2 p = ivec2(int(gl_FragCoord.x), uImageSize.y - 1 - int(gl_FragCoord.y));
+  vec4 colour = vec4(0.0);
+  if (uStoredRendering) {
+    colour = texelFetch(uRendering, p, 0);
+  } else {
+    for (int j = 0; j < uIntervals; ++j) colour += editedAttenuation(p, j) * vec4(uColours[j], 1.0);
+  }
+  if (uLighting) {
+    vec4 lit = lightVolume(p);
+    if (lit.a > 0.0) colour.rgb *= lit.rgb / lit.a;
+  }
+  if (uOcclusion) colour.rgb *= occlusion(p);
+  if (uEnhance) {
+    float g = gradientSum(p);
+    // pow(0, gamma) is 0 for gamma > 0; testing first keeps r = 0 exact.
+    float r = g > 0.0 ? clamp(uEnhanceLaw.x * pow(g, uEnhanceLaw.y), 0.0, 1.0) : 0.0;
+    colour.rgb *= 1.0 - r;
+  }
+  outColour = pngSample(colour);
+}
