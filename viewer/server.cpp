@@ -745,6 +745,8 @@ private:
         };
         nlohmann::json body{{"drawable", recipe.drawable},
                             {"why_not", recipe.why_not},
+                            {"synthesised", recipe.synthesised},
+                            {"fill_radius", recipe.fill_radius_pixels},
                             {"stored_rendering", recipe.stored_rendering},
                             {"opacity_edited", recipe.opacity_edited},
                             {"opacity_scales", recipe.opacity_scales},

@@ -64,8 +64,8 @@ async function settledFrame(count) {
 }
 
 /// The browser drew `frame` from the stored view's proxies, and it matches the CLI's frame.
-function assertDrawnAndMatching(frame, what) {
-  assert.equal(frame.drawnFrom, 'stored view', `${what}: drawn by the browser`);
+function assertDrawnAndMatching(frame, what, drawnFrom = 'stored view') {
+  assert.equal(frame.drawnFrom, drawnFrom, `${what}: drawn by the browser`);
   const expected = decodePng(renderWithCli(binary, archive, frame.options, workDir).colour);
   const shown = { ...frame.image, channels: 4, data: Uint8Array.from(frame.image.data) };
   const psnr = psnrPremultiplied(shown, expected);
@@ -108,10 +108,25 @@ test('the stored view and its edits drawn with WebGL2 match insitu-view render',
   const edited = assertDrawnAndMatching(frame, `opacity x${scale}`);
   assert.ok(differingSamples(edited, recoloured) > 0, 'the opacity edit shows');
 
-  // Headlight and ambient occlusion.
+  // 20 degrees around, with the edits: the light field (no attenuation) cannot make edited
+  // views, so the view's proxies are synthesised in the new camera (Explorer's step 3), then
+  // edited; and relit there from the synthesised mean depths.
+  await page.fill('#azimuth', String(Math.round(info.azimuth + 20)));
+  await page.fill('#elevation', String(Math.round(info.elevation)));
+  await page.dispatchEvent('#elevation', 'change');
+  frame = await settledFrame(frame.count);
+  assert.equal(Number(frame.options.azimuth), Math.round(info.azimuth + 20));
+  const orbited = assertDrawnAndMatching(frame, '20 degree orbit', 'synthesised view');
+  assert.ok(differingSamples(orbited, edited) > 0, 'the orbit moved the picture');
   await page.check('#light-on');
   frame = await settledFrame(frame.count);
   assert.ok(frame.options.light, 'lighting on');
+  assertDrawnAndMatching(frame, 'orbit relit', 'synthesised view');
+
+  // Back at the stored view: headlight and ambient occlusion.
+  await page.click('#reset-view');
+  frame = await settledFrame(frame.count);
+  assert.equal(frame.options.azimuth, undefined);
   assertDrawnAndMatching(frame, 'relight');
   await page.check('#ao-on');
   frame = await settledFrame(frame.count);
@@ -148,8 +163,8 @@ test('the recipe says what the page cannot draw and refuses bad options', async 
   assert.equal(plain.opacity_scales.length, 8);
   const info = await (await fetch(`${server.url}api/step?step=300&view=0`)).json();
   const orbit = await (await recipe(`step=300&azimuth=${info.azimuth + 20}&elevation=${info.elevation}`)).json();
-  assert.equal(orbit.drawable, false);
-  assert.match(orbit.why_not, /synthesised view/);
+  assert.equal(orbit.drawable, false, 'this step has a light field, which makes other views');
+  assert.match(orbit.why_not, /light field/);
   const scaled = await (await recipe('step=300&opacity-scale=2%3D0.5&light=camera&ao=4,2')).json();
   assert.equal(scaled.drawable, true);
   assert.equal(scaled.opacity_edited, true);

@@ -51,3 +51,48 @@ export function orbitCamera(view, azimuthDeg, elevationDeg) {
   }
   return camera;
 }
+
+/// The stored camera (Camera::to_json) in the shape orbitCamera returns, exactly as stored.
+export function storedCamera(json) {
+  return {
+    perspective: json.projection === 'perspective',
+    width: json.size[0],
+    height: json.size[1],
+    forward: json.forward,
+    right: json.right,
+    up: json.up,
+    halfWidth: json.half_width,
+    halfHeight: json.half_height,
+    position: json.position,
+  };
+}
+
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const length = (a) => Math.sqrt(dot(a, a));
+
+/// The rigid map from `from`'s local coordinates (right, up, forward offsets from its position)
+/// to `to`'s, as three rows [r0, r1, r2, t] (seed 000 Eq. 4, M_new M_orig^-1), as view
+/// synthesis's local_map: in double, entries within rounding of 0 or +-1 snapped, so that an
+/// unchanged camera maps every point onto itself.
+export function localMap(from, to) {
+  const fromAxes = [from.right, from.up, from.forward];
+  const toAxes = [to.right, to.up, to.forward];
+  const scale = 1 + length(from.position) + length(to.position);
+  const offset = add(from.position, to.position, -1);
+  return toAxes.map((axis) => {
+    const row = fromAxes.map((f) => {
+      const r = dot(axis, f);
+      return Math.abs(r - Math.round(r)) < 1e-12 ? Math.round(r) : r;
+    });
+    const t = dot(offset, axis);
+    return [...row, Math.abs(t) < 1e-12 * scale ? 0 : t];
+  });
+}
+
+/// The sphere bounding the field (the stored camera's orbit sphere, Camera::to_json) in the
+/// target's local coordinates, radius padded by float rounding: [x, y, z, radius].
+export function boundingSphereIn(stored, target) {
+  const offset = add(stored.orbit_center, target.position, -1);
+  return [dot(offset, target.right), dot(offset, target.up), dot(offset, target.forward),
+    stored.orbit_radius * (1 + 1e-5)];
+}

@@ -30,18 +30,21 @@ function atStoredView(options) {
     sameAngle(Number(options.elevation), state.info.camera.elevation));
 }
 
-// Whether the browser may draw this frame from the stored view's proxies; the frame's recipe
-// then says whether it does (the colour model, for one, is the server's).
-function storedViewInBrowser(options) {
+// Whether the browser may draw this frame from the view's single-perspective proxies; the
+// frame's recipe then says whether it does (the colour model, for one, is the server's).
+function proxiesInBrowser() {
   return Boolean(viewer.gpu && viewer.gpu.proxyRenderer && $('gpu-toggle').checked &&
-    state.info && state.info.camera && atStoredView(options));
+    state.info && state.info.camera);
 }
 
-const recipes = new Map();  // options JSON -> Promise of the recipe
+const recipes = new Map();  // options JSON (angles left out for other views) -> Promise
 const KEPT_RECIPES = 32;
 
+// The recipe depends on the angles only through whether they are the stored view's, so an orbit
+// asks once, not per frame.
 function recipeFor(options) {
-  const key = JSON.stringify(options);
+  const { azimuth, elevation, ...rest } = options;
+  const key = JSON.stringify({ ...rest, synthesised: !atStoredView(options) });
   if (!recipes.has(key)) {
     recipes.set(key, fetch('api/recipe', { method: 'POST', body: new URLSearchParams(options) })
       .then(async (response) => {
@@ -61,15 +64,15 @@ export function requestFrame() {
   const options = currentOptions();
   if (!options || inFlight) return;
   const preview = state.dragging && drawnInBrowser(options);
-  const inBrowser = drawnInBrowser(options) || storedViewInBrowser(options);
   // The same options drawn the same way (toggling "draw in the browser" redraws them).
   if (viewer.displayed && sameOptions(viewer.displayed.options, options) &&
-    !(viewer.displayed.preview && !preview) && Boolean(viewer.displayed.gpu) === inBrowser) return;
+    !(viewer.displayed.preview && !preview) &&
+    viewer.displayed.toggle === $('gpu-toggle').checked) return;
   inFlight = true;
   if (drawnInBrowser(options)) {
     drawInBrowser(options, preview);
-  } else if (storedViewInBrowser(options)) {
-    drawStoredView(options);
+  } else if (proxiesInBrowser()) {
+    drawProxies(options);
   } else {
     serverFrame(options);
   }
@@ -95,9 +98,9 @@ function serverFrame(options) {
     .finally(frameDone);
 }
 
-// The stored view from its proxies, where the recipe allows; else (or when the server refuses
+// A frame from the view's proxies, where the recipe allows; else (or when the server refuses
 // the options: it says why in the frame's answer) the server's frame.
-async function drawStoredView(options) {
+async function drawProxies(options) {
   const entry = state.timeline[state.stepIndex];
   let recipe = null;
   try {
@@ -110,13 +113,15 @@ async function drawStoredView(options) {
     serverFrame(options);
     return;
   }
-  viewer.gpu.drawStoredView(entry.step, state.view, recipe)
+  viewer.gpu.drawProxies(entry.step, state.view, recipe, Number(options.azimuth),
+    Number(options.elevation))
     .then((timing) => {
       if (!timing) {
         serverFrame(options);
         return null;
       }
-      return showGpuFrame(options, timing, 'stored view', recipe.colour_source).then(frameDone);
+      const what = recipe.synthesised ? 'synthesised view' : 'stored view';
+      return showGpuFrame(options, timing, what, recipe.colour_source).then(frameDone);
     })
     .catch((error) => {
       showError(String(error));
@@ -166,8 +171,8 @@ function showGpuFrame(options, timing, what, colourSource) {
   // A preview is smaller than the view: scaled up smoothly, not in blocks.
   $('gpu-frame').style.imageRendering = preview ? 'auto' : '';
   if (viewer.displayed && viewer.displayed.url) URL.revokeObjectURL(viewer.displayed.url);
-  viewer.displayed = { options, gpu: true, drawnFrom: what, preview,
-    milliseconds: timing.milliseconds, synthesised: what === 'light field', colourSource };
+  viewer.displayed = { options, gpu: true, drawnFrom: what, preview, toggle: $('gpu-toggle').checked,
+    milliseconds: timing.milliseconds, synthesised: what !== 'stored view', colourSource };
   const fps = countFrame();
   const open = viewer.gpu.lastOpen;
   $('readout').textContent =
@@ -191,6 +196,7 @@ async function display(options, png, headers, roundTripMs) {
   const header = (name) => headers.get(name);
   viewer.displayed = {
     options,
+    toggle: $('gpu-toggle').checked,
     png,
     url,
     milliseconds: Number(header('X-Insitu-Milliseconds')),

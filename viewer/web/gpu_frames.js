@@ -61,9 +61,10 @@ export class GpuFrames {
       .then(({ value, downloadMs }) => ({ proxies: value, downloadMs }));
   }
 
-  /// Draws the stored view of (step, view) with `recipe` (/api/recipe, drawable). Resolves to
-  /// the frame's timing, or null when the view has no attenuation proxies.
-  async drawStoredView(step, view, recipe) {
+  /// Draws (step, view) from its single-perspective proxies with `recipe` (/api/recipe,
+  /// drawable): the stored view, or for a synthesised recipe the view at the orbit angles.
+  /// Resolves to the frame's timing, or null when the view has no attenuation proxies.
+  async drawProxies(step, view, recipe, azimuthDeg, elevationDeg) {
     const key = `${step}/${view}`;
     const { proxies, downloadMs } = await this.proxies(step, view);
     if (!proxies) return null;
@@ -76,8 +77,10 @@ export class GpuFrames {
       this.uploadedProxies = key;
       this.lastOpen = { key, downloadMs, uploadMs, bytes: proxies.bytes };
     }
+    const target = recipe.synthesised
+      ? reorbit(proxies.header.camera, azimuthDeg, elevationDeg) : null;
     const started = performance.now();
-    this.proxyRenderer.render(recipe, proxies.header.camera);
+    this.proxyRenderer.render(recipe, target);
     await this.proxyRenderer.finish();
     return { milliseconds: performance.now() - started, uploadMs, preview: false };
   }

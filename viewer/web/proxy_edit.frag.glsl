@@ -3,13 +3,15 @@
 // kernels/explore/transfer_function_edit.cl is the reference this follows step for step).
 // Writes a'_j of intervals uFirst .. uFirst + 15 into four RGBA32F layers (interval j at layer
 // j / 4, component j % 4); without an edit (uCopy) a'_j = a_j exactly, as the Explorer then
-// leaves a alone. The JS side prepends #version and MAX_INTERVALS.
+// leaves a alone. A synthesised view's a and mean depths come packed four intervals to a layer
+// (resolve_attenuation.frag.glsl; PACKED) and without optical depth, as the Explorer has none
+// for them. The JS side prepends #version, MAX_INTERVALS and PACKED for those.
 precision highp float;
 precision highp int;
 precision highp sampler2DArray;
 
-uniform sampler2DArray uAttenuation;   // layer j: a_j
-uniform sampler2DArray uMeanDepth;     // layer j: mean depth of interval j, +inf where a_j = 0
+uniform sampler2DArray uAttenuation;   // layer j (PACKED: j / 4, component j % 4): a_j
+uniform sampler2DArray uMeanDepth;     // the same for the mean depth of j, +inf where a_j = 0
 uniform sampler2DArray uOpticalDepth;  // layer j: tau_j, where stored (uHasOpticalDepth)
 uniform bool uHasOpticalDepth;
 uniform bool uCopy;
@@ -22,6 +24,14 @@ layout(location = 1) out vec4 out1;
 layout(location = 2) out vec4 out2;
 layout(location = 3) out vec4 out3;
 
+float planeValue(sampler2DArray planes, ivec2 p, int j) {
+#ifdef PACKED
+  return texelFetch(planes, ivec3(p, j / 4), 0)[j % 4];
+#else
+  return texelFetch(planes, ivec3(p, j), 0).r;
+#endif
+}
+
 // Light left behind a run below which the run counts as opaque (EDIT_OPAQUE_LIGHT).
 const float kOpaqueLight = 1e-6;
 
@@ -31,7 +41,7 @@ void main() {
   float a[MAX_INTERVALS];
   float edited[MAX_INTERVALS];
   for (int j = 0; j < uIntervals; ++j) {
-    a[j] = texelFetch(uAttenuation, ivec3(pixel, j), 0).r;
+    a[j] = planeValue(uAttenuation, pixel, j);
     edited[j] = uCopy ? a[j] : 0.0;
   }
   if (!uCopy) {
@@ -42,7 +52,7 @@ void main() {
     int count = 0;
     for (int j = 0; j < uIntervals; ++j) {
       if (!(a[j] > 0.0)) continue;
-      float z = texelFetch(uMeanDepth, ivec3(pixel, j), 0).r;
+      float z = planeValue(uMeanDepth, pixel, j);
       float key = isnan(z) ? uintBitsToFloat(0x7f800000u) : z;
       int at = count++;
       while (at > 0 && depth[at - 1] > key) {

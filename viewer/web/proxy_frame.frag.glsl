@@ -6,15 +6,15 @@
 //     colours (relighting.cl, normals from each interval's mean depth), then ambient occlusion
 //     (Eq. 5, relighting.cl ambient_occlusion) of the front-most layer;
 //  7. depth-aware enhancement (Eq. 11, enhancement.cl) on the gradients of a'.
-// a' comes from proxy_edit.frag.glsl. The JS side prepends #version, MAX_INTERVALS, MAX_LIGHTS
-// and srgb.glsl.
+// a' comes from proxy_edit.frag.glsl; a synthesised view's mean depths come packed (PACKED, see
+// there). The JS side prepends #version, MAX_INTERVALS, MAX_LIGHTS, PACKED and srgb.glsl.
 precision highp float;
 precision highp int;
 precision highp sampler2D;
 precision highp sampler2DArray;
 
 uniform sampler2DArray uEdited;     // layer g: a'_j of intervals 4g .. 4g + 3
-uniform sampler2DArray uMeanDepth;  // layer j: mean depth of interval j
+uniform sampler2DArray uMeanDepth;  // layer j (PACKED: j / 4, component j % 4): mean depth of j
 uniform sampler2D uRendering;       // the stored rendering, RGBA premultiplied
 uniform sampler2D uFrontDepth;      // front-most layer depth (front_depth.frag.glsl)
 uniform int uIntervals;
@@ -113,7 +113,12 @@ vec2 tangentTerms(int kind, float before, float centre, float after, bool perspe
 }
 
 float meanDepth(ivec2 p, int j) {
-  return inside(p) ? texelFetch(uMeanDepth, ivec3(p, j), 0).r : kInfinity;
+  if (!inside(p)) return kInfinity;
+#ifdef PACKED
+  return texelFetch(uMeanDepth, ivec3(p, j / 4), 0)[j % 4];
+#else
+  return texelFetch(uMeanDepth, ivec3(p, j), 0).r;
+#endif
 }
 
 // depth_normal on interval j's mean depth.

@@ -1,23 +1,30 @@
-// Draws the stored view from its single-perspective proxies on the client's GPU with WebGL2: the
-// step's proxies (proxy_data.js) become textures once (and the front-most depth over the layers
-// is computed once), then every frame is two passes for the frame's recipe (/api/recipe: the
-// edit's per-interval scales and colours, the lights, the occlusion and enhancement terms as the
-// engine resolves them): proxy_edit.frag.glsl turns a into a', proxy_frame.frag.glsl composes,
-// lights, occludes and enhances. The C++ Explorer stays the reference; tests/viewer/
-// proxies.test.mjs holds the two to a stated PSNR.
+// Draws a step's view from its single-perspective proxies on the client's GPU with WebGL2: the
+// step's proxies (proxy_data.js) become textures once (with the front-most depth over the layers
+// and each ray's total attenuation), then every frame is a few passes for the frame's recipe
+// (/api/recipe: the edit's per-interval scales and colours, the lights, the occlusion and
+// enhancement terms as the engine resolves them):
+//  * another view than the stored one first synthesises the attenuation in its camera
+//    (splat_attenuation.*.glsl, one point per source pixel and interval into a depth-tested
+//    target; resolve_attenuation.frag.glsl), as Explorer::render's step 3;
+//  * proxy_edit.frag.glsl turns a into a' (step 4);
+//  * proxy_frame.frag.glsl composes, lights, occludes and enhances (steps 5-7).
+// The C++ Explorer stays the reference; tests/viewer/proxies.test.mjs holds the two to a stated
+// PSNR.
 
+import { boundingSphereIn, localMap, storedCamera } from './camera.js';
 import {
   buildProgram, frameContext, gpuFinished, readCanvas, shaderText, TextureSet,
 } from './webgl.js';
 
 const MAX_LIGHTS = 16;         // kMaxLights (relighting.hpp)
-const EDIT_OUTPUTS = 4;        // draw buffers the edit pass writes (WebGL2 guarantees 4)
-const INTERVALS_PER_DRAW = 4 * EDIT_OUTPUTS;
+const OUTPUTS = 4;             // draw buffers a pass writes (WebGL2 guarantees 4)
+const INTERVALS_PER_DRAW = 4 * OUTPUTS;
+const SPLAT_MARGIN = 2;        // pixels around the synthesised target (splat_attenuation.vert.glsl)
 
 // Texture units, fixed per texture.
 const UNIT = {
   attenuation: 0, meanDepth: 1, opticalDepth: 2, layers: 3, rendering: 4, frontDepth: 5,
-  edited: 6,
+  edited: 6, sourceTotal: 7, synthesisedAttenuation: 8, synthesisedMeanDepth: 9, splat: 10,
 };
 
 export class ProxyRenderer {
@@ -28,10 +35,20 @@ export class ProxyRenderer {
     if (!gl.getExtension('EXT_color_buffer_float')) {
       throw new Error('this WebGL2 cannot render to float textures (EXT_color_buffer_float)');
     }
-    const names = ['fullscreen.vert.glsl', 'srgb.glsl', 'proxy_edit.frag.glsl',
-      'proxy_frame.frag.glsl', 'front_depth.frag.glsl'];
-    const [vertex, srgb, edit, frame, front] = await Promise.all(names.map(shaderText));
-    return new ProxyRenderer(canvas, gl, { vertex, edit, frame: srgb + frame, front });
+    const names = ['fullscreen.vert.glsl', 'srgb.glsl', 'view_synthesis.glsl',
+      'proxy_load.frag.glsl', 'proxy_edit.frag.glsl', 'proxy_frame.frag.glsl',
+      'splat_attenuation.vert.glsl', 'splat_attenuation.frag.glsl',
+      'resolve_attenuation.frag.glsl'];
+    const [fullscreen, srgb, synthesis, load, edit, frame, splatVertex, splatFragment, resolve] =
+      await Promise.all(names.map(shaderText));
+    // Vertex and fragment source of each program.
+    return new ProxyRenderer(canvas, gl, {
+      load: [fullscreen, load],
+      edit: [fullscreen, edit],
+      frame: [fullscreen, srgb + frame],
+      splat: [synthesis + splatVertex, synthesis + splatFragment],
+      resolve: [fullscreen, synthesis + resolve],
+    });
   }
 
   constructor(canvas, gl, sources) {
@@ -41,16 +58,19 @@ export class ProxyRenderer {
     this.programs = new Map();  // by "kind/max intervals"
     this.textures = new TextureSet(gl);  // of the loaded step
     this.framebuffer = gl.createFramebuffer();
+    this.depthBuffer = gl.createRenderbuffer();
     this.vertexArray = gl.createVertexArray();
     this.loaded = null;         // {header, maxIntervals, groups}
   }
 
-  program(kind, maxIntervals) {
-    const key = `${kind}/${maxIntervals}`;
+  /// The program of `kind` for arrays of `maxIntervals`; `packed`: a synthesised view's inputs.
+  program(kind, maxIntervals, packed = false) {
+    const key = `${kind}/${maxIntervals}/${packed}`;
     if (!this.programs.has(key)) {
       const prefix = `#version 300 es\n#define MAX_INTERVALS ${maxIntervals}\n` +
-        `#define MAX_LIGHTS ${MAX_LIGHTS}\n`;
-      const program = buildProgram(this.gl, prefix, this.sources.vertex, this.sources[kind]);
+        `#define MAX_LIGHTS ${MAX_LIGHTS}\n` + (packed ? '#define PACKED\n' : '');
+      const [vertex, fragment] = this.sources[kind];
+      const program = buildProgram(this.gl, prefix, vertex, fragment);
       const locations = new Map();
       this.programs.set(key, {
         program,
@@ -88,7 +108,7 @@ export class ProxyRenderer {
     return texture;
   }
 
-  /// Uploads parsed proxies (parseProxies) and computes their front depth.
+  /// Uploads parsed proxies (parseProxies) and computes their front depth and ray totals.
   load(proxies) {
     const gl = this.gl;
     const { header } = proxies;
@@ -112,28 +132,48 @@ export class ProxyRenderer {
     } else {
       gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, 1, 1, 0, gl.RGBA, gl.FLOAT, new Float32Array(4));
     }
-    const front = this.texture(UNIT.frontDepth, gl.TEXTURE_2D);
-    gl.texImage2D(gl.TEXTURE_2D, 0, gl.R32F, width, height, 0, gl.RED, gl.FLOAT, null);
+    const image = (unit) => {
+      const texture = this.texture(unit, gl.TEXTURE_2D);
+      gl.texImage2D(gl.TEXTURE_2D, 0, gl.R32F, width, height, 0, gl.RED, gl.FLOAT, null);
+      return texture;
+    };
+    const front = image(UNIT.frontDepth);
+    const total = image(UNIT.sourceTotal);
+    // Four intervals to a layer, in whole draws of OUTPUTS layers.
     const groups = Math.ceil(intervals / 4);
-    const edited = this.texture(UNIT.edited, gl.TEXTURE_2D_ARRAY);
-    gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA32F, width, height,
-      Math.ceil(groups / EDIT_OUTPUTS) * EDIT_OUTPUTS, 0, gl.RGBA, gl.FLOAT, null);
+    const layers = Math.ceil(groups / OUTPUTS) * OUTPUTS;
+    const packed = (unit, w, h, count) => {
+      const texture = this.texture(unit, gl.TEXTURE_2D_ARRAY);
+      gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA32F, w, h, count, 0, gl.RGBA, gl.FLOAT, null);
+      return texture;
+    };
+    const edited = packed(UNIT.edited, width, height, layers);
+    const synthesisedAttenuation = packed(UNIT.synthesisedAttenuation, width, height, layers);
+    const synthesisedMeanDepth = packed(UNIT.synthesisedMeanDepth, width, height, layers);
+    const margin = 2 * SPLAT_MARGIN;
+    const splat = packed(UNIT.splat, width + margin, height + margin, intervals);
+    gl.bindRenderbuffer(gl.RENDERBUFFER, this.depthBuffer);
+    gl.renderbufferStorage(gl.RENDERBUFFER, gl.DEPTH_COMPONENT32F, width + margin,
+      height + margin);
     // The shaders' arrays are sized to the step's intervals, rounded up to a group of four.
-    this.loaded = { header, maxIntervals: 4 * groups, front, edited,
-      hasOpticalDepth: Boolean(proxies.opticalDepth) };
+    this.loaded = { header, maxIntervals: 4 * groups, groups, edited, synthesisedAttenuation,
+      synthesisedMeanDepth, splat, hasOpticalDepth: Boolean(proxies.opticalDepth) };
 
-    // Front depth, once per step: ambient occlusion reads it around every pixel.
-    const { program, uniform } = this.program('front', this.loaded.maxIntervals);
+    const { program, uniform } = this.program('load', this.loaded.maxIntervals);
     this.textures.bind();
     gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, front, 0);
-    gl.drawBuffers([gl.COLOR_ATTACHMENT0]);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT1, gl.TEXTURE_2D, total, 0);
+    gl.drawBuffers([gl.COLOR_ATTACHMENT0, gl.COLOR_ATTACHMENT1]);
     gl.viewport(0, 0, width, height);
     gl.useProgram(program);
     gl.uniform1i(uniform('uLayers'), UNIT.layers);
+    gl.uniform1i(uniform('uAttenuation'), UNIT.attenuation);
     gl.uniform1i(uniform('uLayerCount'), header.layers);
+    gl.uniform1i(uniform('uIntervals'), intervals);
     this.drawQuad();
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, null, 0);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT1, gl.TEXTURE_2D, null, 0);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
   }
 
@@ -142,43 +182,143 @@ export class ProxyRenderer {
     this.gl.drawArrays(this.gl.TRIANGLES, 0, 3);
   }
 
-  /// Draws the loaded stored view with `recipe` (/api/recipe, drawable) into the canvas;
-  /// `camera` is the stored camera (Camera::to_json).
-  render(recipe, camera) {
+  /// Attaches layers[k] of `textures[k]` as colour attachment k (null: no output k) and draws.
+  drawInto(targets) {
+    const gl = this.gl;
+    const buffers = [];
+    for (let k = 0; k < OUTPUTS; ++k) {
+      const target = targets[k];
+      gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0 + k,
+        target ? target.texture : null, 0, target ? target.layer : 0);
+      buffers.push(target ? gl.COLOR_ATTACHMENT0 + k : gl.NONE);
+    }
+    gl.drawBuffers(buffers);
+    this.drawQuad();
+  }
+
+  /// Step 3 for another view: the stored view's attenuation seen from `target` (camera.js),
+  /// into the synthesised textures (packed), with holes up to `fillRadius` pixels filled.
+  synthesise(target, fillRadius) {
+    const gl = this.gl;
+    const { header, maxIntervals, groups, splat } = this.loaded;
+    const { width, height, intervals } = header;
+    if (target.width !== width || target.height !== height) {
+      throw new Error(`a ${target.width}x${target.height} view of ${width}x${height} proxies`);
+    }
+    const source = storedCamera(header.camera);
+    const rows = localMap(source, target);
+    const inverse = localMap(target, source);
+    const sphere = boundingSphereIn(header.camera, target);
+    const extent = (camera) => [camera.halfWidth, camera.halfHeight, camera.perspective ? 1 : 0];
+
+    // Pass 1: per interval, the nearest contribution per target pixel (depth-tested points).
+    const splatProgram = this.program('splat', maxIntervals);
+    let u = splatProgram.uniform;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
+    gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER,
+      this.depthBuffer);
+    gl.viewport(0, 0, width + 2 * SPLAT_MARGIN, height + 2 * SPLAT_MARGIN);
+    gl.useProgram(splatProgram.program);
+    gl.uniform1i(u('uMeanDepth'), UNIT.meanDepth);
+    gl.uniform1i(u('uAttenuation'), UNIT.attenuation);
+    gl.uniform1i(u('uIntervals'), intervals);
+    gl.uniform2i(u('uSourceSize'), width, height);
+    gl.uniform3fv(u('uSourceExtent'), extent(source));
+    gl.uniform4fv(u('uRow0'), rows[0]);
+    gl.uniform4fv(u('uRow1'), rows[1]);
+    gl.uniform4fv(u('uRow2'), rows[2]);
+    gl.uniform2i(u('uTargetSize'), width, height);
+    gl.uniform3fv(u('uTargetExtent'), extent(target));
+    gl.uniform1i(u('uMargin'), SPLAT_MARGIN);
+    // Depths a contribution can have: around the bounding sphere, generously.
+    const nearest = sphere[2] - 2 * sphere[3];
+    gl.uniform2f(u('uDepthRange'), nearest, 1 / (4 * sphere[3]));
+    gl.enable(gl.DEPTH_TEST);
+    gl.depthFunc(gl.LESS);
+    gl.clearColor(0, 0, 0, 0);
+    gl.clearDepth(1);
+    gl.bindVertexArray(this.vertexArray);
+    for (let j = 0; j < intervals; ++j) {
+      gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, splat, 0, j);
+      gl.drawBuffers([gl.COLOR_ATTACHMENT0]);
+      gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
+      gl.uniform1i(u('uInterval'), j);
+      gl.drawArrays(gl.POINTS, 0, width * height);
+    }
+    gl.disable(gl.DEPTH_TEST);
+    gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER, null);
+    gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, null, 0, 0);
+
+    // Pass 2: composite per target pixel; a' groups then mean-depth groups, OUTPUTS per draw.
+    const resolve = this.program('resolve', maxIntervals);
+    u = resolve.uniform;
+    gl.viewport(0, 0, width, height);
+    gl.useProgram(resolve.program);
+    gl.uniform1i(u('uSplat'), UNIT.splat);
+    gl.uniform1i(u('uSourceTotal'), UNIT.sourceTotal);
+    gl.uniform1i(u('uMargin'), SPLAT_MARGIN);
+    gl.uniform1i(u('uIntervals'), intervals);
+    gl.uniform1i(u('uFillRadius'), fillRadius);
+    gl.uniform2i(u('uTargetSize'), width, height);
+    gl.uniform3fv(u('uTargetExtent'), extent(target));
+    gl.uniform2i(u('uSourceSize'), width, height);
+    gl.uniform3fv(u('uSourceExtent'), extent(source));
+    gl.uniform4fv(u('uInverse0'), inverse[0]);
+    gl.uniform4fv(u('uInverse1'), inverse[1]);
+    gl.uniform4fv(u('uInverse2'), inverse[2]);
+    gl.uniform4fv(u('uSphere'), sphere);
+    for (let part = 0; part * OUTPUTS < 2 * groups; ++part) {
+      gl.uniform1i(u('uPart'), part);
+      const targets = [];
+      for (let k = 0; k < OUTPUTS; ++k) {
+        const g = part * OUTPUTS + k;
+        targets.push(g >= 2 * groups ? null : g < groups
+          ? { texture: this.loaded.synthesisedAttenuation, layer: g }
+          : { texture: this.loaded.synthesisedMeanDepth, layer: g - groups });
+      }
+      this.drawInto(targets);
+    }
+    this.drawInto([null, null, null, null]);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+  }
+
+  /// Draws the loaded view with `recipe` (/api/recipe, drawable) into the canvas: the stored
+  /// view, or for a synthesised recipe the view from `target` (camera.js, the stored size).
+  render(recipe, target) {
     if (!this.loaded) throw new Error('no proxies loaded');
     const gl = this.gl;
     const { header, maxIntervals, edited } = this.loaded;
     const { width, height, intervals } = header;
     this.textures.bind();
+    const synthesised = Boolean(recipe.synthesised);
+    const camera = synthesised ? target : storedCamera(header.camera);
+    if (synthesised) this.synthesise(target, recipe.fill_radius);
 
-    // Pass 1: a' (or a copy of a), sixteen intervals per draw.
-    const edit = this.program('edit', maxIntervals);
+    // Pass 1: a' (or a copy of a), sixteen intervals per draw. A synthesised view has no
+    // optical depth (the Explorer re-projects none).
+    const edit = this.program('edit', maxIntervals, synthesised);
     gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
     gl.viewport(0, 0, width, height);
     gl.useProgram(edit.program);
-    gl.uniform1i(edit.uniform('uAttenuation'), UNIT.attenuation);
-    gl.uniform1i(edit.uniform('uMeanDepth'), UNIT.meanDepth);
+    gl.uniform1i(edit.uniform('uAttenuation'),
+      synthesised ? UNIT.synthesisedAttenuation : UNIT.attenuation);
+    gl.uniform1i(edit.uniform('uMeanDepth'),
+      synthesised ? UNIT.synthesisedMeanDepth : UNIT.meanDepth);
     gl.uniform1i(edit.uniform('uOpticalDepth'), UNIT.opticalDepth);
-    gl.uniform1i(edit.uniform('uHasOpticalDepth'), this.loaded.hasOpticalDepth ? 1 : 0);
+    gl.uniform1i(edit.uniform('uHasOpticalDepth'),
+      this.loaded.hasOpticalDepth && !synthesised ? 1 : 0);
     gl.uniform1i(edit.uniform('uCopy'), recipe.opacity_edited ? 0 : 1);
     gl.uniform1i(edit.uniform('uIntervals'), intervals);
     const scales = new Float32Array(maxIntervals).fill(1);
     recipe.opacity_scales.forEach((s, j) => { scales[j] = s; });
     gl.uniform1fv(edit.uniform('uScales'), scales);
-    const attachments = [];
-    for (let k = 0; k < EDIT_OUTPUTS; ++k) attachments.push(gl.COLOR_ATTACHMENT0 + k);
-    gl.drawBuffers(attachments);
     for (let first = 0; first < intervals; first += INTERVALS_PER_DRAW) {
-      for (let k = 0; k < EDIT_OUTPUTS; ++k) {
-        gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0 + k, edited, 0,
-          first / 4 + k);
-      }
       gl.uniform1i(edit.uniform('uFirst'), first);
-      this.drawQuad();
+      const targets = [];
+      for (let k = 0; k < OUTPUTS; ++k) targets.push({ texture: edited, layer: first / 4 + k });
+      this.drawInto(targets);
     }
-    for (let k = 0; k < EDIT_OUTPUTS; ++k) {
-      gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0 + k, null, 0, 0);
-    }
+    this.drawInto([null, null, null, null]);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
 
     // Pass 2: the frame, into the canvas.
@@ -186,12 +326,12 @@ export class ProxyRenderer {
       this.canvas.width = width;
       this.canvas.height = height;
     }
-    const frame = this.program('frame', maxIntervals);
+    const frame = this.program('frame', maxIntervals, synthesised);
     const u = frame.uniform;
     gl.viewport(0, 0, width, height);
     gl.useProgram(frame.program);
     gl.uniform1i(u('uEdited'), UNIT.edited);
-    gl.uniform1i(u('uMeanDepth'), UNIT.meanDepth);
+    gl.uniform1i(u('uMeanDepth'), synthesised ? UNIT.synthesisedMeanDepth : UNIT.meanDepth);
     gl.uniform1i(u('uRendering'), UNIT.rendering);
     gl.uniform1i(u('uFrontDepth'), UNIT.frontDepth);
     gl.uniform1i(u('uIntervals'), intervals);
@@ -202,8 +342,8 @@ export class ProxyRenderer {
     gl.uniform3fv(u('uForward'), camera.forward);
     gl.uniform3fv(u('uRight'), camera.right);
     gl.uniform3fv(u('uUp'), camera.up);
-    gl.uniform3f(u('uHalfExtent'), camera.half_width, camera.half_height,
-      camera.projection === 'perspective' ? 1 : 0);
+    gl.uniform3f(u('uHalfExtent'), camera.halfWidth, camera.halfHeight,
+      camera.perspective ? 1 : 0);
     gl.uniform2i(u('uImageSize'), width, height);
     const lighting = recipe.lighting;
     gl.uniform1i(u('uLighting'), lighting ? 1 : 0);

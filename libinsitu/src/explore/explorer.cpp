@@ -866,18 +866,34 @@ FrameRecipe Explorer::recipe(const ExploreRequest& request) {
         return recipe;
     }
     const Camera& stored = single->camera;
-    if (!same_angle(request.azimuth_deg.value_or(stored.azimuth_deg()), stored.azimuth_deg()) ||
-        !same_angle(request.elevation_deg.value_or(stored.elevation_deg()),
-                    stored.elevation_deg())) {
-        recipe.why_not = "a synthesised view (not the stored view's angles)";
+    recipe.synthesised =
+        !same_angle(request.azimuth_deg.value_or(stored.azimuth_deg()), stored.azimuth_deg()) ||
+        !same_angle(request.elevation_deg.value_or(stored.elevation_deg()), stored.elevation_deg());
+    if (recipe.synthesised && request.source == ProxySource::automatic) {
+        // As render() decides: a light field of the view's field makes other views (the view's
+        // proxies filling in), unless the frame needs attenuation the light field lacks.
+        const std::string field = archive_->entry(request.step, request.view).field;
+        const LightField* light_field = load_light_field(request.step, field, {0});
+        const bool needs_attenuation = request.transfer_function.has_value() ||
+                                       !request.opacity_scales.empty() ||
+                                       request.enhancement.has_value();
+        if (light_field && !(needs_attenuation && !light_field->settings.attenuation)) {
+            recipe.why_not = "the light field makes this view";
+            return recipe;
+        }
+    }
+    if (recipe.synthesised && request.ambient_occlusion) {
+        recipe.why_not = "ambient occlusion of a synthesised view (its layers are the server's)";
         return recipe;
     }
+    recipe.fill_radius_pixels = request.synthesis.hole_fill_radius_pixels;
     // The rest as Explorer::render's proxies_frame and finish_frame decide it at the stored view.
     const TransferFunction stored_tf = archive_->transfer_function(request.step, request.view);
     const TransferFunction& shown_tf =
         request.transfer_function ? *request.transfer_function : stored_tf;
-    recipe.stored_rendering = shows_stored_rendering(*single, asks_stored_tf(request, stored_tf),
-                                                     scales_any_opacity(request), request);
+    recipe.stored_rendering =
+        !recipe.synthesised && shows_stored_rendering(*single, asks_stored_tf(request, stored_tf),
+                                                      scales_any_opacity(request), request);
     const ColourModel* model = single->colour_model ? &*single->colour_model : nullptr;
     if (recipe.stored_rendering) {
         recipe.opacity_scales.assign(static_cast<std::size_t>(single->intervals->count()), 1.0);

@@ -108,15 +108,19 @@ struct ExploreFrame {
 
 /// What a client that draws frames itself (the web viewer's WebGL2 renderer) needs besides the
 /// view's stored single-perspective proxies to make, per pixel, the frame render() makes from
-/// them at the stored view: the terms render() derives from the request once per frame. The
-/// pixels then follow explorer.hpp's steps 4-7 with these terms (the shaders in viewer/web/).
+/// them: the terms render() derives from the request once per frame. The pixels then follow
+/// explorer.hpp's steps 3-7 with these terms (the shaders in viewer/web/).
 struct FrameRecipe {
-    /// Whether the frame is one of the stored view's single-perspective proxies with attenuation
-    /// and a colour the terms below determine; else `why_not` says what the client cannot
-    /// draw (another source, a synthesised view, the colour model) and the client asks for the
-    /// frame instead.
+    /// Whether render() makes the frame from the view's single-perspective proxies with
+    /// attenuation, with a colour the terms below determine; else `why_not` says what the client
+    /// cannot draw (another source, the light field's views, the colour model, occlusion of a
+    /// synthesised view) and the client asks for the frame instead.
     bool drawable = false;
     std::string why_not;
+    /// Another view than the stored one: its attenuation is synthesised (view_synthesis.hpp)
+    /// with this hole-filling radius.
+    bool synthesised = false;
+    int fill_radius_pixels = 0;
     /// The stored rendering is the colour (the run's own function, unedited; steps 4-5 skipped).
     bool stored_rendering = false;
     std::vector<double> opacity_scales;  ///< s_j as estimate_attenuation applies them; all 1: none

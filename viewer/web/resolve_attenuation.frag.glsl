@@ -1,0 +1,182 @@
+// Pass 2 of attenuation synthesis, per target pixel (view_synthesis.cl resolve_attenuation): the
+// contributions that landed here, else, in a hole the source does not prove transparent, those
+// of the nearest surrounding pixel within the fill radius; composited front to back in target
+// depth order, a'_j = (a_j / T_j) T' clamped into [0, T'], T' = 1 - the a' in front; the mean
+// depth of each interval that adds light. A pixel where nothing landed is background when every
+// point of its ray (inside the bounding sphere, at half a source pixel per step) lies on a
+// transparent source ray. Writes 16 of the 2L values per draw: group g (four intervals) of a'
+// for g < G, of the mean depths for g >= G (G = L / 4 rounded up), groups 4 uPart ..
+// 4 uPart + 3. The JS side prepends #version, MAX_INTERVALS and view_synthesis.glsl.
+precision highp sampler2D;
+precision highp sampler2DArray;
+
+uniform sampler2DArray uSplat;   // layer j: (a_j, T_j, depth, landed) with a margin of uMargin
+uniform sampler2D uSourceTotal;  // per source pixel, the sum of its a_j (0: a transparent ray)
+uniform int uMargin;
+uniform int uIntervals;
+uniform int uPart;
+uniform int uFillRadius;
+uniform ivec2 uTargetSize;
+uniform vec3 uTargetExtent;
+uniform ivec2 uSourceSize;
+uniform vec3 uSourceExtent;
+uniform vec4 uInverse0;  // target local -> source local
+uniform vec4 uInverse1;
+uniform vec4 uInverse2;
+uniform vec4 uSphere;    // the bounding sphere in target local coordinates
+
+layout(location = 0) out vec4 out0;
+layout(location = 1) out vec4 out1;
+layout(location = 2) out vec4 out2;
+layout(location = 3) out vec4 out3;
+
+vec4 splat(ivec2 p, int j) {
+  return texelFetch(uSplat, ivec3(p + uMargin, j), 0);
+}
+
+bool landedAny(ivec2 p) {
+  for (int j = 0; j < uIntervals; ++j) {
+    if (splat(p, j).w > 0.0) return true;
+  }
+  return false;
+}
+
+// target_ray_in_source + the march: whether every point of the target ray through pixel p lies
+// on a source ray that is transparent (single-perspective sources: one source pixel per point).
+bool rayProvenEmpty(ivec2 p) {
+  vec2 uv = planeCoordinates(p, uTargetSize, uTargetExtent);
+  vec3 origin = vec3(uv, 0.0);
+  vec3 direction = vec3(0.0, 0.0, 1.0);
+  if (uTargetExtent.z != 0.0) {
+    origin = vec3(0.0);
+    direction = normalize(vec3(uv, 1.0));
+  }
+  vec3 oc = origin - uSphere.xyz;
+  float b = dot(oc, direction);
+  float discriminant = b * b - (dot(oc, oc) - uSphere.w * uSphere.w);
+  if (discriminant < 0.0) return true;
+  float root = sqrt(discriminant);
+  float t0 = max(-b - root, 0.0);
+  float t1 = -b + root;
+  if (!(t1 > t0)) return true;
+  vec3 sourceOrigin = applyRows(uInverse0, uInverse1, uInverse2, origin);
+  vec3 sourceDirection = vec3(dot(uInverse0.xyz, direction), dot(uInverse1.xyz, direction),
+                              dot(uInverse2.xyz, direction));
+  float lengthPixels;
+  vec3 start = sourceOrigin + t0 * sourceDirection;
+  vec3 end = sourceOrigin + t1 * sourceDirection;
+  if (uSourceExtent.z != 0.0) {
+    vec3 a, e;
+    bool projected = projectLocal(start, uSourceSize, uSourceExtent, a);
+    projected = projectLocal(end, uSourceSize, uSourceExtent, e) && projected;
+    lengthPixels = projected ? length(e.xy - a.xy) : float(uSourceSize.x + uSourceSize.y);
+  } else {
+    lengthPixels = (t1 - t0) * length(sourceDirection.xy) /
+                   pixelWorld(uSourceSize, uSourceExtent, 1.0);
+  }
+  float cap = 4.0 * float(uSourceSize.x + uSourceSize.y);
+  int steps = int(ceil(min(2.0 * lengthPixels, cap))) + 1;
+  for (int i = 0; i < steps; ++i) {
+    float t = t0 + (t1 - t0) * (float(i) + 0.5) / float(steps);
+    vec3 q = sourceOrigin + t * sourceDirection;
+    // source_pixels_through for a single-perspective source.
+    vec2 plane;
+    if (uSourceExtent.z != 0.0) {
+      if (!(q.z > 0.0)) return false;
+      plane = q.xy / q.z;
+    } else {
+      plane = q.xy;
+    }
+    float px = (plane.x / uSourceExtent.x + 1.0) * 0.5 * float(uSourceSize.x);
+    float py = (1.0 - plane.y / uSourceExtent.y) * 0.5 * float(uSourceSize.y);
+    if (!(px >= 0.0 && px < float(uSourceSize.x) && py >= 0.0 && py < float(uSourceSize.y))) {
+      return false;
+    }
+    if (texelFetch(uSourceTotal, ivec2(int(px), int(py)), 0).r != 0.0) return false;
+  }
+  return true;
+}
+
+// nearest_surrounding: the nearest pixel within the fill radius that received anything, on a
+// line of four directions with contributions on both sides; (-1, -1) where none.
+ivec2 nearestSurrounding(ivec2 p) {
+  ivec2 best = ivec2(-1);
+  int bestStep = 0;
+  for (int k = 0; k < 4; ++k) {
+    ivec2 direction = ivec2(k == 1 ? 0 : 1, k == 0 ? 0 : (k == 3 ? -1 : 1));
+    ivec2 found[2] = ivec2[2](ivec2(-1), ivec2(-1));
+    int steps[2] = int[2](0, 0);
+    for (int side = 0; side < 2; ++side) {
+      int sign = side == 0 ? 1 : -1;
+      for (int s = 1; s <= uFillRadius && found[side].x < 0; ++s) {
+        ivec2 q = p + sign * s * direction;
+        if (q.x < 0 || q.y < 0 || q.x >= uTargetSize.x || q.y >= uTargetSize.y) break;
+        if (landedAny(q)) {
+          found[side] = q;
+          steps[side] = s;
+        }
+      }
+    }
+    if (found[0].x < 0 || found[1].x < 0) continue;
+    int side = steps[1] < steps[0] ? 1 : 0;
+    if (best.x < 0 || steps[side] < bestStep) {
+      best = found[side];
+      bestStep = steps[side];
+    }
+  }
+  return best;
+}
+
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  float attenuation[MAX_INTERVALS];
+  float meanDepth[MAX_INTERVALS];
+  for (int j = 0; j < uIntervals; ++j) {
+    attenuation[j] = 0.0;
+    meanDepth[j] = kInfinity;
+  }
+  ivec2 from = landedAny(p) ? p : ivec2(-1);
+  if (from.x < 0 && !rayProvenEmpty(p)) from = nearestSurrounding(p);
+  if (from.x >= 0) {
+    float transmittance = 1.0;
+    float previousDepth = 0.0;
+    int previous = -1;
+    for (int visited = 0; visited < uIntervals; ++visited) {
+      int next = -1;
+      float nextDepth = kInfinity;
+      vec4 nextSample = vec4(0.0);
+      for (int j = 0; j < uIntervals; ++j) {
+        vec4 entry = splat(from, j);
+        if (!(entry.w > 0.0)) continue;
+        bool afterPrevious = previous < 0 || before(previousDepth, previous, entry.z, j);
+        if (afterPrevious && (next < 0 || entry.z < nextDepth)) {
+          next = j;
+          nextDepth = entry.z;
+          nextSample = entry;
+        }
+      }
+      if (next < 0) break;
+      float ratio = nextSample.y > 0.0 ? transmittance / nextSample.y : 0.0;
+      float a = min(max(nextSample.x * ratio, 0.0), transmittance);
+      attenuation[next] = a;
+      if (a > 0.0) meanDepth[next] = nextDepth;
+      transmittance -= a;
+      previous = next;
+      previousDepth = nextDepth;
+    }
+  }
+  int groups = (uIntervals + 3) / 4;
+  vec4 outputs[4];
+  for (int k = 0; k < 4; ++k) {
+    int g = 4 * uPart + k;
+    for (int c = 0; c < 4; ++c) {
+      int j = 4 * (g < groups ? g : g - groups) + c;
+      bool depth = g >= groups;
+      outputs[k][c] = j < uIntervals ? (depth ? meanDepth[j] : attenuation[j]) : 0.0;
+    }
+  }
+  out0 = outputs[0];
+  out1 = outputs[1];
+  out2 = outputs[2];
+  out3 = outputs[3];
+}

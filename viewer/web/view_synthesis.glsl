@@ -1,0 +1,63 @@
+// Camera-local geometry of view synthesis from single-perspective proxies, as
+// kernels/explore/view_synthesis.cl defines it (the method: insitu/explore/view_synthesis.hpp).
+// Local coordinates (a, b, z): offsets along right, up and forward from the camera's position,
+// world units. `extent` = (half width, half height, 1 perspective / 0 orthographic). The JS side
+// prepends it to the synthesis shaders.
+precision highp float;
+precision highp int;
+
+// Neighbouring samples lie on one surface when their depths differ by at most this many times
+// their lateral distance; steeper steps are silhouettes, never bridged.
+const float kMaxSurfaceSlope = 4.0;
+// A footprint is splatted only while it spans at most this many target pixels from its centre.
+const float kMaxFootprintPixels = 1.0;
+const float kInfinity = uintBitsToFloat(0x7f800000u);
+
+bool finite(float x) {
+  return !isinf(x) && !isnan(x);
+}
+
+vec2 planeCoordinates(ivec2 p, ivec2 size, vec3 extent) {
+  return vec2((2.0 * (float(p.x) + 0.5) / float(size.x) - 1.0) * extent.x,
+              (1.0 - 2.0 * (float(p.y) + 0.5) / float(size.y)) * extent.y);
+}
+
+// A stored sample at `depth` on the ray of plane point uv.
+vec3 storedPoint(vec2 uv, float depth, vec3 extent) {
+  return extent.z != 0.0 ? vec3(uv * depth, depth) : vec3(uv, depth);
+}
+
+vec3 applyRows(vec4 row0, vec4 row1, vec4 row2, vec3 p) {
+  return vec3(dot(row0.xyz, p) + row0.w, dot(row1.xyz, p) + row1.w, dot(row2.xyz, p) + row2.w);
+}
+
+// Image position (pixels) and depth of a local point; false behind a perspective camera.
+bool projectLocal(vec3 p, ivec2 size, vec3 extent, out vec3 pixelDepth) {
+  float a = p.x;
+  float b = p.y;
+  pixelDepth = vec3(0.0);
+  if (extent.z != 0.0) {
+    if (!(p.z > 0.0)) return false;
+    a /= p.z;
+    b /= p.z;
+  }
+  pixelDepth = vec3((a / extent.x + 1.0) * 0.5 * float(size.x),
+                    (1.0 - b / extent.y) * 0.5 * float(size.y), p.z);
+  return finite(pixelDepth.x) && finite(pixelDepth.y);
+}
+
+// Lateral size (world units) of one pixel at depth z.
+float pixelWorld(ivec2 size, vec3 extent, float z) {
+  float sizeAtUnit = min(2.0 * extent.x / float(size.x), 2.0 * extent.y / float(size.y));
+  return extent.z != 0.0 ? sizeAtUnit * abs(z) : sizeAtUnit;
+}
+
+bool continuous(vec3 p, vec3 q, float nominalPixel) {
+  float lateral = max(length(q.xy - p.xy), nominalPixel);
+  return abs(q.z - p.z) <= kMaxSurfaceSlope * lateral;
+}
+
+// Order of interval contributions along a ray: by depth, then by interval index.
+bool before(float depthA, int a, float depthB, int b) {
+  return depthA < depthB || (depthA == depthB && a < b);
+}
