@@ -453,10 +453,9 @@ TEST_F(ExplorerTest, TheRecipeHoldsTheTermsRenderApplies) {
     EXPECT_GT(recipe.ambient_occlusion->inverse_neighbours, 0.0);
 
     // Another view: synthesised from the proxies (no light field here), with the fill radius
-    // asked; its occlusion would need synthesised layers, which the client does not draw.
+    // asked.
     ExploreRequest orbit = edited;
     orbit.azimuth_deg = 50.0;
-    orbit.ambient_occlusion.reset();
     orbit.synthesis.hole_fill_radius_pixels = 3;
     const FrameRecipe synthesised = explorer.recipe(orbit);
     EXPECT_TRUE(synthesised.drawable) << synthesised.why_not;
@@ -464,10 +463,7 @@ TEST_F(ExplorerTest, TheRecipeHoldsTheTermsRenderApplies) {
     EXPECT_FALSE(synthesised.stored_rendering);
     EXPECT_EQ(synthesised.fill_radius_pixels, 3);
     EXPECT_EQ(synthesised.opacity_scales, recipe.opacity_scales);
-    orbit.ambient_occlusion = AmbientOcclusionSettings{};
-    const FrameRecipe occluded = explorer.recipe(orbit);
-    EXPECT_FALSE(occluded.drawable);
-    EXPECT_THAT(occluded.why_not, HasSubstr("ambient occlusion of a synthesised view"));
+    EXPECT_TRUE(synthesised.ambient_occlusion.has_value());
     ExploreRequest multi = plain;
     multi.source = ProxySource::multi;
     EXPECT_FALSE(explorer.recipe(multi).drawable);

@@ -1,7 +1,8 @@
 // The stored view drawn by the page itself from its single-perspective proxies (WebGL2 through
 // chromium's SwiftShader): /api/proxies once per step, /api/recipe per change of the request.
 // The canvas must match `insitu-view render` (the C++ Explorer) for the same options: the
-// stored view, a recolour, an opacity edit, headlight relighting with ambient occlusion,
+// stored view, a recolour, an opacity edit, a 20-degree orbit with those edits (synthesised from
+// the proxies), headlight relighting with ambient occlusion there and at the stored view,
 // depth-aware enhancement and a timestep change. The recipe API says what the page cannot draw
 // and refuses what the frame endpoint refuses.
 //
@@ -121,16 +122,18 @@ test('the stored view and its edits drawn with WebGL2 match insitu-view render',
   await page.check('#light-on');
   frame = await settledFrame(frame.count);
   assert.ok(frame.options.light, 'lighting on');
-  assertDrawnAndMatching(frame, 'orbit relit', 'synthesised view');
-
-  // Back at the stored view: headlight and ambient occlusion.
-  await page.click('#reset-view');
-  frame = await settledFrame(frame.count);
-  assert.equal(frame.options.azimuth, undefined);
-  assertDrawnAndMatching(frame, 'relight');
+  const relitOrbit = assertDrawnAndMatching(frame, 'orbit relit', 'synthesised view');
+  // Ambient occlusion there reads the front depth of the layers synthesised in the new camera.
   await page.check('#ao-on');
   frame = await settledFrame(frame.count);
   assert.equal(frame.options.ao, '8,1');
+  const occludedOrbit = assertDrawnAndMatching(frame, 'orbit relit + AO', 'synthesised view');
+  assert.ok(differingSamples(occludedOrbit, relitOrbit) > 0, 'occlusion shows on the orbit');
+
+  // Back at the stored view, relit and occluded.
+  await page.click('#reset-view');
+  frame = await settledFrame(frame.count);
+  assert.equal(frame.options.azimuth, undefined);
   const lit = assertDrawnAndMatching(frame, 'relight + AO');
   assert.ok(differingSamples(lit, edited) > 0, 'lighting and occlusion show');
 

@@ -25,7 +25,12 @@ const SPLAT_MARGIN = 2;        // pixels around the synthesised target (splat_at
 const UNIT = {
   attenuation: 0, meanDepth: 1, opticalDepth: 2, layers: 3, rendering: 4, frontDepth: 5,
   edited: 6, sourceTotal: 7, synthesisedAttenuation: 8, synthesisedMeanDepth: 9, splat: 10,
+  synthesisedFrontDepth: 11,
 };
+const MAX_LAYERS = 32;         // kMaxSynthesisLayers (view_synthesis.cpp)
+
+// A camera's extent as the shaders take it: half width, half height, 1 for perspective.
+const extentOf = (camera) => [camera.halfWidth, camera.halfHeight, camera.perspective ? 1 : 0];
 
 export class ProxyRenderer {
   /// `canvas`: the element drawn into (its context is shared with the light-field renderer).
@@ -38,9 +43,9 @@ export class ProxyRenderer {
     const names = ['fullscreen.vert.glsl', 'srgb.glsl', 'view_synthesis.glsl',
       'proxy_load.frag.glsl', 'proxy_edit.frag.glsl', 'proxy_frame.frag.glsl',
       'splat_attenuation.vert.glsl', 'splat_attenuation.frag.glsl',
-      'resolve_attenuation.frag.glsl'];
-    const [fullscreen, srgb, synthesis, load, edit, frame, splatVertex, splatFragment, resolve] =
-      await Promise.all(names.map(shaderText));
+      'resolve_attenuation.frag.glsl', 'resolve_layers.frag.glsl'];
+    const [fullscreen, srgb, synthesis, load, edit, frame, splatVertex, splatFragment, resolve,
+      resolveLayers] = await Promise.all(names.map(shaderText));
     // Vertex and fragment source of each program.
     return new ProxyRenderer(canvas, gl, {
       load: [fullscreen, load],
@@ -48,6 +53,7 @@ export class ProxyRenderer {
       frame: [fullscreen, srgb + frame],
       splat: [synthesis + splatVertex, synthesis + splatFragment],
       resolve: [fullscreen, synthesis + resolve],
+      resolveLayers: [fullscreen, synthesis + resolveLayers],
     });
   }
 
@@ -68,7 +74,8 @@ export class ProxyRenderer {
     const key = `${kind}/${maxIntervals}/${packed}`;
     if (!this.programs.has(key)) {
       const prefix = `#version 300 es\n#define MAX_INTERVALS ${maxIntervals}\n` +
-        `#define MAX_LIGHTS ${MAX_LIGHTS}\n` + (packed ? '#define PACKED\n' : '');
+        `#define MAX_LIGHTS ${MAX_LIGHTS}\n#define MAX_LAYERS ${MAX_LAYERS}\n` +
+        (packed ? '#define PACKED\n' : '');
       const [vertex, fragment] = this.sources[kind];
       const program = buildProgram(this.gl, prefix, vertex, fragment);
       const locations = new Map();
@@ -118,6 +125,9 @@ export class ProxyRenderer {
       throw new Error(`the proxies need ${Math.max(intervals, header.layers)} texture layers, ` +
         `this GPU has ${maxLayers}`);
     }
+    if (header.layers > MAX_LAYERS) {
+      throw new Error(`${header.layers} depth layers (view synthesis takes at most ${MAX_LAYERS})`);
+    }
     this.release();
     gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
     this.planes(UNIT.attenuation, proxies.attenuation, width, height, intervals);
@@ -139,6 +149,7 @@ export class ProxyRenderer {
     };
     const front = image(UNIT.frontDepth);
     const total = image(UNIT.sourceTotal);
+    const synthesisedFront = image(UNIT.synthesisedFrontDepth);
     // Four intervals to a layer, in whole draws of OUTPUTS layers.
     const groups = Math.ceil(intervals / 4);
     const layers = Math.ceil(groups / OUTPUTS) * OUTPUTS;
@@ -151,13 +162,14 @@ export class ProxyRenderer {
     const synthesisedAttenuation = packed(UNIT.synthesisedAttenuation, width, height, layers);
     const synthesisedMeanDepth = packed(UNIT.synthesisedMeanDepth, width, height, layers);
     const margin = 2 * SPLAT_MARGIN;
-    const splat = packed(UNIT.splat, width + margin, height + margin, intervals);
+    const splat = packed(UNIT.splat, width + margin, height + margin,
+      Math.max(intervals, header.layers, 1));
     gl.bindRenderbuffer(gl.RENDERBUFFER, this.depthBuffer);
     gl.renderbufferStorage(gl.RENDERBUFFER, gl.DEPTH_COMPONENT32F, width + margin,
       height + margin);
     // The shaders' arrays are sized to the step's intervals, rounded up to a group of four.
     this.loaded = { header, maxIntervals: 4 * groups, groups, edited, synthesisedAttenuation,
-      synthesisedMeanDepth, splat, hasOpticalDepth: Boolean(proxies.opticalDepth) };
+      synthesisedMeanDepth, synthesisedFront, splat, hasOpticalDepth: Boolean(proxies.opticalDepth) };
 
     const { program, uniform } = this.program('load', this.loaded.maxIntervals);
     this.textures.bind();
@@ -200,73 +212,24 @@ export class ProxyRenderer {
   /// into the synthesised textures (packed), with holes up to `fillRadius` pixels filled.
   synthesise(target, fillRadius) {
     const gl = this.gl;
-    const { header, maxIntervals, groups, splat } = this.loaded;
+    const { header, maxIntervals, groups } = this.loaded;
     const { width, height, intervals } = header;
     if (target.width !== width || target.height !== height) {
       throw new Error(`a ${target.width}x${target.height} view of ${width}x${height} proxies`);
     }
-    const source = storedCamera(header.camera);
-    const rows = localMap(source, target);
-    const inverse = localMap(target, source);
-    const sphere = boundingSphereIn(header.camera, target);
-    const extent = (camera) => [camera.halfWidth, camera.halfHeight, camera.perspective ? 1 : 0];
-
     // Pass 1: per interval, the nearest contribution per target pixel (depth-tested points).
-    const splatProgram = this.program('splat', maxIntervals);
-    let u = splatProgram.uniform;
-    gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
-    gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER,
-      this.depthBuffer);
-    gl.viewport(0, 0, width + 2 * SPLAT_MARGIN, height + 2 * SPLAT_MARGIN);
-    gl.useProgram(splatProgram.program);
-    gl.uniform1i(u('uMeanDepth'), UNIT.meanDepth);
-    gl.uniform1i(u('uAttenuation'), UNIT.attenuation);
-    gl.uniform1i(u('uIntervals'), intervals);
-    gl.uniform2i(u('uSourceSize'), width, height);
-    gl.uniform3fv(u('uSourceExtent'), extent(source));
-    gl.uniform4fv(u('uRow0'), rows[0]);
-    gl.uniform4fv(u('uRow1'), rows[1]);
-    gl.uniform4fv(u('uRow2'), rows[2]);
-    gl.uniform2i(u('uTargetSize'), width, height);
-    gl.uniform3fv(u('uTargetExtent'), extent(target));
-    gl.uniform1i(u('uMargin'), SPLAT_MARGIN);
-    // Depths a contribution can have: around the bounding sphere, generously.
-    const nearest = sphere[2] - 2 * sphere[3];
-    gl.uniform2f(u('uDepthRange'), nearest, 1 / (4 * sphere[3]));
-    gl.enable(gl.DEPTH_TEST);
-    gl.depthFunc(gl.LESS);
-    gl.clearColor(0, 0, 0, 0);
-    gl.clearDepth(1);
-    gl.bindVertexArray(this.vertexArray);
-    for (let j = 0; j < intervals; ++j) {
-      gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, splat, 0, j);
-      gl.drawBuffers([gl.COLOR_ATTACHMENT0]);
-      gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
-      gl.uniform1i(u('uInterval'), j);
-      gl.drawArrays(gl.POINTS, 0, width * height);
-    }
-    gl.disable(gl.DEPTH_TEST);
-    gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER, null);
-    gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, null, 0, 0);
+    this.splatPlanes(UNIT.meanDepth, intervals, true, target);
 
     // Pass 2: composite per target pixel; a' groups then mean-depth groups, OUTPUTS per draw.
     const resolve = this.program('resolve', maxIntervals);
-    u = resolve.uniform;
+    const u = resolve.uniform;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
     gl.viewport(0, 0, width, height);
     gl.useProgram(resolve.program);
     gl.uniform1i(u('uSplat'), UNIT.splat);
     gl.uniform1i(u('uSourceTotal'), UNIT.sourceTotal);
-    gl.uniform1i(u('uMargin'), SPLAT_MARGIN);
     gl.uniform1i(u('uIntervals'), intervals);
-    gl.uniform1i(u('uFillRadius'), fillRadius);
-    gl.uniform2i(u('uTargetSize'), width, height);
-    gl.uniform3fv(u('uTargetExtent'), extent(target));
-    gl.uniform2i(u('uSourceSize'), width, height);
-    gl.uniform3fv(u('uSourceExtent'), extent(source));
-    gl.uniform4fv(u('uInverse0'), inverse[0]);
-    gl.uniform4fv(u('uInverse1'), inverse[1]);
-    gl.uniform4fv(u('uInverse2'), inverse[2]);
-    gl.uniform4fv(u('uSphere'), sphere);
+    this.targetRayUniforms(u, target, fillRadius);
     for (let part = 0; part * OUTPUTS < 2 * groups; ++part) {
       gl.uniform1i(u('uPart'), part);
       const targets = [];
@@ -282,6 +245,102 @@ export class ProxyRenderer {
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
   }
 
+  /// The maps between the stored camera and `target` (camera.js) that synthesis needs.
+  geometry(target) {
+    const { camera } = this.loaded.header;
+    const source = storedCamera(camera);
+    return { source, rows: localMap(source, target), inverse: localMap(target, source),
+      sphere: boundingSphereIn(camera, target) };
+  }
+
+  /// What both resolve passes need to march target rays through the source.
+  targetRayUniforms(u, target, fillRadius) {
+    const gl = this.gl;
+    const { width, height } = this.loaded.header;
+    const { source, inverse, sphere } = this.geometry(target);
+    gl.uniform1i(u('uMargin'), SPLAT_MARGIN);
+    gl.uniform1i(u('uFillRadius'), fillRadius);
+    gl.uniform2i(u('uTargetSize'), width, height);
+    gl.uniform3fv(u('uTargetExtent'), extentOf(target));
+    gl.uniform2i(u('uSourceSize'), width, height);
+    gl.uniform3fv(u('uSourceExtent'), extentOf(source));
+    gl.uniform4fv(u('uInverse0'), inverse[0]);
+    gl.uniform4fv(u('uInverse1'), inverse[1]);
+    gl.uniform4fv(u('uInverse2'), inverse[2]);
+    gl.uniform4fv(u('uSphere'), sphere);
+  }
+
+  /// Splats `count` planes of the depth-like texture array on `depthUnit` (the mean depths, with
+  /// their (a_j, T_j) values; or the depth layers) into layers 0.. of the splat texture, seen
+  /// from `target`: per plane, the nearest sample per target pixel.
+  splatPlanes(depthUnit, count, withValues, target) {
+    const gl = this.gl;
+    const { header, maxIntervals, splat } = this.loaded;
+    const { width, height } = header;
+    const { source, rows, sphere } = this.geometry(target);
+    const program = this.program('splat', maxIntervals);
+    const u = program.uniform;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
+    gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER,
+      this.depthBuffer);
+    gl.viewport(0, 0, width + 2 * SPLAT_MARGIN, height + 2 * SPLAT_MARGIN);
+    gl.useProgram(program.program);
+    gl.uniform1i(u('uMeanDepth'), depthUnit);
+    gl.uniform1i(u('uAttenuation'), UNIT.attenuation);
+    gl.uniform1i(u('uWithValues'), withValues ? 1 : 0);
+    gl.uniform1i(u('uIntervals'), header.intervals);
+    gl.uniform2i(u('uSourceSize'), width, height);
+    gl.uniform3fv(u('uSourceExtent'), extentOf(source));
+    gl.uniform4fv(u('uRow0'), rows[0]);
+    gl.uniform4fv(u('uRow1'), rows[1]);
+    gl.uniform4fv(u('uRow2'), rows[2]);
+    gl.uniform2i(u('uTargetSize'), width, height);
+    gl.uniform3fv(u('uTargetExtent'), extentOf(target));
+    gl.uniform1i(u('uMargin'), SPLAT_MARGIN);
+    // Depths a sample can have: around the bounding sphere, generously.
+    gl.uniform2f(u('uDepthRange'), sphere[2] - 2 * sphere[3], 1 / (4 * sphere[3]));
+    gl.enable(gl.DEPTH_TEST);
+    gl.depthFunc(gl.LESS);
+    gl.clearColor(0, 0, 0, 0);
+    gl.clearDepth(1);
+    gl.bindVertexArray(this.vertexArray);
+    for (let j = 0; j < count; ++j) {
+      gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, splat, 0, j);
+      gl.drawBuffers([gl.COLOR_ATTACHMENT0]);
+      gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
+      gl.uniform1i(u('uInterval'), j);
+      gl.drawArrays(gl.POINTS, 0, width * height);
+    }
+    gl.disable(gl.DEPTH_TEST);
+    gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER, null);
+    gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, null, 0, 0);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+  }
+
+  /// The front-most depth of the stored layers seen from `target` (synthesise_layers, then
+  /// FrontSurface), into the synthesised front-depth texture: what occlusion reads there.
+  synthesiseFrontDepth(target, fillRadius) {
+    const gl = this.gl;
+    const { header, maxIntervals, synthesisedFront } = this.loaded;
+    const { width, height } = header;
+    this.splatPlanes(UNIT.layers, header.layers, false, target);
+    const program = this.program('resolveLayers', maxIntervals);
+    const u = program.uniform;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D,
+      synthesisedFront, 0);
+    gl.drawBuffers([gl.COLOR_ATTACHMENT0]);
+    gl.viewport(0, 0, width, height);
+    gl.useProgram(program.program);
+    gl.uniform1i(u('uSplat'), UNIT.splat);
+    gl.uniform1i(u('uLayers'), UNIT.layers);
+    gl.uniform1i(u('uLayerCount'), header.layers);
+    this.targetRayUniforms(u, target, fillRadius);
+    this.drawQuad();
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, null, 0);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+  }
+
   /// Draws the loaded view with `recipe` (/api/recipe, drawable) into the canvas: the stored
   /// view, or for a synthesised recipe the view from `target` (camera.js, the stored size).
   render(recipe, target) {
@@ -292,7 +351,10 @@ export class ProxyRenderer {
     this.textures.bind();
     const synthesised = Boolean(recipe.synthesised);
     const camera = synthesised ? target : storedCamera(header.camera);
-    if (synthesised) this.synthesise(target, recipe.fill_radius);
+    if (synthesised) {
+      this.synthesise(target, recipe.fill_radius);
+      if (recipe.ambient_occlusion) this.synthesiseFrontDepth(target, recipe.fill_radius);
+    }
 
     // Pass 1: a' (or a copy of a), sixteen intervals per draw. A synthesised view has no
     // optical depth (the Explorer re-projects none).
@@ -333,7 +395,7 @@ export class ProxyRenderer {
     gl.uniform1i(u('uEdited'), UNIT.edited);
     gl.uniform1i(u('uMeanDepth'), synthesised ? UNIT.synthesisedMeanDepth : UNIT.meanDepth);
     gl.uniform1i(u('uRendering'), UNIT.rendering);
-    gl.uniform1i(u('uFrontDepth'), UNIT.frontDepth);
+    gl.uniform1i(u('uFrontDepth'), synthesised ? UNIT.synthesisedFrontDepth : UNIT.frontDepth);
     gl.uniform1i(u('uIntervals'), intervals);
     gl.uniform1i(u('uStoredRendering'), recipe.stored_rendering ? 1 : 0);
     const colours = new Float32Array(3 * maxIntervals);

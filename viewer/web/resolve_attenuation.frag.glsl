@@ -41,58 +41,21 @@ bool landedAny(ivec2 p) {
   return false;
 }
 
-// target_ray_in_source + the march: whether every point of the target ray through pixel p lies
-// on a source ray that is transparent (single-perspective sources: one source pixel per point).
+// Whether every point of the target ray through pixel p (inside the bounding sphere) lies on a
+// source ray that is transparent.
 bool rayProvenEmpty(ivec2 p) {
-  vec2 uv = planeCoordinates(p, uTargetSize, uTargetExtent);
-  vec3 origin = vec3(uv, 0.0);
-  vec3 direction = vec3(0.0, 0.0, 1.0);
-  if (uTargetExtent.z != 0.0) {
-    origin = vec3(0.0);
-    direction = normalize(vec3(uv, 1.0));
+  SourceRay ray;
+  if (!targetRayInSource(p, uTargetSize, uTargetExtent, uInverse0, uInverse1, uInverse2, uSphere,
+                         uSourceSize, uSourceExtent, ray)) {
+    return true;
   }
-  vec3 oc = origin - uSphere.xyz;
-  float b = dot(oc, direction);
-  float discriminant = b * b - (dot(oc, oc) - uSphere.w * uSphere.w);
-  if (discriminant < 0.0) return true;
-  float root = sqrt(discriminant);
-  float t0 = max(-b - root, 0.0);
-  float t1 = -b + root;
-  if (!(t1 > t0)) return true;
-  vec3 sourceOrigin = applyRows(uInverse0, uInverse1, uInverse2, origin);
-  vec3 sourceDirection = vec3(dot(uInverse0.xyz, direction), dot(uInverse1.xyz, direction),
-                              dot(uInverse2.xyz, direction));
-  float lengthPixels;
-  vec3 start = sourceOrigin + t0 * sourceDirection;
-  vec3 end = sourceOrigin + t1 * sourceDirection;
-  if (uSourceExtent.z != 0.0) {
-    vec3 a, e;
-    bool projected = projectLocal(start, uSourceSize, uSourceExtent, a);
-    projected = projectLocal(end, uSourceSize, uSourceExtent, e) && projected;
-    lengthPixels = projected ? length(e.xy - a.xy) : float(uSourceSize.x + uSourceSize.y);
-  } else {
-    lengthPixels = (t1 - t0) * length(sourceDirection.xy) /
-                   pixelWorld(uSourceSize, uSourceExtent, 1.0);
-  }
-  float cap = 4.0 * float(uSourceSize.x + uSourceSize.y);
-  int steps = int(ceil(min(2.0 * lengthPixels, cap))) + 1;
-  for (int i = 0; i < steps; ++i) {
-    float t = t0 + (t1 - t0) * (float(i) + 0.5) / float(steps);
-    vec3 q = sourceOrigin + t * sourceDirection;
-    // source_pixels_through for a single-perspective source.
-    vec2 plane;
-    if (uSourceExtent.z != 0.0) {
-      if (!(q.z > 0.0)) return false;
-      plane = q.xy / q.z;
-    } else {
-      plane = q.xy;
-    }
-    float px = (plane.x / uSourceExtent.x + 1.0) * 0.5 * float(uSourceSize.x);
-    float py = (1.0 - plane.y / uSourceExtent.y) * 0.5 * float(uSourceSize.y);
-    if (!(px >= 0.0 && px < float(uSourceSize.x) && py >= 0.0 && py < float(uSourceSize.y))) {
+  for (int i = 0; i < ray.steps; ++i) {
+    float t = ray.t0 + (ray.t1 - ray.t0) * (float(i) + 0.5) / float(ray.steps);
+    ivec2 source;
+    if (!sourcePixelThrough(ray.origin + t * ray.direction, uSourceSize, uSourceExtent, source) ||
+        texelFetch(uSourceTotal, source, 0).r != 0.0) {
       return false;
     }
-    if (texelFetch(uSourceTotal, ivec2(int(px), int(py)), 0).r != 0.0) return false;
   }
   return true;
 }

@@ -5,7 +5,8 @@
 // surface). The depth test keeps the nearest contribution per target pixel, as the kernels'
 // atomic_min of depth keys does. The point is 3 pixels wide around the pixel under the centre,
 // which holds every footprint (at most kMaxFootprintPixels from the centre); the fragment shader
-// keeps the covered ones. The target is drawn with a margin of 2 pixels on every side so that a
+// keeps the covered ones. The same points splat a depth layer (uWithValues 0: depth only), as
+// splat_layers does. The target is drawn with a margin of 2 pixels on every side so that a
 // footprint whose centre lies just outside the image still reaches it. The JS side prepends
 // #version and view_synthesis.glsl.
 precision highp sampler2DArray;
@@ -22,6 +23,7 @@ uniform vec4 uRow2;
 uniform ivec2 uTargetSize;
 uniform vec3 uTargetExtent;
 uniform int uMargin;
+uniform bool uWithValues;
 
 flat out vec3 vCentre;      // target pixels (x, y) and depth
 flat out vec3 vDx;          // target pixels and depth per source pixel along x
@@ -111,7 +113,7 @@ void main() {
   float transmittance = 1.0;
   float previousDepth = -kInfinity;
   int previous = -1;
-  for (int visited = 0; visited < uIntervals; ++visited) {
+  for (int visited = 0; uWithValues && visited < uIntervals; ++visited) {
     int next = -1;
     float nextDepth = kInfinity;
     for (int j = 0; j < uIntervals; ++j) {

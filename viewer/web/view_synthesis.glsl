@@ -61,3 +61,71 @@ bool continuous(vec3 p, vec3 q, float nominalPixel) {
 bool before(float depthA, int a, float depthB, int b) {
   return depthA < depthB || (depthA == depthB && a < b);
 }
+
+// A target ray in source-local coordinates, clipped to the sphere that bounds the field:
+// origin + t direction for t in [t0, t1], marched in `steps` steps at most half a source pixel
+// apart (target_ray_in_source); false when the ray misses the sphere.
+struct SourceRay {
+  vec3 origin;
+  vec3 direction;
+  float t0;
+  float t1;
+  float targetDirectionZ;  // target depth per unit t
+  int steps;
+};
+
+bool targetRayInSource(ivec2 p, ivec2 targetSize, vec3 targetExtent, vec4 inverse0,
+                       vec4 inverse1, vec4 inverse2, vec4 sphere, ivec2 sourceSize,
+                       vec3 sourceExtent, out SourceRay ray) {
+  vec2 uv = planeCoordinates(p, targetSize, targetExtent);
+  vec3 origin = vec3(uv, 0.0);
+  vec3 direction = vec3(0.0, 0.0, 1.0);
+  if (targetExtent.z != 0.0) {
+    origin = vec3(0.0);
+    direction = normalize(vec3(uv, 1.0));
+  }
+  vec3 oc = origin - sphere.xyz;
+  float b = dot(oc, direction);
+  float discriminant = b * b - (dot(oc, oc) - sphere.w * sphere.w);
+  ray.targetDirectionZ = direction.z;
+  float root = sqrt(max(discriminant, 0.0));
+  ray.t0 = max(-b - root, 0.0);
+  ray.t1 = -b + root;
+  ray.origin = applyRows(inverse0, inverse1, inverse2, origin);
+  ray.direction = vec3(dot(inverse0.xyz, direction), dot(inverse1.xyz, direction),
+                       dot(inverse2.xyz, direction));
+  ray.steps = 0;
+  if (discriminant < 0.0 || !(ray.t1 > ray.t0)) return false;
+  // Projected length on the source image, in source pixels.
+  float lengthPixels;
+  vec3 start = ray.origin + ray.t0 * ray.direction;
+  vec3 end = ray.origin + ray.t1 * ray.direction;
+  if (sourceExtent.z != 0.0) {
+    vec3 a, e;
+    bool projected = projectLocal(start, sourceSize, sourceExtent, a);
+    projected = projectLocal(end, sourceSize, sourceExtent, e) && projected;
+    lengthPixels = projected ? length(e.xy - a.xy) : float(sourceSize.x + sourceSize.y);
+  } else {
+    lengthPixels = (ray.t1 - ray.t0) * length(ray.direction.xy) /
+                   pixelWorld(sourceSize, sourceExtent, 1.0);
+  }
+  float cap = 4.0 * float(sourceSize.x + sourceSize.y);
+  ray.steps = int(ceil(min(2.0 * lengthPixels, cap))) + 1;
+  return true;
+}
+
+// The source pixel whose ray passes through local point q (source_pixels_through for a
+// single-perspective source); false where q lies outside everything the source saw.
+bool sourcePixelThrough(vec3 q, ivec2 size, vec3 extent, out ivec2 pixel) {
+  pixel = ivec2(0);
+  vec2 plane = q.xy;
+  if (extent.z != 0.0) {
+    if (!(q.z > 0.0)) return false;
+    plane = q.xy / q.z;
+  }
+  float px = (plane.x / extent.x + 1.0) * 0.5 * float(size.x);
+  float py = (1.0 - plane.y / extent.y) * 0.5 * float(size.y);
+  if (!(px >= 0.0 && px < float(size.x) && py >= 0.0 && py < float(size.y))) return false;
+  pixel = ivec2(int(px), int(py));
+  return true;
+}

@@ -882,8 +882,9 @@ FrameRecipe Explorer::recipe(const ExploreRequest& request) {
             return recipe;
         }
     }
-    if (recipe.synthesised && request.ambient_occlusion) {
-        recipe.why_not = "ambient occlusion of a synthesised view (its layers are the server's)";
+    if (request.ambient_occlusion && single->depth_layers.empty()) {
+        // render() takes them from the multi-perspective proxies, or says there are none.
+        recipe.why_not = "ambient occlusion without single-perspective depth layers";
         return recipe;
     }
     recipe.fill_radius_pixels = request.synthesis.hole_fill_radius_pixels;
@@ -925,10 +926,6 @@ FrameRecipe Explorer::recipe(const ExploreRequest& request) {
         }
     }
     if (request.ambient_occlusion) {
-        if (single->depth_layers.empty()) {
-            fail<InvalidArgument>("ambient occlusion needs depth (layers or a light field), and ",
-                                  where, " has none");
-        }
         recipe.ambient_occlusion = occlusion_terms(*request.ambient_occlusion, stored);
     }
     recipe.enhancement = request.enhancement;

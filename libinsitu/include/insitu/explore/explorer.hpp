@@ -112,13 +112,13 @@ struct ExploreFrame {
 /// explorer.hpp's steps 3-7 with these terms (the shaders in viewer/web/).
 struct FrameRecipe {
     /// Whether render() makes the frame from the view's single-perspective proxies with
-    /// attenuation, with a colour the terms below determine; else `why_not` says what the client
-    /// cannot draw (another source, the light field's views, the colour model, occlusion of a
-    /// synthesised view) and the client asks for the frame instead.
+    /// attenuation (and, for occlusion, depth layers), with a colour the terms below determine;
+    /// else `why_not` says what the client cannot draw (another source, the light field's views,
+    /// the colour model) and the client asks for the frame instead.
     bool drawable = false;
     std::string why_not;
-    /// Another view than the stored one: its attenuation is synthesised (view_synthesis.hpp)
-    /// with this hole-filling radius.
+    /// Another view than the stored one: its attenuation (and, for occlusion, its layers) are
+    /// synthesised (view_synthesis.hpp) with this hole-filling radius.
     bool synthesised = false;
     int fill_radius_pixels = 0;
     /// The stored rendering is the colour (the run's own function, unedited; steps 4-5 skipped).
