@@ -3,9 +3,12 @@
 //     frame (X-Insitu-Milliseconds), the round trip, and frames per second;
 //  2. in headless chromium: frames per second the page displays during a continuous orbit drag
 //     (round trip + PNG decode + display), with WebGL disabled (server frames only);
-//  3. the same drag with WebGL2 through SwiftShader (software, the worst case): where the step
-//     has a light field, the page draws every orbit frame itself; reported with the time to the
-//     first frame after opening a step (download + upload) and the bytes transferred per step.
+//  3. the same drag with WebGL2 through SwiftShader (software, the worst case): the page draws
+//     every orbit frame itself, from the step's light field where it has one, else from the
+//     view's single-perspective proxies (view synthesis in the browser); then again with a
+//     headlight and ambient occlusion on (drawn from the proxies where the recipe allows).
+//     Reported with what drew the frames, the time to the first frame after opening a step
+//     (download + upload) and the bytes transferred per step.
 //
 //   node tests/viewer/frame_rate.mjs INSITU_VIEW ARCHIVE [FRAMES]
 import { performance } from 'node:perf_hooks';
@@ -62,13 +65,29 @@ try {
 
   // The page itself: a pointer dragging across the viewport for a few seconds.
   const { chromium } = loadPlaywright();
-  for (const [label, args] of [['server frames (WebGL off)', [...CHROMIUM_ARGS, '--disable-webgl']],
-    ['WebGL2 (SwiftShader)', WEBGL_ARGS]]) {
+  const relit = async (page) => {
+    await page.check('#light-on');
+    await page.check('#ao-on');
+  };
+  for (const [label, args, setup] of [
+    ['server frames (WebGL off)', [...CHROMIUM_ARGS, '--disable-webgl'], null],
+    ['WebGL2 (SwiftShader)', WEBGL_ARGS, null],
+    ['server frames (WebGL off), headlight + AO (r 8)', [...CHROMIUM_ARGS, '--disable-webgl'], relit],
+    ['WebGL2 (SwiftShader), headlight + AO (r 8)', WEBGL_ARGS, relit]]) {
     const browser = await chromium.launch({ executablePath: CHROMIUM, args });
     try {
       const page = await browser.newPage({ viewport: { width: 1280, height: 900 } });
       await page.goto(server.url);
       await page.waitForFunction(() => window.insituViewer.frameCount > 0);
+      if (setup) {
+        const before = await page.evaluate(() => window.insituViewer.frameCount);
+        await setup(page);
+        await page.waitForFunction((n) => {
+          const v = window.insituViewer;
+          return v.frameCount > n && v.displayed &&
+            JSON.stringify(v.displayed.options) === JSON.stringify(v.options());
+        }, before, { timeout: 60000 });
+      }
       const box = await page.locator('#viewport').boundingBox();
       const y = box.y + box.height / 2;
       await page.mouse.move(box.x + 100, y);
@@ -90,12 +109,14 @@ try {
       await page.mouse.up();
       const gpu = await page.evaluate(() => {
         const v = window.insituViewer;
-        return v.displayed.gpu ? { ms: v.displayed.milliseconds, open: v.gpu.lastOpen } : null;
+        return v.displayed.gpu ? { ms: v.displayed.milliseconds, open: v.gpu.lastOpen,
+          from: v.displayed.drawnFrom, preview: v.displayed.preview } : null;
       });
       let line = `page, orbit drag, ${label}: ${shown} frames displayed in ` +
         `${(elapsed / 1000).toFixed(1)} s = ${((shown * 1000) / elapsed).toFixed(1)} frames/s`;
       if (gpu) {
-        line += `; drawn in the browser, last frame ${gpu.ms.toFixed(1)} ms on the GPU; step ` +
+        line += `; drawn in the browser (${gpu.from}${gpu.preview ? ', preview' : ''}), last frame ` +
+          `${gpu.ms.toFixed(1)} ms on the GPU; step ` +
           `opened (download ${gpu.open.downloadMs.toFixed(0)} ms + upload ` +
           `${gpu.open.uploadMs.toFixed(0)} ms, ${(gpu.open.bytes / 1e6).toFixed(1)} MB payload), ` +
           `first orbit frame ${firstFrameMs.toFixed(0)} ms after the drag began`;

@@ -3,7 +3,7 @@
 // The canvas must match `insitu-view render` (the C++ Explorer) for the same options: the
 // stored view, a recolour, an opacity edit, a 20-degree orbit with those edits (synthesised from
 // the proxies), headlight relighting with ambient occlusion there and at the stored view,
-// depth-aware enhancement and a timestep change. The recipe API says what the page cannot draw
+// depth-aware enhancement, a timestep change and a drag (previews, then the full frame). The recipe API says what the page cannot draw
 // and refuses what the frame endpoint refuses.
 //
 //   INSITU_VIEW=build/viewer/insitu-view ARCHIVE=viewer_lf.cdb WORK_DIR=dir node proxies.test.mjs
@@ -149,6 +149,29 @@ test('the stored view and its edits drawn with WebGL2 match insitu-view render',
   frame = await settledFrame(frame.count);
   assert.equal(frame.options.step, '600');
   assertDrawnAndMatching(frame, 'step 600');
+
+  // A drag: previews from coarser proxies while the pointer moves, then the full frame, which
+  // matches the CLI again.
+  const box = await page.locator('#viewport').boundingBox();
+  const y = box.y + box.height / 2;
+  await page.mouse.move(box.x + box.width / 2, y);
+  await page.mouse.down();
+  let previews = 0;
+  for (let i = 1; i <= 12; ++i) {
+    await page.mouse.move(box.x + box.width / 2 + 3 * i, y);
+    await new Promise((resolve) => setTimeout(resolve, 60));
+    if (await page.evaluate(() => Boolean(window.insituViewer.displayed.preview))) ++previews;
+  }
+  await page.mouse.up();
+  assert.ok(previews > 0, 'the drag showed previews');
+  await page.waitForFunction(() => {
+    const v = window.insituViewer;
+    return v.displayed && !v.displayed.preview &&
+      JSON.stringify(v.displayed.options) === JSON.stringify(v.options());
+  }, null, { timeout: 60000 });
+  frame = await settledFrame(0);
+  assert.ok(frame.options.azimuth !== undefined, 'the drag orbited');
+  assertDrawnAndMatching(frame, 'after a drag', 'synthesised view');
 
   const opened = await page.evaluate(() => window.insituViewer.gpu.lastOpen);
   console.log(`WebGL2 stored view vs insitu-view render: ${results.join(', ')}`);

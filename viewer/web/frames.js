@@ -63,7 +63,8 @@ function recipeFor(options) {
 export function requestFrame() {
   const options = currentOptions();
   if (!options || inFlight) return;
-  const preview = state.dragging && drawnInBrowser(options);
+  // While dragging, what the browser draws is a preview (the full frame once the pointer rests).
+  const preview = state.dragging && (drawnInBrowser(options) || proxiesInBrowser());
   // The same options drawn the same way (toggling "draw in the browser" redraws them).
   if (viewer.displayed && sameOptions(viewer.displayed.options, options) &&
     !(viewer.displayed.preview && !preview) &&
@@ -72,7 +73,7 @@ export function requestFrame() {
   if (drawnInBrowser(options)) {
     drawInBrowser(options, preview);
   } else if (proxiesInBrowser()) {
-    drawProxies(options);
+    drawProxies(options, preview);
   } else {
     serverFrame(options);
   }
@@ -100,7 +101,7 @@ function serverFrame(options) {
 
 // A frame from the view's proxies, where the recipe allows; else (or when the server refuses
 // the options: it says why in the frame's answer) the server's frame.
-async function drawProxies(options) {
+async function drawProxies(options, preview) {
   const entry = state.timeline[state.stepIndex];
   let recipe = null;
   try {
@@ -114,7 +115,7 @@ async function drawProxies(options) {
     return;
   }
   viewer.gpu.drawProxies(entry.step, state.view, recipe, Number(options.azimuth),
-    Number(options.elevation))
+    Number(options.elevation), preview)
     .then((timing) => {
       if (!timing) {
         serverFrame(options);

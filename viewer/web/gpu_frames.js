@@ -12,7 +12,7 @@
 import { reorbit } from './camera.js';
 import { fetchLightField } from './light_field_data.js';
 import { LightFieldRenderer, webgl2Available } from './light_field_renderer.js';
-import { fetchProxies } from './proxy_data.js';
+import { coarserProxies, fetchProxies } from './proxy_data.js';
 import { ProxyRenderer } from './proxy_renderer.js';
 
 const KEPT_STEPS = 3;  // light fields kept parsed: the shown step and the ones around it
@@ -37,21 +37,26 @@ export class GpuFrames {
       return null;
     }
     let proxies = null;
+    let previews = null;
     try {
       proxies = await ProxyRenderer.create(canvas);
+      previews = await ProxyRenderer.create(canvas);
     } catch (error) {
-      console.warn(`the stored view is drawn by the server: ${error.message}`);
+      console.warn(`frames from the view's proxies are drawn by the server: ${error.message}`);
+      proxies = null;
     }
-    return new GpuFrames(lightFields, proxies);
+    return new GpuFrames(lightFields, proxies, previews);
   }
 
-  constructor(renderer, proxyRenderer) {
+  constructor(renderer, proxyRenderer, previewRenderer) {
     this.renderer = renderer;
-    this.proxyRenderer = proxyRenderer;  // null: stored views are the server's
+    this.proxyRenderer = proxyRenderer;  // null: frames from the view's proxies are the server's
+    this.previewRenderer = previewRenderer;  // the same for previews (coarser proxies)
     this.cache = new Map();  // "step/view" -> Promise of {lightField, downloadMs} (or null)
     this.proxyCache = new Map();  // "step/view" -> Promise of {proxies, downloadMs} (or null)
     this.uploaded = null;    // key of the light field on the GPU
     this.uploadedProxies = null;  // key of the proxies on the GPU
+    this.uploadedPreviews = null;  // key of the coarser proxies on the GPU
     this.lastOpen = null;    // {key, downloadMs, uploadMs, bytes}
   }
 
@@ -64,25 +69,34 @@ export class GpuFrames {
   /// Draws (step, view) from its single-perspective proxies with `recipe` (/api/recipe,
   /// drawable): the stored view, or for a synthesised recipe the view at the orbit angles.
   /// Resolves to the frame's timing, or null when the view has no attenuation proxies.
-  async drawProxies(step, view, recipe, azimuthDeg, elevationDeg) {
+  async drawProxies(step, view, recipe, azimuthDeg, elevationDeg, preview = false) {
     const key = `${step}/${view}`;
     const { proxies, downloadMs } = await this.proxies(step, view);
     if (!proxies) return null;
     let uploadMs = 0;
-    if (this.uploadedProxies !== key) {
+    const { width, height } = proxies.header;
+    const divisor = preview ? Math.max(1, Math.ceil(Math.max(width, height) / PREVIEW_SIDE)) : 1;
+    const coarse = divisor > 1;
+    const renderer = coarse ? this.previewRenderer : this.proxyRenderer;
+    if ((coarse ? this.uploadedPreviews : this.uploadedProxies) !== key) {
       const started = performance.now();
-      this.proxyRenderer.load(proxies);
-      await this.proxyRenderer.finish();
+      const loaded = coarse ? coarserProxies(proxies, divisor) : proxies;
+      renderer.load(loaded);
+      await renderer.finish();
       uploadMs = performance.now() - started;
-      this.uploadedProxies = key;
-      this.lastOpen = { key, downloadMs, uploadMs, bytes: proxies.bytes };
+      if (coarse) {
+        this.uploadedPreviews = key;
+      } else {
+        this.uploadedProxies = key;
+        this.lastOpen = { key, downloadMs, uploadMs, bytes: proxies.bytes };
+      }
     }
-    const target = recipe.synthesised
-      ? reorbit(proxies.header.camera, azimuthDeg, elevationDeg) : null;
+    const camera = renderer.loaded.header.camera;
+    const target = recipe.synthesised ? reorbit(camera, azimuthDeg, elevationDeg) : null;
     const started = performance.now();
-    this.proxyRenderer.render(recipe, target);
-    await this.proxyRenderer.finish();
-    return { milliseconds: performance.now() - started, uploadMs, preview: false };
+    renderer.render(coarse ? previewRecipe(recipe, divisor) : recipe, target);
+    await renderer.finish();
+    return { milliseconds: performance.now() - started, uploadMs, preview: coarse };
   }
 
   lightField(step, view) {
@@ -147,4 +161,19 @@ function cached(cache, key, load) {
     while (cache.size > KEPT_STEPS) cache.delete(cache.keys().next().value);
   }
   return cache.get(key);
+}
+
+/// A recipe for proxies `divisor` times coarser: occlusion's radius in their pixels (at least 1)
+/// and the disc's neighbour count to match.
+function previewRecipe(recipe, divisor) {
+  const occlusion = recipe.ambient_occlusion;
+  if (!occlusion || occlusion.radius === 0) return recipe;
+  const radius = Math.max(1, Math.round(occlusion.radius / divisor));
+  let neighbours = 0;
+  for (let dy = -radius; dy <= radius; ++dy) {
+    for (let dx = -radius; dx <= radius; ++dx) {
+      if ((dx !== 0 || dy !== 0) && dx * dx + dy * dy <= radius * radius) ++neighbours;
+    }
+  }
+  return { ...recipe, ambient_occlusion: { ...occlusion, radius, inverse_neighbours: 1 / neighbours } };
 }

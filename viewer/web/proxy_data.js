@@ -38,3 +38,47 @@ export async function fetchProxies(step, view) {
     `proxies of step ${step} view ${view}`);
   return buffer && parseProxies(buffer);
 }
+
+/// Proxies of a coarser camera with the same frustum, for previews while the user drags: every
+/// plane sampled at the source pixel nearest each coarse pixel's centre (`divisor` source pixels
+/// a side per coarse pixel). An approximation (no filtering, a different pixel grid), which is
+/// why previews are followed by the full frame once the pointer rests.
+export function coarserProxies(proxies, divisor) {
+  const { header } = proxies;
+  const width = Math.max(1, Math.round(header.width / divisor));
+  const height = Math.max(1, Math.round(header.height / divisor));
+  const columns = [];
+  const rows = [];
+  for (let x = 0; x < width; ++x) {
+    columns.push(Math.min(header.width - 1, Math.floor((x + 0.5) * header.width / width)));
+  }
+  for (let y = 0; y < height; ++y) {
+    rows.push(Math.min(header.height - 1, Math.floor((y + 0.5) * header.height / height)));
+  }
+  // `planes` one-channel planes, or one plane of `channels` interleaved channels.
+  const sample = (plane, planes, channels = 1) => {
+    if (!plane) return null;
+    const source = plane.values;
+    const values = new source.constructor(planes * width * height * channels);
+    const sourcePlane = header.width * header.height * channels;
+    let at = 0;
+    for (let k = 0; k < planes; ++k) {
+      for (const y of rows) {
+        for (const x of columns) {
+          const from = k * sourcePlane + (y * header.width + x) * channels;
+          for (let c = 0; c < channels; ++c) values[at++] = source[from + c];
+        }
+      }
+    }
+    return { type: plane.type, values };
+  };
+  return {
+    header: { ...header, width, height, camera: { ...header.camera, size: [width, height] } },
+    attenuation: sample(proxies.attenuation, header.intervals),
+    meanDepth: sample(proxies.meanDepth, header.intervals),
+    layers: sample(proxies.layers, header.layers),
+    rendering: sample(proxies.rendering, 1, 4),
+    opticalDepth: sample(proxies.opticalDepth, header.intervals),
+    bytes: proxies.bytes,
+  };
+}

@@ -25,9 +25,11 @@ const SPLAT_MARGIN = 2;        // pixels around the synthesised target (splat_at
 const UNIT = {
   attenuation: 0, meanDepth: 1, opticalDepth: 2, layers: 3, rendering: 4, frontDepth: 5,
   edited: 6, sourceTotal: 7, synthesisedAttenuation: 8, synthesisedMeanDepth: 9, splat: 10,
-  synthesisedFrontDepth: 11,
+  synthesisedFrontDepth: 11, transmittance: 12,
 };
 const MAX_LAYERS = 32;         // kMaxSynthesisLayers (view_synthesis.cpp)
+
+const programsOf = new WeakMap();  // WebGL2 context -> its programs
 
 // A camera's extent as the shaders take it: half width, half height, 1 for perspective.
 const extentOf = (camera) => [camera.halfWidth, camera.halfHeight, camera.perspective ? 1 : 0];
@@ -43,12 +45,14 @@ export class ProxyRenderer {
     const names = ['fullscreen.vert.glsl', 'srgb.glsl', 'view_synthesis.glsl',
       'proxy_load.frag.glsl', 'proxy_edit.frag.glsl', 'proxy_frame.frag.glsl',
       'splat_attenuation.vert.glsl', 'splat_attenuation.frag.glsl',
-      'resolve_attenuation.frag.glsl', 'resolve_layers.frag.glsl'];
+      'resolve_attenuation.frag.glsl', 'resolve_layers.frag.glsl',
+      'proxy_transmittance.frag.glsl'];
     const [fullscreen, srgb, synthesis, load, edit, frame, splatVertex, splatFragment, resolve,
-      resolveLayers] = await Promise.all(names.map(shaderText));
+      resolveLayers, transmittance] = await Promise.all(names.map(shaderText));
     // Vertex and fragment source of each program.
     return new ProxyRenderer(canvas, gl, {
       load: [fullscreen, load],
+      transmittance: [fullscreen, synthesis + transmittance],
       edit: [fullscreen, edit],
       frame: [fullscreen, srgb + frame],
       splat: [synthesis + splatVertex, synthesis + splatFragment],
@@ -61,7 +65,9 @@ export class ProxyRenderer {
     this.canvas = canvas;
     this.gl = gl;
     this.sources = sources;
-    this.programs = new Map();  // by "kind/max intervals"
+    // Programs are the context's, shared by every ProxyRenderer on it (previews use a second).
+    if (!programsOf.has(gl)) programsOf.set(gl, new Map());
+    this.programs = programsOf.get(gl);  // by "kind/max intervals/packed"
     this.textures = new TextureSet(gl);  // of the loaded step
     this.framebuffer = gl.createFramebuffer();
     this.depthBuffer = gl.createRenderbuffer();
@@ -159,6 +165,7 @@ export class ProxyRenderer {
       return texture;
     };
     const edited = packed(UNIT.edited, width, height, layers);
+    const transmittance = packed(UNIT.transmittance, width, height, layers);
     const synthesisedAttenuation = packed(UNIT.synthesisedAttenuation, width, height, layers);
     const synthesisedMeanDepth = packed(UNIT.synthesisedMeanDepth, width, height, layers);
     const margin = 2 * SPLAT_MARGIN;
@@ -186,6 +193,20 @@ export class ProxyRenderer {
     this.drawQuad();
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, null, 0);
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT1, gl.TEXTURE_2D, null, 0);
+
+    // T_j of every source pixel, for view synthesis: once per step, not per orbit frame.
+    const pass = this.program('transmittance', this.loaded.maxIntervals);
+    gl.useProgram(pass.program);
+    gl.uniform1i(pass.uniform('uAttenuation'), UNIT.attenuation);
+    gl.uniform1i(pass.uniform('uMeanDepth'), UNIT.meanDepth);
+    gl.uniform1i(pass.uniform('uIntervals'), intervals);
+    for (let first = 0; first < intervals; first += INTERVALS_PER_DRAW) {
+      gl.uniform1i(pass.uniform('uFirst'), first);
+      const targets = [];
+      for (let k = 0; k < OUTPUTS; ++k) targets.push({ texture: transmittance, layer: first / 4 + k });
+      this.drawInto(targets);
+    }
+    this.attach([null, null, null, null]);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
   }
 
@@ -194,8 +215,8 @@ export class ProxyRenderer {
     this.gl.drawArrays(this.gl.TRIANGLES, 0, 3);
   }
 
-  /// Attaches layers[k] of `textures[k]` as colour attachment k (null: no output k) and draws.
-  drawInto(targets) {
+  /// Attaches `targets[k]` ({texture, layer}; null: none) as colour attachment k.
+  attach(targets) {
     const gl = this.gl;
     const buffers = [];
     for (let k = 0; k < OUTPUTS; ++k) {
@@ -205,6 +226,11 @@ export class ProxyRenderer {
       buffers.push(target ? gl.COLOR_ATTACHMENT0 + k : gl.NONE);
     }
     gl.drawBuffers(buffers);
+  }
+
+  /// Draws the full-screen pass into `targets` (attach).
+  drawInto(targets) {
+    this.attach(targets);
     this.drawQuad();
   }
 
@@ -241,7 +267,7 @@ export class ProxyRenderer {
       }
       this.drawInto(targets);
     }
-    this.drawInto([null, null, null, null]);
+    this.attach([null, null, null, null]);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
   }
 
@@ -287,8 +313,8 @@ export class ProxyRenderer {
     gl.useProgram(program.program);
     gl.uniform1i(u('uMeanDepth'), depthUnit);
     gl.uniform1i(u('uAttenuation'), UNIT.attenuation);
+    gl.uniform1i(u('uTransmittance'), UNIT.transmittance);
     gl.uniform1i(u('uWithValues'), withValues ? 1 : 0);
-    gl.uniform1i(u('uIntervals'), header.intervals);
     gl.uniform2i(u('uSourceSize'), width, height);
     gl.uniform3fv(u('uSourceExtent'), extentOf(source));
     gl.uniform4fv(u('uRow0'), rows[0]);
@@ -380,7 +406,7 @@ export class ProxyRenderer {
       for (let k = 0; k < OUTPUTS; ++k) targets.push({ texture: edited, layer: first / 4 + k });
       this.drawInto(targets);
     }
-    this.drawInto([null, null, null, null]);
+    this.attach([null, null, null, null]);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
 
     // Pass 2: the frame, into the canvas.

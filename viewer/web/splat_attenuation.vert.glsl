@@ -13,8 +13,8 @@ precision highp sampler2DArray;
 
 uniform sampler2DArray uMeanDepth;   // layer j: mean depth of interval j (source)
 uniform sampler2DArray uAttenuation; // layer j: a_j (source)
+uniform sampler2DArray uTransmittance;  // T_j packed four to a layer (source)
 uniform int uInterval;
-uniform int uIntervals;
 uniform ivec2 uSourceSize;
 uniform vec3 uSourceExtent;
 uniform vec4 uRow0;  // source local -> target local (local_map)
@@ -107,32 +107,12 @@ void main() {
   vTangent = tangent ? 1 : 0;
   vOwn = ownPixel;
 
-  // (a_j, T_j): T_j the light in front of interval j on its source ray, contributions ordered
-  // by (mean depth, index); (0, 1), no contribution, where a_j is 0.
+  // (a_j, T_j), T_j the light in front of interval j on its source ray (computed once per step:
+  // proxy_transmittance.frag.glsl); (0, 1), no contribution, where a_j is 0.
   vValue = vec2(0.0, 1.0);
-  float transmittance = 1.0;
-  float previousDepth = -kInfinity;
-  int previous = -1;
-  for (int visited = 0; uWithValues && visited < uIntervals; ++visited) {
-    int next = -1;
-    float nextDepth = kInfinity;
-    for (int j = 0; j < uIntervals; ++j) {
-      float z = texelFetch(uMeanDepth, ivec3(s, j), 0).r;
-      if (!finite(z) || !(texelFetch(uAttenuation, ivec3(s, j), 0).r > 0.0)) continue;
-      if (before(previousDepth, previous, z, j) && (next < 0 || before(z, j, nextDepth, next))) {
-        next = j;
-        nextDepth = z;
-      }
-    }
-    if (next < 0) break;
-    float a = texelFetch(uAttenuation, ivec3(s, next), 0).r;
-    if (next == uInterval) {
-      vValue = vec2(a, transmittance);
-      break;
-    }
-    transmittance -= a;
-    previous = next;
-    previousDepth = nextDepth;
+  float a = texelFetch(uAttenuation, ivec3(s, uInterval), 0).r;
+  if (uWithValues && a > 0.0) {
+    vValue = vec2(a, texelFetch(uTransmittance, ivec3(s, uInterval / 4), 0)[uInterval % 4]);
   }
 
   // The point's centre: the centre of the pixel under the sample's centre, in the target with
