@@ -72,6 +72,9 @@ export class ProxyRenderer {
     this.framebuffer = gl.createFramebuffer();
     this.depthBuffer = gl.createRenderbuffer();
     this.vertexArray = gl.createVertexArray();
+    // The splat's points: per plane, the source pixels with a finite depth (attribute aPixel).
+    this.pointArray = gl.createVertexArray();
+    this.pointBuffer = gl.createBuffer();
     this.loaded = null;         // {header, maxIntervals, groups}
   }
 
@@ -174,9 +177,13 @@ export class ProxyRenderer {
     gl.bindRenderbuffer(gl.RENDERBUFFER, this.depthBuffer);
     gl.renderbufferStorage(gl.RENDERBUFFER, gl.DEPTH_COMPONENT32F, width + margin,
       height + margin);
+    // Per plane of mean depth, then of layers, the pixels with a finite depth: the only ones a
+    // splat draws (empty space costs nothing).
+    const pointRuns = this.uploadPoints([[proxies.meanDepth, intervals],
+      [proxies.layers, header.layers]], width * height);
     // The shaders' arrays are sized to the step's intervals, rounded up to a group of four.
     this.loaded = { header, maxIntervals: 4 * groups, groups, edited, synthesisedAttenuation,
-      synthesisedMeanDepth, synthesisedFront, splat, hasOpticalDepth: Boolean(proxies.opticalDepth) };
+      synthesisedMeanDepth, synthesisedFront, splat, pointRuns, hasOpticalDepth: Boolean(proxies.opticalDepth) };
 
     const { program, uniform } = this.program('load', this.loaded.maxIntervals);
     this.textures.bind();
@@ -208,6 +215,37 @@ export class ProxyRenderer {
     }
     this.attach([null, null, null, null]);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+  }
+
+  /// Uploads the pixel indices of finite depths of each plane of `groups` ([plane, count]) into
+  /// the point buffer; returns per group and plane [first, count].
+  uploadPoints(groups, pixels) {
+    const gl = this.gl;
+    const indices = [];
+    const runs = groups.map(([plane, count]) => {
+      const planeRuns = [];
+      for (let k = 0; k < count; ++k) {
+        const first = indices.length;
+        if (plane) {
+          const values = plane.values;
+          const half = plane.type === 'half';
+          for (let p = 0; p < pixels; ++p) {
+            const v = values[k * pixels + p];
+            // Half bits with an all-ones exponent are +-inf or NaN.
+            if (half ? (v & 0x7c00) !== 0x7c00 : Number.isFinite(v)) indices.push(p);
+          }
+        }
+        planeRuns.push([first, indices.length - first]);
+      }
+      return planeRuns;
+    });
+    gl.bindVertexArray(this.pointArray);
+    gl.bindBuffer(gl.ARRAY_BUFFER, this.pointBuffer);
+    gl.bufferData(gl.ARRAY_BUFFER, new Int32Array(indices.length ? indices : [0]), gl.STATIC_DRAW);
+    gl.enableVertexAttribArray(0);
+    gl.vertexAttribIPointer(0, 1, gl.INT, 0, 0);
+    gl.bindVertexArray(null);
+    return runs;
   }
 
   drawQuad() {
@@ -301,9 +339,10 @@ export class ProxyRenderer {
   /// from `target`: per plane, the nearest sample per target pixel.
   splatPlanes(depthUnit, count, withValues, target) {
     const gl = this.gl;
-    const { header, maxIntervals, splat } = this.loaded;
+    const { header, maxIntervals, splat, pointRuns } = this.loaded;
     const { width, height } = header;
     const { source, rows, sphere } = this.geometry(target);
+    const runs = pointRuns[depthUnit === UNIT.layers ? 1 : 0];
     const program = this.program('splat', maxIntervals);
     const u = program.uniform;
     gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
@@ -329,13 +368,14 @@ export class ProxyRenderer {
     gl.depthFunc(gl.LESS);
     gl.clearColor(0, 0, 0, 0);
     gl.clearDepth(1);
-    gl.bindVertexArray(this.vertexArray);
+    gl.bindVertexArray(this.pointArray);
     for (let j = 0; j < count; ++j) {
       gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, splat, 0, j);
       gl.drawBuffers([gl.COLOR_ATTACHMENT0]);
       gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
       gl.uniform1i(u('uInterval'), j);
-      gl.drawArrays(gl.POINTS, 0, width * height);
+      const [first, points] = runs[j];
+      if (points > 0) gl.drawArrays(gl.POINTS, first, points);
     }
     gl.disable(gl.DEPTH_TEST);
     gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER, null);

@@ -1,5 +1,5 @@
 // Pass 1 of attenuation synthesis (view_synthesis.cl splat_attenuation_depth / _values), one
-// point per source pixel for interval uInterval: its contribution at its mean depth, carried into
+// point per source pixel with a finite mean depth for interval uInterval: its contribution at its mean depth, carried into
 // the target camera (Eq. 4), covers the target pixels of its footprint (splat_footprint: half a
 // source pixel along each axis, mapped by the finite differences to its neighbours on the same
 // surface). The depth test keeps the nearest contribution per target pixel, as the kernels'
@@ -24,6 +24,9 @@ uniform ivec2 uTargetSize;
 uniform vec3 uTargetExtent;
 uniform int uMargin;
 uniform bool uWithValues;
+
+// The source pixel (y * width + x): only those whose plane holds a finite depth are drawn.
+layout(location = 0) in int aPixel;
 
 flat out vec3 vCentre;      // target pixels (x, y) and depth
 flat out vec3 vDx;          // target pixels and depth per source pixel along x
@@ -68,7 +71,7 @@ void cull() {
 }
 
 void main() {
-  ivec2 s = ivec2(gl_VertexID % uSourceSize.x, gl_VertexID / uSourceSize.x);
+  ivec2 s = ivec2(aPixel % uSourceSize.x, aPixel / uSourceSize.x);
   vec3 own, centre;
   if (!sourcePoint(s, own) ||
       !projectLocal(applyRows(uRow0, uRow1, uRow2, own), uTargetSize, uTargetExtent, centre)) {
