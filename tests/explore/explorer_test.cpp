@@ -471,6 +471,10 @@ TEST_F(ExplorerTest, TheRecipeHoldsTheTermsRenderApplies) {
     bad.opacity_scales = {{kIntervals, 0.5}};
     testing::expect_error_naming<InvalidArgument>([&] { explorer.recipe(bad); },
                                                   "opacity-scale interval 6");
+    ExploreRequest bad_enhancement = plain;
+    bad_enhancement.enhancement = EnhancementSettings{1.0, 0.0};
+    testing::expect_error_naming<InvalidArgument>([&] { explorer.recipe(bad_enhancement); },
+                                                  "enhancement gamma = 0");
 }
 
 TEST_F(ExplorerTest, StepsWrittenLaterAppearAfterRefresh) {

@@ -888,7 +888,7 @@ FrameRecipe Explorer::recipe(const ExploreRequest& request) {
         return recipe;
     }
     recipe.fill_radius_pixels = request.synthesis.hole_fill_radius_pixels;
-    // The rest as Explorer::render's proxies_frame and finish_frame decide it at the stored view.
+    // The rest as Explorer::render's proxies_frame and finish_frame decide it.
     const TransferFunction stored_tf = archive_->transfer_function(request.step, request.view);
     const TransferFunction& shown_tf =
         request.transfer_function ? *request.transfer_function : stored_tf;
@@ -928,6 +928,7 @@ FrameRecipe Explorer::recipe(const ExploreRequest& request) {
     if (request.ambient_occlusion) {
         recipe.ambient_occlusion = occlusion_terms(*request.ambient_occlusion, stored);
     }
+    if (request.enhancement) validate(*request.enhancement);
     recipe.enhancement = request.enhancement;
     recipe.drawable = true;
     return recipe;
