@@ -14,7 +14,7 @@ import { after, before, test } from 'node:test';
 
 import {
   CHROMIUM, CHROMIUM_ARGS, decodePng, differingSamples, env, loadPlaywright, makeWorkDir,
-  renderWithCli, startServer, stopServer,
+  renderWithCli, startServer, stopServer, waitForSettledFrame,
 } from './lib.mjs';
 
 const binary = env('INSITU_VIEW');
@@ -44,11 +44,7 @@ after(async () => {
 /// Waits for a frame newer than `count` whose options are the page's current ones (no request
 /// left to send), then returns what is displayed: options, decoded pixels, raw PNG.
 async function settledFrame(count) {
-  await page.waitForFunction((n) => {
-    const v = window.insituViewer;
-    return v.frameCount > n && v.displayed &&
-      JSON.stringify(v.displayed.options) === JSON.stringify(v.options());
-  }, count, { timeout: 20000 });
+  await waitForSettledFrame(page, count, 20000);
   const shown = await page.evaluate(() => {
     const v = window.insituViewer;
     const image = document.getElementById('frame');

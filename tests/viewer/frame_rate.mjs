@@ -14,7 +14,8 @@
 import { performance } from 'node:perf_hooks';
 
 import {
-  CHROMIUM, CHROMIUM_ARGS, loadPlaywright, startServer, stopServer, WEBGL_ARGS,
+  CHROMIUM, CHROMIUM_ARGS, loadPlaywright, startServer, stopServer, waitForSettledFrame,
+  WEBGL_ARGS,
 } from './lib.mjs';
 
 const [binary, archive, framesText] = process.argv.slice(2);
@@ -82,11 +83,7 @@ try {
       if (setup) {
         const before = await page.evaluate(() => window.insituViewer.frameCount);
         await setup(page);
-        await page.waitForFunction((n) => {
-          const v = window.insituViewer;
-          return v.frameCount > n && v.displayed &&
-            JSON.stringify(v.displayed.options) === JSON.stringify(v.options());
-        }, before, { timeout: 60000 });
+        await waitForSettledFrame(page, before);
       }
       const box = await page.locator('#viewport').boundingBox();
       const y = box.y + box.height / 2;

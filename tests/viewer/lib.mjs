@@ -165,6 +165,27 @@ export function differingSamples(a, b) {
   return count;
 }
 
+/// A new page of the viewer at `url` in `context` (a playwright browser or context), 1280x900;
+/// its uncaught errors and console errors go into `errors`. Resolves once it shows a frame.
+export async function openViewerPage(context, url, errors) {
+  const page = await context.newPage({ viewport: { width: 1280, height: 900 } });
+  page.on('pageerror', (error) => errors.push(error.message));
+  page.on('console', (message) => { if (message.type() === 'error') errors.push(message.text()); });
+  await page.goto(url);
+  await page.waitForFunction(() => window.insituViewer.frameCount > 0, null, { timeout: 30000 });
+  return page;
+}
+
+/// Waits until `page` shows a whole frame (not a drag's preview) newer than frame number `count`
+/// whose options are the page's current ones: nothing is left to request or redraw.
+export function waitForSettledFrame(page, count = 0, timeout = 60000) {
+  return page.waitForFunction((n) => {
+    const v = window.insituViewer;
+    return v.frameCount > n && v.displayed && !v.displayed.preview &&
+      JSON.stringify(v.displayed.options) === JSON.stringify(v.options());
+  }, count, { timeout });
+}
+
 export function makeWorkDir(prefix) {
   const base = process.env.WORK_DIR || tmpdir();
   if (!existsSync(base)) throw new Error(`WORK_DIR ${base} does not exist`);

@@ -3,8 +3,8 @@
 // The canvas must match `insitu-view render` (the C++ Explorer) for the same options: the
 // stored view, a recolour, an opacity edit, a 20-degree orbit with those edits (synthesised from
 // the proxies), headlight relighting with ambient occlusion there and at the stored view,
-// depth-aware enhancement, a timestep change and a drag (previews, then the full frame). The recipe API says what the page cannot draw
-// and refuses what the frame endpoint refuses.
+// depth-aware enhancement, a timestep change and a drag (previews, then the full frame). The
+// recipe API says what the page cannot draw and refuses what the frame endpoint refuses.
 //
 //   INSITU_VIEW=build/viewer/insitu-view ARCHIVE=viewer_lf.cdb WORK_DIR=dir node proxies.test.mjs
 import assert from 'node:assert/strict';
@@ -12,7 +12,7 @@ import { after, before, test } from 'node:test';
 
 import {
   CHROMIUM, decodePng, differingSamples, env, loadPlaywright, makeWorkDir, psnrPremultiplied,
-  renderWithCli, startServer, stopServer, WEBGL_ARGS,
+  renderWithCli, startServer, stopServer, waitForSettledFrame, WEBGL_ARGS,
 } from './lib.mjs';
 
 const binary = env('INSITU_VIEW');
@@ -46,11 +46,7 @@ after(async () => {
 /// Waits for a frame newer than `count` whose options are the page's current ones, then returns
 /// it: options, whether the browser drew it, the canvas pixels.
 async function settledFrame(count) {
-  await page.waitForFunction((n) => {
-    const v = window.insituViewer;
-    return v.frameCount > n && v.displayed &&
-      JSON.stringify(v.displayed.options) === JSON.stringify(v.options());
-  }, count, { timeout: 60000 });
+  await waitForSettledFrame(page, count);
   return page.evaluate(() => {
     const v = window.insituViewer;
     const shown = v.displayed.gpu ? v.gpuPixels() : null;
@@ -164,11 +160,6 @@ test('the stored view and its edits drawn with WebGL2 match insitu-view render',
   }
   await page.mouse.up();
   assert.ok(previews > 0, 'the drag showed previews');
-  await page.waitForFunction(() => {
-    const v = window.insituViewer;
-    return v.displayed && !v.displayed.preview &&
-      JSON.stringify(v.displayed.options) === JSON.stringify(v.options());
-  }, null, { timeout: 60000 });
   frame = await settledFrame(0);
   assert.ok(frame.options.azimuth !== undefined, 'the drag orbited');
   assertDrawnAndMatching(frame, 'after a drag', 'synthesised view');

@@ -12,8 +12,8 @@ import assert from 'node:assert/strict';
 import { after, before, test } from 'node:test';
 
 import {
-  CHROMIUM, decodePng, differingSamples, env, loadPlaywright, makeWorkDir, psnrPremultiplied,
-  renderWithCli, startServer, stopServer, WEBGL_ARGS,
+  CHROMIUM, decodePng, differingSamples, env, loadPlaywright, makeWorkDir, openViewerPage,
+  psnrPremultiplied, renderWithCli, startServer, stopServer, waitForSettledFrame, WEBGL_ARGS,
 } from './lib.mjs';
 
 const binary = env('INSITU_VIEW');
@@ -41,24 +41,15 @@ after(async () => {
   if (server) assert.equal(await stopServer(server), 0, 'serve exits 0 on SIGTERM');
 });
 
-async function openPage(context, url) {
-  const page = await context.newPage({ viewport: { width: 1280, height: 900 } });
-  page.on('pageerror', (error) => pageErrors.push(error.message));
-  page.on('console', (message) => { if (message.type() === 'error') pageErrors.push(message.text()); });
-  await page.goto(url);
-  await page.waitForFunction(() => window.insituViewer.frameCount > 0, null, { timeout: 30000 });
-  return page;
+function openPage(context, url) {
+  return openViewerPage(context, url, pageErrors);
 }
 
 /// Runs `action`, then waits for a newer frame whose options are the page's current ones.
 async function frameAfter(page, action) {
   const count = await page.evaluate(() => window.insituViewer.frameCount);
   await action();
-  await page.waitForFunction((n) => {
-    const v = window.insituViewer;
-    return v.frameCount > n && v.displayed && !v.displayed.preview &&
-      JSON.stringify(v.displayed.options) === JSON.stringify(v.options());
-  }, count, { timeout: 60000 });
+  await waitForSettledFrame(page, count);
   return page.evaluate(() => window.insituViewer.displayed.options);
 }
 

@@ -9,8 +9,8 @@ import assert from 'node:assert/strict';
 import { after, before, test } from 'node:test';
 
 import {
-  CHROMIUM, decodePng, env, loadPlaywright, makeWorkDir, psnrPremultiplied, renderWithCli,
-  startServer, stopServer, WEBGL_ARGS,
+  CHROMIUM, decodePng, env, loadPlaywright, makeWorkDir, openViewerPage, psnrPremultiplied,
+  renderWithCli, startServer, stopServer, waitForSettledFrame, WEBGL_ARGS,
 } from './lib.mjs';
 
 const binary = env('INSITU_VIEW');
@@ -36,13 +36,8 @@ after(async () => {
   if (server) assert.equal(await stopServer(server), 0, 'serve exits 0 on SIGTERM');
 });
 
-async function openPage(context) {
-  const page = await context.newPage({ viewport: { width: 1280, height: 900 } });
-  page.on('pageerror', (error) => pageErrors.push(error.message));
-  page.on('console', (message) => { if (message.type() === 'error') pageErrors.push(message.text()); });
-  await page.goto(server.url);
-  await page.waitForFunction(() => window.insituViewer.frameCount > 0, null, { timeout: 30000 });
-  return page;
+function openPage(context) {
+  return openViewerPage(context, server.url, pageErrors);
 }
 
 /// Sets the orbit angles through the page's inputs and waits for that frame to be displayed.
@@ -51,12 +46,10 @@ async function orbitTo(page, azimuth, elevation) {
   await page.fill('#azimuth', String(azimuth));
   await page.fill('#elevation', String(elevation));
   await page.dispatchEvent('#elevation', 'change');
-  await page.waitForFunction(({ n, az }) => {
-    const v = window.insituViewer;
-    return v.frameCount > n && v.displayed && Number(v.displayed.options.azimuth) === az &&
-      JSON.stringify(v.displayed.options) === JSON.stringify(v.options());
-  }, { n: count, az: azimuth }, { timeout: 60000 });
-  return page.evaluate(() => window.insituViewer.displayed.options);
+  await waitForSettledFrame(page, count);
+  const options = await page.evaluate(() => window.insituViewer.displayed.options);
+  assert.equal(Number(options.azimuth), azimuth, 'the frame shown is the one asked for');
+  return options;
 }
 
 test('orbit views drawn with WebGL2 match insitu-view render --source lightfield', async () => {

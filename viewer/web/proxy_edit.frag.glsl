@@ -1,11 +1,12 @@
 // Opacity edits of the stored view's attenuation proxies, per pixel: a' = estimate_attenuation
 // (libinsitu/include/insitu/explore/transfer_function_edit.hpp states the estimator;
 // kernels/explore/transfer_function_edit.cl is the reference this follows step for step).
-// Writes a'_j of intervals uFirst .. uFirst + 15 into four RGBA32F layers (interval j at layer
-// j / 4, component j % 4); without an edit (uCopy) a'_j = a_j exactly, as the Explorer then
+// Writes a'_j of intervals uFirst .. uFirst + 4 OUTPUTS - 1 into OUTPUTS RGBA32F layers
+// (interval j at layer j / 4, component j % 4); without an edit (uCopy) a'_j = a_j exactly, as the Explorer then
 // leaves a alone. A synthesised view's a and mean depths come packed four intervals to a layer
 // (resolve_attenuation.frag.glsl; PACKED) and without optical depth, as the Explorer has none
-// for them. The JS side prepends #version, MAX_INTERVALS and PACKED for those.
+// for them. The JS side prepends #version, MAX_INTERVALS, OUTPUTS, PACKED for those,
+// view_synthesis.glsl (insertByDepth) and draw_buffers.glsl.
 precision highp float;
 precision highp int;
 precision highp sampler2DArray;
@@ -18,11 +19,6 @@ uniform bool uCopy;
 uniform int uIntervals;
 uniform int uFirst;
 uniform float uScales[MAX_INTERVALS];
-
-layout(location = 0) out vec4 out0;
-layout(location = 1) out vec4 out1;
-layout(location = 2) out vec4 out2;
-layout(location = 3) out vec4 out3;
 
 float planeValue(sampler2DArray planes, ivec2 p, int j) {
 #ifdef PACKED
@@ -45,23 +41,16 @@ void main() {
     edited[j] = uCopy ? a[j] : 0.0;
   }
   if (!uCopy) {
-    // 1. The intervals that recorded anything, front to back by mean depth (insertion sort; a
-    // tie keeps index order, as only a strictly nearer depth moves an entry).
+    // 1. The intervals that recorded anything, front to back by mean depth (a tie keeps index
+    // order).
     int order[MAX_INTERVALS];
     float depth[MAX_INTERVALS];
     int count = 0;
     for (int j = 0; j < uIntervals; ++j) {
       if (!(a[j] > 0.0)) continue;
       float z = planeValue(uMeanDepth, pixel, j);
-      float key = isnan(z) ? uintBitsToFloat(0x7f800000u) : z;
-      int at = count++;
-      while (at > 0 && depth[at - 1] > key) {
-        order[at] = order[at - 1];
-        depth[at] = depth[at - 1];
-        --at;
-      }
-      order[at] = j;
-      depth[at] = key;
+      float key = isnan(z) ? kInfinity : z;
+      insertByDepth(order, depth, count, j, key);
     }
     // 2-4. t_j from the walk (or tau_j), t_j' = t_j^s_j, a_j' = T' (1 - t_j').
     float transmittance = 1.0;
@@ -86,15 +75,12 @@ void main() {
       editedTransmittance *= tEdited;
     }
   }
-  vec4 outputs[4];
-  for (int k = 0; k < 4; ++k) {
+  vec4 outputs[OUTPUTS];
+  for (int k = 0; k < OUTPUTS; ++k) {
     for (int c = 0; c < 4; ++c) {
       int j = uFirst + 4 * k + c;
       outputs[k][c] = j < uIntervals ? edited[j] : 0.0;
     }
   }
-  out0 = outputs[0];
-  out1 = outputs[1];
-  out2 = outputs[2];
-  out3 = outputs[3];
+  writeOutputs(outputs);
 }

@@ -17,8 +17,9 @@ import {
 } from './webgl.js';
 
 const MAX_LIGHTS = 16;         // kMaxLights (relighting.hpp)
-const OUTPUTS = 4;             // draw buffers a pass writes (WebGL2 guarantees 4)
-const INTERVALS_PER_DRAW = 4 * OUTPUTS;
+// Draw buffers a pass writes at most: 8 halve the draws of 16 intervals where the GPU has them
+// (SwiftShader does), else the 4 WebGL2 guarantees (draw_buffers.glsl).
+const MAX_OUTPUTS = 8;
 const SPLAT_MARGIN = 2;        // pixels around the synthesised target (splat_attenuation.vert.glsl)
 
 // Texture units, fixed per texture.
@@ -46,18 +47,19 @@ export class ProxyRenderer {
       'proxy_load.frag.glsl', 'proxy_edit.frag.glsl', 'proxy_frame.frag.glsl',
       'splat_attenuation.vert.glsl', 'splat_attenuation.frag.glsl',
       'resolve_attenuation.frag.glsl', 'resolve_layers.frag.glsl',
-      'proxy_transmittance.frag.glsl'];
+      'proxy_transmittance.frag.glsl', 'target_ray.glsl', 'draw_buffers.glsl'];
     const [fullscreen, srgb, synthesis, load, edit, frame, splatVertex, splatFragment, resolve,
-      resolveLayers, transmittance] = await Promise.all(names.map(shaderText));
+      resolveLayers, transmittance, targetRay, drawBuffers] =
+      await Promise.all(names.map(shaderText));
     // Vertex and fragment source of each program.
     return new ProxyRenderer(canvas, gl, {
       load: [fullscreen, load],
-      transmittance: [fullscreen, synthesis + transmittance],
-      edit: [fullscreen, edit],
+      transmittance: [fullscreen, synthesis + drawBuffers + transmittance],
+      edit: [fullscreen, synthesis + drawBuffers + edit],
       frame: [fullscreen, srgb + frame],
       splat: [synthesis + splatVertex, synthesis + splatFragment],
-      resolve: [fullscreen, synthesis + resolve],
-      resolveLayers: [fullscreen, synthesis + resolveLayers],
+      resolve: [fullscreen, synthesis + targetRay + drawBuffers + resolve],
+      resolveLayers: [fullscreen, synthesis + targetRay + resolveLayers],
     });
   }
 
@@ -68,6 +70,8 @@ export class ProxyRenderer {
     // Programs are the context's, shared by every ProxyRenderer on it (previews use a second).
     if (!programsOf.has(gl)) programsOf.set(gl, new Map());
     this.programs = programsOf.get(gl);  // by "kind/max intervals/packed"
+    this.outputs = Math.min(MAX_OUTPUTS, gl.getParameter(gl.MAX_DRAW_BUFFERS),
+      gl.getParameter(gl.MAX_COLOR_ATTACHMENTS));
     this.textures = new TextureSet(gl);  // of the loaded step
     this.framebuffer = gl.createFramebuffer();
     this.depthBuffer = gl.createRenderbuffer();
@@ -84,6 +88,7 @@ export class ProxyRenderer {
     if (!this.programs.has(key)) {
       const prefix = `#version 300 es\n#define MAX_INTERVALS ${maxIntervals}\n` +
         `#define MAX_LIGHTS ${MAX_LIGHTS}\n#define MAX_LAYERS ${MAX_LAYERS}\n` +
+        `#define OUTPUTS ${this.outputs}\n` +
         (packed ? '#define PACKED\n' : '');
       const [vertex, fragment] = this.sources[kind];
       const program = buildProgram(this.gl, prefix, vertex, fragment);
@@ -159,9 +164,9 @@ export class ProxyRenderer {
     const front = image(UNIT.frontDepth);
     const total = image(UNIT.sourceTotal);
     const synthesisedFront = image(UNIT.synthesisedFrontDepth);
-    // Four intervals to a layer, in whole draws of OUTPUTS layers.
+    // Four intervals to a layer.
     const groups = Math.ceil(intervals / 4);
-    const layers = Math.ceil(groups / OUTPUTS) * OUTPUTS;
+    const layers = Math.max(groups, 1);
     const packed = (unit, w, h, count) => {
       const texture = this.texture(unit, gl.TEXTURE_2D_ARRAY);
       gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA32F, w, h, count, 0, gl.RGBA, gl.FLOAT, null);
@@ -207,13 +212,11 @@ export class ProxyRenderer {
     gl.uniform1i(pass.uniform('uAttenuation'), UNIT.attenuation);
     gl.uniform1i(pass.uniform('uMeanDepth'), UNIT.meanDepth);
     gl.uniform1i(pass.uniform('uIntervals'), intervals);
-    for (let first = 0; first < intervals; first += INTERVALS_PER_DRAW) {
+    for (let first = 0; first < intervals; first += 4 * this.outputs) {
       gl.uniform1i(pass.uniform('uFirst'), first);
-      const targets = [];
-      for (let k = 0; k < OUTPUTS; ++k) targets.push({ texture: transmittance, layer: first / 4 + k });
-      this.drawInto(targets);
+      this.drawInto(this.groupTargets(transmittance, first / 4, groups));
     }
-    this.attach([null, null, null, null]);
+    this.attach([]);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
   }
 
@@ -253,17 +256,28 @@ export class ProxyRenderer {
     this.gl.drawArrays(this.gl.TRIANGLES, 0, 3);
   }
 
-  /// Attaches `targets[k]` ({texture, layer}; null: none) as colour attachment k.
+  /// Attaches `targets[k]` ({texture, layer}; null or missing: none) as colour attachment k.
   attach(targets) {
     const gl = this.gl;
     const buffers = [];
-    for (let k = 0; k < OUTPUTS; ++k) {
+    for (let k = 0; k < this.outputs; ++k) {
       const target = targets[k];
       gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0 + k,
         target ? target.texture : null, 0, target ? target.layer : 0);
       buffers.push(target ? gl.COLOR_ATTACHMENT0 + k : gl.NONE);
     }
     gl.drawBuffers(buffers);
+  }
+
+  /// The targets of one draw over groups of four intervals from `firstGroup`: layers of
+  /// `texture`, none past the last of `groups`.
+  groupTargets(texture, firstGroup, groups) {
+    const targets = [];
+    for (let k = 0; k < this.outputs; ++k) {
+      const layer = firstGroup + k;
+      targets.push(layer < groups ? { texture, layer } : null);
+    }
+    return targets;
   }
 
   /// Draws the full-screen pass into `targets` (attach).
@@ -284,7 +298,8 @@ export class ProxyRenderer {
     // Pass 1: per interval, the nearest contribution per target pixel (depth-tested points).
     this.splatPlanes(UNIT.meanDepth, intervals, true, target);
 
-    // Pass 2: composite per target pixel; a' groups then mean-depth groups, OUTPUTS per draw.
+    // Pass 2: composite per target pixel; a' groups then mean-depth groups, this.outputs per
+    // draw.
     const resolve = this.program('resolve', maxIntervals);
     const u = resolve.uniform;
     gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
@@ -294,18 +309,18 @@ export class ProxyRenderer {
     gl.uniform1i(u('uSourceTotal'), UNIT.sourceTotal);
     gl.uniform1i(u('uIntervals'), intervals);
     this.targetRayUniforms(u, target, fillRadius);
-    for (let part = 0; part * OUTPUTS < 2 * groups; ++part) {
+    for (let part = 0; part * this.outputs < 2 * groups; ++part) {
       gl.uniform1i(u('uPart'), part);
       const targets = [];
-      for (let k = 0; k < OUTPUTS; ++k) {
-        const g = part * OUTPUTS + k;
+      for (let k = 0; k < this.outputs; ++k) {
+        const g = part * this.outputs + k;
         targets.push(g >= 2 * groups ? null : g < groups
           ? { texture: this.loaded.synthesisedAttenuation, layer: g }
           : { texture: this.loaded.synthesisedMeanDepth, layer: g - groups });
       }
       this.drawInto(targets);
     }
-    this.attach([null, null, null, null]);
+    this.attach([]);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
   }
 
@@ -412,7 +427,7 @@ export class ProxyRenderer {
   render(recipe, target) {
     if (!this.loaded) throw new Error('no proxies loaded');
     const gl = this.gl;
-    const { header, maxIntervals, edited } = this.loaded;
+    const { header, maxIntervals, groups, edited } = this.loaded;
     const { width, height, intervals } = header;
     this.textures.bind();
     const synthesised = Boolean(recipe.synthesised);
@@ -422,7 +437,7 @@ export class ProxyRenderer {
       if (recipe.ambient_occlusion) this.synthesiseFrontDepth(target, recipe.fill_radius);
     }
 
-    // Pass 1: a' (or a copy of a), sixteen intervals per draw. A synthesised view has no
+    // Pass 1: a' (or a copy of a), 4 this.outputs intervals per draw. A synthesised view has no
     // optical depth (the Explorer re-projects none).
     const edit = this.program('edit', maxIntervals, synthesised);
     gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
@@ -440,13 +455,11 @@ export class ProxyRenderer {
     const scales = new Float32Array(maxIntervals).fill(1);
     recipe.opacity_scales.forEach((s, j) => { scales[j] = s; });
     gl.uniform1fv(edit.uniform('uScales'), scales);
-    for (let first = 0; first < intervals; first += INTERVALS_PER_DRAW) {
+    for (let first = 0; first < intervals; first += 4 * this.outputs) {
       gl.uniform1i(edit.uniform('uFirst'), first);
-      const targets = [];
-      for (let k = 0; k < OUTPUTS; ++k) targets.push({ texture: edited, layer: first / 4 + k });
-      this.drawInto(targets);
+      this.drawInto(this.groupTargets(edited, first / 4, groups));
     }
-    this.attach([null, null, null, null]);
+    this.attach([]);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
 
     // Pass 2: the frame, into the canvas.

@@ -4,35 +4,17 @@
 // depth order, a'_j = (a_j / T_j) T' clamped into [0, T'], T' = 1 - the a' in front; the mean
 // depth of each interval that adds light. A pixel where nothing landed is background when every
 // point of its ray (inside the bounding sphere, at half a source pixel per step) lies on a
-// transparent source ray. Writes 16 of the 2L values per draw: group g (four intervals) of a'
-// for g < G, of the mean depths for g >= G (G = L / 4 rounded up), groups 4 uPart ..
-// 4 uPart + 3. The JS side prepends #version, MAX_INTERVALS and view_synthesis.glsl.
+// transparent source ray. Writes 4 OUTPUTS of the 2L values per draw: group g (four intervals)
+// of a' for g < G, of the mean depths for g >= G (G = L / 4 rounded up), groups OUTPUTS uPart
+// .. OUTPUTS (uPart + 1) - 1. The JS side prepends #version, MAX_INTERVALS, OUTPUTS,
+// view_synthesis.glsl, target_ray.glsl and draw_buffers.glsl.
 precision highp sampler2D;
 precision highp sampler2DArray;
 
-uniform sampler2DArray uSplat;   // layer j: (a_j, T_j, depth, landed) with a margin of uMargin
+// uSplat (target_ray.glsl), layer j: (a_j, T_j, depth, landed).
 uniform sampler2D uSourceTotal;  // per source pixel, the sum of its a_j (0: a transparent ray)
-uniform int uMargin;
 uniform int uIntervals;
 uniform int uPart;
-uniform int uFillRadius;
-uniform ivec2 uTargetSize;
-uniform vec3 uTargetExtent;
-uniform ivec2 uSourceSize;
-uniform vec3 uSourceExtent;
-uniform vec4 uInverse0;  // target local -> source local
-uniform vec4 uInverse1;
-uniform vec4 uInverse2;
-uniform vec4 uSphere;    // the bounding sphere in target local coordinates
-
-layout(location = 0) out vec4 out0;
-layout(location = 1) out vec4 out1;
-layout(location = 2) out vec4 out2;
-layout(location = 3) out vec4 out3;
-
-vec4 splat(ivec2 p, int j) {
-  return texelFetch(uSplat, ivec3(p + uMargin, j), 0);
-}
 
 bool landedAny(ivec2 p) {
   for (int j = 0; j < uIntervals; ++j) {
@@ -45,8 +27,7 @@ bool landedAny(ivec2 p) {
 // source ray that is transparent.
 bool rayProvenEmpty(ivec2 p) {
   SourceRay ray;
-  if (!targetRayInSource(p, uTargetSize, uTargetExtent, uInverse0, uInverse1, uInverse2, uSphere,
-                         uSourceSize, uSourceExtent, ray)) {
+  if (!targetRay(p, ray)) {
     return true;
   }
   for (int i = 0; i < ray.steps; ++i) {
@@ -129,17 +110,14 @@ void main() {
     }
   }
   int groups = (uIntervals + 3) / 4;
-  vec4 outputs[4];
-  for (int k = 0; k < 4; ++k) {
-    int g = 4 * uPart + k;
+  vec4 outputs[OUTPUTS];
+  for (int k = 0; k < OUTPUTS; ++k) {
+    int g = OUTPUTS * uPart + k;
     for (int c = 0; c < 4; ++c) {
       int j = 4 * (g < groups ? g : g - groups) + c;
       bool depth = g >= groups;
       outputs[k][c] = j < uIntervals ? (depth ? meanDepth[j] : attenuation[j]) : 0.0;
     }
   }
-  out0 = outputs[0];
-  out1 = outputs[1];
-  out2 = outputs[2];
-  out3 = outputs[3];
+  writeOutputs(outputs);
 }

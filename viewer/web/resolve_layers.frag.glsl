@@ -4,32 +4,18 @@
 // on the layer's depth), else a fill between the nearest samples on one surface on both sides
 // within the fill radius; then the target ray is checked against what the source saw: a layer
 // whose fill the source proves empty all along is background (+inf). The JS side prepends
-// #version and view_synthesis.glsl.
+// #version, view_synthesis.glsl and target_ray.glsl.
 precision highp sampler2DArray;
 
-uniform sampler2DArray uSplat;   // layer l: (-, -, depth, landed) with a margin of uMargin
+// uSplat (target_ray.glsl), layer l: (-, -, depth, landed).
 uniform sampler2DArray uLayers;  // the source's layers (depth; +inf = no crossing)
-uniform int uMargin;
 uniform int uLayerCount;
-uniform int uFillRadius;
-uniform ivec2 uTargetSize;
-uniform vec3 uTargetExtent;
-uniform ivec2 uSourceSize;
-uniform vec3 uSourceExtent;
-uniform vec4 uInverse0;  // target local -> source local
-uniform vec4 uInverse1;
-uniform vec4 uInverse2;
-uniform vec4 uSphere;    // the bounding sphere in target local coordinates
 
 out vec4 outFrontDepth;
 
 // Space within this many source pixels in front of a found surface is not required to be seen
 // empty by the source (SURFACE_MARGIN_PIXELS).
 const float kSurfaceMarginPixels = 2.0;
-
-vec4 splat(ivec2 p, int l) {
-  return texelFetch(uSplat, ivec3(p + uMargin, l), 0);
-}
 
 // fill_between: the depth between the nearest samples on both sides along one of four
 // directions within the radius, when they lie on one surface (the shortest span wins).
@@ -83,8 +69,7 @@ void main() {
   uint settled = 0u;
   uint unknown = 0u;
   SourceRay ray;
-  bool crosses = targetRayInSource(p, uTargetSize, uTargetExtent, uInverse0, uInverse1,
-                                   uInverse2, uSphere, uSourceSize, uSourceExtent, ray);
+  bool crosses = targetRay(p, ray);
   for (int i = 0; crosses && i < ray.steps && settled != all; ++i) {
     float t = ray.t0 + (ray.t1 - ray.t0) * (float(i) + 0.5) / float(ray.steps);
     vec3 q = ray.origin + t * ray.direction;

@@ -62,6 +62,21 @@ bool before(float depthA, int a, float depthB, int b) {
   return depthA < depthB || (depthA == depthB && a < b);
 }
 
+// Adds interval j at depth `key` to the first `count` entries of order / depth, which stay
+// ordered as before() orders them: intervals arrive in index order, so only a strictly nearer
+// depth moves an entry (insertion sort; L is at most a few dozen).
+void insertByDepth(inout int order[MAX_INTERVALS], inout float depth[MAX_INTERVALS],
+                   inout int count, int j, float key) {
+  int at = count++;
+  while (at > 0 && depth[at - 1] > key) {
+    order[at] = order[at - 1];
+    depth[at] = depth[at - 1];
+    --at;
+  }
+  order[at] = j;
+  depth[at] = key;
+}
+
 // A target ray in source-local coordinates, clipped to the sphere that bounds the field:
 // origin + t direction for t in [t0, t1], marched in `steps` steps at most half a source pixel
 // apart (target_ray_in_source); false when the ray misses the sphere.
