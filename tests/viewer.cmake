@@ -52,6 +52,12 @@ set_tests_properties(viewer.setup_archive PROPERTIES
 set(viewer_environment
     INSITU_VIEW=$<TARGET_FILE:insitu-view> GRAY_SCOTT=$<TARGET_FILE:gray-scott>
     ARCHIVE=${viewer_archive} WORK_DIR=${viewer_work})
+# The drag's frame budget (viewer/web/frame_cost.js) needs neither a browser nor an archive.
+add_test(NAME viewer.frame_cost
+         COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/frame_cost.test.mjs
+         WORKING_DIRECTORY ${viewer_tests_dir})
+set_tests_properties(viewer.frame_cost PROPERTIES TIMEOUT 60)
+
 foreach(suite IN ITEMS browser api)
   add_test(NAME viewer.${suite}
            COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/${suite}.test.mjs

@@ -2,7 +2,9 @@
 //  1. over HTTP, one request in flight as the page does: per scenario the engine's time per
 //     frame (X-Insitu-Milliseconds), the round trip, and frames per second;
 //  2. in headless chromium: frames per second the page displays during a continuous orbit drag
-//     (round trip + PNG decode + display), with WebGL disabled (server frames only);
+//     (round trip + PNG decode + display), with WebGL disabled (server frames only), driven
+//     twice: by playwright's mouse moves (each waits for the page to take the one before) and
+//     by pointer events at 120 Hz dispatched in the page, as a real mouse sends them;
 //  3. the same drag with WebGL2 through SwiftShader (software, the worst case): the page draws
 //     every orbit frame itself, from the step's light field where it has one, else from the
 //     view's single-perspective proxies (view synthesis in the browser); then again with a
@@ -103,17 +105,51 @@ try {
       }
       const shown = (await page.evaluate(() => window.insituViewer.frameCount)) - first;
       const elapsed = performance.now() - start;
+      // The same drag as a real mouse makes it: pointer events at 120 Hz dispatched in the page,
+      // each without waiting for the page to acknowledge the one before (playwright's moves
+      // above do wait, so they can come no faster than the page draws and composites).
+      const stream = await page.evaluate(async (ms) => {
+        const v = window.insituViewer;
+        const viewport = document.getElementById('viewport');
+        const box = viewport.getBoundingClientRect();
+        const pointer = (type, x) => viewport.dispatchEvent(new PointerEvent(type, {
+          pointerId: 1, pointerType: 'mouse', isPrimary: true, bubbles: true, clientX: x,
+          clientY: box.top + box.height / 2, buttons: 1 }));
+        const counted = v.frameCount;
+        const frames = [];
+        let seen = v.frameCount;
+        const began = performance.now();
+        await new Promise((resolve) => {
+          let i = 0;
+          const timer = setInterval(() => {
+            pointer('pointermove', box.left + 100 + (i++ % 300));
+            if (v.frameCount !== seen && v.displayed.gpu) {
+              seen = v.frameCount;
+              frames.push({ ms: v.displayed.milliseconds, size: v.displayed.size });
+            }
+            if (performance.now() - began >= ms) {
+              clearInterval(timer);
+              resolve();
+            }
+          }, 8);
+        });
+        return { shown: v.frameCount - counted, elapsed: performance.now() - began, frames };
+      }, dragMs);
       await page.mouse.up();
       const gpu = await page.evaluate(() => {
         const v = window.insituViewer;
         return v.displayed.gpu ? { ms: v.displayed.milliseconds, open: v.gpu.lastOpen,
           from: v.displayed.drawnFrom, preview: v.displayed.preview } : null;
       });
-      let line = `page, orbit drag, ${label}: ${shown} frames displayed in ` +
-        `${(elapsed / 1000).toFixed(1)} s = ${((shown * 1000) / elapsed).toFixed(1)} frames/s`;
+      const rate = (n, ms) => `${n} frames in ${(ms / 1000).toFixed(1)} s = ` +
+        `${((n * 1000) / ms).toFixed(1)} frames/s`;
+      let line = `page, orbit drag, ${label}: playwright's moves ${rate(shown, elapsed)}; ` +
+        `pointer events at 120 Hz ${rate(stream.shown, stream.elapsed)}`;
       if (gpu) {
-        line += `; drawn in the browser (${gpu.from}${gpu.preview ? ', preview' : ''}), last frame ` +
-          `${gpu.ms.toFixed(1)} ms on the GPU; step ` +
+        const ms = stream.frames.map((f) => f.ms).sort((p, q) => p - q);
+        const sides = [...new Set(stream.frames.map((f) => f.size && f.size[0]))].join('/');
+        line += `; drawn in the browser (${gpu.from}), ${sides} pixels a side while dragging, ` +
+          `GPU ms per frame median ${ms.length ? ms[ms.length >> 1].toFixed(0) : '-'}; step ` +
           `opened (download ${gpu.open.downloadMs.toFixed(0)} ms + upload ` +
           `${gpu.open.uploadMs.toFixed(0)} ms, ${(gpu.open.bytes / 1e6).toFixed(1)} MB payload), ` +
           `first orbit frame ${firstFrameMs.toFixed(0)} ms after the drag began`;

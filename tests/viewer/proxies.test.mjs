@@ -146,23 +146,45 @@ test('the stored view and its edits drawn with WebGL2 match insitu-view render',
   assert.equal(frame.options.step, '600');
   assertDrawnAndMatching(frame, 'step 600');
 
-  // A drag: previews from coarser proxies while the pointer moves, then the full frame, which
-  // matches the CLI again.
+  // Drags. With a frame budget no GPU meets, previews from coarser proxies while the pointer
+  // moves, then the full frame, which matches the CLI again; with one every GPU meets, full
+  // frames all along.
   const box = await page.locator('#viewport').boundingBox();
   const y = box.y + box.height / 2;
-  await page.mouse.move(box.x + box.width / 2, y);
-  await page.mouse.down();
-  let previews = 0;
-  for (let i = 1; i <= 12; ++i) {
-    await page.mouse.move(box.x + box.width / 2 + 3 * i, y);
-    await new Promise((resolve) => setTimeout(resolve, 60));
-    if (await page.evaluate(() => Boolean(window.insituViewer.displayed.preview))) ++previews;
-  }
-  await page.mouse.up();
-  assert.ok(previews > 0, 'the drag showed previews');
+  const drag = async (budgetMs, from) => {
+    await page.evaluate((ms) => { window.insituViewer.gpu.dragFrameMs = ms; }, budgetMs);
+    await page.mouse.move(from, y);
+    await page.mouse.down();
+    const shown = [];
+    for (let i = 1; i <= 12; ++i) {
+      await page.mouse.move(from + 3 * i, y);
+      await new Promise((resolve) => setTimeout(resolve, 60));
+      shown.push(await page.evaluate(() => {
+        const { preview, size, options } = window.insituViewer.displayed;
+        return { preview: Boolean(preview), size, azimuth: options.azimuth };
+      }));
+    }
+    await page.mouse.up();
+    return shown;
+  };
+  const full = frame.image.width;
+  let shown = await drag(0, box.x + box.width / 2);
+  const previews = shown.filter((f) => f.preview);
+  assert.ok(previews.length > 0, 'the drag showed previews');
+  assert.ok(previews.every((f) => f.size[0] < full && f.size[0] >= 48),
+    `previews are smaller than the view and at least 48 pixels wide: ${previews.map((f) => f.size[0])}`);
   frame = await settledFrame(0);
   assert.ok(frame.options.azimuth !== undefined, 'the drag orbited');
   assertDrawnAndMatching(frame, 'after a drag', 'synthesised view');
+
+  shown = await drag(1e9, box.x + box.width / 2 + 40);
+  const during = shown.filter((f) => f.azimuth !== frame.options.azimuth);
+  assert.ok(during.length > 0, 'frames were drawn during the second drag');
+  assert.ok(during.every((f) => !f.preview && f.size[0] === full),
+    'within the frame budget, drag frames are full frames');
+  frame = await settledFrame(0);
+  assertDrawnAndMatching(frame, 'full frames while dragging', 'synthesised view');
+  await page.evaluate(() => { window.insituViewer.gpu.dragFrameMs = 50; });
 
   const opened = await page.evaluate(() => window.insituViewer.gpu.lastOpen);
   console.log(`WebGL2 stored view vs insitu-view render: ${results.join(', ')}`);

@@ -8,6 +8,8 @@ import { currentOptions, sameOptions } from './explore_options.js';
 import { schedulePlay } from './timeline.js';
 
 let inFlight = false;
+const READOUT_EVERY_MS = 250;
+let readoutShownAt = 0;
 
 // Whether the browser draws this frame from the light field: an orbit view (the stored view is
 // the archive's own proxies, exact) of a step with a light field, without what only the server's
@@ -63,17 +65,18 @@ function recipeFor(options) {
 export function requestFrame() {
   const options = currentOptions();
   if (!options || inFlight) return;
-  // While dragging, what the browser draws is a preview (the full frame once the pointer rests).
-  const preview = state.dragging && (drawnInBrowser(options) || proxiesInBrowser());
+  // While dragging, what the browser draws may be a preview (gpu_frames.js: the full frame
+  // once the pointer rests).
+  const dragging = state.dragging && (drawnInBrowser(options) || proxiesInBrowser());
   // The same options drawn the same way (toggling "draw in the browser" redraws them).
   if (viewer.displayed && sameOptions(viewer.displayed.options, options) &&
-    !(viewer.displayed.preview && !preview) &&
+    !(viewer.displayed.preview && !dragging) &&
     viewer.displayed.toggle === $('gpu-toggle').checked) return;
   inFlight = true;
   if (drawnInBrowser(options)) {
-    drawInBrowser(options, preview);
+    drawInBrowser(options, dragging);
   } else if (proxiesInBrowser()) {
-    drawProxies(options, preview);
+    drawProxies(options, dragging);
   } else {
     serverFrame(options);
   }
@@ -101,7 +104,7 @@ function serverFrame(options) {
 
 // A frame from the view's proxies, where the recipe allows; else (or when the server refuses
 // the options: it says why in the frame's answer) the server's frame.
-async function drawProxies(options, preview) {
+async function drawProxies(options, dragging) {
   const entry = state.timeline[state.stepIndex];
   let recipe = null;
   try {
@@ -115,7 +118,7 @@ async function drawProxies(options, preview) {
     return;
   }
   viewer.gpu.drawProxies(entry.step, state.view, recipe, Number(options.azimuth),
-    Number(options.elevation), preview)
+    Number(options.elevation), dragging)
     .then((timing) => {
       if (!timing) {
         serverFrame(options);
@@ -153,10 +156,10 @@ function showCanvas(canvas) {
   $('gpu-frame').hidden = !canvas;
 }
 
-function drawInBrowser(options, preview) {
+function drawInBrowser(options, dragging) {
   const entry = state.timeline[state.stepIndex];
   viewer.gpu.draw(entry.step, state.view, state.info.camera, Number(options.azimuth),
-    Number(options.elevation), state.segmentScales.slice(), preview)
+    Number(options.elevation), state.segmentScales.slice(), dragging)
     .then((timing) => {
       if (!timing) throw new Error('the step has no light field');
       return showGpuFrame(options, timing, 'light field', 'captured');
@@ -172,12 +175,18 @@ function showGpuFrame(options, timing, what, colourSource) {
   // A preview is smaller than the view: scaled up smoothly, not in blocks.
   $('gpu-frame').style.imageRendering = preview ? 'auto' : '';
   if (viewer.displayed && viewer.displayed.url) URL.revokeObjectURL(viewer.displayed.url);
-  viewer.displayed = { options, gpu: true, drawnFrom: what, preview, toggle: $('gpu-toggle').checked,
-    milliseconds: timing.milliseconds, synthesised: what !== 'stored view', colourSource };
+  viewer.displayed = { options, gpu: true, drawnFrom: what, preview, size: timing.size,
+    toggle: $('gpu-toggle').checked, milliseconds: timing.milliseconds,
+    synthesised: what !== 'stored view', colourSource };
   const fps = countFrame();
   const open = viewer.gpu.lastOpen;
+  // While dragging, the readout changes a few times a second (it is re-rastered each time).
+  const now = performance.now();
+  if (state.dragging && now - readoutShownAt < READOUT_EVERY_MS) return updateMask();
+  readoutShownAt = now;
   $('readout').textContent =
-    `frame ${timing.milliseconds.toFixed(1)} ms (WebGL2, ${what}${preview ? ', preview' : ''})` +
+    `frame ${timing.milliseconds.toFixed(1)} ms (WebGL2, ${what}` +
+    `${preview ? `, preview ${timing.size[0]}x${timing.size[1]}` : ''})` +
     ` · ${fps.toFixed(1)} fps · step opened in ${(open.downloadMs + open.uploadMs).toFixed(0)} ms` +
     ` (${(open.bytes / 1e6).toFixed(1)} MB)` + ` · colour ${colourSource}`;
   showError('');

@@ -3,25 +3,25 @@
 //  * orbit views from the step's light field (light_field_renderer.js): what
 //    reconstruct_light_field gives without edits, the light field's own colours and
 //    per-segment opacity fades;
-//  * the stored view from its single-perspective proxies (proxy_renderer.js), with recolouring,
-//    opacity edits, relighting, ambient occlusion and enhancement, as the frame's recipe
-//    (/api/recipe) says.
-// Everything else (orbit views from single-view proxies, the colour model, edits through a light
-// field) stays with the server's frames.
+//  * the stored view and other views from its single-perspective proxies (proxy_renderer.js),
+//    with recolouring, opacity edits, relighting, ambient occlusion and enhancement, as the
+//    frame's recipe (/api/recipe) says.
+// The colour model's frames and edits through a light field stay with the server's frames.
 
 import { reorbit } from './camera.js';
+import { DRAG_FRAME_MS, FrameCost } from './frame_cost.js';
 import { fetchLightField } from './light_field_data.js';
 import { LightFieldRenderer, webgl2Available } from './light_field_renderer.js';
 import { coarserProxies, fetchProxies } from './proxy_data.js';
 import { ProxyRenderer } from './proxy_renderer.js';
 
 const KEPT_STEPS = 3;  // light fields kept parsed: the shown step and the ones around it
-// While the user drags, frames are previews: at most PREVIEW_SIDE pixels a side (the image
-// scaled down by a whole factor) and PREVIEW_SEARCH_STEPS search steps instead of the
-// reference's 64, so that even a software rasteriser follows the pointer; the full frame follows
-// once the pointer rests. On SwiftShader (2 cores) a 512^2 frame takes 3.3 s in full, 87 ms as
-// a preview; on a GPU both take a few milliseconds.
-const PREVIEW_SIDE = 128;
+// While the user drags, each frame is drawn at the largest size that keeps the GPU's time for it
+// within a budget (frame_cost.js): the full frame where the GPU draws it that fast, else a
+// preview (the image scaled down by a whole factor; light fields with PREVIEW_SEARCH_STEPS
+// search steps instead of the reference's 64), and the full frame once the pointer rests. On
+// SwiftShader (2 cores) a 512^2 light-field frame takes about 3.3 s in full, 87 ms as a 128^2
+// preview; on a GPU both take a few milliseconds.
 const PREVIEW_SEARCH_STEPS = 16;
 const FULL_SEARCH_STEPS = 64;  // LightFieldReconstructionSettings::search_steps' default
 
@@ -58,6 +58,13 @@ export class GpuFrames {
     this.uploadedProxies = null;  // key of the proxies on the GPU
     this.uploadedPreviews = null;  // key of the coarser proxies on the GPU
     this.lastOpen = null;    // {key, downloadMs, uploadMs, bytes}
+    this.costs = new Map();  // kind of frame -> FrameCost
+    this.dragFrameMs = DRAG_FRAME_MS;  // tests change it to force previews or full frames
+  }
+
+  cost(kind, fullFactor = 1) {
+    if (!this.costs.has(kind)) this.costs.set(kind, new FrameCost(fullFactor));
+    return this.costs.get(kind);
   }
 
   /// The parsed proxies of (step, view) with their download time; null without attenuation.
@@ -67,17 +74,22 @@ export class GpuFrames {
   }
 
   /// Draws (step, view) from its single-perspective proxies with `recipe` (/api/recipe,
-  /// drawable): the stored view, or for a synthesised recipe the view at the orbit angles.
-  /// Resolves to the frame's timing, or null when the view has no attenuation proxies.
-  async drawProxies(step, view, recipe, azimuthDeg, elevationDeg, preview = false) {
-    const key = `${step}/${view}`;
+  /// drawable): the stored view, or for a synthesised recipe the view at the orbit angles; while
+  /// `dragging`, at the size the frame budget allows. Resolves to the frame's timing, or null
+  /// when the view has no attenuation proxies.
+  async drawProxies(step, view, recipe, azimuthDeg, elevationDeg, dragging = false) {
     const { proxies, downloadMs } = await this.proxies(step, view);
     if (!proxies) return null;
     let uploadMs = 0;
     const { width, height } = proxies.header;
-    const divisor = preview ? Math.max(1, Math.ceil(Math.max(width, height) / PREVIEW_SIDE)) : 1;
+    // The passes a frame takes decide its cost.
+    const cost = this.cost(['proxies', recipe.synthesised, Boolean(recipe.lighting),
+      Boolean(recipe.ambient_occlusion), Boolean(recipe.enhancement), recipe.opacity_edited]
+      .join('/'));
+    const divisor = dragging ? cost.dragDivisor(width, height, this.dragFrameMs) : 1;
     const coarse = divisor > 1;
     const renderer = coarse ? this.previewRenderer : this.proxyRenderer;
+    const key = coarse ? `${step}/${view}/${divisor}` : `${step}/${view}`;
     if ((coarse ? this.uploadedPreviews : this.uploadedProxies) !== key) {
       const started = performance.now();
       const loaded = coarse ? coarserProxies(proxies, divisor) : proxies;
@@ -96,7 +108,9 @@ export class GpuFrames {
     const started = performance.now();
     renderer.render(coarse ? previewRecipe(recipe, divisor) : recipe, target);
     await renderer.finish();
-    return { milliseconds: performance.now() - started, uploadMs, preview: coarse };
+    const milliseconds = performance.now() - started;
+    cost.record(coarse, milliseconds, camera.size[0] * camera.size[1]);
+    return { milliseconds, uploadMs, preview: coarse, size: camera.size };
   }
 
   lightField(step, view) {
@@ -117,9 +131,9 @@ export class GpuFrames {
   }
 
   /// Draws (step, view) from `storedCamera` (Camera::to_json) reorbited to the angles, with
-  /// per-segment opacity scales, in full or as a preview. Resolves to the frame's timing, or
-  /// null without a light field.
-  async draw(step, view, storedCamera, azimuthDeg, elevationDeg, segmentScales, preview = false) {
+  /// per-segment opacity scales; while `dragging`, at the size the frame budget allows.
+  /// Resolves to the frame's timing, or null without a light field.
+  async draw(step, view, storedCamera, azimuthDeg, elevationDeg, segmentScales, dragging = false) {
     const key = `${step}/${view}`;
     const { lightField, downloadMs } = await this.lightField(step, view);
     if (!lightField) return null;
@@ -132,18 +146,19 @@ export class GpuFrames {
       this.uploaded = key;
       this.lastOpen = { key, downloadMs, uploadMs, bytes: lightField.bytes };
     }
-    let camera = storedCamera;
-    if (preview) {
-      const [width, height] = storedCamera.size;
-      const divisor = Math.max(1, Math.ceil(Math.max(width, height) / PREVIEW_SIDE));
-      camera = { ...storedCamera, size: [Math.max(1, Math.round(width / divisor)),
-        Math.max(1, Math.round(height / divisor))] };
-    }
+    const [width, height] = storedCamera.size;
+    const cost = this.cost('light field', FULL_SEARCH_STEPS / PREVIEW_SEARCH_STEPS);
+    const divisor = dragging ? cost.dragDivisor(width, height, this.dragFrameMs) : 1;
+    const preview = divisor > 1;
+    const size = [Math.max(1, Math.round(width / divisor)),
+      Math.max(1, Math.round(height / divisor))];
     const started = performance.now();
-    this.renderer.render(reorbit(camera, azimuthDeg, elevationDeg), segmentScales,
-      preview ? PREVIEW_SEARCH_STEPS : FULL_SEARCH_STEPS);
+    this.renderer.render(reorbit({ ...storedCamera, size }, azimuthDeg, elevationDeg),
+      segmentScales, preview ? PREVIEW_SEARCH_STEPS : FULL_SEARCH_STEPS);
     await this.renderer.finish();
-    return { milliseconds: performance.now() - started, uploadMs, preview };
+    const milliseconds = performance.now() - started;
+    cost.record(preview, milliseconds, size[0] * size[1]);
+    return { milliseconds, uploadMs, preview, size };
   }
 }
 

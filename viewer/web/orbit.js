@@ -16,10 +16,23 @@ function normaliseAzimuth(degrees) {
   return a;
 }
 
+// While a pointer drags, the angle inputs and the trust map (an SVG rebuilt each time) follow
+// every INPUTS_EVERY_MS, not every event (a pointer moves up to a few hundred times a second):
+// each change is laid out and rastered again, on the same GPU as the frames.
+const INPUTS_EVERY_MS = 100;
+let inputsTimer = null;
+
 export function setOrbit(azimuth, elevation) {
   state.azimuth = normaliseAzimuth(azimuth);
   state.elevation = Math.max(-89, Math.min(89, elevation));
-  syncOrbitInputs();
+  if (!state.dragging) {
+    syncOrbitInputs();
+  } else if (inputsTimer === null) {
+    inputsTimer = setTimeout(() => {
+      inputsTimer = null;
+      syncOrbitInputs();
+    }, INPUTS_EVERY_MS);
+  }
   requestFrame();
 }
 
