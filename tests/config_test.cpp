@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -583,6 +585,69 @@ TEST(InstrumentConfig, BudgetParsesValidatesAndRoundTrips) {
             EXPECT_THAT(error.what(), HasSubstr(named)) << text;
         }
     }
+
+    // "rotations": the default +-20 degrees, [] (the stored view only) and explicit turns.
+    EXPECT_THAT(config.budget->rotations_deg, ElementsAre(-20.0, 20.0));
+    EXPECT_THAT(again.budget->rotations_deg, ElementsAre(-20.0, 20.0));
+    const InstrumentConfig stored_only =
+        InstrumentConfig::from_json_text(R"({"budget": {"rotations": []}})", nullptr);
+    EXPECT_TRUE(stored_only.budget->rotations_deg.empty());
+    EXPECT_TRUE(
+        InstrumentConfig::from_json(stored_only.to_json(), nullptr).budget->rotations_deg.empty());
+    const InstrumentConfig turned =
+        InstrumentConfig::from_json_text(R"({"budget": {"rotations": [-45.5, 180]}})", nullptr);
+    EXPECT_THAT(InstrumentConfig::from_json(turned.to_json(), nullptr).budget->rotations_deg,
+                ElementsAre(-45.5, 180.0));
+
+    // "precision" is chosen by default, kept where the configuration gives it, unless "choose"
+    // names it; "choose" round-trips.
+    EXPECT_TRUE(config.budget->chooses_precision);
+    EXPECT_TRUE(again.budget->chooses_precision);
+    const InstrumentConfig given_precision = InstrumentConfig::from_json_text(
+        R"({"precision": "float", "budget": {"psnr_db": 40}})", nullptr);
+    EXPECT_FALSE(given_precision.budget->chooses_precision);
+    EXPECT_TRUE(given_precision.budget->chooses_intervals);
+    EXPECT_FALSE(
+        InstrumentConfig::from_json(given_precision.to_json(), nullptr).budget->chooses_precision);
+    const InstrumentConfig precision_only = InstrumentConfig::from_json_text(
+        R"({"precision": "float", "budget": {"choose": ["precision"]}})", nullptr);
+    EXPECT_TRUE(precision_only.budget->chooses_precision);
+    EXPECT_FALSE(precision_only.budget->chooses_intervals);
+    const InstrumentConfig precision_again =
+        InstrumentConfig::from_json(precision_only.to_json(), nullptr);
+    EXPECT_TRUE(precision_again.budget->chooses_precision);
+    EXPECT_FALSE(precision_again.budget->chooses_intervals);
+    EXPECT_FALSE(
+        InstrumentConfig::from_json_text(R"({"budget": {"choose": ["intervals"]}})", nullptr)
+            .budget->chooses_precision);
+    EXPECT_EQ(to_string(StoragePrecision::single), "float");
+    EXPECT_EQ(parse_storage_precision("half"), StoragePrecision::half);
+    EXPECT_THROW(parse_storage_precision("double"), InvalidArgument);
+
+    // Bad rotations are refused naming the element and its value.
+    for (const auto& [text, named, value] : std::vector<std::array<std::string, 3>>{
+             {R"({"budget": {"rotations": [10, 200]}})", "budget.rotations[1]", "200"},
+             {R"({"budget": {"rotations": [-180]}})", "budget.rotations[0]", "-180"},
+             {R"({"budget": {"rotations": [0, "x"]}})", "budget.rotations[1]", "\"x\""},
+             {R"({"budget": {"rotations": 20}})", "budget.rotations", "20"}}) {
+        try {
+            InstrumentConfig::from_json_text(text, nullptr);
+            ADD_FAILURE() << text << " was accepted";
+        } catch (const Error& error) {
+            EXPECT_THAT(error.what(), HasSubstr(named)) << text;
+            EXPECT_THAT(error.what(), HasSubstr(value)) << text;
+        }
+    }
+    InstrumentConfig nonfinite = config;
+    nonfinite.budget->rotations_deg = {std::numeric_limits<double>::infinity()};
+    try {
+        nonfinite.validate();
+        ADD_FAILURE() << "an infinite rotation was accepted";
+    } catch (const InvalidArgument& error) {
+        EXPECT_THAT(error.what(), HasSubstr("budget.rotations[0]"));
+        EXPECT_THAT(error.what(), HasSubstr("inf"));
+    }
+
     std::vector<std::string> unknown;
     InstrumentConfig::from_json_text(R"({"budget": {"psnr_d": 40}})", &unknown);
     EXPECT_THAT(unknown, ElementsAre("budget.psnr_d"));

@@ -539,10 +539,30 @@ TEST_F(InstrumentTest, FinalizeStatesTheInSituShareOfWallTime) {
     EXPECT_THAT(log, HasSubstr("between calls"));
 }
 
-// "budget": the Instrument measures each interval count and mode on the stored view (a
-// held-out edit against its ground truth, the view's bytes and pass time), archives with the
-// cheapest that meets the budget, records the choice per step and re-checks every
-// "check_every" archived steps.
+/// Runs `steps` steps of `volume` with `config` (which holds a "budget"); with `log`, what the
+/// Instrument said at finalize.
+ArchiveReader run_with_budget(const InstrumentConfig& config, const SampledVolume& volume,
+                              std::int64_t steps, std::string* log = nullptr) {
+    InstrumentOptions options;
+    options.log = log != nullptr;
+    if (log) ::testing::internal::CaptureStderr();
+    {
+        Instrument instrument(config, options);
+        for (std::int64_t step = 0; step < steps; ++step) {
+            EXPECT_EQ(instrument.execute(step, 0.1 * static_cast<double>(step), {volume.field()}),
+                      Status::ok)
+                << instrument.last_error();
+        }
+        EXPECT_EQ(instrument.finalize(), Status::ok) << instrument.last_error();
+    }
+    if (log) *log = ::testing::internal::GetCapturedStderr();
+    return ArchiveReader(config.archive);
+}
+
+// "budget": the Instrument measures each interval count and mode on the stored view and its
+// rotations (a held-out edit against their ground truths, the view's bytes and pass time),
+// archives with the cheapest that meets the budget, records the choice per step and re-checks
+// every "check_every" archived steps.
 TEST_F(InstrumentTest, AnErrorBudgetChoosesTheCheapestIntervalsThatMeetIt) {
     const auto run = [&](const fs::path& path, BudgetConfig budget,
                          std::optional<int> given_intervals, std::string* log) {
@@ -550,21 +570,11 @@ TEST_F(InstrumentTest, AnErrorBudgetChoosesTheCheapestIntervalsThatMeetIt) {
         if (given_intervals) config.interval_count = *given_intervals;
         budget.chooses_intervals = !given_intervals;
         config.budget = budget;
-        InstrumentOptions options;
-        options.log = log != nullptr;
-        if (log) ::testing::internal::CaptureStderr();
-        {
-            Instrument instrument(config, options);
-            for (std::int64_t step = 0; step < 5; ++step) {
-                EXPECT_EQ(instrument.execute(step, 0.1 * step, {volume_.field()}), Status::ok);
-            }
-            EXPECT_EQ(instrument.finalize(), Status::ok);
-        }
-        if (log) *log = ::testing::internal::GetCapturedStderr();
-        return ArchiveReader(path.string());
+        return run_with_budget(config, volume_, 5, log);
     };
 
-    // Any PSNR a candidate reaches: the fewest bytes win, and 4 intervals store the least.
+    // Any PSNR a candidate reaches: the fewest bytes win, and 4 intervals in half store the
+    // least.
     BudgetConfig easy;
     easy.psnr_db = 1.0;
     easy.check_every = 2;
@@ -575,15 +585,28 @@ TEST_F(InstrumentTest, AnErrorBudgetChoosesTheCheapestIntervalsThatMeetIt) {
         ASSERT_EQ(choice.size(), 1u) << "step " << step;
         EXPECT_EQ(choice[0].field, "f");
         EXPECT_EQ(choice[0].intervals, 4) << "step " << step;
+        EXPECT_EQ(choice[0].precision, StoragePrecision::half) << "step " << step;
         EXPECT_TRUE(choice[0].met);
         EXPECT_GT(choice[0].bytes, 0.0);
         EXPECT_GT(choice[0].milliseconds, 0.0);
+        EXPECT_GT(choice[0].check_milliseconds, choice[0].milliseconds);
         EXPECT_EQ(choice[0].checked, step % 2 == 0) << "step " << step;  // steps 0, 2, 4
         EXPECT_EQ(cheap.load(step, 0).intervals->count(), 4) << "step " << step;
+        // The stored view and the default rotations, the PSNR the least of them.
+        ASSERT_EQ(choice[0].views.size(), 3u);
+        EXPECT_EQ(choice[0].views[0].azimuth_offset_deg, 0.0);
+        EXPECT_EQ(choice[0].views[1].azimuth_offset_deg, -20.0);
+        EXPECT_EQ(choice[0].views[2].azimuth_offset_deg, 20.0);
+        EXPECT_EQ(choice[0].psnr_db,
+                  std::min({choice[0].views[0].psnr_db, choice[0].views[1].psnr_db,
+                            choice[0].views[2].psnr_db}));
     }
     EXPECT_THAT(log, HasSubstr("budget: field \"f\" 4 "));
+    EXPECT_THAT(log, HasSubstr("half chosen"));
     EXPECT_THAT(log, HasSubstr("3 check(s)"));
+    EXPECT_THAT(log, HasSubstr("worst of 3 views"));
     EXPECT_THAT(log, HasSubstr(", met"));
+    EXPECT_THAT(log, HasSubstr("the check took"));
 
     // A PSNR no candidate reaches: the most accurate one, said not to meet it.
     BudgetConfig strict;
@@ -601,11 +624,114 @@ TEST_F(InstrumentTest, AnErrorBudgetChoosesTheCheapestIntervalsThatMeetIt) {
         run(directory_ / "tiny.cdb", tiny, std::nullopt, nullptr).budget(0).at(0);
     EXPECT_FALSE(cheapest.met);
     EXPECT_EQ(cheapest.intervals, 4);
+    EXPECT_EQ(cheapest.precision, StoragePrecision::half);
 
     // Explicit settings win: the given intervals are measured and kept.
     const ArchiveReader given = run(directory_ / "given.cdb", easy, 16, nullptr);
     EXPECT_EQ(given.budget(0).at(0).intervals, 16);
     EXPECT_EQ(given.load(0, 0).intervals->count(), 16);
+}
+
+// "rotations": the PSNR a budget asks is the least over the stored view and views turned in
+// azimuth, synthesised from the stored view's proxies. On Gaussian blobs the turned views lose
+// what the stored one hides (their PSNR is below the stored view's), so a PSNR the stored view
+// alone meets with 8 intervals needs more with rotations; [] measures the stored view only, and
+// a turn of 0 degrees synthesises the stored view back exactly (the same choice as []).
+TEST_F(InstrumentTest, AnErrorBudgetMeasuresRotatedViewsSynthesisedFromTheStoredOne) {
+    const auto choice = [&](const std::string& name, std::vector<double> rotations) {
+        InstrumentConfig config = small_config(directory_ / name, 48);
+        BudgetConfig budget;
+        budget.psnr_db = 60.0;
+        budget.rotations_deg = std::move(rotations);
+        budget.chooses_precision = false;
+        config.budget = budget;
+        return run_with_budget(config, volume_, 1).budget(0).at(0);
+    };
+    const BudgetRecord stored_only = choice("stored.cdb", {});
+    ASSERT_EQ(stored_only.views.size(), 1u);
+    EXPECT_EQ(stored_only.views[0].azimuth_offset_deg, 0.0);
+    EXPECT_EQ(stored_only.psnr_db, stored_only.views[0].psnr_db);
+    EXPECT_TRUE(stored_only.met);
+    EXPECT_EQ(stored_only.intervals, 8);
+    EXPECT_EQ(stored_only.interval_mode, IntervalMode::uniform);
+
+    const BudgetRecord unturned = choice("unturned.cdb", {0.0});
+    ASSERT_EQ(unturned.views.size(), 2u);
+    EXPECT_EQ(unturned.intervals, stored_only.intervals);
+    EXPECT_EQ(unturned.interval_mode, stored_only.interval_mode);
+    EXPECT_NEAR(unturned.views[1].psnr_db, unturned.views[0].psnr_db, 0.01);
+    EXPECT_EQ(unturned.views[0].psnr_db, stored_only.psnr_db);
+
+    const BudgetRecord turned = choice("turned.cdb", {-20.0, 20.0});
+    ASSERT_EQ(turned.views.size(), 3u);
+    EXPECT_EQ(turned.views[1].azimuth_offset_deg, -20.0);
+    EXPECT_EQ(turned.views[2].azimuth_offset_deg, 20.0);
+    EXPECT_LT(turned.views[1].psnr_db, turned.views[0].psnr_db - 5.0);
+    EXPECT_LT(turned.views[2].psnr_db, turned.views[0].psnr_db - 5.0);
+    EXPECT_EQ(turned.psnr_db, std::min(turned.views[1].psnr_db, turned.views[2].psnr_db));
+    // Met by no candidate: the most accurate, with more intervals than the stored view needs.
+    EXPECT_FALSE(turned.met);
+    EXPECT_GT(turned.intervals, stored_only.intervals);
+}
+
+// "choose": ["precision"]: each candidate is measured as a reader gets it back in half and in
+// float, and the writer stores the views at the precision chosen. The blobs in a domain 240 km
+// wide (10 km voxels, the function's unit length scaled alike): their mean depths pass half's
+// 65504, so the views turned from half proxies lose their intervals' placement (33 dB against
+// 45 dB from float proxies at +-20 degrees, measured on PoCL; the stored view 64 against 70).
+TEST_F(InstrumentTest, AnErrorBudgetChoosesThePrecisionOfTheViewsItArchives) {
+    constexpr double kVoxel = 1e4;
+    SampledVolume wide = volume_;
+    wide.spacing = glm::dvec3(kVoxel);
+    const auto run = [&](const std::string& name, BudgetConfig budget, std::string* log) {
+        InstrumentConfig config = small_config(directory_ / name, 48);
+        config.transfer_function =
+            TransferFunction(config.transfer_function->rows().front().points, kVoxel);
+        config.interval_count = 16;
+        budget.chooses_intervals = false;
+        config.budget = budget;
+        return run_with_budget(config, wide, 1, log);
+    };
+    // The farthest stored mean depth (+inf marks an empty interval, and where half overflows).
+    const auto largest_mean_depth = [](const ArchiveReader& reader) {
+        const Image mean_depth = reader.load(0, 0).mean_depth;
+        float largest = 0.0f;
+        for (const float depth : mean_depth.pixels) {
+            if (std::isfinite(depth)) largest = std::max(largest, depth);
+        }
+        return largest;
+    };
+
+    // An accuracy only float proxies reach, bytes to spare: float, and the views stored so.
+    BudgetConfig accurate;
+    accurate.psnr_db = 40.0;
+    std::string log;
+    const ArchiveReader in_float = run("float.cdb", accurate, &log);
+    const BudgetRecord float_choice = in_float.budget(0).at(0);
+    EXPECT_EQ(float_choice.precision, StoragePrecision::single);
+    EXPECT_TRUE(float_choice.met);
+    EXPECT_GE(float_choice.psnr_db, 40.0);
+    EXPECT_THAT(log, HasSubstr("float chosen"));
+    EXPECT_GT(largest_mean_depth(in_float), 65504.0f);
+
+    // The same accuracy, bytes for half proxies only: half, the closest affordable, not met;
+    // the views stored in half (their far mean depths overflow).
+    BudgetConfig tight = accurate;
+    tight.bytes_per_step = float_choice.bytes - 1.0;
+    const ArchiveReader in_half = run("half.cdb", tight, nullptr);
+    const BudgetRecord half_choice = in_half.budget(0).at(0);
+    EXPECT_EQ(half_choice.precision, StoragePrecision::half);
+    EXPECT_FALSE(half_choice.met);
+    EXPECT_LT(half_choice.bytes, float_choice.bytes);
+    EXPECT_LT(half_choice.psnr_db, 40.0);
+    EXPECT_LE(largest_mean_depth(in_half), 65504.0f);
+
+    // Explicit settings win: a precision the budget does not choose is measured and kept.
+    BudgetConfig given = accurate;
+    given.chooses_precision = false;
+    const BudgetRecord kept = run("given.cdb", given, nullptr).budget(0).at(0);
+    EXPECT_EQ(kept.precision, StoragePrecision::half);
+    EXPECT_FALSE(kept.met);
 }
 
 TEST_F(InstrumentTest, MissingFieldIsAnErrorNamingIt) {

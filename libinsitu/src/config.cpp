@@ -314,8 +314,11 @@ const Key<ColourModelConfig> kColourModelKeys[] = {
      [](const ColourModelConfig& model) { return json(model.enabled); }},
 };
 
-// "budget": {"psnr_db", "bytes_per_step", "ms_per_step", "check_every", "choose"}.
-constexpr Choice<int> kBudgetChoices[] = {{"intervals", 0}};
+// "budget": {"psnr_db", "bytes_per_step", "ms_per_step", "check_every", "rotations",
+// "choose"}.
+enum class BudgetChoice { intervals, precision };
+constexpr Choice<BudgetChoice> kBudgetChoices[] = {{"intervals", BudgetChoice::intervals},
+                                                   {"precision", BudgetChoice::precision}};
 const Key<BudgetConfig> kBudgetKeys[] = {
     {"psnr_db",
      [](const json& value, const std::string& key, BudgetConfig& budget, Unknown&) {
@@ -341,17 +344,29 @@ const Key<BudgetConfig> kBudgetKeys[] = {
          budget.check_every = small_integer(value, key);
      },
      [](const BudgetConfig& budget) { return json(budget.check_every); }},
+    {"rotations",
+     [](const json& value, const std::string& key, BudgetConfig& budget, Unknown&) {
+         budget.rotations_deg = list_of<double>(value, key, number);
+     },
+     [](const BudgetConfig& budget) { return json(budget.rotations_deg); }},
     {"choose",
      [](const json& value, const std::string& key, BudgetConfig& budget, Unknown&) {
          require_array(value, key);
          budget.chooses_intervals = false;
+         budget.chooses_precision = false;
          for (std::size_t i = 0; i < value.size(); ++i) {
-             (void)choose(value[i], element_key(key, i), kBudgetChoices);
-             budget.chooses_intervals = true;
+             const BudgetChoice choice = choose(value[i], element_key(key, i), kBudgetChoices);
+             (choice == BudgetChoice::intervals ? budget.chooses_intervals
+                                                : budget.chooses_precision) = true;
          }
      },
      [](const BudgetConfig& budget) {
-         return budget.chooses_intervals ? json::array({"intervals"}) : json::array();
+         json chosen = json::array();
+         if (budget.chooses_intervals)
+             chosen.push_back(name_of(BudgetChoice::intervals, kBudgetChoices));
+         if (budget.chooses_precision)
+             chosen.push_back(name_of(BudgetChoice::precision, kBudgetChoices));
+         return chosen;
      }},
 };
 
@@ -659,6 +674,14 @@ std::string join(const std::vector<std::string>& names) {
 
 }  // namespace
 
+std::string to_string(StoragePrecision precision) {
+    return name_of(precision, kPrecisions);
+}
+
+StoragePrecision parse_storage_precision(const std::string& text) {
+    return choose(json(text), "precision", kPrecisions);
+}
+
 std::string suggest_key(const std::string& unknown_path) {
     const std::size_t dot = unknown_path.rfind('.');
     const std::string key = dot == std::string::npos ? unknown_path : unknown_path.substr(dot + 1);
@@ -724,10 +747,11 @@ InstrumentConfig InstrumentConfig::from_json(const nlohmann::json& document,
     Unknown unknown;
     InstrumentConfig config;
     parse_object(document, "", kTopLevelKeys, config, unknown);
-    // Explicit settings win over the budget: given "intervals" are kept unless "choose" says
-    // otherwise.
-    if (config.budget && document.contains("intervals") && !document["budget"].contains("choose")) {
-        config.budget->chooses_intervals = false;
+    // Explicit settings win over the budget: given "intervals" or "precision" are kept unless
+    // "choose" says otherwise.
+    if (config.budget && !document["budget"].contains("choose")) {
+        if (document.contains("intervals")) config.budget->chooses_intervals = false;
+        if (document.contains("precision")) config.budget->chooses_precision = false;
     }
     config.validate();
     if (unknown_keys != nullptr) {
@@ -878,6 +902,13 @@ void InstrumentConfig::validate() const {
         }
         if (budget->check_every < 1) {
             out_of_range("budget.check_every", text_of(budget->check_every), "must be >= 1");
+        }
+        for (std::size_t i = 0; i < budget->rotations_deg.size(); ++i) {
+            const double rotation = budget->rotations_deg[i];
+            if (!(std::isfinite(rotation) && rotation > -180.0 && rotation <= 180.0)) {
+                out_of_range(element_key("budget.rotations", i), text_of(rotation),
+                             "degrees of azimuth, must be finite and in (-180, 180]");
+            }
         }
         // Its held-out edit scales opacity per interval, which a 2D function does not have.
         bool two_d = transfer_function && transfer_function->is_2d();

@@ -8,11 +8,13 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 
 #include "archive/archive_format.hpp"
 #include "archive/manifest_entries.hpp"
+#include "insitu/archive/step_record.hpp"
 #include "insitu/error.hpp"
 #include "support/expect_error.hpp"
 
@@ -92,6 +94,84 @@ TEST(Manifest, NeverWritesWhatItsReaderWouldRefuse) {
                                     "time\" has the wrong type: nan");
     EXPECT_EQ(read_manifest(archive.string()), manifest);
     EXPECT_FALSE(fs::exists(archive / kJournalFile));
+    fs::remove_all(archive);
+}
+
+// A budget choice reads back whole through the file, an infinite PSNR (a measured view whose
+// recomposition equals its ground truth) included: nlohmann writes +inf as null, which reads
+// back as +inf, not as an archive the reader refuses. Entries of archives written before the
+// rotated views and the precision read with those keys absent.
+TEST(Manifest, BudgetChoicesRoundTripWithInfinitePsnr) {
+    const fs::path archive =
+        fs::temp_directory_path() / ("insitu_manifest_budget_" + std::to_string(::getpid()));
+    fs::remove_all(archive);
+    fs::create_directories(archive);
+    BudgetRecord choice;
+    choice.field = "v";
+    choice.intervals = 8;
+    choice.interval_mode = IntervalMode::histogram_equalized;
+    choice.precision = StoragePrecision::single;
+    choice.checked = true;
+    choice.met = true;
+    choice.psnr_db = 31.5;
+    choice.bytes = 12345.0;
+    choice.milliseconds = 6.5;
+    choice.views = {{0.0, std::numeric_limits<double>::infinity()}, {-20.0, 31.5}, {20.0, 33.0}};
+    choice.check_milliseconds = 80.25;
+    nlohmann::json manifest = empty_manifest();
+    manifest["producer"] = "libinsitu test";
+    manifest["configuration"] = nlohmann::json::object();
+    nlohmann::json entry = step_entry(3);
+    entry[kBudgetKey] = nlohmann::json::array({budget_entry(choice)});
+    BudgetRecord identical = choice;  // every view exact
+    identical.psnr_db = std::numeric_limits<double>::infinity();
+    identical.views = {{0.0, identical.psnr_db}};
+    entry[kBudgetKey].push_back(budget_entry(identical));
+    insert_step(manifest, entry);
+    write_manifest(archive.string(), manifest);
+    const nlohmann::json again = read_manifest(archive.string());
+    const nlohmann::json& entries = again.at("steps").at(0).at(kBudgetKey);
+    ASSERT_EQ(entries.size(), 2u);
+    const BudgetRecord back = budget_from_entry(entries[0]);
+    EXPECT_EQ(back.field, "v");
+    EXPECT_EQ(back.intervals, 8);
+    EXPECT_EQ(back.interval_mode, IntervalMode::histogram_equalized);
+    EXPECT_EQ(back.precision, StoragePrecision::single);
+    EXPECT_EQ(back.psnr_db, 31.5);
+    EXPECT_EQ(back.check_milliseconds, 80.25);
+    ASSERT_EQ(back.views.size(), 3u);
+    EXPECT_EQ(back.views[0].azimuth_offset_deg, 0.0);
+    EXPECT_TRUE(std::isinf(back.views[0].psnr_db) && back.views[0].psnr_db > 0.0);
+    EXPECT_EQ(back.views[1].azimuth_offset_deg, -20.0);
+    EXPECT_EQ(back.views[1].psnr_db, 31.5);
+    EXPECT_EQ(back.views[2].psnr_db, 33.0);
+    const BudgetRecord exact = budget_from_entry(entries[1]);
+    EXPECT_TRUE(std::isinf(exact.psnr_db) && exact.psnr_db > 0.0);
+    EXPECT_TRUE(std::isinf(exact.views.at(0).psnr_db));
+
+    // An older entry: no "views", "check_ms" or "precision".
+    nlohmann::json old = budget_entry(choice);
+    old.erase("views");
+    old.erase("check_ms");
+    old.erase("precision");
+    const BudgetRecord older = budget_from_entry(nlohmann::json::parse(old.dump()));
+    EXPECT_TRUE(older.views.empty());
+    EXPECT_EQ(older.check_milliseconds, 0.0);
+    EXPECT_FALSE(older.precision.has_value());
+    EXPECT_EQ(older.psnr_db, 31.5);
+    nlohmann::json not_a_list = budget_entry(choice);
+    not_a_list["views"] = 5;
+    expect_error_naming<ParseError>([&] { budget_from_entry(not_a_list); }, "views 5");
+
+    // A PSNR that is not a number is never written (the reader would refuse it).
+    nlohmann::json bad = manifest;
+    nlohmann::json nan_entry = step_entry(4);
+    BudgetRecord nan_choice = choice;
+    nan_choice.views[1].psnr_db = std::nan("");
+    nan_entry[kBudgetKey] = nlohmann::json::array({budget_entry(nan_choice)});
+    insert_step(bad, nan_entry);
+    expect_error_naming<ParseError>([&] { write_manifest(archive.string(), bad); }, "budget[0]");
+    EXPECT_EQ(read_manifest(archive.string()), again);
     fs::remove_all(archive);
 }
 

@@ -34,7 +34,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         (void)reader.diagnostics();
         (void)reader.view_count();
         for (const std::int64_t step : reader.steps()) {
-            (void)step;
+            (void)reader.budget(step);
         }
         (void)reader.verify();
         (void)reader.configuration();

@@ -17,7 +17,7 @@
 //  "light_field": {"cameras": 42, "size": 256, "segments": "layers", "attenuation": true,
 //                  "depth_bits": 8, "depth_threshold": 0.3},
 //  "budget": {"psnr_db": 40, "bytes_per_step": 8e6, "ms_per_step": 500, "check_every": 10,
-//             "choose": ["intervals"]}}
+//             "rotations": [-20, 20], "choose": ["intervals", "precision"]}}
 //
 // Every key is optional; defaults are listed on the members below. Unknown keys (at any level)
 // are collected by name, not silently ignored: an Instrument refuses them unless "strict" is
@@ -58,8 +58,11 @@ struct ViewConfig {
     nlohmann::json to_json() const;
 };
 
-enum class StoragePrecision { half, single };  ///< "half" / "float"
-enum class WhenFull { block, drop };           ///< writer policy when its queue is full
+enum class StoragePrecision { half, single };       ///< "half" / "float"
+std::string to_string(StoragePrecision precision);  ///< "half" / "float"
+/// The precision "half" or "float" names; InvalidArgument naming the text otherwise.
+StoragePrecision parse_storage_precision(const std::string& text);
+enum class WhenFull { block, drop };  ///< writer policy when its queue is full
 
 /// Proxies a run emits ("proxies" list). "multi_attenuation" without "distortion" still makes a
 /// multi-perspective frame, holding only the attenuation proxies.
@@ -105,22 +108,37 @@ struct ColourModelConfig {
 /// (the multi-perspective, training and light-field passes come on top). Distributed runs
 /// refuse it (its ground truth needs the whole field on one process).
 struct BudgetConfig {
-    /// "psnr_db": the least PSNR of a held-out edit of the stored view (the run's function
-    /// with every opacity halved, a' = 1 - (1 - a)^0.5), recomposed from the candidate's
-    /// attenuation proxies, against the ground truth of that function; in (0, 200].
+    /// "psnr_db": the least PSNR, over the stored view and its "rotations", of a held-out edit
+    /// (the run's function with every opacity halved, a' = 1 - (1 - a)^0.5) recomposed from
+    /// the candidate's attenuation proxies as a reader gets them back from the archive (at the
+    /// candidate's precision), against the ground truth of that function in that view; in
+    /// (0, 200]. A rotated view is synthesised from the stored view's proxies
+    /// (synthesise_attenuation, as the Explorer makes new views), so the measure also prices
+    /// what the proxies cannot show from elsewhere (disocclusion, depth spread).
     std::optional<double> psnr_db;
     std::optional<double> bytes_per_step;  ///< "bytes_per_step": a step's archived bytes, > 0
     std::optional<double> ms_per_step;     ///< "ms_per_step": a step's passes' time, > 0
-    /// "check_every": archived steps between two checks, >= 1. A check costs a ground-truth
-    /// pass and one proxy pass per candidate (kBudgetIntervalCounts x 2 modes) for each field's
+    /// "check_every": archived steps between two checks, >= 1. A check costs one ground-truth
+    /// pass per measured view (the stored one and each rotation, once per check) and one proxy
+    /// pass per candidate (kBudgetIntervalCounts x 2 modes), each candidate encoded, read back
+    /// and synthesised into the rotated views once per precision measured, for each field's
     /// first view; a field more than kBudgetMovedShare of whose values moved since the last
     /// check (histogram_distance: a reaction front spreading, a shock) is checked at once,
     /// whatever the count.
     int check_every = 10;
-    /// "choose": what the budget may choose. Today the intervals (count and mode), which are
-    /// what the recomposition's accuracy and the archive's bytes turn on; by default chosen
-    /// unless the configuration sets "intervals" itself (explicit settings win).
+    /// "rotations": azimuth offsets (degrees, finite, in (-180, 180]) from the stored view of
+    /// the views "psnr_db" is measured in besides the stored one; [] measures the stored view
+    /// only. Default +-20 degrees: a turn the Explorer's synthesis serves (bench/RESULTS.md,
+    /// "Depth correlation by proxy source", measures 15 and 30 degrees).
+    std::vector<double> rotations_deg{-20.0, 20.0};
+    /// "choose": what the budget may choose: "intervals" (count and mode), which are what the
+    /// recomposition's accuracy and the archive's bytes turn on, and "precision" (the views'
+    /// proxies stored as half or float, measured as read back; light fields keep the run's
+    /// "precision"). Both by default; explicit
+    /// settings win: a configuration that sets "intervals" or "precision" itself keeps it
+    /// unless "choose" is given and names it.
     bool chooses_intervals = true;
+    bool chooses_precision = true;
 };
 
 /// Interval counts and modes a budget check measures: L in {4, 8, 16, 32}, uniform and
@@ -222,6 +240,8 @@ struct InstrumentConfig {
     std::int64_t every = 10;
     std::vector<std::int64_t> steps;
     std::string archive = "run.cdb";  ///< "archive": directory of the proxy archive
+    /// "precision": of the stored views' proxies (and light fields); a "budget" that chooses it
+    /// sets it per field and step for the views (BudgetConfig::chooses_precision).
     StoragePrecision precision = StoragePrecision::half;
     std::string compression = "zip";       ///< "compression": none, rle, zips, zip, piz, pxr24, b44
     int writer_queue = 4;                  ///< "writer": {"queue": N}, steps held in memory at most

@@ -275,7 +275,8 @@ StepWriteResult ArchiveWriter::write(const StepRecord& record) {
             if (record.light_fields.empty() || af::holds_proxy_images(view)) {
                 const std::string exr_path = af::proxy_relative_path(record.step, view.view_index);
                 af::EncodedView exr =
-                    af::encode_view(record, view, config_.precision, config_.compression, exr_path);
+                    af::encode_view(record, view, view.precision.value_or(config_.precision),
+                                    config_.compression, exr_path);
                 result.files.push_back(place_file(archive, exr_path, exr.bytes));
                 files.push_back(af::file_entry(result.files.back(), af::kProxyKind));
                 parts = std::move(exr.parts);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
@@ -162,15 +163,35 @@ void check_budget_entries(const nlohmann::json& step, const std::string& file,
 
 }  // namespace
 
+nlohmann::json psnr_json(double psnr_db) {
+    return std::isinf(psnr_db) && psnr_db > 0.0 ? nlohmann::json(nullptr) : nlohmann::json(psnr_db);
+}
+
+double psnr_from_json(const nlohmann::json& value) {
+    if (value.is_null()) return std::numeric_limits<double>::infinity();
+    const double psnr_db = value.get<double>();
+    if (!std::isfinite(psnr_db)) fail<ParseError>("PSNR ", psnr_db, " is not finite");
+    return psnr_db;
+}
+
 nlohmann::json budget_entry(const BudgetRecord& choice) {
-    return {{"field", choice.field},
-            {"intervals", choice.intervals},
-            {"mode", to_string(choice.interval_mode)},
-            {"checked", choice.checked},
-            {"met", choice.met},
-            {"psnr_db", choice.psnr_db},
-            {"bytes", choice.bytes},
-            {"ms", choice.milliseconds}};
+    nlohmann::json views = nlohmann::json::array();
+    for (const BudgetRecord::View& view : choice.views) {
+        views.push_back(
+            {{"azimuth_offset", view.azimuth_offset_deg}, {"psnr_db", psnr_json(view.psnr_db)}});
+    }
+    nlohmann::json entry{{"field", choice.field},
+                         {"intervals", choice.intervals},
+                         {"mode", to_string(choice.interval_mode)},
+                         {"checked", choice.checked},
+                         {"met", choice.met},
+                         {"psnr_db", psnr_json(choice.psnr_db)},
+                         {"bytes", choice.bytes},
+                         {"ms", choice.milliseconds},
+                         {"views", std::move(views)},
+                         {"check_ms", choice.check_milliseconds}};
+    if (choice.precision) entry["precision"] = to_string(*choice.precision);
+    return entry;
 }
 
 BudgetRecord budget_from_entry(const nlohmann::json& entry) {
@@ -183,9 +204,24 @@ BudgetRecord budget_from_entry(const nlohmann::json& entry) {
     choice.interval_mode = parse_interval_mode(entry.at("mode").get<std::string>());
     choice.checked = entry.at("checked").get<bool>();
     choice.met = entry.at("met").get<bool>();
-    choice.psnr_db = entry.at("psnr_db").get<double>();
+    choice.psnr_db = psnr_from_json(entry.at("psnr_db"));
     choice.bytes = entry.at("bytes").get<double>();
     choice.milliseconds = entry.at("ms").get<double>();
+    // Optional: archives written before the budget chose precision and measured rotated views.
+    if (entry.contains("precision")) {
+        choice.precision = parse_storage_precision(entry.at("precision").get<std::string>());
+    }
+    if (entry.contains("views")) {
+        const nlohmann::json& views = entry.at("views");
+        if (!views.is_array()) fail<ParseError>("views ", views.dump(), " is not a list");
+        for (const nlohmann::json& view : views) {
+            BudgetRecord::View measured;
+            measured.azimuth_offset_deg = view.at("azimuth_offset").get<double>();
+            measured.psnr_db = psnr_from_json(view.at("psnr_db"));
+            choice.views.push_back(measured);
+        }
+    }
+    if (entry.contains("check_ms")) choice.check_milliseconds = entry.at("check_ms").get<double>();
     return choice;
 }
 

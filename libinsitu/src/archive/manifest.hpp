@@ -7,11 +7,17 @@
 //                          "files": [{"kind", "path", "bytes", "crc32"}, ...]}],
 //               "light_fields": [{"field", "file", "bytes", "crc32", "cameras", "map_size"}],
 //                   (only on steps with light fields; "cameras" and "map_size" are the rig's)
-//               "fields": [{"field", "histogram": {"min", "max", "counts"}, "nonfinite"}]}]}
+//               "fields": [{"field", "histogram": {"min", "max", "counts"}, "nonfinite"}],
 //                   (the values of each field at the step, core/histogram.hpp; "fields" and a
 //                   view's "transfer_function", the one it was made with, are absent from
 //                   archives written before they were, and readers fall back to the
 //                   configuration's function)
+//               "budget": [{"field", "intervals", "mode", "precision", "checked", "met",
+//                           "psnr_db", "bytes", "ms", "check_ms",
+//                           "views": [{"azimuth_offset", "psnr_db"}, ...]}]}]}
+//                   (only with an error budget: BudgetRecord; a PSNR of +inf, an exact view,
+//                   is null; "precision", "views" and "check_ms" are absent from archives
+//                   written before the budget chose precision and measured turned views)
 //    "malformed_steps": [{"entry", "problem"}]   (only when a writer set entries aside)
 // Steps are kept sorted; each view lists one proxy_exr and one preview_png file (in a step with
 // light fields a view may list only its preview: "proxies" none, the light field stands in).
@@ -44,6 +50,11 @@ nlohmann::json empty_manifest();
 /// or nlohmann's exceptions for an entry of the wrong form: check_step_entry names it).
 nlohmann::json budget_entry(const BudgetRecord& choice);
 BudgetRecord budget_from_entry(const nlohmann::json& entry);
+
+/// A PSNR as a manifest holds it: +inf (identical images) as null, which JSON can spell and
+/// nlohmann writes for it anyway, and back; any other non-finite value is a ParseError.
+nlohmann::json psnr_json(double psnr_db);
+double psnr_from_json(const nlohmann::json& value);
 
 /// Checks one step entry: required keys and their types (numbers finite), safe relative paths,
 /// no repeated views; the optional light-field list likewise (no repeated field, a camera count

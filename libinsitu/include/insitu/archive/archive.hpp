@@ -20,7 +20,8 @@
 //   of (4 L + 3) floats per cluster, with libinsitu.model_{intervals, clusters, layout,
 //   training_transfer_functions}), multi.depth (multi.depth.layer0..), multi.distortion
 //   (multi.distortion.layer0..), multi.attenuation (multi.attenuation.a00.., ...).
-// Depth, distortion and the model are always FLOAT; the rest HALF or FLOAT by "precision". The
+// Depth, distortion and the model are always FLOAT; the rest HALF or FLOAT by "precision" (a
+// budget that chooses it sets it per step and field: ViewRecord::precision). The
 // model is stored whenever the Instrument fitted one (training transfer functions configured);
 // the training renderings it was fitted on only with keep_training_images. Every part
 // carries the header attributes libinsitu.{schema_version, step, time, field, view, view_config,

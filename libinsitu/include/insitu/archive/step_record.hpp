@@ -27,6 +27,8 @@ struct ViewRecord {
     Image preview;                     ///< RGBA, ground truth of the configured TF
     TransferFunction transfer_function{std::vector<ControlPoint>{{0.0, {0, 0, 0, 0}}}};
     std::vector<TransferFunction> training_transfer_functions;
+    /// Storage precision of this view's proxies where a budget chose it; none = the archive's.
+    std::optional<StoragePrecision> precision;
 };
 
 /// One field's values at one timestep (the whole grid's, in a distributed run): what the
@@ -40,14 +42,27 @@ struct FieldSummaryRecord {
 /// What an error budget ("budget", insitu/config.hpp) archived one field with at one timestep,
 /// and what it measured at the check that chose it: the manifest's step entry "budget".
 struct BudgetRecord {
+    /// The held-out edit's PSNR in one measured view: the stored one (offset 0) or a rotation.
+    struct View {
+        double azimuth_offset_deg = 0.0;  ///< from the stored view
+        double psnr_db = 0.0;             ///< +inf where the images agree exactly
+    };
     std::string field;
     int intervals = 0;
     IntervalMode interval_mode = IntervalMode::uniform;
+    /// The views' proxies' storage precision; none in archives written before the budget chose
+    /// it (the run's "precision" then).
+    std::optional<StoragePrecision> precision;
     bool checked = false;       ///< measured at this step; otherwise the last check's choice, kept
     bool met = false;           ///< the choice met every limit the budget gives
-    double psnr_db = 0.0;       ///< the held-out edit's PSNR with the choice, at its check
+    double psnr_db = 0.0;       ///< the held-out edit's PSNR with the choice: the least of views
     double bytes = 0.0;         ///< the field's views' archived bytes per step, at its check
     double milliseconds = 0.0;  ///< the field's views' passes per step, at its check
+    /// Per measured view, stored one first (empty in archives written before rotated views).
+    std::vector<View> views;
+    /// The whole check's time (every candidate and view; the check that chose this), or 0 in
+    /// older archives.
+    double check_milliseconds = 0.0;
 };
 
 /// One field's light field at one timestep (written as one multi-part EXR, a part per camera).
