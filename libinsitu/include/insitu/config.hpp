@@ -134,9 +134,8 @@ struct BudgetConfig {
     /// "choose": what the budget may choose: "intervals" (count and mode), which are what the
     /// recomposition's accuracy and the archive's bytes turn on, and "precision" (the views'
     /// proxies stored as half or float, measured as read back; light fields keep the run's
-    /// "precision"). Both by default; explicit
-    /// settings win: a configuration that sets "intervals" or "precision" itself keeps it
-    /// unless "choose" is given and names it.
+    /// "precision"). Both by default; explicit settings win: a configuration that sets
+    /// "intervals" or "precision" itself keeps it unless "choose" is given and names it.
     bool chooses_intervals = true;
     bool chooses_precision = true;
 };
