@@ -82,31 +82,25 @@ void main() {
   ivec2 from = landedAny(p) ? p : ivec2(-1);
   if (from.x < 0 && !rayProvenEmpty(p)) from = nearestSurrounding(p);
   if (from.x >= 0) {
+    // What landed, in target depth order (depth, then interval: insertByDepth); each entry
+    // read once, not once per place in the order.
+    vec4 landed[MAX_INTERVALS];
+    int order[MAX_INTERVALS];
+    float depth[MAX_INTERVALS];
+    int count = 0;
+    for (int j = 0; j < uIntervals; ++j) {
+      landed[j] = splat(from, j);
+      if (landed[j].w > 0.0) insertByDepth(order, depth, count, j, landed[j].z);
+    }
     float transmittance = 1.0;
-    float previousDepth = 0.0;
-    int previous = -1;
-    for (int visited = 0; visited < uIntervals; ++visited) {
-      int next = -1;
-      float nextDepth = kInfinity;
-      vec4 nextSample = vec4(0.0);
-      for (int j = 0; j < uIntervals; ++j) {
-        vec4 entry = splat(from, j);
-        if (!(entry.w > 0.0)) continue;
-        bool afterPrevious = previous < 0 || before(previousDepth, previous, entry.z, j);
-        if (afterPrevious && (next < 0 || entry.z < nextDepth)) {
-          next = j;
-          nextDepth = entry.z;
-          nextSample = entry;
-        }
-      }
-      if (next < 0) break;
-      float ratio = nextSample.y > 0.0 ? transmittance / nextSample.y : 0.0;
-      float a = min(max(nextSample.x * ratio, 0.0), transmittance);
-      attenuation[next] = a;
-      if (a > 0.0) meanDepth[next] = nextDepth;
+    for (int i = 0; i < count; ++i) {
+      int j = order[i];
+      vec4 entry = landed[j];
+      float ratio = entry.y > 0.0 ? transmittance / entry.y : 0.0;
+      float a = min(max(entry.x * ratio, 0.0), transmittance);
+      attenuation[j] = a;
+      if (a > 0.0) meanDepth[j] = depth[i];
       transmittance -= a;
-      previous = next;
-      previousDepth = nextDepth;
     }
   }
   int groups = (uIntervals + 3) / 4;

@@ -57,14 +57,10 @@ bool continuous(vec3 p, vec3 q, float nominalPixel) {
   return abs(q.z - p.z) <= kMaxSurfaceSlope * lateral;
 }
 
-// Order of interval contributions along a ray: by depth, then by interval index.
-bool before(float depthA, int a, float depthB, int b) {
-  return depthA < depthB || (depthA == depthB && a < b);
-}
-
-// Adds interval j at depth `key` to the first `count` entries of order / depth, which stay
-// ordered as before() orders them: intervals arrive in index order, so only a strictly nearer
-// depth moves an entry (insertion sort; L is at most a few dozen).
+// Adds interval j at depth `key` to the first `count` entries of order / depth, which stay in
+// the order of interval contributions along a ray: by depth, then by interval index. Intervals
+// arrive in index order, so only a strictly nearer depth moves an entry (insertion sort; L is at
+// most a few dozen).
 void insertByDepth(inout int order[MAX_INTERVALS], inout float depth[MAX_INTERVALS],
                    inout int count, int j, float key) {
   int at = count++;
