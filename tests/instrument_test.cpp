@@ -608,13 +608,52 @@ TEST_F(InstrumentTest, AnErrorBudgetChoosesTheCheapestIntervalsThatMeetIt) {
     EXPECT_THAT(log, HasSubstr(", met"));
     EXPECT_THAT(log, HasSubstr("the check took"));
 
-    // A PSNR no candidate reaches: the most accurate one, said not to meet it.
+    // A PSNR no candidate reaches: the cheapest affordable candidate within kBudgetPsnrTolerance
+    // of the most accurate affordable one, said not to meet it. Each candidate measured alone
+    // (given intervals are only measured) says which one that is; a byte limit just under the
+    // most accurate one's bytes leaves candidates within the tolerance of the best affordable.
     BudgetConfig strict;
     strict.psnr_db = 199.0;
-    const ArchiveReader best = run(directory_ / "best.cdb", strict, std::nullopt, &log);
-    const BudgetRecord most_accurate = best.budget(0).at(0);
-    EXPECT_FALSE(most_accurate.met);
-    EXPECT_GT(most_accurate.psnr_db, cheap.budget(0).at(0).psnr_db);
+    strict.chooses_precision = false;
+    std::vector<BudgetRecord> alone;
+    for (const int count : kBudgetIntervalCounts) {
+        for (const IntervalMode mode : {IntervalMode::uniform, IntervalMode::histogram_equalized}) {
+            InstrumentConfig config = small_config(
+                directory_ / ("alone_" + std::to_string(count) + to_string(mode) + ".cdb"), 48);
+            config.interval_count = count;
+            config.interval_mode = mode;
+            BudgetConfig measure_only = strict;
+            measure_only.chooses_intervals = false;
+            config.budget = measure_only;
+            alone.push_back(run_with_budget(config, volume_, 1).budget(0).at(0));
+        }
+    }
+    const auto most_accurate_of = [&](double bytes_limit) {
+        const BudgetRecord* best = nullptr;
+        for (const BudgetRecord& c : alone) {
+            if (c.bytes <= bytes_limit && (!best || c.psnr_db > best->psnr_db)) best = &c;
+        }
+        return best;
+    };
+    strict.bytes_per_step = most_accurate_of(1e30)->bytes - 1.0;
+    const BudgetRecord* best_affordable = most_accurate_of(*strict.bytes_per_step);
+    const BudgetRecord* cheapest_close = nullptr;
+    for (const BudgetRecord& c : alone) {
+        if (c.bytes <= *strict.bytes_per_step &&
+            c.psnr_db >= best_affordable->psnr_db - kBudgetPsnrTolerance &&
+            (!cheapest_close || c.bytes < cheapest_close->bytes)) {
+            cheapest_close = &c;
+        }
+    }
+    ASSERT_NE(cheapest_close, nullptr);
+    ASSERT_NE(cheapest_close, best_affordable) << "the scene no longer tells the rule apart";
+    const ArchiveReader closest_run = run(directory_ / "closest.cdb", strict, std::nullopt, &log);
+    const BudgetRecord closest = closest_run.budget(0).at(0);
+    EXPECT_FALSE(closest.met);
+    EXPECT_EQ(closest.intervals, cheapest_close->intervals);
+    EXPECT_EQ(closest.interval_mode, cheapest_close->interval_mode);
+    EXPECT_LT(closest.psnr_db, best_affordable->psnr_db);
+    EXPECT_GT(closest.psnr_db, cheap.budget(0).at(0).psnr_db);
     EXPECT_THAT(log, HasSubstr("NOT met"));
 
     // A byte limit below every candidate: the cheapest, not met.

@@ -693,9 +693,8 @@ void section_budget(const Options& options, const fs::path& scratch) {
                     request.elevation_deg = config.views[0].orbit.elevation_deg;
                 }
                 const ExploreFrame frame = explorer.render(request);
-                return psnr_db(
-                    renderer.render_ground_truth(frame.camera, held_out, settings).rgba,
-                    frame.colour);
+                return psnr_db(renderer.render_ground_truth(frame.camera, held_out, settings).rgba,
+                               frame.colour);
             };
             const double achieved_stored = achieved_at(std::nullopt);
             double achieved = achieved_stored;
@@ -708,8 +707,8 @@ void section_budget(const Options& options, const fs::path& scratch) {
                 fs::file_size(files.exr_path) + fs::file_size(files.preview_path);
             const int intervals = explorer.archive().load(step, 0).intervals->count();
             if (choice.empty()) {
-                csv.row(run.name, "", step, intervals, "uniform", to_string(config.precision), 0,
-                        1, "", achieved, achieved_stored, static_cast<double>(bytes), "", "");
+                csv.row(run.name, "", step, intervals, "uniform", to_string(config.precision), 0, 1,
+                        "", achieved, achieved_stored, static_cast<double>(bytes), "", "");
             } else {
                 const BudgetRecord& c = choice.front();
                 csv.row(run.name, *run.psnr_db, step, c.intervals, to_string(c.interval_mode),

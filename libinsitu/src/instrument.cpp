@@ -720,8 +720,11 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
     } else {
         candidates.emplace_back(config.interval_count, config.interval_mode);
     }
-    std::vector<StoragePrecision> precisions{config.precision};
-    if (budget.chooses_precision) precisions = {StoragePrecision::half, StoragePrecision::single};
+    // Half first, for every interval set; float only where that cannot meet the budget, for the
+    // most accurate half candidate (float stores twice the bytes in the same time, and pays only
+    // where half's rounding is what limits the accuracy: depths beyond its range, say).
+    const StoragePrecision first_precision =
+        budget.chooses_precision ? StoragePrecision::half : config.precision;
     const auto affordable = [&](const BudgetRecord& c) {
         return (!budget.bytes_per_step || c.bytes <= share * *budget.bytes_per_step) &&
                (!budget.ms_per_step || c.milliseconds <= share * *budget.ms_per_step);
@@ -729,13 +732,57 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
     const auto accurate = [&](const BudgetRecord& c) {
         return !budget.psnr_db || c.psnr_db >= *budget.psnr_db;
     };
+    // A candidate's proxies as compute_field makes them, and what its accuracy is measured with.
+    struct CandidateProxies {
+        ViewRecord view;
+        std::vector<double> scales;
+        std::vector<float> colours;
+        double pass_ms = 0.0;
+    };
+    // Encodes the candidate at `precision`, reads it back as a reader would, and measures the
+    // held-out edit in every measured view.
+    const auto measure = [&](const CandidateProxies& proxies, int count, IntervalMode mode,
+                             StoragePrecision precision) {
+        BudgetRecord candidate;
+        candidate.field = plan.name;
+        candidate.intervals = count;
+        candidate.interval_mode = mode;
+        candidate.precision = precision;
+        StepRecord record;
+        record.field = plan.name;
+        const archive_format::EncodedView encoded = archive_format::encode_view(
+            record, proxies.view, precision, config.compression, "budget check");
+        candidate.bytes = view_count * static_cast<double>(encoded.bytes.size());
+        candidate.milliseconds = view_count * (proxies.pass_ms + preview_ms);
+        const ProxyFrame stored = archive_format::decode_frame(
+            std::vector<char>(encoded.bytes.begin(), encoded.bytes.end()), "budget check",
+            encoded.parts, false);
+        candidate.psnr_db = std::numeric_limits<double>::infinity();
+        for (const MeasuredView& target : measured_views) {
+            Image edited;
+            if (&target == &measured_views.front()) {
+                edited = estimate_attenuation(stored.attenuation, stored.mean_depth, nullptr,
+                                              proxies.scales);
+            } else {
+                const SynthesisedAttenuation turned = synthesise_attenuation(stored, target.camera);
+                edited = estimate_attenuation(turned.attenuation, turned.mean_depth, nullptr,
+                                              proxies.scales);
+            }
+            const double psnr_db = psnr_rgb_db(target.truth, recolour(edited, proxies.colours));
+            candidate.views.push_back({target.azimuth_offset_deg, psnr_db});
+            candidate.psnr_db = std::min(candidate.psnr_db, psnr_db);
+        }
+        return candidate;
+    };
+    const auto meets = [&](const BudgetRecord& c) { return affordable(c) && accurate(c); };
     std::vector<BudgetRecord> measured;
+    std::optional<CandidateProxies> most_accurate;  // of the affordable ones measured so far
+    double most_accurate_db = -std::numeric_limits<double>::infinity();
     for (const auto& [count, mode] : candidates) {
         // Bytes and time grow with the count: past a count that met an accuracy budget (both
         // modes measured), larger ones can only cost more. An easy budget costs two passes.
         if (budget.psnr_db && !measured.empty() && measured.back().intervals != count &&
-            std::any_of(measured.begin(), measured.end(),
-                        [&](const BudgetRecord& c) { return affordable(c) && accurate(c); })) {
+            std::any_of(measured.begin(), measured.end(), meets)) {
             break;
         }
         // The single-perspective pass as compute_field makes it, with these intervals.
@@ -748,73 +795,52 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
         request.interleaving = config.proxies.interleaving;
         const auto start = Clock::now();
         ProxyFrame frame = renderer->render(camera, request);
-        const double pass_ms = 1e3 * seconds_since(start);
-        const std::vector<double> scales =
-            opacity_scales(plan.transfer_function, held_out, *request.intervals);
-        const std::vector<float> colours = interval_colours(held_out, *request.intervals);
+        CandidateProxies proxies;
+        proxies.pass_ms = 1e3 * seconds_since(start);
+        proxies.scales = opacity_scales(plan.transfer_function, held_out, *request.intervals);
+        proxies.colours = interval_colours(held_out, *request.intervals);
         // Bytes as the writer stores the view (the rendering is the preview's size).
         if (config.proxies.rendering) frame.rendering = measured_views.front().truth;
-        StepRecord record;
-        record.field = plan.name;
-        ViewRecord view_record;
-        view_record.field = plan.name;
-        view_record.view = view;
-        view_record.transfer_function = plan.transfer_function;
-        view_record.single = std::move(frame);
-        for (const StoragePrecision precision : precisions) {
-            // Float stores more bytes in the same time: where half meets every limit it cannot
-            // be cheaper, and need not be measured.
-            if (precision == StoragePrecision::single && budget.psnr_db && !measured.empty() &&
-                measured.back().intervals == count && measured.back().interval_mode == mode &&
-                affordable(measured.back()) && accurate(measured.back())) {
-                continue;
-            }
-            BudgetRecord candidate;
-            candidate.field = plan.name;
-            candidate.intervals = count;
-            candidate.interval_mode = mode;
-            candidate.precision = precision;
-            const archive_format::EncodedView encoded = archive_format::encode_view(
-                record, view_record, precision, config.compression, "budget check");
-            candidate.bytes = view_count * static_cast<double>(encoded.bytes.size());
-            candidate.milliseconds = view_count * (pass_ms + preview_ms);
-            // The accuracy of what a reader gets back: the proxies as stored at this precision.
-            const ProxyFrame stored = archive_format::decode_frame(
-                std::vector<char>(encoded.bytes.begin(), encoded.bytes.end()), "budget check",
-                encoded.parts, false);
-            candidate.psnr_db = std::numeric_limits<double>::infinity();
-            for (const MeasuredView& target : measured_views) {
-                Image edited;
-                if (&target == &measured_views.front()) {
-                    edited = estimate_attenuation(stored.attenuation, stored.mean_depth, nullptr,
-                                                  scales);
-                } else {
-                    const SynthesisedAttenuation turned =
-                        synthesise_attenuation(stored, target.camera);
-                    edited = estimate_attenuation(turned.attenuation, turned.mean_depth, nullptr,
-                                                  scales);
-                }
-                const double psnr_db = psnr_rgb_db(target.truth, recolour(edited, colours));
-                candidate.views.push_back({target.azimuth_offset_deg, psnr_db});
-                candidate.psnr_db = std::min(candidate.psnr_db, psnr_db);
-            }
-            measured.push_back(candidate);
+        proxies.view.field = plan.name;
+        proxies.view.view = view;
+        proxies.view.transfer_function = plan.transfer_function;
+        proxies.view.single = std::move(frame);
+        measured.push_back(measure(proxies, count, mode, first_precision));
+        const BudgetRecord& candidate = measured.back();
+        if (budget.chooses_precision && affordable(candidate) &&
+            candidate.psnr_db > most_accurate_db) {
+            most_accurate_db = candidate.psnr_db;
+            most_accurate = std::move(proxies);
         }
     }
+    if (most_accurate && std::none_of(measured.begin(), measured.end(), meets)) {
+        const auto of_it = std::find_if(measured.begin(), measured.end(), [&](const auto& c) {
+            return affordable(c) && c.psnr_db == most_accurate_db;
+        });
+        const int count = of_it->intervals;
+        const IntervalMode mode = of_it->interval_mode;
+        measured.push_back(measure(*most_accurate, count, mode, StoragePrecision::single));
+    }
     // With an accuracy asked: the cheapest (bytes, then time) that meets every limit. Else (or
-    // without one: only cost limits) the most accurate one affordable; else the cheapest.
+    // without one: only cost limits) the cheapest of the affordable ones within
+    // kBudgetPsnrTolerance of the most accurate; else the cheapest.
     const auto cheaper = [](const BudgetRecord& a, const BudgetRecord& b) {
         return a.bytes < b.bytes || (a.bytes == b.bytes && a.milliseconds < b.milliseconds);
     };
     const BudgetRecord* chosen = nullptr;
     for (const BudgetRecord& c : measured) {
-        if (budget.psnr_db && affordable(c) && accurate(c) && (!chosen || cheaper(c, *chosen))) {
-            chosen = &c;
-        }
+        if (budget.psnr_db && meets(c) && (!chosen || cheaper(c, *chosen))) chosen = &c;
     }
     if (!chosen) {
+        double best_db = -std::numeric_limits<double>::infinity();
         for (const BudgetRecord& c : measured) {
-            if (affordable(c) && (!chosen || c.psnr_db > chosen->psnr_db)) chosen = &c;
+            if (affordable(c)) best_db = std::max(best_db, c.psnr_db);
+        }
+        for (const BudgetRecord& c : measured) {
+            if (affordable(c) && c.psnr_db >= best_db - kBudgetPsnrTolerance &&
+                (!chosen || cheaper(c, *chosen))) {
+                chosen = &c;
+            }
         }
     }
     if (!chosen) {

@@ -100,9 +100,11 @@ struct ColourModelConfig {
 
 /// "budget": what a step may cost and how accurate its proxies must be; the Instrument measures
 /// candidate configurations in situ and archives with the cheapest that meets it (fewest bytes,
-/// then least time), else the most accurate affordable one, else the cheapest (issue 17); with
-/// cost limits only, the most accurate affordable one. Candidates are measured in increasing
-/// interval count, stopping after the first count that meets an accuracy asked. Any
+/// then least time), else the cheapest affordable one within kBudgetPsnrTolerance of the most
+/// accurate affordable one, else the cheapest (issue 17); with cost limits only, the same as
+/// where accuracy is not met. Candidates are measured in increasing interval count, stopping
+/// after the first count that meets an accuracy asked, in half precision (where "precision" is
+/// chosen), and in float only for the most accurate affordable one when none meets it. Any
 /// subset of the three limits; with several fields each gets an even share of bytes and time.
 /// The bytes and time are the field's views' single-perspective proxies, rendering and preview
 /// (the multi-perspective, training and light-field passes come on top). Distributed runs
@@ -143,6 +145,12 @@ struct BudgetConfig {
 /// Interval counts and modes a budget check measures: L in {4, 8, 16, 32}, uniform and
 /// histogram-equalised.
 inline constexpr int kBudgetIntervalCounts[] = {4, 8, 16, 32};
+/// PSNR a budget gives up for bytes where it cannot meet its accuracy (or asks none): it takes
+/// the cheapest affordable candidate within this of the most accurate one. About what one
+/// choice's achieved PSNR moves between neighbouring archived steps (0.05-0.35 dB on Gray-Scott,
+/// bench/RESULTS.md "Error budget over a Gray-Scott run"): a difference the next step may
+/// reverse is not worth more bytes.
+inline constexpr double kBudgetPsnrTolerance = 0.5;
 /// Share of a field's samples whose values may move (histogram_distance) before the budget is
 /// checked again ahead of "check_every".
 inline constexpr double kBudgetMovedShare = 0.1;
