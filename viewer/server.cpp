@@ -746,6 +746,7 @@ private:
         nlohmann::json body{{"drawable", recipe.drawable},
                             {"why_not", recipe.why_not},
                             {"synthesised", recipe.synthesised},
+                            {"light_field", recipe.light_field},
                             {"fill_radius", recipe.fill_radius_pixels},
                             {"stored_rendering", recipe.stored_rendering},
                             {"opacity_edited", recipe.opacity_edited},

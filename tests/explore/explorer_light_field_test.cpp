@@ -186,6 +186,55 @@ TEST_F(ExplorerLightField, OpacityEditsGoThroughTheAttenuationLightField) {
     EXPECT_GT(psnr, 25.0);
 }
 
+// The recipe of another view (source auto) says the light field makes it, and what of it a
+// client can draw: lights through the front surface and occlusion of a light field's colours,
+// not what needs its attenuation (edits, enhancement, and light_volume's lighting).
+TEST_F(ExplorerLightField, TheRecipeSaysWhenTheLightFieldMakesTheView) {
+    config_.light_field->attenuation = false;
+    write_step();
+    Explorer explorer(config_.archive);
+    ExploreRequest lit = at(120.0, -25.0, ProxySource::automatic);
+    lit.lighting = LightingSettings{};
+    lit.lighting->lights.front().direction_world = glm::dvec3(0.0);  // a headlight
+    lit.ambient_occlusion = AmbientOcclusionSettings{};
+    const FrameRecipe recipe = explorer.recipe(lit);
+    EXPECT_TRUE(recipe.drawable) << recipe.why_not;
+    EXPECT_TRUE(recipe.light_field);
+    EXPECT_TRUE(recipe.synthesised);
+    EXPECT_EQ(recipe.colour_source, ColourSource::captured);
+    EXPECT_EQ(recipe.colour_source, explorer.render(lit).colour_source);
+    ASSERT_TRUE(recipe.lighting.has_value());
+    EXPECT_EQ(recipe.lighting->lights.front().direction_world, glm::dvec3(0.0));
+    ASSERT_TRUE(recipe.ambient_occlusion.has_value());
+    EXPECT_TRUE(recipe.opacity_scales.empty());
+
+    // An edit: this light field has no attenuation, so the view's proxies make the frame.
+    ExploreRequest edited = lit;
+    edited.opacity_scales = {{2, 0.5}};
+    const FrameRecipe from_proxies = explorer.recipe(edited);
+    EXPECT_FALSE(from_proxies.light_field);
+    EXPECT_TRUE(from_proxies.drawable) << from_proxies.why_not;
+    // The stored view is the view's own proxies.
+    ExploreRequest stored = lit;
+    stored.azimuth_deg.reset();
+    stored.elevation_deg.reset();
+    EXPECT_FALSE(explorer.recipe(stored).light_field);
+}
+
+TEST_F(ExplorerLightField, TheLightingOfAnAttenuationLightFieldIsTheServers) {
+    write_step();  // the fixture's light field has attenuation
+    Explorer explorer(config_.archive);
+    ExploreRequest occluded = at(120.0, -25.0, ProxySource::automatic);
+    occluded.ambient_occlusion = AmbientOcclusionSettings{};
+    EXPECT_TRUE(explorer.recipe(occluded).drawable) << explorer.recipe(occluded).why_not;
+    ExploreRequest lit = occluded;
+    lit.lighting = LightingSettings{};
+    const FrameRecipe recipe = explorer.recipe(lit);
+    EXPECT_TRUE(recipe.light_field);
+    EXPECT_FALSE(recipe.drawable);
+    EXPECT_NE(recipe.why_not.find("attenuation"), std::string::npos) << recipe.why_not;
+}
+
 TEST_F(ExplorerLightField, ArchivesWithOnlyALightFieldRenderEveryView) {
     config_.proxies = ProxySelection{false, false, false, false, false, false};
     write_step();

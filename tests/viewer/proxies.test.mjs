@@ -201,9 +201,16 @@ test('the recipe says what the page cannot draw and refuses bad options', async 
   assert.equal(plain.stored_rendering, true);
   assert.equal(plain.opacity_scales.length, 8);
   const info = await (await fetch(`${server.url}api/step?step=300&view=0`)).json();
-  const orbit = await (await recipe(`step=300&azimuth=${info.azimuth + 20}&elevation=${info.elevation}`)).json();
-  assert.equal(orbit.drawable, false, 'this step has a light field, which makes other views');
-  assert.match(orbit.why_not, /light field/);
+  const orbitQuery = `step=300&azimuth=${info.azimuth + 20}&elevation=${info.elevation}`;
+  const orbit = await (await recipe(`${orbitQuery}&light=camera&ao=4,2`)).json();
+  assert.equal(orbit.light_field, true, 'this step has a light field, which makes other views');
+  assert.equal(orbit.drawable, true, 'lit and occluded by the page');
+  assert.equal(orbit.colour_source, 'captured');
+  assert.equal(orbit.ambient_occlusion.radius, 4);
+  // Edits need attenuation, which this light field lacks: the view's proxies make that frame.
+  const edited = await (await recipe(`${orbitQuery}&opacity-scale=2%3D0.5`)).json();
+  assert.equal(edited.light_field, false);
+  assert.equal(edited.synthesised, true);
   const scaled = await (await recipe('step=300&opacity-scale=2%3D0.5&light=camera&ao=4,2')).json();
   assert.equal(scaled.drawable, true);
   assert.equal(scaled.opacity_edited, true);

@@ -1,8 +1,8 @@
 // The page's own frames in a real browser: headless Debian chromium with WebGL2 through its
 // software rasteriser (SwiftShader), on an archive with a light field. Orbit views drawn by the
 // page's WebGL2 light-field renderer must match `insitu-view render --source lightfield` (the
-// C++ reference) for the same angles; the page must fall back to the server's frames when WebGL
-// is disabled.
+// C++ reference) for the same angles, also relit by a headlight and occluded; the page must fall
+// back to the server's frames when WebGL is disabled.
 //
 //   INSITU_VIEW=build/viewer/insitu-view ARCHIVE=viewer_lf.cdb WORK_DIR=dir node webgl.test.mjs
 import assert from 'node:assert/strict';
@@ -52,6 +52,28 @@ async function orbitTo(page, azimuth, elevation) {
   return options;
 }
 
+/// The frame shown, drawn by the browser from the light field, against the CLI's with the same
+/// options from the light field: its PSNR, which must reach MIN_PSNR_DB, and its pixels.
+async function compareWithCli(page, what) {
+  const displayed = await page.evaluate(() => window.insituViewer.displayed);
+  assert.equal(displayed.gpu, true, `the browser drew ${what}`);
+  assert.equal(displayed.drawnFrom, 'light field', `${what}: from the light field`);
+  const shown = await page.evaluate(() => {
+    const { width, height, data } = window.insituViewer.gpuPixels();
+    return { width, height, data: Array.from(data) };
+  });
+  const expected = decodePng(renderWithCli(binary, archive,
+    { ...displayed.options, source: 'lightfield' }, workDir).colour);
+  assert.equal(expected.channels, 4);
+  const image = { ...shown, data: Uint8Array.from(shown.data) };
+  const psnr = psnrPremultiplied(image, expected);
+  let covered = 0;
+  for (let p = 3; p < expected.data.length; p += 4) covered += expected.data[p] > 8 ? 1 : 0;
+  assert.ok(covered > 0.05 * expected.width * expected.height, 'something to compare');
+  assert.ok(psnr >= MIN_PSNR_DB, `WebGL2 vs C++, ${what}: ${psnr.toFixed(2)} dB`);
+  return { psnr, image };
+}
+
 test('orbit views drawn with WebGL2 match insitu-view render --source lightfield', async () => {
   const context = await browser.newContext();
   const page = await openPage(context);
@@ -60,26 +82,29 @@ test('orbit views drawn with WebGL2 match insitu-view render --source lightfield
   const info = await (await fetch(`${server.url}api/step?step=300`)).json();
   const results = [];
   // 20 degrees around the stored view, both ways, and one from below.
+  let plain = null;
   for (const [da, de] of [[20, 0], [-20, 10], [35, -40]]) {
     const azimuth = Math.round(info.azimuth + da);
     const elevation = Math.round(info.elevation + de);
-    const options = await orbitTo(page, azimuth, elevation);
-    const displayed = await page.evaluate(() => window.insituViewer.displayed.gpu);
-    assert.equal(displayed, true, `the browser drew az ${azimuth} el ${elevation}`);
-    const shown = await page.evaluate(() => {
-      const { width, height, data } = window.insituViewer.gpuPixels();
-      return { width, height, data: Array.from(data) };
-    });
-    const expected = decodePng(renderWithCli(binary, archive,
-      { ...options, source: 'lightfield' }, workDir).colour);
-    assert.equal(expected.channels, 4);
-    const psnr = psnrPremultiplied({ ...shown, data: Uint8Array.from(shown.data) }, expected);
-    let covered = 0;
-    for (let p = 3; p < expected.data.length; p += 4) covered += expected.data[p] > 8 ? 1 : 0;
+    await orbitTo(page, azimuth, elevation);
+    const { psnr, image } = await compareWithCli(page, `az ${azimuth} el ${elevation}`);
+    plain = image;
     results.push(`az ${azimuth} el ${elevation}: ${psnr.toFixed(1)} dB`);
-    assert.ok(covered > 0.05 * expected.width * expected.height, 'something to compare');
-    assert.ok(psnr >= MIN_PSNR_DB, `WebGL2 vs C++ at az ${azimuth} el ${elevation}: ${psnr.toFixed(2)} dB`);
   }
+  // There, relit by a headlight (through the normals of the reconstructed first hit), then
+  // occluded too (Eq. 5 on that depth): drawn by the page as the recipe says.
+  let count = await page.evaluate(() => window.insituViewer.frameCount);
+  await page.check('#light-on');
+  await waitForSettledFrame(page, count);
+  const relit = await compareWithCli(page, 'relit');
+  assert.ok(relit.image.data.some((v, i) => v !== plain.data[i]), 'the lighting shows');
+  results.push(`relit: ${relit.psnr.toFixed(1)} dB`);
+  count = await page.evaluate(() => window.insituViewer.frameCount);
+  await page.check('#ao-on');
+  await waitForSettledFrame(page, count);
+  const occluded = await compareWithCli(page, 'relit + AO');
+  assert.ok(occluded.image.data.some((v, i) => v !== relit.image.data[i]), 'occlusion shows');
+  results.push(`relit + AO: ${occluded.psnr.toFixed(1)} dB`);
   console.log(`WebGL2 light field vs insitu-view render: ${results.join(', ')}`);
   const opened = await page.evaluate(() => window.insituViewer.gpu.lastOpen);
   console.log(`step opened in ${(opened.downloadMs + opened.uploadMs).toFixed(0)} ms ` +

@@ -1,7 +1,8 @@
 // Frames: at most one in flight; a control moved meanwhile is drawn once that one is done (the
-// server also coalesces, per session). Orbit views of a step with a light field, and the stored
-// view where its recipe allows (/api/recipe), are drawn here by WebGL2 (gpu_frames.js); every
-// other frame is the server's exploration engine's PNG. The confidence overlay is the engine's
+// server also coalesces, per session). Orbit views of a step with a light field (lit and
+// occluded too), and the view's proxies' frames where their recipe allows (/api/recipe), are
+// drawn here by WebGL2 (gpu_frames.js); every other frame is the server's exploration engine's
+// PNG. The confidence overlay is the engine's
 // mask of the frame shown.
 import { $, FPS_WINDOW_MS, errorText, session, showError, state, viewer } from './page.js';
 import { currentOptions, sameOptions } from './explore_options.js';
@@ -11,9 +12,10 @@ let inFlight = false;
 const READOUT_EVERY_MS = 250;
 let readoutShownAt = 0;
 
-// Whether the browser draws this frame from the light field: an orbit view (the stored view is
-// the archive's own proxies, exact) of a step with a light field, without what only the server's
-// engine does (transfer-function edits, lighting, enhancement).
+// Whether the browser draws this frame from the light field without asking for its recipe: an
+// orbit view (the stored view is the archive's own proxies, exact) of a step with a light field,
+// without edits, lights, occlusion or enhancement. With lights or occlusion the recipe says
+// whether the light field makes the frame (drawProxies).
 export function drawnInBrowser(options) {
   return Boolean(viewer.gpu && $('gpu-toggle').checked && state.lightField && state.info &&
     state.info.camera && options.azimuth !== undefined && !atStoredView(options) && !options.tf &&
@@ -117,6 +119,10 @@ async function drawProxies(options, dragging) {
     serverFrame(options);
     return;
   }
+  if (recipe.light_field) {
+    drawInBrowser(options, dragging, recipe);
+    return;
+  }
   viewer.gpu.drawProxies(entry.step, state.view, recipe, Number(options.azimuth),
     Number(options.elevation), dragging)
     .then((timing) => {
@@ -156,16 +162,23 @@ function showCanvas(canvas) {
   $('gpu-frame').hidden = !canvas;
 }
 
-function drawInBrowser(options, dragging) {
+// A frame from the step's light field; with a `recipe` (/api/recipe, light_field), lit and
+// occluded as it says. Without a light field here after all, the server's frame.
+function drawInBrowser(options, dragging, recipe = null) {
   const entry = state.timeline[state.stepIndex];
   viewer.gpu.draw(entry.step, state.view, state.info.camera, Number(options.azimuth),
-    Number(options.elevation), state.segmentScales.slice(), dragging)
+    Number(options.elevation), state.segmentScales.slice(), dragging, recipe)
     .then((timing) => {
-      if (!timing) throw new Error('the step has no light field');
-      return showGpuFrame(options, timing, 'light field', 'captured');
+      if (!timing) {
+        serverFrame(options);
+        return null;
+      }
+      return showGpuFrame(options, timing, 'light field', 'captured').then(frameDone);
     })
-    .catch((error) => showError(String(error)))
-    .finally(frameDone);
+    .catch((error) => {
+      showError(String(error));
+      frameDone();
+    });
 }
 
 // Shows the canvas the GPU just drew (`what`: light field or stored view).

@@ -2,11 +2,13 @@
 // prefetched while the user scrubs) and the GPU keeps:
 //  * orbit views from the step's light field (light_field_renderer.js): what
 //    reconstruct_light_field gives without edits, the light field's own colours and
-//    per-segment opacity fades;
+//    per-segment opacity fades, lit (through the first hit's normals) and occluded as the
+//    frame's recipe says;
 //  * the stored view and other views from its single-perspective proxies (proxy_renderer.js),
 //    with recolouring, opacity edits, relighting, ambient occlusion and enhancement, as the
 //    frame's recipe (/api/recipe) says.
-// The colour model's frames and edits through a light field stay with the server's frames.
+// The colour model's frames, edits through a light field and the lighting of an attenuation
+// light field stay with the server's frames.
 
 import { reorbit } from './camera.js';
 import { DRAG_FRAME_MS, FrameCost } from './frame_cost.js';
@@ -131,9 +133,11 @@ export class GpuFrames {
   }
 
   /// Draws (step, view) from `storedCamera` (Camera::to_json) reorbited to the angles, with
-  /// per-segment opacity scales; while `dragging`, at the size the frame budget allows.
-  /// Resolves to the frame's timing, or null without a light field.
-  async draw(step, view, storedCamera, azimuthDeg, elevationDeg, segmentScales, dragging = false) {
+  /// per-segment opacity scales and, given a `recipe` (/api/recipe, light_field), its lights and
+  /// occlusion; while `dragging`, at the size the frame budget allows. Resolves to the frame's
+  /// timing, or null without a light field.
+  async draw(step, view, storedCamera, azimuthDeg, elevationDeg, segmentScales, dragging = false,
+    recipe = null) {
     const key = `${step}/${view}`;
     const { lightField, downloadMs } = await this.lightField(step, view);
     if (!lightField) return null;
@@ -147,14 +151,18 @@ export class GpuFrames {
       this.lastOpen = { key, downloadMs, uploadMs, bytes: lightField.bytes };
     }
     const [width, height] = storedCamera.size;
-    const cost = this.cost('light field', FULL_SEARCH_STEPS / PREVIEW_SEARCH_STEPS);
+    const lit = Boolean(recipe && (recipe.lighting || recipe.ambient_occlusion));
+    const cost = this.cost(lit ? `light field/${Boolean(recipe.lighting)}/` +
+      `${Boolean(recipe.ambient_occlusion)}` : 'light field',
+    FULL_SEARCH_STEPS / PREVIEW_SEARCH_STEPS);
     const divisor = dragging ? cost.dragDivisor(width, height, this.dragFrameMs) : 1;
     const preview = divisor > 1;
     const size = [Math.max(1, Math.round(width / divisor)),
       Math.max(1, Math.round(height / divisor))];
     const started = performance.now();
     this.renderer.render(reorbit({ ...storedCamera, size }, azimuthDeg, elevationDeg),
-      segmentScales, preview ? PREVIEW_SEARCH_STEPS : FULL_SEARCH_STEPS);
+      segmentScales, preview ? PREVIEW_SEARCH_STEPS : FULL_SEARCH_STEPS,
+      lit ? (preview ? previewRecipe(recipe, divisor) : recipe) : null);
     await this.renderer.finish();
     const milliseconds = performance.now() - started;
     cost.record(preview, milliseconds, size[0] * size[1]);

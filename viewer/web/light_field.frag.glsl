@@ -11,8 +11,12 @@
 //     the camera sees that point, or, without a hit, where it sees the ray's point nearest the
 //     centre unless it recorded a surface there (one the ray passes by: it holds nothing);
 //  3. per segment, the cameras that hold something of the ray blend with renormalised weights;
-//     segments composite front to back, segment s with its opacity scaled: A' = 1 - (1 - A)^k.
-// The JS side prepends #version, MAX_SEGMENTS, for 8-bit depth DEPTH_CODES, and srgb.glsl.
+//     segments composite front to back, segment s with its opacity scaled: A' = 1 - (1 - A)^k;
+//  4. (BASIS) the target camera's depth of the first hit, its t blended over the cameras that
+//     recorded one (LightFieldReconstruction::depth): what lighting and occlusion read.
+// The JS side prepends #version, MAX_SEGMENTS, for 8-bit depth DEPTH_CODES, BASIS for the
+// basis of a lit or occluded frame (premultiplied linear RGBA and depth, into textures that
+// proxy_frame.frag.glsl finishes) rather than the canvas's sRGB, and srgb.glsl.
 precision highp float;
 precision highp int;
 precision highp sampler2D;
@@ -57,7 +61,14 @@ uniform vec3 uUp;
 uniform vec2 uHalfExtent;  // half width, half height: world units, or tangents
 uniform vec2 uImageSize;
 
+#ifdef BASIS
+layout(location = 0) out vec4 outColour;  // premultiplied linear RGBA
+layout(location = 1) out vec4 outDepth;   // r: target depth of the first hit, +inf none
+const bool kWholeRayHits = true;
+#else
 out vec4 outColour;
+const bool kWholeRayHits = false;  // only a single segment reads them
+#endif
 
 const int TABLE_WIDTH = 1024;
 const float NO_HIT = 1e30;  // +inf of the C++ code, kept finite for the arithmetic
@@ -215,12 +226,20 @@ vec2 sphereChord(vec3 origin, vec3 direction, float radius) {
 }
 
 void main() {
+#ifdef BASIS
+  // Texel row y holds image row y (rows from the top), as the frame pass reads its textures.
+  vec2 pixel = gl_FragCoord.xy;
+#else
   // gl_FragCoord's y runs up; the image's rows run down.
   vec2 pixel = vec2(gl_FragCoord.x, uImageSize.y - gl_FragCoord.y);
+#endif
   vec2 plane = vec2(2.0 * pixel.x / uImageSize.x - 1.0, 1.0 - 2.0 * pixel.y / uImageSize.y) * uHalfExtent;
   vec3 origin = uPerspective ? uEye : uEye + plane.x * uRight + plane.y * uUp;
   vec3 direction = uPerspective ? normalize(uForward + plane.x * uRight + plane.y * uUp) : uForward;
   outColour = vec4(0.0);
+#ifdef BASIS
+  outDepth = vec4(uintBitsToFloat(0x7f800000u));
+#endif
 
   vec2 chord = sphereChord(origin, direction, uBoundingRadius);
   if (!(chord.y > chord.x)) return;
@@ -254,7 +273,8 @@ void main() {
   for (int i = 0; i < present; ++i) {
     weights[i] /= presentWeight;
     cameras[i] = rigCamera(indices[i]);
-    hits[i] = uSegments == 1 ? firstHit(cameras[i], slots[i], origin, direction, t0, t1) : -1.0;
+    hits[i] = uSegments == 1 || kWholeRayHits
+                  ? firstHit(cameras[i], slots[i], origin, direction, t0, t1) : -1.0;
   }
 
   vec3 colour = vec3(0.0);
@@ -281,8 +301,19 @@ void main() {
     colour += transmittance * colourFactor * blended.rgb;
     transmittance *= 1.0 - scaledAlpha;
   }
+  float a = 1.0 - transmittance;
+#ifdef BASIS
+  outColour = vec4(colour, a);
+  float hitWeight = 0.0, hitT = 0.0;
+  for (int i = 0; i < present; ++i) {
+    if (hits[i] < 0.0) continue;
+    hitWeight += weights[i];
+    hitT += weights[i] * hits[i];
+  }
+  if (hitWeight > 0.0) outDepth.r = dot(origin + (hitT / hitWeight) * direction - uEye, uForward);
+#else
   // 8-bit sRGB with straight alpha, as write_png stores the server's frames (the canvas is not
   // premultiplied), so the canvas holds the PNG's samples.
-  float a = 1.0 - transmittance;
   outColour = vec4(a > 0.0 ? linearToSrgb(colour / a) : vec3(0.0), a);
+#endif
 }

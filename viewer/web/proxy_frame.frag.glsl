@@ -3,8 +3,10 @@
 // them, with the frame's terms from /api/recipe (FrameRecipe):
 //  5. colour: the stored rendering, or sum_j c_j a'_j (recolour, transfer_function_edit.cl);
 //  6. lighting: colour.rgb *= lit.rgb / lit.a, lit = light_volume of a' with white interval
-//     colours (relighting.cl, normals from each interval's mean depth), then ambient occlusion
-//     (Eq. 5, relighting.cl ambient_occlusion) of the front-most layer;
+//     colours (relighting.cl, normals from each interval's mean depth); or, for a light field's
+//     colours without attenuation (uFrontSurfaceLighting), relighting.cl's shade through the
+//     normals of the front depth (normals_from_depth); then ambient occlusion (Eq. 5,
+//     relighting.cl ambient_occlusion) of the front depth;
 //  7. depth-aware enhancement (Eq. 11, enhancement.cl) on the gradients of a'.
 // a' comes from proxy_edit.frag.glsl; a synthesised view's mean depths come packed (PACKED, see
 // there). The JS side prepends #version, MAX_INTERVALS, MAX_LIGHTS, PACKED and srgb.glsl.
@@ -15,8 +17,8 @@ precision highp sampler2DArray;
 
 uniform sampler2DArray uEdited;     // layer g: a'_j of intervals 4g .. 4g + 3
 uniform sampler2DArray uMeanDepth;  // layer j (PACKED: j / 4, component j % 4): mean depth of j
-uniform sampler2D uRendering;       // the stored rendering, RGBA premultiplied
-uniform sampler2D uFrontDepth;      // front-most layer depth (front_depth.frag.glsl)
+uniform sampler2D uRendering;       // the stored rendering (or a light field's), premultiplied
+uniform sampler2D uFrontDepth;      // front-most depth (layers, or a light field's first hit)
 uniform int uIntervals;
 uniform bool uStoredRendering;
 uniform vec3 uColours[MAX_INTERVALS];
@@ -28,6 +30,7 @@ uniform vec3 uUp;
 uniform vec3 uHalfExtent;
 uniform ivec2 uImageSize;
 uniform bool uLighting;
+uniform bool uFrontSurfaceLighting;  // shade through the front depth's normals
 uniform float uAmbient;
 uniform int uLightCount;
 // Three per light: (unit direction toward it, shininess), (diffuse colour, 0), (specular, 0).
@@ -112,8 +115,14 @@ vec2 tangentTerms(int kind, float before, float centre, float after, bool perspe
   return vec2(centre - before, perspective ? before : 1.0);
 }
 
+float frontDepth(ivec2 p) {
+  return inside(p) ? texelFetch(uFrontDepth, p, 0).r : kInfinity;
+}
+
+// Interval j's mean depth; j = -1: the front depth.
 float meanDepth(ivec2 p, int j) {
   if (!inside(p)) return kInfinity;
+  if (j < 0) return frontDepth(p);
 #ifdef PACKED
   return texelFetch(uMeanDepth, ivec3(p, j / 4), 0)[j % 4];
 #else
@@ -155,15 +164,39 @@ float specularLobe(float nDotH, float shininess) {
   return exp2(shininess * log2(min(nDotH, 1.0)));
 }
 
+// half_vectors_of: normalize(l_k + view).
+void halfVectorsOf(vec3 view, out vec3 halfVectors[MAX_LIGHTS]) {
+  for (int k = 0; k < uLightCount; ++k) {
+    vec3 h = uLights[3 * k].xyz + view;
+    float lengthSquared = dot(h, h);
+    halfVectors[k] = lengthSquared > 0.0 ? h * inversesqrt(lengthSquared) : view;
+  }
+}
+
+// shade: the base colour lit through the front depth's normal (unchanged without depth).
+vec3 shadeFrontSurface(ivec2 p, vec4 base) {
+  PixelFrame f = pixelFrame(p);
+  vec3 n = depthNormal(p, -1, f);
+  float lengthSquared = dot(n, n);
+  if (!(lengthSquared > 0.0) || !finite(lengthSquared)) return base.rgb;
+  n *= inversesqrt(lengthSquared);
+  vec3 halfVectors[MAX_LIGHTS];
+  halfVectorsOf(f.view, halfVectors);
+  vec3 diffuse = vec3(uAmbient), specular = vec3(0.0);
+  for (int k = 0; k < uLightCount; ++k) {
+    float nDotL = dot(n, uLights[3 * k].xyz);
+    if (nDotL <= 0.0) continue;
+    diffuse += nDotL * uLights[3 * k + 1].xyz;
+    specular += specularLobe(dot(n, halfVectors[k]), uLights[3 * k].w) * uLights[3 * k + 2].xyz;
+  }
+  return base.rgb * diffuse + base.a * specular;
+}
+
 // light_volume of a' with white interval colours: (rgb, alpha).
 vec4 lightVolume(ivec2 p) {
   PixelFrame f = pixelFrame(p);
   vec3 halfVectors[MAX_LIGHTS];
-  for (int k = 0; k < uLightCount; ++k) {
-    vec3 h = uLights[3 * k].xyz + f.view;
-    float lengthSquared = dot(h, h);
-    halfVectors[k] = lengthSquared > 0.0 ? h * inversesqrt(lengthSquared) : f.view;
-  }
+  halfVectorsOf(f.view, halfVectors);
   vec3 rgb = vec3(0.0);
   float alpha = 0.0;
   for (int j = 0; j < uIntervals; ++j) {
@@ -182,9 +215,6 @@ vec4 lightVolume(ivec2 p) {
 }
 
 // --- relighting.cl ambient_occlusion (Eq. 5) on the front depth ---
-float frontDepth(ivec2 p) {
-  return inside(p) ? texelFetch(uFrontDepth, p, 0).r : kInfinity;
-}
 
 float tangentPlaneQuantity(float depth, bool perspective) {
   return perspective ? 1.0 / depth : depth;
@@ -257,7 +287,9 @@ void main() {
   } else {
     for (int j = 0; j < uIntervals; ++j) colour += editedAttenuation(p, j) * vec4(uColours[j], 1.0);
   }
-  if (uLighting) {
+  if (uLighting && uFrontSurfaceLighting) {
+    colour.rgb = shadeFrontSurface(p, colour);
+  } else if (uLighting) {
     vec4 lit = lightVolume(p);
     if (lit.a > 0.0) colour.rgb *= lit.rgb / lit.a;
   }

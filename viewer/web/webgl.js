@@ -85,6 +85,12 @@ export class TextureSet {
     return texture;
   }
 
+  /// Deletes one texture of the set.
+  remove(texture) {
+    this.gl.deleteTexture(texture);
+    this.entries = this.entries.filter((entry) => entry.texture !== texture);
+  }
+
   bind() {
     for (const { unit, target, texture } of this.entries) {
       this.gl.activeTexture(this.gl.TEXTURE0 + unit);

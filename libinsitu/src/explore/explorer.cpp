@@ -869,16 +869,50 @@ FrameRecipe Explorer::recipe(const ExploreRequest& request) {
     recipe.synthesised =
         !same_angle(request.azimuth_deg.value_or(stored.azimuth_deg()), stored.azimuth_deg()) ||
         !same_angle(request.elevation_deg.value_or(stored.elevation_deg()), stored.elevation_deg());
-    if (recipe.synthesised && request.source == ProxySource::automatic) {
+    // Lights and occlusion as render()'s finish_frame applies them, for either source.
+    const auto add_lighting_and_occlusion = [&] {
+        if (request.lighting) {
+            // Checked as render() checks it, with the headlights pointed at the stored camera.
+            LightingSettings aimed = *request.lighting;
+            for (Light& light : aimed.lights) {
+                if (light.direction_world == glm::dvec3(0.0))
+                    light.direction_world = -stored.forward();
+            }
+            validate(aimed);
+            recipe.lighting = request.lighting;
+            for (Light& light : recipe.lighting->lights) {
+                // Headlights stay (0, 0, 0): the client points them at its camera.
+                if (light.direction_world != glm::dvec3(0.0)) {
+                    light.direction_world = glm::normalize(light.direction_world);
+                }
+            }
+        }
+        if (request.ambient_occlusion) {
+            recipe.ambient_occlusion = occlusion_terms(*request.ambient_occlusion, stored);
+        }
+    };
+    if (request.source == ProxySource::automatic) {
         // As render() decides: a light field of the view's field makes other views (the view's
-        // proxies filling in), unless the frame needs attenuation the light field lacks.
+        // proxies filling in where it knows nothing of a ray), unless the frame needs
+        // attenuation the light field lacks.
         const std::string field = archive_->entry(request.step, request.view).field;
-        const LightField* light_field = load_light_field(request.step, field, {0});
-        const bool needs_attenuation = request.transfer_function.has_value() ||
-                                       !request.opacity_scales.empty() ||
-                                       request.enhancement.has_value();
+        const LightField* light_field =
+            recipe.synthesised ? load_light_field(request.step, field, {0}) : nullptr;
+        const bool edits = request.transfer_function.has_value() || !request.opacity_scales.empty();
+        const bool needs_attenuation = edits || request.enhancement.has_value();
         if (light_field && !(needs_attenuation && !light_field->settings.attenuation)) {
-            recipe.why_not = "the light field makes this view";
+            // The client reconstructs the light field's colour and first-hit depth, then lights
+            // (through the front surface's normals) and occludes them. Edits, enhancement and
+            // the lighting of an attenuation light field (light_volume of its reconstructed a_j)
+            // stay the server's.
+            recipe.light_field = true;
+            if (needs_attenuation || (request.lighting && light_field->settings.attenuation)) {
+                recipe.why_not = "the light field's attenuation makes this frame";
+                return recipe;
+            }
+            recipe.colour_source = ColourSource::captured;
+            add_lighting_and_occlusion();
+            recipe.drawable = true;
             return recipe;
         }
     }
@@ -910,24 +944,7 @@ FrameRecipe Explorer::recipe(const ExploreRequest& request) {
         recipe.colours = std::move(plan.colours);
         recipe.colour_source = ColourSource::recompose;
     }
-    if (request.lighting) {
-        // Checked as render() checks it, with the headlights pointed at the stored camera.
-        LightingSettings aimed = *request.lighting;
-        for (Light& light : aimed.lights) {
-            if (light.direction_world == glm::dvec3(0.0)) light.direction_world = -stored.forward();
-        }
-        validate(aimed);
-        recipe.lighting = request.lighting;
-        for (Light& light : recipe.lighting->lights) {
-            // Headlights stay (0, 0, 0): the client points them at its camera.
-            if (light.direction_world != glm::dvec3(0.0)) {
-                light.direction_world = glm::normalize(light.direction_world);
-            }
-        }
-    }
-    if (request.ambient_occlusion) {
-        recipe.ambient_occlusion = occlusion_terms(*request.ambient_occlusion, stored);
-    }
+    add_lighting_and_occlusion();
     if (request.enhancement) validate(*request.enhancement);
     recipe.enhancement = request.enhancement;
     recipe.drawable = true;

@@ -111,16 +111,21 @@ struct ExploreFrame {
 /// them: the terms render() derives from the request once per frame. The pixels then follow
 /// explorer.hpp's steps 3-7 with these terms (the shaders in viewer/web/).
 struct FrameRecipe {
-    /// Whether render() makes the frame from the view's single-perspective proxies with
-    /// attenuation (and, for occlusion, depth layers), with a colour the terms below determine;
-    /// else `why_not` says what the client cannot draw (another source, the light field's views,
-    /// the colour model) and the client asks for the frame instead.
+    /// Whether the client can draw the frame as render() makes it: from the view's
+    /// single-perspective proxies with attenuation (and, for occlusion, depth layers), or from
+    /// the step's light field (`light_field`), with a colour the terms below determine; else
+    /// `why_not` says what the client cannot draw (another source, the light field's
+    /// attenuation, the colour model) and the client asks for the frame instead.
     bool drawable = false;
     std::string why_not;
     /// Another view than the stored one: its attenuation (and, for occlusion, its layers) are
     /// synthesised (view_synthesis.hpp) with this hole-filling radius.
     bool synthesised = false;
     int fill_radius_pixels = 0;
+    /// The step's light field makes this view (source auto, another view than the stored one):
+    /// the client reconstructs it (colour and first-hit depth) and applies the lights and
+    /// occlusion below; no edit terms. Set also where it is not drawable, to say why.
+    bool light_field = false;
     /// The stored rendering is the colour (the run's own function, unedited; steps 4-5 skipped).
     bool stored_rendering = false;
     std::vector<double> opacity_scales;  ///< s_j as estimate_attenuation applies them; all 1: none
