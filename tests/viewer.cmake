@@ -69,13 +69,14 @@ foreach(suite IN ITEMS browser api)
                        TIMEOUT 120)
 endforeach()
 
-# The browser's own frames (WebGL2 through chromium's SwiftShader): an archive with a light field
-# of 42 cameras at 128^2 beside the stored view's proxies, at steps 300 and 600 of a 40^3 run
-# (half the image covered by then; about 2 s); webgl.test.mjs compares the
-# canvas with `insitu-view render --source lightfield` and checks the fallback without WebGL2.
-set(viewer_lf_archive ${viewer_work}/viewer_lf.cdb)
-set(viewer_lf_config ${CMAKE_CURRENT_BINARY_DIR}/viewer_lf_config.json)
-file(WRITE ${viewer_lf_config} [=[
+# The 40^3 Gray-Scott run archived at steps 300 and 600 (half the image covered by then) in
+# 160^2 with 8 intervals and the light field `light_field` (its JSON object) beside the stored
+# view's proxies: archive viewer_NAME.cdb, fixture viewer_NAME_archive (about 1-2 s). The
+# object may come in parts (joined).
+function(viewer_light_field_archive name)
+  string(JOIN "" light_field ${ARGN})
+  set(config ${CMAKE_CURRENT_BINARY_DIR}/viewer_${name}_config.json)
+  file(WRITE ${config} [=[
 {"fields": ["v"],
  "views": [{"azimuth": 30, "elevation": 20, "size": [160, 160]}],
  "transfer_function": {"points": [[0.0, 0.1, 0.25, 0.75, 0.0], [0.12, 0.1, 0.25, 0.75, 0.0],
@@ -83,64 +84,61 @@ file(WRITE ${viewer_lf_config} [=[
                                   [0.36, 0.95, 0.8, 0.3, 0.22], [0.45, 1.0, 0.4, 0.15, 0.4]],
                        "unit_length": 1.0},
  "intervals": {"count": 8},
- "light_field": {"cameras": 42, "size": 128, "attenuation": false},
- "every": 300}
-]=])
-add_test(NAME viewer.setup_lf_archive
-         COMMAND gray-scott --size 40 --steps 600 --config ${viewer_lf_config} --out ${viewer_lf_archive})
-set_tests_properties(viewer.setup_lf_archive PROPERTIES
-                     FIXTURES_REQUIRED viewer_work FIXTURES_SETUP viewer_lf_archive TIMEOUT 120)
-add_test(NAME viewer.webgl
-         COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/webgl.test.mjs
-         WORKING_DIRECTORY ${viewer_tests_dir})
-set_tests_properties(viewer.webgl PROPERTIES
-                     FIXTURES_REQUIRED viewer_lf_archive
-                     ENVIRONMENT "INSITU_VIEW=$<TARGET_FILE:insitu-view>;ARCHIVE=${viewer_lf_archive};WORK_DIR=${viewer_work}"
-                     TIMEOUT 180)
+ "every": 300,
+ "light_field": ]=] "${light_field}}\n")
+  add_test(NAME viewer.setup_${name}_archive
+           COMMAND gray-scott --size 40 --steps 600 --config ${config}
+                   --out ${viewer_work}/viewer_${name}.cdb)
+  set_tests_properties(viewer.setup_${name}_archive PROPERTIES
+                       FIXTURES_REQUIRED viewer_work FIXTURES_SETUP viewer_${name}_archive
+                       TIMEOUT 120)
+endfunction()
+
+# A browser test tests/viewer/SUITE.test.mjs on the archive viewer_NAME.cdb (ctest viewer.SUITE),
+# with more environment (KEY=VALUE) and fixtures after the name.
+function(viewer_browser_test suite name)
+  cmake_parse_arguments(PARSE_ARGV 2 arg "" "" "ENVIRONMENT;FIXTURES")
+  add_test(NAME viewer.${suite}
+           COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/${suite}.test.mjs
+           WORKING_DIRECTORY ${viewer_tests_dir})
+  set(environment INSITU_VIEW=$<TARGET_FILE:insitu-view> ARCHIVE=${viewer_work}/viewer_${name}.cdb
+                  WORK_DIR=${viewer_work} ${arg_ENVIRONMENT})
+  set_tests_properties(viewer.${suite} PROPERTIES
+                       FIXTURES_REQUIRED "viewer_${name}_archive;${arg_FIXTURES}"
+                       ENVIRONMENT "${environment}"
+                       TIMEOUT 180)
+endfunction()
+
+# The browser's own frames (WebGL2 through chromium's SwiftShader), on an archive with a light
+# field of 42 cameras at 128^2: webgl.test.mjs compares orbit views (also relit and occluded)
+# with `insitu-view render --source lightfield` and checks the fallback without WebGL2.
+set(viewer_lf_archive ${viewer_work}/viewer_lf.cdb)
+viewer_light_field_archive(lf [=[{"cameras": 42, "size": 128, "attenuation": false}]=])
+viewer_browser_test(webgl lf)
 
 # The stored view drawn by the page from its single-perspective proxies (/api/proxies,
 # /api/recipe): proxies.test.mjs edits, relights, occludes, enhances and changes the step on the
 # same archive, comparing the canvas with `insitu-view render` each time.
-add_test(NAME viewer.proxies
-         COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/proxies.test.mjs
-         WORKING_DIRECTORY ${viewer_tests_dir})
-set_tests_properties(viewer.proxies PROPERTIES
-                     FIXTURES_REQUIRED viewer_lf_archive
-                     ENVIRONMENT "INSITU_VIEW=$<TARGET_FILE:insitu-view>;ARCHIVE=${viewer_lf_archive};WORK_DIR=${viewer_work}"
-                     TIMEOUT 180)
+viewer_browser_test(proxies lf)
+
+# Edits through an attenuation light field (issue 15): the same run with the light field's a_j
+# and mean depths per camera; light_field_edits.test.mjs edits opacity and colour, relights,
+# occludes and enhances an orbit view in the page, comparing the canvas with
+# `insitu-view render --source lightfield` each time.
+viewer_light_field_archive(lf_attenuation [=[{"cameras": 42, "size": 128, "attenuation": true}]=])
+viewer_browser_test(light_field_edits lf_attenuation)
 
 # Per-segment fades (issue 15): the same run with its light field split at opacity 0.5 into two
 # segments, depth in half floats; segments.test.mjs moves the page's faders and compares the
 # canvas with `insitu-view render --source lightfield --segment-opacity`, checks the refusals of
 # bad segment-opacity values, and that the faders are hidden for the archives above (no light
 # field; one segment).
-set(viewer_lf_segments_archive ${viewer_work}/viewer_lf_segments.cdb)
-set(viewer_lf_segments_config ${CMAKE_CURRENT_BINARY_DIR}/viewer_lf_segments_config.json)
-file(WRITE ${viewer_lf_segments_config} [=[
-{"fields": ["v"],
- "views": [{"azimuth": 30, "elevation": 20, "size": [160, 160]}],
- "transfer_function": {"points": [[0.0, 0.1, 0.25, 0.75, 0.0], [0.12, 0.1, 0.25, 0.75, 0.0],
-                                  [0.2, 0.15, 0.55, 0.9, 0.04], [0.28, 0.35, 0.85, 0.7, 0.1],
-                                  [0.36, 0.95, 0.8, 0.3, 0.22], [0.45, 1.0, 0.4, 0.15, 0.4]],
-                       "unit_length": 1.0},
- "intervals": {"count": 8},
- "light_field": {"cameras": 42, "size": 128, "attenuation": false, "segments": [0.5],
-                 "depth_bits": 16},
- "every": 300}
-]=])
-add_test(NAME viewer.setup_lf_segments_archive
-         COMMAND gray-scott --size 40 --steps 600 --config ${viewer_lf_segments_config}
-                 --out ${viewer_lf_segments_archive})
-set_tests_properties(viewer.setup_lf_segments_archive PROPERTIES
-                     FIXTURES_REQUIRED viewer_work FIXTURES_SETUP viewer_lf_segments_archive
-                     TIMEOUT 120)
-add_test(NAME viewer.segments
-         COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/segments.test.mjs
-         WORKING_DIRECTORY ${viewer_tests_dir})
-set_tests_properties(viewer.segments PROPERTIES
-                     FIXTURES_REQUIRED "viewer_archive;viewer_lf_archive;viewer_lf_segments_archive"
-                     ENVIRONMENT "INSITU_VIEW=$<TARGET_FILE:insitu-view>;ARCHIVE=${viewer_lf_segments_archive};ARCHIVE_ONE_SEGMENT=${viewer_lf_archive};ARCHIVE_NO_LIGHT_FIELD=${viewer_archive};WORK_DIR=${viewer_work}"
-                     TIMEOUT 180)
+viewer_light_field_archive(lf_segments [=[{"cameras": 42, "size": 128, "attenuation": false,]=]
+                           [=[ "segments": [0.5], "depth_bits": 16}]=])
+viewer_browser_test(segments lf_segments
+                    ENVIRONMENT ARCHIVE_ONE_SEGMENT=${viewer_lf_archive}
+                                ARCHIVE_NO_LIGHT_FIELD=${viewer_archive}
+                    FIXTURES viewer_archive viewer_lf_archive)
 
 # serve's command line: exit 2 and one line on stderr for bad arguments or archives.
 function(viewer_serve_case name exit_status stream text)

@@ -28,12 +28,37 @@ void check_plane(const Image& image, int size, int channels, int camera, const c
     }
 }
 
-void append_half(std::string& out, const Image& image) {
+void append_half(std::string& out, const std::vector<float>& values) {
     const std::size_t at = out.size();
-    out.resize(at + 2 * image.pixels.size());
-    for (std::size_t i = 0; i < image.pixels.size(); ++i) {
-        const std::uint16_t bits = Imath::half(image.pixels[i]).bits();
+    out.resize(at + 2 * values.size());
+    for (std::size_t i = 0; i < values.size(); ++i) {
+        const std::uint16_t bits = Imath::half(values[i]).bits();
         std::memcpy(&out[at + 2 * i], &bits, 2);  // little-endian hosts only (x86, ARM)
+    }
+}
+
+void append_half(std::string& out, const Image& image) {
+    append_half(out, image.pixels);
+}
+
+void append_float(std::string& out, const std::vector<float>& values) {
+    const std::size_t at = out.size();
+    out.resize(at + 4 * values.size());
+    std::memcpy(&out[at], values.data(), 4 * values.size());
+}
+
+// One camera's L-channel image as G planes of four intervals each (interval 4g + c at component
+// c of plane g), `padding` past the last interval.
+void append_groups(std::vector<float>& out, const Image& image, int groups, float padding) {
+    const std::size_t pixels = image.pixel_count();
+    const int intervals = image.channels;
+    for (int g = 0; g < groups; ++g) {
+        for (std::size_t p = 0; p < pixels; ++p) {
+            for (int c = 0; c < 4; ++c) {
+                const int j = 4 * g + c;
+                out.push_back(j < intervals ? image.pixels[p * intervals + j] : padding);
+            }
+        }
     }
 }
 
@@ -64,6 +89,10 @@ std::string light_field_payload(const LightField& light_field, std::int64_t step
     const int n = rig.map_size();
     const int segments = light_field.segment_count();
     const int depth_bits = light_field.settings.depth_bits;
+    const int intervals = light_field.settings.attenuation && light_field.intervals
+                              ? light_field.intervals->count()
+                              : 0;
+    const int groups = (intervals + 3) / 4;
     std::vector<int> present;
     for (const LightFieldImages& images : light_field.cameras) {
         if (images.camera < 0 || images.camera >= rig.camera_count()) {
@@ -83,6 +112,10 @@ std::string light_field_payload(const LightField& light_field, std::int64_t step
         for (const Image& depth : images.segment_depth) {
             check_plane(depth, n, 1, images.camera, "segment_depth");
         }
+        if (intervals > 0) {
+            check_plane(images.attenuation, n, intervals, images.camera, "attenuation");
+            check_plane(images.mean_depth, n, intervals, images.camera, "mean_depth");
+        }
         present.push_back(images.camera);
     }
 
@@ -91,6 +124,21 @@ std::string light_field_payload(const LightField& light_field, std::int64_t step
     const std::size_t slots = present.size();
     const std::size_t rgba_bytes = slots * segments * pixels * 4 * 2;
     const std::size_t first_hit_bytes = slots * pixels * depth_bytes;
+    const std::size_t depth_end = rgba_bytes + first_hit_bytes * (segments > 1 ? segments + 1 : 1);
+    // The attenuation planes, as the page uploads them.
+    std::vector<float> attenuation;
+    std::vector<float> mean_depth;
+    for (const LightFieldImages& images : light_field.cameras) {
+        if (intervals == 0) break;
+        append_groups(attenuation, images.attenuation, groups, 0.0f);
+        append_groups(mean_depth, images.mean_depth, groups, INFINITY);
+    }
+    const bool attenuation_half = all_half(attenuation);
+    const bool mean_depth_half = all_half(mean_depth);
+    const std::size_t attenuation_at = (depth_end + 3) / 4 * 4;
+    const std::size_t mean_depth_at =
+        attenuation_at + attenuation.size() * (attenuation_half ? 2 : 4);
+    const std::size_t end = mean_depth_at + mean_depth.size() * (mean_depth_half ? 2 : 4);
 
     json cameras = json::array();
     for (int k = 0; k < rig.camera_count(); ++k) {
@@ -107,6 +155,16 @@ std::string light_field_payload(const LightField& light_field, std::int64_t step
     for (const std::vector<int>& cell : rig.cell_triangles()) {
         for (const int t : cell) cell_triangles.push_back(t);
         cell_offsets.push_back(cell_triangles.size());
+    }
+    json planes{{"rgba", 0},
+                {"depth", rgba_bytes},
+                {"segment_depth", segments > 1 ? rgba_bytes + first_hit_bytes : 0},
+                {"depth_type", depth_bits == 8 ? "uint8 code" : "half"}};
+    if (intervals > 0) {
+        planes["attenuation"] = {{"offset", attenuation_at},
+                                 {"type", attenuation_half ? "half" : "float"}};
+        planes["mean_depth"] = {{"offset", mean_depth_at},
+                                {"type", mean_depth_half ? "half" : "float"}};
     }
     const json header{{"step", step},
                       {"field", field},
@@ -126,15 +184,12 @@ std::string light_field_payload(const LightField& light_field, std::int64_t step
                       {"segment_rule", to_string(light_field.settings.segments)},
                       {"depth_bits", depth_bits},
                       {"depth_threshold", light_field.settings.depth_threshold},
+                      {"intervals", intervals},
                       {"present", present},
-                      {"planes",
-                       {{"rgba", 0},
-                        {"depth", rgba_bytes},
-                        {"segment_depth", segments > 1 ? rgba_bytes + first_hit_bytes : 0},
-                        {"depth_type", depth_bits == 8 ? "uint8 code" : "half"}}}};
+                      {"planes", planes}};
     std::string out = payload_opening("insituLF", kLightFieldPayloadVersion, header);
     const std::size_t data_start = out.size();
-    out.reserve(data_start + rgba_bytes + first_hit_bytes * (segments > 1 ? segments + 1 : 1));
+    out.reserve(data_start + end);
     for (const LightFieldImages& images : light_field.cameras) {
         for (const Image& rgba : images.segment_rgba) append_half(out, rgba);
     }
@@ -153,8 +208,20 @@ std::string light_field_payload(const LightField& light_field, std::int64_t step
             for (const Image& depth : images.segment_depth) append_depth(depth, images.camera);
         }
     }
-    INSITU_CHECK_EQ(out.size() - data_start,
-                    rgba_bytes + first_hit_bytes * (segments > 1 ? segments + 1 : 1));
+    INSITU_CHECK_EQ(out.size() - data_start, depth_end);
+    if (intervals > 0) {
+        out.resize(data_start + attenuation_at, '\0');
+        const auto append = [&out](const std::vector<float>& values, bool half) {
+            if (half) {
+                append_half(out, values);
+            } else {
+                append_float(out, values);
+            }
+        };
+        append(attenuation, attenuation_half);
+        append(mean_depth, mean_depth_half);
+    }
+    INSITU_CHECK_EQ(out.size() - data_start, end);
     return out;
 }
 

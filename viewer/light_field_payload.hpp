@@ -16,10 +16,15 @@
 //                first-hit depth of each slot; then, with S > 1, segment s's depth of slot i at
 //                i * S + s. Depth is seed 001's secant fraction (Eq. 3): 8-bit light fields send
 //                the archive's code (round(f * 254), 255 = no hit) as uint8, 16-bit ones the half
-//                (+inf = no hit).
+//                (+inf = no hit). Attenuation light fields then hold, at byte offsets 4-aligned
+//                (planes "attenuation" and "mean_depth", each with its "type", half or float),
+//                per slot i and group g of four intervals (G = ceil(L / 4) groups), an N x N x 4
+//                plane i * G + g: a_j, then the mean depth (source camera depth, +inf where
+//                a_j = 0), of intervals 4g .. 4g + 3 (a 0 and depth +inf past the last).
 // Every value is the one ArchiveReader::load_light_field returns, exactly (the archive stores
-// RGBA as half and depth as these codes or halves), so the page reconstructs from the same
-// numbers as the C++ Explorer.
+// RGBA as half and depth as these codes or halves; attenuation goes as half where every value
+// is one, as the archive's precision gives it), so the page reconstructs from the same numbers
+// as the C++ Explorer.
 #include <cstdint>
 #include <string>
 
@@ -27,7 +32,7 @@
 
 namespace insitu::viewer {
 
-inline constexpr std::uint32_t kLightFieldPayloadVersion = 1;
+inline constexpr std::uint32_t kLightFieldPayloadVersion = 2;
 
 /// The payload of `light_field` (any subset of its rig's cameras). `step` and `field` are
 /// recorded in the header. InvalidArgument when its images do not fit its rig (as

@@ -3,11 +3,25 @@
 // proxy_payload.hpp; viewer/web/page.js readPayloadHeader reads it): 8 bytes of magic, a uint32
 // format version, a uint32 byte count H, then H bytes of JSON header padded with spaces to a
 // multiple of 8, so that the planes after it are aligned for their element types.
+#include <Imath/half.h>
+
+#include <cmath>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 namespace insitu::viewer {
+
+/// Whether half holds every value exactly (+-inf and NaN included): then a plane goes as half,
+/// else as float, so that the page reads exactly what ArchiveReader returns.
+inline bool all_half(const std::vector<float>& values) {
+    for (const float v : values) {
+        if (std::isnan(v)) continue;
+        if (static_cast<float>(Imath::half(v)) != v) return false;
+    }
+    return true;
+}
 
 /// The payload's opening; its planes follow at out.size().
 inline std::string payload_opening(const char (&magic)[9], std::uint32_t version,

@@ -31,15 +31,6 @@ struct PlaneGroup {
     std::vector<float> values;
 };
 
-// Whether half holds every value exactly (+-inf and NaN included): then the group goes as half.
-bool all_half(const std::vector<float>& values) {
-    for (const float v : values) {
-        if (std::isnan(v)) continue;
-        if (static_cast<float>(Imath::half(v)) != v) return false;
-    }
-    return true;
-}
-
 // Interleaved channels of `image` as planes (channel c at c * pixels).
 std::vector<float> planar(const Image& image) {
     const std::size_t pixels = image.pixel_count();

@@ -747,6 +747,7 @@ private:
                             {"why_not", recipe.why_not},
                             {"synthesised", recipe.synthesised},
                             {"light_field", recipe.light_field},
+                            {"light_field_attenuation", recipe.light_field_attenuation},
                             {"fill_radius", recipe.fill_radius_pixels},
                             {"stored_rendering", recipe.stored_rendering},
                             {"opacity_edited", recipe.opacity_edited},

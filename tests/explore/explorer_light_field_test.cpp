@@ -221,18 +221,34 @@ TEST_F(ExplorerLightField, TheRecipeSaysWhenTheLightFieldMakesTheView) {
     EXPECT_FALSE(explorer.recipe(stored).light_field);
 }
 
-TEST_F(ExplorerLightField, TheLightingOfAnAttenuationLightFieldIsTheServers) {
+// An attenuation light field's a_j are reconstructed where render() needs them (edits, lights,
+// enhancement), and the recipe says so, with the edit's terms in the light field's intervals.
+TEST_F(ExplorerLightField, TheRecipeOfAnAttenuationLightFieldSaysWhenItsAttenuationIsNeeded) {
     write_step();  // the fixture's light field has attenuation
     Explorer explorer(config_.archive);
     ExploreRequest occluded = at(120.0, -25.0, ProxySource::automatic);
     occluded.ambient_occlusion = AmbientOcclusionSettings{};
-    EXPECT_TRUE(explorer.recipe(occluded).drawable) << explorer.recipe(occluded).why_not;
+    const FrameRecipe occlusion = explorer.recipe(occluded);
+    EXPECT_TRUE(occlusion.drawable) << occlusion.why_not;
+    EXPECT_TRUE(occlusion.light_field);
+    EXPECT_FALSE(occlusion.light_field_attenuation) << "occlusion reads the first hit's depth";
     ExploreRequest lit = occluded;
     lit.lighting = LightingSettings{};
-    const FrameRecipe recipe = explorer.recipe(lit);
-    EXPECT_TRUE(recipe.light_field);
-    EXPECT_FALSE(recipe.drawable);
-    EXPECT_NE(recipe.why_not.find("attenuation"), std::string::npos) << recipe.why_not;
+    const FrameRecipe lighting = explorer.recipe(lit);
+    EXPECT_TRUE(lighting.drawable) << lighting.why_not;
+    EXPECT_TRUE(lighting.light_field_attenuation) << "lit through the mean depths";
+    EXPECT_EQ(lighting.colour_source, ColourSource::captured);
+
+    ExploreRequest edited = at(200.0, 10.0, ProxySource::automatic);
+    edited.opacity_scales = {{3, 0.25}};
+    const FrameRecipe edit = explorer.recipe(edited);
+    const ExploreFrame frame = explorer.render(edited);
+    EXPECT_TRUE(edit.drawable) << edit.why_not;
+    EXPECT_TRUE(edit.light_field_attenuation);
+    EXPECT_TRUE(edit.opacity_edited);
+    EXPECT_EQ(edit.opacity_scales, frame.opacity_scales);
+    EXPECT_EQ(edit.colour_source, frame.colour_source);
+    EXPECT_EQ(edit.colours.size(), 3u * config_.interval_count);
 }
 
 TEST_F(ExplorerLightField, ArchivesWithOnlyALightFieldRenderEveryView) {

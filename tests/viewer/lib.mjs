@@ -1,10 +1,12 @@
 // Helpers of the viewer tests: start `insitu-view serve`, render the same options with
 // `insitu-view render`, and decode PNGs to compare pixels (no dependency beyond node's zlib).
+import assert from 'node:assert/strict';
 import { spawn, spawnSync } from 'node:child_process';
 import { existsSync, mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
+import { after, before } from 'node:test';
 import { inflateSync } from 'node:zlib';
 
 /// A required environment variable (set by tests/viewer.cmake).
@@ -215,4 +217,44 @@ export function psnrPremultiplied(a, b) {
   }
   const mse = sum / (3 * pixels);
   return mse > 0 ? 10 * Math.log10(1 / mse) : Infinity;
+}
+
+/// The frame `page` shows, drawn by the browser from the light field, against `insitu-view
+/// render` with the same options from the light field (`--source lightfield`): asserts a PSNR
+/// of at least `minPsnrDb` over a picture with something in it; returns {psnr, image}.
+export async function lightFieldFrameMatches(page, binary, archive, workDir, what, minPsnrDb) {
+  const displayed = await page.evaluate(() => window.insituViewer.displayed);
+  assert.equal(displayed.gpu, true, `the browser drew ${what}`);
+  assert.equal(displayed.drawnFrom, 'light field', `${what}: from the light field`);
+  const shown = await page.evaluate(() => {
+    const { width, height, data } = window.insituViewer.gpuPixels();
+    return { width, height, data: Array.from(data) };
+  });
+  const expected = decodePng(renderWithCli(binary, archive,
+    { ...displayed.options, source: 'lightfield' }, workDir).colour);
+  assert.equal(expected.channels, 4);
+  const image = { ...shown, data: Uint8Array.from(shown.data) };
+  const psnr = psnrPremultiplied(image, expected);
+  let covered = 0;
+  for (let p = 3; p < expected.data.length; p += 4) covered += expected.data[p] > 8 ? 1 : 0;
+  assert.ok(covered > 0.05 * expected.width * expected.height, `${what}: something to compare`);
+  assert.ok(psnr >= minPsnrDb, `WebGL2 vs C++, ${what}: ${psnr.toFixed(2)} dB`);
+  return { psnr, image };
+}
+
+/// Registers the hooks of a browser test file: before its tests `insitu-view serve` on `archive`
+/// and headless chromium with WebGL2 (SwiftShader) start, after them both stop (serve must exit
+/// 0 on SIGTERM). Returns {server, browser}, filled in once the tests run.
+export function serverAndBrowser(binary, archive) {
+  const session = { server: null, browser: null };
+  before(async () => {
+    session.server = await startServer(binary, archive);
+    session.browser = await loadPlaywright().chromium.launch(
+      { executablePath: CHROMIUM, args: WEBGL_ARGS });
+  });
+  after(async () => {
+    if (session.browser) await session.browser.close();
+    if (session.server) assert.equal(await stopServer(session.server), 0, 'serve exits 0 on SIGTERM');
+  });
+  return session;
 }

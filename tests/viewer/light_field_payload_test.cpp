@@ -163,6 +163,63 @@ TEST(LightFieldPayload, HoldsTheRigAndEveryPlaneExactly) {
     }
 }
 
+// Attenuation light fields add a_j and mean depth per camera in groups of four intervals (the
+// last padded with a = 0, depth +inf): half where every value is one, else float.
+TEST(LightFieldPayload, HoldsTheAttenuationInGroupsOfFourIntervals) {
+    constexpr int kIntervals = 5;  // two groups, the second padded
+    for (const bool exact_in_half : {true, false}) {
+        SCOPED_TRACE(exact_in_half ? "half" : "float");
+        LightField light_field = small_light_field(1, 16);
+        light_field.settings.attenuation = true;
+        light_field.intervals = IntervalSet::uniform(0.0, 1.0, kIntervals);
+        for (LightFieldImages& images : light_field.cameras) {
+            images.attenuation = Image(8, 8, kIntervals, 0.0f);
+            images.mean_depth = Image(8, 8, kIntervals, kInf);
+            for (std::size_t i = 0; i < images.attenuation.pixels.size(); ++i) {
+                if (i % 3 == 0) continue;  // empty: a = 0, depth +inf
+                images.attenuation.pixels[i] = static_cast<float>((i + images.camera) % 32) / 64.0f;
+                images.mean_depth.pixels[i] = 2.0f + static_cast<float>(i % 17) / 16.0f;
+            }
+            // A depth half cannot hold sends the mean depths as float.
+            if (!exact_in_half) images.mean_depth.pixels[1] = 2.0001f;
+        }
+        const Decoded decoded = decode(light_field_payload(light_field, 40, "v"));
+        EXPECT_EQ(decoded.header.at("intervals"), kIntervals);
+        const auto& planes = decoded.header.at("planes");
+        EXPECT_EQ(planes.at("attenuation").at("type"), "half");
+        EXPECT_EQ(planes.at("mean_depth").at("type"), exact_in_half ? "half" : "float");
+        const std::size_t a_at = planes.at("attenuation").at("offset");
+        const std::size_t z_at = planes.at("mean_depth").at("offset");
+        EXPECT_EQ(a_at % 4, 0u);
+        const std::size_t values = 2 * 2 * 64 * 4;  // slots x groups x pixels x 4
+        EXPECT_EQ(z_at, a_at + 2 * values);
+        EXPECT_EQ(decoded.data.size(), z_at + (exact_in_half ? 2 : 4) * values);
+        const auto mean_depth_at = [&](std::size_t index) {
+            if (exact_in_half) return half_at(decoded.data, z_at + 2 * index);
+            float value = 0.0f;
+            std::memcpy(&value, decoded.data.data() + z_at + 4 * index, 4);
+            return value;
+        };
+        for (std::size_t slot = 0; slot < 2; ++slot) {
+            const LightFieldImages& images = light_field.cameras[slot];
+            for (std::size_t g = 0; g < 2; ++g) {
+                for (std::size_t p = 0; p < 64; ++p) {
+                    for (std::size_t c = 0; c < 4; ++c) {
+                        const std::size_t j = 4 * g + c;
+                        const std::size_t index = ((slot * 2 + g) * 64 + p) * 4 + c;
+                        const bool real = j < static_cast<std::size_t>(kIntervals);
+                        const std::size_t texel = p * kIntervals + j;
+                        ASSERT_EQ(half_at(decoded.data, a_at + 2 * index),
+                                  real ? images.attenuation.pixels[texel] : 0.0f);
+                        ASSERT_EQ(mean_depth_at(index),
+                                  real ? images.mean_depth.pixels[texel] : kInf);
+                    }
+                }
+            }
+        }
+    }
+}
+
 TEST(LightFieldPayload, RefusesDepthsThatAreNotCodesAndImagesThatDoNotFit) {
     LightField not_a_code = small_light_field(1, 8);
     not_a_code.cameras[1].depth.pixels[5] = 0.3333f;

@@ -9,8 +9,8 @@ import assert from 'node:assert/strict';
 import { after, before, test } from 'node:test';
 
 import {
-  CHROMIUM, decodePng, env, loadPlaywright, makeWorkDir, openViewerPage, psnrPremultiplied,
-  renderWithCli, startServer, stopServer, waitForSettledFrame, WEBGL_ARGS,
+  CHROMIUM, env, lightFieldFrameMatches, loadPlaywright, makeWorkDir, openViewerPage,
+  startServer, stopServer, waitForSettledFrame, WEBGL_ARGS,
 } from './lib.mjs';
 
 const binary = env('INSITU_VIEW');
@@ -52,26 +52,9 @@ async function orbitTo(page, azimuth, elevation) {
   return options;
 }
 
-/// The frame shown, drawn by the browser from the light field, against the CLI's with the same
-/// options from the light field: its PSNR, which must reach MIN_PSNR_DB, and its pixels.
-async function compareWithCli(page, what) {
-  const displayed = await page.evaluate(() => window.insituViewer.displayed);
-  assert.equal(displayed.gpu, true, `the browser drew ${what}`);
-  assert.equal(displayed.drawnFrom, 'light field', `${what}: from the light field`);
-  const shown = await page.evaluate(() => {
-    const { width, height, data } = window.insituViewer.gpuPixels();
-    return { width, height, data: Array.from(data) };
-  });
-  const expected = decodePng(renderWithCli(binary, archive,
-    { ...displayed.options, source: 'lightfield' }, workDir).colour);
-  assert.equal(expected.channels, 4);
-  const image = { ...shown, data: Uint8Array.from(shown.data) };
-  const psnr = psnrPremultiplied(image, expected);
-  let covered = 0;
-  for (let p = 3; p < expected.data.length; p += 4) covered += expected.data[p] > 8 ? 1 : 0;
-  assert.ok(covered > 0.05 * expected.width * expected.height, 'something to compare');
-  assert.ok(psnr >= MIN_PSNR_DB, `WebGL2 vs C++, ${what}: ${psnr.toFixed(2)} dB`);
-  return { psnr, image };
+/// The frame shown against the CLI's from the light field (lightFieldFrameMatches).
+function compareWithCli(page, what) {
+  return lightFieldFrameMatches(page, binary, archive, workDir, what, MIN_PSNR_DB);
 }
 
 test('orbit views drawn with WebGL2 match insitu-view render --source lightfield', async () => {

@@ -2,13 +2,12 @@
 // prefetched while the user scrubs) and the GPU keeps:
 //  * orbit views from the step's light field (light_field_renderer.js): what
 //    reconstruct_light_field gives without edits, the light field's own colours and
-//    per-segment opacity fades, lit (through the first hit's normals) and occluded as the
-//    frame's recipe says;
+//    per-segment opacity fades; edited (an attenuation light field's a_j), lit and occluded as
+//    the frame's recipe says;
 //  * the stored view and other views from its single-perspective proxies (proxy_renderer.js),
 //    with recolouring, opacity edits, relighting, ambient occlusion and enhancement, as the
 //    frame's recipe (/api/recipe) says.
-// The colour model's frames, edits through a light field and the lighting of an attenuation
-// light field stay with the server's frames.
+// The colour model's frames stay with the server's frames.
 
 import { reorbit } from './camera.js';
 import { DRAG_FRAME_MS, FrameCost } from './frame_cost.js';
@@ -151,10 +150,14 @@ export class GpuFrames {
       this.lastOpen = { key, downloadMs, uploadMs, bytes: lightField.bytes };
     }
     const [width, height] = storedCamera.size;
-    const lit = Boolean(recipe && (recipe.lighting || recipe.ambient_occlusion));
-    const cost = this.cost(lit ? `light field/${Boolean(recipe.lighting)}/` +
-      `${Boolean(recipe.ambient_occlusion)}` : 'light field',
-    FULL_SEARCH_STEPS / PREVIEW_SEARCH_STEPS);
+    const attenuation = Boolean(recipe && recipe.light_field_attenuation);
+    const finished = attenuation ||
+      Boolean(recipe && (recipe.lighting || recipe.ambient_occlusion));
+    // What this GPU cannot finish is the server's frame.
+    if (finished && !this.renderer.finishes(attenuation)) return null;
+    const cost = this.cost(finished ? ['light field', attenuation, recipe.opacity_edited,
+      Boolean(recipe.lighting), Boolean(recipe.ambient_occlusion), Boolean(recipe.enhancement)]
+      .join('/') : 'light field', FULL_SEARCH_STEPS / PREVIEW_SEARCH_STEPS);
     const divisor = dragging ? cost.dragDivisor(width, height, this.dragFrameMs) : 1;
     const preview = divisor > 1;
     const size = [Math.max(1, Math.round(width / divisor)),
@@ -162,7 +165,7 @@ export class GpuFrames {
     const started = performance.now();
     this.renderer.render(reorbit({ ...storedCamera, size }, azimuthDeg, elevationDeg),
       segmentScales, preview ? PREVIEW_SEARCH_STEPS : FULL_SEARCH_STEPS,
-      lit ? (preview ? previewRecipe(recipe, divisor) : recipe) : null);
+      finished ? (preview ? previewRecipe(recipe, divisor) : recipe) : null);
     await this.renderer.finish();
     const milliseconds = performance.now() - started;
     cost.record(preview, milliseconds, size[0] * size[1]);

@@ -13,10 +13,17 @@
 //  3. per segment, the cameras that hold something of the ray blend with renormalised weights;
 //     segments composite front to back, segment s with its opacity scaled: A' = 1 - (1 - A)^k;
 //  4. (BASIS) the target camera's depth of the first hit, its t blended over the cameras that
-//     recorded one (LightFieldReconstruction::depth): what lighting and occlusion read.
+//     recorded one (LightFieldReconstruction::depth): what lighting and occlusion read; with
+//     SAMPLES, per camera around the ray where it was read and its weight (0 for one the ray
+//     passes by), for
+//  5. (ATTENUATION, a pass of its own) attenuation light fields' a_j, read the same way at the
+//     whole-ray first hit and blended over the cameras that see the ray, and the per-interval
+//     mean depth carried into the target camera (the point at that depth along the source
+//     camera's ray, seen from the target), blended with the weights w_k a_jk.
 // The JS side prepends #version, MAX_SEGMENTS, for 8-bit depth DEPTH_CODES, BASIS for the
-// basis of a lit or occluded frame (premultiplied linear RGBA and depth, into textures that
-// proxy_frame.frag.glsl finishes) rather than the canvas's sRGB, and srgb.glsl.
+// basis of a lit, occluded or edited frame (premultiplied linear RGBA and depth, into textures
+// that proxy_edit.frag.glsl and proxy_frame.frag.glsl finish) rather than the canvas's sRGB,
+// SAMPLES, or ATTENUATION and OUTPUTS with draw_buffers.glsl; and srgb.glsl.
 precision highp float;
 precision highp int;
 precision highp sampler2D;
@@ -61,14 +68,32 @@ uniform vec3 uUp;
 uniform vec2 uHalfExtent;  // half width, half height: world units, or tangents
 uniform vec2 uImageSize;
 
-#ifdef BASIS
+#if defined(ATTENUATION)
+// Camera i around the target ray, layer i: (slot + 4096 camera, map x, map y, weight w_k
+// renormalised over the cameras present, 0 where the ray passes by what the camera saw).
+uniform sampler2DArray uSamples;
+// Layer slot * uGroups + g: a_j (then mean depth) of intervals 4g .. 4g + 3 of that camera.
+uniform sampler2DArray uSourceAttenuation;
+uniform sampler2DArray uSourceMeanDepth;
+uniform int uGroups;
+uniform int uFirstGroup;  // outputs 2k and 2k + 1: a and mean depth of group uFirstGroup + k
+#elif defined(BASIS)
 layout(location = 0) out vec4 outColour;  // premultiplied linear RGBA
 layout(location = 1) out vec4 outDepth;   // r: target depth of the first hit, +inf none
-const bool kWholeRayHits = true;
+#ifdef SAMPLES
+layout(location = 2) out vec4 outSample0;  // as uSamples (ATTENUATION) holds them
+layout(location = 3) out vec4 outSample1;
+layout(location = 4) out vec4 outSample2;
+#endif
 #else
 out vec4 outColour;
+#endif
+#ifdef BASIS
+const bool kWholeRayHits = true;
+#else
 const bool kWholeRayHits = false;  // only a single segment reads them
 #endif
+const float kInfinity = uintBitsToFloat(0x7f800000u);
 
 const int TABLE_WIDTH = 1024;
 const float NO_HIT = 1e30;  // +inf of the C++ code, kept finite for the arithmetic
@@ -225,6 +250,76 @@ vec2 sphereChord(vec3 origin, vec3 direction, float radius) {
   return vec2(-b - root, -b + root);
 }
 
+#ifdef ATTENUATION
+void main() {
+  // FBO passes keep the image's rows: texel row y is image row y.
+  ivec2 pixel = ivec2(gl_FragCoord.xy);
+  vec4 samples[3];
+  float seeing = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    samples[i] = texelFetch(uSamples, ivec3(pixel, i), 0);
+    seeing += samples[i].w;
+  }
+  vec4 outputs[OUTPUTS];
+  for (int k = 0; k < OUTPUTS / 2; ++k) {
+    outputs[2 * k] = vec4(0.0);
+    outputs[2 * k + 1] = vec4(kInfinity);
+  }
+  for (int k = 0; k < OUTPUTS / 2 && seeing > 0.0; ++k) {
+    int g = uFirstGroup + k;
+    if (g >= uGroups) break;
+    vec4 aSum = vec4(0.0), weightedDepth = vec4(0.0), depthWeight = vec4(0.0);
+    for (int i = 0; i < 3; ++i) {
+      float w = samples[i].w;
+      if (!(w > 0.0)) continue;
+      int code = int(samples[i].x);
+      int layer = (code % 4096) * uGroups + g;
+      RigCamera c = rigCamera(code / 4096);
+      vec2 map = samples[i].yz;
+      // Bilinear over pixel centres, clamped at the map's edges (bilinear_taps); the mean depth
+      // weighted by w a_j over the taps where it is defined, so empty texels do not pull it.
+      vec2 f = clamp(map - 0.5, vec2(0.0), vec2(float(uMapSize - 1)));
+      ivec2 p0 = ivec2(f);
+      ivec2 p1 = min(p0 + 1, ivec2(uMapSize - 1));
+      vec2 t = f - vec2(p0);
+      ivec2 taps[4] = ivec2[4](p0, ivec2(p1.x, p0.y), ivec2(p0.x, p1.y), p1);
+      float tapWeights[4] = float[4]((1.0 - t.x) * (1.0 - t.y), t.x * (1.0 - t.y),
+                                     (1.0 - t.x) * t.y, t.x * t.y);
+      vec4 a = vec4(0.0), zSum = vec4(0.0), zWeight = vec4(0.0);
+      for (int q = 0; q < 4; ++q) {
+        vec4 aTap = texelFetch(uSourceAttenuation, ivec3(taps[q], layer), 0);
+        vec4 zTap = texelFetch(uSourceMeanDepth, ivec3(taps[q], layer), 0);
+        a += tapWeights[q] * aTap;
+        for (int m = 0; m < 4; ++m) {
+          if (aTap[m] > 0.0 && !isinf(zTap[m]) && !isnan(zTap[m])) {
+            zSum[m] += tapWeights[q] * aTap[m] * zTap[m];
+            zWeight[m] += tapWeights[q] * aTap[m];
+          }
+        }
+      }
+      aSum += w * a;
+      // The source camera's ray through the map position, scaled to unit depth along its
+      // forward axis: the point at mean depth z is eye + z ray.
+      vec2 plane = vec2(2.0 * map.x / float(uMapSize) - 1.0, 1.0 - 2.0 * map.y / float(uMapSize)) *
+                   uMapHalfExtent;
+      vec3 ray = c.forward + plane.x * c.right + plane.y * c.up;
+      for (int m = 0; m < 4; ++m) {
+        if (!(zWeight[m] > 0.0)) continue;
+        float zTarget = dot(c.eye + (zSum[m] / zWeight[m]) * ray - uEye, uForward);
+        weightedDepth[m] += w * a[m] * zTarget;
+        depthWeight[m] += w * a[m];
+      }
+    }
+    aSum /= seeing;
+    outputs[2 * k] = aSum;
+    for (int m = 0; m < 4; ++m) {
+      outputs[2 * k + 1][m] =
+          aSum[m] > 0.0 && depthWeight[m] > 0.0 ? weightedDepth[m] / depthWeight[m] : kInfinity;
+    }
+  }
+  writeOutputs(outputs);
+}
+#else
 void main() {
 #ifdef BASIS
   // Texel row y holds image row y (rows from the top), as the frame pass reads its textures.
@@ -238,7 +333,12 @@ void main() {
   vec3 direction = uPerspective ? normalize(uForward + plane.x * uRight + plane.y * uUp) : uForward;
   outColour = vec4(0.0);
 #ifdef BASIS
-  outDepth = vec4(uintBitsToFloat(0x7f800000u));
+  outDepth = vec4(kInfinity);
+#endif
+#ifdef SAMPLES
+  outSample0 = vec4(0.0);
+  outSample1 = vec4(0.0);
+  outSample2 = vec4(0.0);
 #endif
 
   vec2 chord = sphereChord(origin, direction, uBoundingRadius);
@@ -311,9 +411,21 @@ void main() {
     hitT += weights[i] * hits[i];
   }
   if (hitWeight > 0.0) outDepth.r = dot(origin + (hitT / hitWeight) * direction - uEye, uForward);
+#ifdef SAMPLES
+  vec4 samples[3] = vec4[3](vec4(0.0), vec4(0.0), vec4(0.0));
+  for (int i = 0; i < present; ++i) {
+    vec2 map = project(cameras[i], origin + (hits[i] >= 0.0 ? hits[i] : tCentre) * direction);
+    bool passesBy = hits[i] < 0.0 && recorded(storedDistance(slots[i], map));
+    samples[i] = vec4(float(slots[i] + 4096 * indices[i]), map, passesBy ? 0.0 : weights[i]);
+  }
+  outSample0 = samples[0];
+  outSample1 = samples[1];
+  outSample2 = samples[2];
+#endif
 #else
   // 8-bit sRGB with straight alpha, as write_png stores the server's frames (the canvas is not
   // premultiplied), so the canvas holds the PNG's samples.
   outColour = vec4(a > 0.0 ? linearToSrgb(colour / a) : vec3(0.0), a);
 #endif
 }
+#endif

@@ -1,55 +1,85 @@
 // Draws light-field reconstructions on the client's GPU with WebGL2: the step's light field
 // (light_field_data.js) becomes textures once, then every frame is one full-screen pass of
-// light_field.frag.glsl for the target camera (camera.js). A lit or occluded frame (its recipe,
-// /api/recipe, says so) takes two: the reconstruction's colour and first-hit depth into
-// textures (BASIS), then proxy_frame.frag.glsl lights and occludes them into the canvas, as
-// Explorer::render's finish_frame does a light field's frame. The C++ Explorer stays the
-// reference; tests/viewer/webgl.test.mjs and proxies.test.mjs hold the two to a stated PSNR.
+// light_field.frag.glsl for the target camera (camera.js). A lit, occluded or edited frame (its
+// recipe, /api/recipe, says so) takes more, as Explorer::render's finish_frame makes a light
+// field's frame: the reconstruction's colour and first-hit depth into textures (BASIS); for an
+// attenuation light field also where each camera around the ray was read (SAMPLES), from which
+// a_j and the mean depths follow in the target camera (ATTENUATION), then proxy_edit.frag.glsl's
+// opacity edit; last proxy_frame.frag.glsl recolours, lights, occludes and enhances into the
+// canvas. The C++ Explorer stays the reference; tests/viewer/webgl.test.mjs holds the two to a
+// stated PSNR.
 
-import { MAX_LIGHTS, setFrameTerms } from './frame_terms.js';
+import { setFrameTerms } from './frame_terms.js';
+import { drawOutputs, proxyProgram, proxySources } from './proxy_renderer.js';
 import {
-  buildProgram, frameContext, gpuFinished, readCanvas, shaderText, TextureSet,
+  attachTargets, buildProgram, frameContext, gpuFinished, layerTargets, readCanvas, shaderText,
+  TextureSet,
 } from './webgl.js';
 
 export { webgl2Available } from './webgl.js';
 
 const TABLE_WIDTH = 1024;  // rows of the 1D tables, as the shader reads them
-// Texture units: the light field's own (0-4, see load), then a lit frame's basis and a stand-in
-// for the frame pass's attenuation arrays, which a light field's frame does not read.
-const UNIT = { basisColour: 5, basisDepth: 6, noAttenuation: 7 };
+// Texture units: the light field's own (0-4 and its attenuation, see load), then a frame's
+// basis, the stand-in for optical depth (or attenuation where the light field has none) and
+// what edits read and write in the target camera.
+const UNIT = {
+  sourceAttenuation: 8, sourceMeanDepth: 9, basisColour: 5, basisDepth: 6, none: 7,
+  samples: 10, attenuation: 11, meanDepth: 12, edited: 13,
+};
+// The samples pass writes colour, depth and three cameras' samples.
+const SAMPLE_OUTPUTS = 5;
+const MAX_CAMERAS = 4096;  // a sample packs slot + MAX_CAMERAS * camera into one float exactly
 
 export class LightFieldRenderer {
   /// `canvas`: the element drawn into. Throws when WebGL2 is missing.
   static async create(canvas) {
     const gl = frameContext(canvas);
-    const [vertex, srgb, fragment, frame] = await Promise.all(['fullscreen.vert.glsl',
-      'srgb.glsl', 'light_field.frag.glsl', 'proxy_frame.frag.glsl'].map(shaderText));
-    return new LightFieldRenderer(canvas, gl, vertex, srgb + fragment, srgb + frame);
+    const [vertex, srgb, fragment, drawBuffers] = await Promise.all(['fullscreen.vert.glsl',
+      'srgb.glsl', 'light_field.frag.glsl', 'draw_buffers.glsl'].map(shaderText));
+    // Finishing a frame needs float render targets; without them those frames stay the
+    // server's.
+    const finishes = Boolean(gl.getExtension('EXT_color_buffer_float'));
+    return new LightFieldRenderer(canvas, gl, vertex, srgb + fragment,
+      srgb + drawBuffers + fragment, finishes ? await proxySources() : null);
   }
 
-  constructor(canvas, gl, vertexSource, fragmentSource, frameSource) {
+  constructor(canvas, gl, vertexSource, fragmentSource, attenuationSource, proxySourceSet) {
     this.canvas = canvas;
     this.gl = gl;
     this.vertexSource = vertexSource;
     this.fragmentSource = fragmentSource;
-    this.frameSource = frameSource;
-    this.programs = new Map();  // by "depth bits/max segments/basis"
+    this.attenuationSource = attenuationSource;
+    this.proxySources = proxySourceSet;  // null: frames are not finished here
+    this.outputs = drawOutputs(gl);
+    this.programs = new Map();  // by "depth bits/max segments/mode"
     this.textures = new TextureSet(gl);
-    this.loaded = null;          // {header, maxSegments, setUp, prepared}
+    this.loaded = null;          // {header, maxSegments, groups, hasAttenuation, setUp, prepared}
     this.vertexArray = gl.createVertexArray();
-    // Lit frames need float render targets; without them they stay the server's.
-    this.lightsFrames = Boolean(gl.getExtension('EXT_color_buffer_float'));
     this.framebuffer = gl.createFramebuffer();
-    this.basis = null;           // {width, height}: the basis textures' size
-    this.framePass = null;       // {program, uniform}
+    this.targets = null;         // {width, height, ...}: the textures of a frame's basis
   }
 
-  program(depthBits, maxSegments, basis) {
-    const key = `${depthBits}/${maxSegments}/${basis}`;
+  /// Whether this GPU finishes frames here: lights and occlusion; with `attenuation`, edits and
+  /// the lighting of an attenuation light field too (that takes SAMPLE_OUTPUTS draw buffers and
+  /// the loaded light field's attenuation).
+  finishes(attenuation) {
+    if (!this.proxySources) return false;
+    return !attenuation || (this.outputs >= SAMPLE_OUTPUTS && Boolean(this.loaded) &&
+      this.loaded.hasAttenuation);
+  }
+
+  /// `mode`: 'canvas' (sRGB into the canvas), 'basis' (colour and depth), 'samples' (and the
+  /// cameras' samples) or 'attenuation' (a_j and mean depth from those).
+  program(depthBits, maxSegments, mode) {
+    const key = `${depthBits}/${maxSegments}/${mode}`;
     if (this.programs.has(key)) return this.programs.get(key);
+    const defines = { canvas: '', basis: '#define BASIS\n',
+      samples: '#define BASIS\n#define SAMPLES\n',
+      attenuation: `#define ATTENUATION\n#define OUTPUTS ${this.outputs}\n` }[mode];
     const prefix = `#version 300 es\n#define MAX_SEGMENTS ${maxSegments}\n` +
-      (depthBits === 8 ? '#define DEPTH_CODES\n' : '') + (basis ? '#define BASIS\n' : '');
-    const program = buildProgram(this.gl, prefix, this.vertexSource, this.fragmentSource);
+      (depthBits === 8 ? '#define DEPTH_CODES\n' : '') + defines;
+    const program = buildProgram(this.gl, prefix, this.vertexSource,
+      mode === 'attenuation' ? this.attenuationSource : this.fragmentSource);
     this.programs.set(key, program);
     return program;
   }
@@ -57,21 +87,21 @@ export class LightFieldRenderer {
   release() {
     this.textures.release();
     this.loaded = null;
-    this.basis = null;
+    this.targets = null;
   }
 
-  /// The reconstruction's program (BASIS: a lit frame's basis) with the loaded light field's
-  /// uniforms set, and its uniform look-up.
-  prepared(basis) {
+  /// The program of `mode` (see program) with the loaded light field's uniforms set, and its
+  /// uniform look-up.
+  prepared(mode) {
     const { header, maxSegments, setUp, prepared } = this.loaded;
-    if (!prepared.has(basis)) {
-      const program = this.program(header.depth_bits, maxSegments, basis);
+    if (!prepared.has(mode)) {
+      const program = this.program(header.depth_bits, maxSegments, mode);
       const uniform = (name) => this.gl.getUniformLocation(program, name);
       this.gl.useProgram(program);
       setUp(uniform);
-      prepared.set(basis, { program, uniform });
+      prepared.set(mode, { program, uniform });
     }
-    return prepared.get(basis);
+    return prepared.get(mode);
   }
 
   texture(unit, target) {
@@ -138,9 +168,32 @@ export class LightFieldRenderer {
     gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, TABLE_WIDTH, vertexRows, 0, gl.RGBA, gl.FLOAT,
       vertices);
 
+    // An attenuation light field's a_j and mean depths, four intervals to a texel, layer
+    // slot * groups + g (where this GPU has the layers; else its edits stay the server's).
+    const groups = Math.ceil((header.intervals || 0) / 4);
+    const hasAttenuation = Boolean(lightField.attenuation) && slots * groups <= maxLayers &&
+      header.cameras <= MAX_CAMERAS;
+    if (hasAttenuation) {
+      for (const [unit, plane] of [[UNIT.sourceAttenuation, lightField.attenuation],
+        [UNIT.sourceMeanDepth, lightField.meanDepth]]) {
+        const half = plane.type === 'half';
+        this.texture(unit, gl.TEXTURE_2D_ARRAY);
+        gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, half ? gl.RGBA16F : gl.RGBA32F, n, n,
+          slots * groups, 0, gl.RGBA, half ? gl.HALF_FLOAT : gl.FLOAT, plane.values);
+      }
+    }
+    // The stand-in for arrays a frame pass declares but this frame does not read.
+    this.texture(UNIT.none, gl.TEXTURE_2D_ARRAY);
+    gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.R32F, 1, 1, 1, 0, gl.RED, gl.FLOAT,
+      new Float32Array([0]));
+
     const maxSegments = Math.max(segments, 1);
     // The step's uniforms, set on each program once it is first used for this step.
     const setUp = (uniform) => {
+      gl.uniform1i(uniform('uSamples'), UNIT.samples);
+      gl.uniform1i(uniform('uSourceAttenuation'), UNIT.sourceAttenuation);
+      gl.uniform1i(uniform('uSourceMeanDepth'), UNIT.sourceMeanDepth);
+      gl.uniform1i(uniform('uGroups'), groups);
       gl.uniform1i(uniform('uRgba'), 0);
       gl.uniform1i(uniform('uDepth'), 1);
       gl.uniform1i(uniform('uCameraFrames'), 2);
@@ -160,23 +213,27 @@ export class LightFieldRenderer {
       gl.uniform1f(uniform('uBoundingRadius'), header.bounding_radius);
       gl.uniform1f(uniform('uCameraRadius'), header.camera_radius);
     };
-    this.loaded = { header, maxSegments, setUp, prepared: new Map() };
-    this.prepared(false);
+    this.loaded = { header, maxSegments, groups, hasAttenuation, setUp, prepared: new Map() };
+    this.prepared('canvas');
   }
 
   /// Draws the reconstruction for `camera` (camera.js) with per-segment opacity scales
   /// (missing entries are 1) and `searchSteps` of the coarse depth search (the reference's
   /// LightFieldReconstructionSettings::search_steps); with a `recipe` (/api/recipe,
-  /// light_field) that has lights or occlusion, lit and occluded as it says. Resizes the canvas
-  /// to the camera's image.
+  /// light_field), finished as it says: edited (light_field_attenuation), lit, occluded and
+  /// enhanced. Resizes the canvas to the camera's image.
   render(camera, segmentScales, searchSteps, recipe = null) {
     if (!this.loaded) throw new Error('no light field loaded');
     const gl = this.gl;
     const { maxSegments } = this.loaded;
     const { width, height } = camera;
-    const lit = Boolean(recipe && (recipe.lighting || recipe.ambient_occlusion));
-    if (lit && !this.lightsFrames) {
-      throw new Error('this WebGL2 cannot render to float textures (EXT_color_buffer_float)');
+    const attenuation = Boolean(recipe && recipe.light_field_attenuation);
+    const finished = attenuation ||
+      Boolean(recipe && (recipe.lighting || recipe.ambient_occlusion));
+    if (finished && !this.finishes(attenuation)) {
+      throw new Error(attenuation
+        ? 'this WebGL2 cannot edit through this light field (draw buffers or texture layers)'
+        : 'this WebGL2 cannot render to float textures (EXT_color_buffer_float)');
     }
     if (this.canvas.width !== width || this.canvas.height !== height) {
       this.canvas.width = width;
@@ -184,91 +241,166 @@ export class LightFieldRenderer {
     }
     // The canvas's context is shared with the proxy renderer: take back the units and the
     // framebuffer.
+    if (finished) this.allocateTargets(width, height);
     this.textures.bind();
-    if (lit) {
-      this.bindBasis(width, height);
+    if (finished) {
+      gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
+      const { colour, depth, samples } = this.targets;
+      gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, colour, 0);
+      gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT1, gl.TEXTURE_2D, depth, 0);
+      const buffers = [gl.COLOR_ATTACHMENT0, gl.COLOR_ATTACHMENT1];
+      if (attenuation) {
+        for (let i = 0; i < 3; ++i) {
+          gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT2 + i, samples, 0, i);
+          buffers.push(gl.COLOR_ATTACHMENT2 + i);
+        }
+      }
+      gl.drawBuffers(buffers);
     } else {
       gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     }
     gl.viewport(0, 0, width, height);
-    const { program, uniform } = this.prepared(lit);
+    const { program, uniform } =
+      this.prepared(finished ? (attenuation ? 'samples' : 'basis') : 'canvas');
     gl.useProgram(program);
     const scales = new Float32Array(maxSegments).fill(1);
     segmentScales.slice(0, maxSegments).forEach((s, i) => { scales[i] = s; });
     gl.uniform1fv(uniform('uScales'), scales);
     gl.uniform1i(uniform('uSearchSteps'), searchSteps);
+    this.cameraUniforms(uniform, camera);
+    this.drawQuad();
+    if (!finished) return;
+    attachTargets(gl, [], this.outputs);
+    if (attenuation) {
+      this.reconstructAttenuation(camera);
+      this.editAttenuation(recipe);
+    }
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    this.finishFrame(recipe, camera, attenuation);
+  }
+
+  cameraUniforms(uniform, camera) {
+    const gl = this.gl;
     gl.uniform1i(uniform('uPerspective'), camera.perspective ? 1 : 0);
     gl.uniform3fv(uniform('uEye'), camera.position);
     gl.uniform3fv(uniform('uForward'), camera.forward);
     gl.uniform3fv(uniform('uRight'), camera.right);
     gl.uniform3fv(uniform('uUp'), camera.up);
     gl.uniform2f(uniform('uHalfExtent'), camera.halfWidth, camera.halfHeight);
-    gl.uniform2f(uniform('uImageSize'), width, height);
-    gl.bindVertexArray(this.vertexArray);
-    gl.drawArrays(gl.TRIANGLES, 0, 3);
-    if (lit) this.finishFrame(recipe, camera);
+    gl.uniform2f(uniform('uImageSize'), camera.width, camera.height);
   }
 
-  /// The basis textures (colour, depth) at width x height as the framebuffer's targets.
-  bindBasis(width, height) {
-    const gl = this.gl;
-    if (!this.basis || this.basis.width !== width || this.basis.height !== height) {
-      if (this.basis) {
-        this.textures.remove(this.basis.colour);
-        this.textures.remove(this.basis.depth);
-      } else {
-        this.texture(UNIT.noAttenuation, gl.TEXTURE_2D_ARRAY);
-        gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.R32F, 1, 1, 1, 0, gl.RED, gl.FLOAT,
-          new Float32Array([0]));
-      }
-      const image = (unit, format) => {
-        const texture = this.texture(unit, gl.TEXTURE_2D);
-        gl.texImage2D(gl.TEXTURE_2D, 0, format, width, height, 0,
-          format === gl.RGBA32F ? gl.RGBA : gl.RED, gl.FLOAT, null);
-        return texture;
-      };
-      // Sizes change with the preview's, a few times a drag.
-      this.basis = { width, height, colour: image(UNIT.basisColour, gl.RGBA32F),
-        depth: image(UNIT.basisDepth, gl.R32F) };
-      this.textures.bind();
-    }
-    gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
-    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D,
-      this.basis.colour, 0);
-    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT1, gl.TEXTURE_2D,
-      this.basis.depth, 0);
-    gl.drawBuffers([gl.COLOR_ATTACHMENT0, gl.COLOR_ATTACHMENT1]);
+  drawQuad() {
+    this.gl.bindVertexArray(this.vertexArray);
+    this.gl.drawArrays(this.gl.TRIANGLES, 0, 3);
   }
 
-  /// Lights and occludes the basis into the canvas (proxy_frame.frag.glsl with the light field's
-  /// colour as the "rendering" and its first-hit depth as the front depth).
-  finishFrame(recipe, camera) {
+  /// The textures a finished frame needs at width x height (kept while the size stays; it
+  /// changes with the preview's, a few times a drag).
+  allocateTargets(width, height) {
     const gl = this.gl;
-    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, null, 0);
-    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT1, gl.TEXTURE_2D, null, 0);
-    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    if (!this.framePass) {
-      const prefix = `#version 300 es\n#define MAX_INTERVALS 4\n#define MAX_LIGHTS ${MAX_LIGHTS}\n`;
-      const program = buildProgram(gl, prefix, this.vertexSource, this.frameSource);
-      const locations = new Map();
-      const uniform = (name) => {
-        if (!locations.has(name)) locations.set(name, gl.getUniformLocation(program, name));
-        return locations.get(name);
-      };
-      this.framePass = { program, uniform };
+    if (this.targets && this.targets.width === width && this.targets.height === height) return;
+    if (this.targets) {
+      for (const texture of this.targets.all) this.textures.remove(texture);
     }
-    const { program, uniform: u } = this.framePass;
+    const image = (unit, format) => {
+      const texture = this.texture(unit, gl.TEXTURE_2D);
+      gl.texImage2D(gl.TEXTURE_2D, 0, format, width, height, 0,
+        format === gl.RGBA32F ? gl.RGBA : gl.RED, gl.FLOAT, null);
+      return texture;
+    };
+    const layers = (unit, count) => {
+      const texture = this.texture(unit, gl.TEXTURE_2D_ARRAY);
+      gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA32F, width, height, count, 0, gl.RGBA,
+        gl.FLOAT, null);
+      return texture;
+    };
+    const targets = { width, height, colour: image(UNIT.basisColour, gl.RGBA32F),
+      depth: image(UNIT.basisDepth, gl.R32F) };
+    const groups = this.loaded.groups;
+    if (this.loaded.hasAttenuation && this.outputs >= SAMPLE_OUTPUTS) {
+      Object.assign(targets, { samples: layers(UNIT.samples, 3),
+        attenuation: layers(UNIT.attenuation, groups), meanDepth: layers(UNIT.meanDepth, groups),
+        edited: layers(UNIT.edited, groups) });
+    }
+    targets.all = [targets.colour, targets.depth, targets.samples, targets.attenuation,
+      targets.meanDepth, targets.edited].filter(Boolean);
+    this.targets = targets;
+  }
+
+  /// a_j and mean depths in the target camera from the cameras' samples (ATTENUATION), into
+  /// the packed attenuation and mean-depth textures: groups of four intervals, this.outputs / 2
+  /// of them per draw.
+  reconstructAttenuation(camera) {
+    const gl = this.gl;
+    const { groups } = this.loaded;
+    const { program, uniform } = this.prepared('attenuation');
     gl.useProgram(program);
+    this.cameraUniforms(uniform, camera);
+    const perDraw = Math.floor(this.outputs / 2);
+    for (let first = 0; first < groups; first += perDraw) {
+      gl.uniform1i(uniform('uFirstGroup'), first);
+      const targets = [];
+      for (let k = 0; k < perDraw; ++k) {
+        const g = first + k;
+        targets.push(g < groups ? { texture: this.targets.attenuation, layer: g } : null);
+        targets.push(g < groups ? { texture: this.targets.meanDepth, layer: g } : null);
+      }
+      attachTargets(gl, targets, this.outputs);
+      this.drawQuad();
+    }
+    attachTargets(gl, [], this.outputs);
+  }
+
+  /// a' (proxy_edit.frag.glsl, packed inputs without optical depth, as the Explorer edits a
+  /// light field's a_j), or a copy of a without an opacity edit.
+  editAttenuation(recipe) {
+    const gl = this.gl;
+    const { header, groups } = this.loaded;
+    const intervals = header.intervals;
+    const edit = proxyProgram(gl, this.proxySources, 'edit', 4 * groups, true);
+    gl.useProgram(edit.program);
+    gl.uniform1i(edit.uniform('uAttenuation'), UNIT.attenuation);
+    gl.uniform1i(edit.uniform('uMeanDepth'), UNIT.meanDepth);
+    gl.uniform1i(edit.uniform('uOpticalDepth'), UNIT.none);
+    gl.uniform1i(edit.uniform('uHasOpticalDepth'), 0);
+    gl.uniform1i(edit.uniform('uCopy'), recipe.opacity_edited ? 0 : 1);
+    gl.uniform1i(edit.uniform('uIntervals'), intervals);
+    const scales = new Float32Array(4 * groups).fill(1);
+    (recipe.opacity_scales || []).forEach((s, j) => { scales[j] = s; });
+    gl.uniform1fv(edit.uniform('uScales'), scales);
+    for (let first = 0; first < intervals; first += 4 * this.outputs) {
+      gl.uniform1i(edit.uniform('uFirst'), first);
+      attachTargets(gl, layerTargets(this.targets.edited, first / 4, groups, this.outputs),
+        this.outputs);
+      this.drawQuad();
+    }
+    attachTargets(gl, [], this.outputs);
+  }
+
+  /// The frame into the canvas (proxy_frame.frag.glsl): the light field's colour, or with an
+  /// edit sum_j c_j a'_j; lit through the mean depths of a' where the light field has
+  /// attenuation, else through the first hit's normals; occluded on the first hit's depth;
+  /// enhanced on a'.
+  finishFrame(recipe, camera, attenuation) {
+    const gl = this.gl;
+    const groups = attenuation ? this.loaded.groups : 1;
+    const frame = proxyProgram(gl, this.proxySources, 'frame', 4 * groups, attenuation);
+    const u = frame.uniform;
+    gl.useProgram(frame.program);
     gl.uniform1i(u('uRendering'), UNIT.basisColour);
     gl.uniform1i(u('uFrontDepth'), UNIT.basisDepth);
-    gl.uniform1i(u('uEdited'), UNIT.noAttenuation);
-    gl.uniform1i(u('uMeanDepth'), UNIT.noAttenuation);
-    gl.uniform1i(u('uIntervals'), 0);
-    gl.uniform1i(u('uStoredRendering'), 1);
-    gl.uniform1i(u('uFrontSurfaceLighting'), 1);
+    gl.uniform1i(u('uEdited'), attenuation ? UNIT.edited : UNIT.none);
+    gl.uniform1i(u('uMeanDepth'), attenuation ? UNIT.meanDepth : UNIT.none);
+    gl.uniform1i(u('uIntervals'), attenuation ? this.loaded.header.intervals : 0);
+    // Unedited, the colour is the light field's own.
+    gl.uniform1i(u('uStoredRendering'), recipe.colour_source === 'captured' ? 1 : 0);
+    const colours = new Float32Array(3 * 4 * groups);
+    colours.set((recipe.colours || []).slice(0, colours.length));
+    gl.uniform3fv(u('uColours'), colours);
+    gl.uniform1i(u('uFrontSurfaceLighting'), attenuation ? 0 : 1);
     setFrameTerms(gl, u, recipe, camera, camera.width, camera.height);
-    gl.bindVertexArray(this.vertexArray);
-    gl.drawArrays(gl.TRIANGLES, 0, 3);
+    this.drawQuad();
   }
 
   /// The canvas's RGBA bytes, rows from the top (as a PNG holds them).

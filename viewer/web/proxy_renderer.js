@@ -14,7 +14,8 @@
 import { boundingSphereIn, localMap, storedCamera } from './camera.js';
 import { MAX_LIGHTS, setFrameTerms } from './frame_terms.js';
 import {
-  buildProgram, frameContext, gpuFinished, readCanvas, shaderText, TextureSet,
+  attachTargets, buildProgram, frameContext, gpuFinished, layerTargets, readCanvas, shaderText,
+  TextureSet,
 } from './webgl.js';
 
 // Draw buffers a pass writes at most: 8 halve the draws of 16 intervals where the GPU has them
@@ -32,6 +33,59 @@ const MAX_LAYERS = 32;         // kMaxSynthesisLayers (view_synthesis.cpp)
 
 const programsOf = new WeakMap();  // WebGL2 context -> its programs
 
+/// Draw buffers a pass writes at most on this GPU (MAX_OUTPUTS, or fewer where it has fewer).
+export function drawOutputs(gl) {
+  return Math.min(MAX_OUTPUTS, gl.getParameter(gl.MAX_DRAW_BUFFERS),
+    gl.getParameter(gl.MAX_COLOR_ATTACHMENTS));
+}
+
+/// The passes' shader sources (fetched once): kind -> [vertex source, fragment source].
+export async function proxySources() {
+  const names = ['fullscreen.vert.glsl', 'srgb.glsl', 'view_synthesis.glsl',
+    'proxy_load.frag.glsl', 'proxy_edit.frag.glsl', 'proxy_frame.frag.glsl',
+    'splat_attenuation.vert.glsl', 'splat_attenuation.frag.glsl',
+    'resolve_attenuation.frag.glsl', 'resolve_layers.frag.glsl',
+    'proxy_transmittance.frag.glsl', 'target_ray.glsl', 'draw_buffers.glsl'];
+  const [fullscreen, srgb, synthesis, load, edit, frame, splatVertex, splatFragment, resolve,
+    resolveLayers, transmittance, targetRay, drawBuffers] =
+    await Promise.all(names.map(shaderText));
+  return {
+    load: [fullscreen, load],
+    transmittance: [fullscreen, synthesis + drawBuffers + transmittance],
+    edit: [fullscreen, synthesis + drawBuffers + edit],
+    frame: [fullscreen, srgb + frame],
+    splat: [synthesis + splatVertex, synthesis + splatFragment],
+    resolve: [fullscreen, synthesis + targetRay + drawBuffers + resolve],
+    resolveLayers: [fullscreen, synthesis + targetRay + resolveLayers],
+  };
+}
+
+/// The program of pass `kind` (proxySources) for arrays of `maxIntervals`, `packed` for inputs
+/// four intervals to a texel (a synthesised view's, a light field's): {program, uniform(name)}.
+/// Built once per context, shared by every renderer on it.
+export function proxyProgram(gl, sources, kind, maxIntervals, packed = false) {
+  if (!programsOf.has(gl)) programsOf.set(gl, new Map());
+  const programs = programsOf.get(gl);
+  const outputs = drawOutputs(gl);
+  const key = `${kind}/${maxIntervals}/${packed}`;
+  if (!programs.has(key)) {
+    const prefix = `#version 300 es\n#define MAX_INTERVALS ${maxIntervals}\n` +
+      `#define MAX_LIGHTS ${MAX_LIGHTS}\n#define MAX_LAYERS ${MAX_LAYERS}\n` +
+      `#define OUTPUTS ${outputs}\n` + (packed ? '#define PACKED\n' : '');
+    const [vertex, fragment] = sources[kind];
+    const program = buildProgram(gl, prefix, vertex, fragment);
+    const locations = new Map();
+    programs.set(key, {
+      program,
+      uniform: (name) => {
+        if (!locations.has(name)) locations.set(name, gl.getUniformLocation(program, name));
+        return locations.get(name);
+      },
+    });
+  }
+  return programs.get(key);
+}
+
 // A camera's extent as the shaders take it: half width, half height, 1 for perspective.
 const extentOf = (camera) => [camera.halfWidth, camera.halfHeight, camera.perspective ? 1 : 0];
 
@@ -43,35 +97,14 @@ export class ProxyRenderer {
     if (!gl.getExtension('EXT_color_buffer_float')) {
       throw new Error('this WebGL2 cannot render to float textures (EXT_color_buffer_float)');
     }
-    const names = ['fullscreen.vert.glsl', 'srgb.glsl', 'view_synthesis.glsl',
-      'proxy_load.frag.glsl', 'proxy_edit.frag.glsl', 'proxy_frame.frag.glsl',
-      'splat_attenuation.vert.glsl', 'splat_attenuation.frag.glsl',
-      'resolve_attenuation.frag.glsl', 'resolve_layers.frag.glsl',
-      'proxy_transmittance.frag.glsl', 'target_ray.glsl', 'draw_buffers.glsl'];
-    const [fullscreen, srgb, synthesis, load, edit, frame, splatVertex, splatFragment, resolve,
-      resolveLayers, transmittance, targetRay, drawBuffers] =
-      await Promise.all(names.map(shaderText));
-    // Vertex and fragment source of each program.
-    return new ProxyRenderer(canvas, gl, {
-      load: [fullscreen, load],
-      transmittance: [fullscreen, synthesis + drawBuffers + transmittance],
-      edit: [fullscreen, synthesis + drawBuffers + edit],
-      frame: [fullscreen, srgb + frame],
-      splat: [synthesis + splatVertex, synthesis + splatFragment],
-      resolve: [fullscreen, synthesis + targetRay + drawBuffers + resolve],
-      resolveLayers: [fullscreen, synthesis + targetRay + resolveLayers],
-    });
+    return new ProxyRenderer(canvas, gl, await proxySources());
   }
 
   constructor(canvas, gl, sources) {
     this.canvas = canvas;
     this.gl = gl;
     this.sources = sources;
-    // Programs are the context's, shared by every ProxyRenderer on it (previews use a second).
-    if (!programsOf.has(gl)) programsOf.set(gl, new Map());
-    this.programs = programsOf.get(gl);  // by "kind/max intervals/packed"
-    this.outputs = Math.min(MAX_OUTPUTS, gl.getParameter(gl.MAX_DRAW_BUFFERS),
-      gl.getParameter(gl.MAX_COLOR_ATTACHMENTS));
+    this.outputs = drawOutputs(gl);
     this.textures = new TextureSet(gl);  // of the loaded step
     this.framebuffer = gl.createFramebuffer();
     this.depthBuffer = gl.createRenderbuffer();
@@ -84,24 +117,7 @@ export class ProxyRenderer {
 
   /// The program of `kind` for arrays of `maxIntervals`; `packed`: a synthesised view's inputs.
   program(kind, maxIntervals, packed = false) {
-    const key = `${kind}/${maxIntervals}/${packed}`;
-    if (!this.programs.has(key)) {
-      const prefix = `#version 300 es\n#define MAX_INTERVALS ${maxIntervals}\n` +
-        `#define MAX_LIGHTS ${MAX_LIGHTS}\n#define MAX_LAYERS ${MAX_LAYERS}\n` +
-        `#define OUTPUTS ${this.outputs}\n` +
-        (packed ? '#define PACKED\n' : '');
-      const [vertex, fragment] = this.sources[kind];
-      const program = buildProgram(this.gl, prefix, vertex, fragment);
-      const locations = new Map();
-      this.programs.set(key, {
-        program,
-        uniform: (name) => {
-          if (!locations.has(name)) locations.set(name, this.gl.getUniformLocation(program, name));
-          return locations.get(name);
-        },
-      });
-    }
-    return this.programs.get(key);
+    return proxyProgram(this.gl, this.sources, kind, maxIntervals, packed);
   }
 
   release() {
@@ -258,26 +274,13 @@ export class ProxyRenderer {
 
   /// Attaches `targets[k]` ({texture, layer}; null or missing: none) as colour attachment k.
   attach(targets) {
-    const gl = this.gl;
-    const buffers = [];
-    for (let k = 0; k < this.outputs; ++k) {
-      const target = targets[k];
-      gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0 + k,
-        target ? target.texture : null, 0, target ? target.layer : 0);
-      buffers.push(target ? gl.COLOR_ATTACHMENT0 + k : gl.NONE);
-    }
-    gl.drawBuffers(buffers);
+    attachTargets(this.gl, targets, this.outputs);
   }
 
   /// The targets of one draw over groups of four intervals from `firstGroup`: layers of
   /// `texture`, none past the last of `groups`.
   groupTargets(texture, firstGroup, groups) {
-    const targets = [];
-    for (let k = 0; k < this.outputs; ++k) {
-      const layer = firstGroup + k;
-      targets.push(layer < groups ? { texture, layer } : null);
-    }
-    return targets;
+    return layerTargets(texture, firstGroup, groups, this.outputs);
   }
 
   /// Draws the full-screen pass into `targets` (attach).

@@ -104,6 +104,30 @@ export class TextureSet {
   }
 }
 
+/// Attaches `targets[k]` ({texture, layer} of a texture array; null or missing: none) as colour
+/// attachment k of the bound framebuffer, for k < outputs, and draws into those.
+export function attachTargets(gl, targets, outputs) {
+  const buffers = [];
+  for (let k = 0; k < outputs; ++k) {
+    const target = targets[k];
+    gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0 + k,
+      target ? target.texture : null, 0, target ? target.layer : 0);
+    buffers.push(target ? gl.COLOR_ATTACHMENT0 + k : gl.NONE);
+  }
+  gl.drawBuffers(buffers);
+}
+
+/// The targets of one draw into `outputs` consecutive layers of `texture` from `first`, none
+/// past the last of `layers`.
+export function layerTargets(texture, first, layers, outputs) {
+  const targets = [];
+  for (let k = 0; k < outputs; ++k) {
+    const layer = first + k;
+    targets.push(layer < layers ? { texture, layer } : null);
+  }
+  return targets;
+}
+
 /// The canvas's RGBA bytes, rows from the top (as a PNG holds them).
 export function readCanvas(gl, canvas) {
   const { width, height } = canvas;

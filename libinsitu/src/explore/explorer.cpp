@@ -891,6 +891,32 @@ FrameRecipe Explorer::recipe(const ExploreRequest& request) {
             recipe.ambient_occlusion = occlusion_terms(*request.ambient_occlusion, stored);
         }
     };
+    const TransferFunction stored_tf = archive_->transfer_function(request.step, request.view);
+    const TransferFunction& shown_tf =
+        request.transfer_function ? *request.transfer_function : stored_tf;
+    const ColourModel* model = single->colour_model ? &*single->colour_model : nullptr;
+    const bool edits = request.transfer_function.has_value() || !request.opacity_scales.empty();
+    // An edit's terms over `intervals` (the view's, or the light field's), as finish_frame plans
+    // them; false where the colour model predicts the frame (the client cannot).
+    const auto add_edit = [&](const IntervalSet& intervals) {
+        EditPlan plan = plan_edit(request, stored_tf, shown_tf, intervals, model, where);
+        if (plan.use_model) {
+            recipe.why_not = "the colour model predicts this frame's colours";
+            return false;
+        }
+        recipe.opacity_scales = std::move(plan.scales);
+        recipe.opacity_edited = plan.opacity_edited;
+        recipe.colours = std::move(plan.colours);
+        recipe.colour_source = ColourSource::recompose;
+        return true;
+    };
+    const auto finish = [&] {
+        add_lighting_and_occlusion();
+        if (request.enhancement) validate(*request.enhancement);
+        recipe.enhancement = request.enhancement;
+        recipe.drawable = true;
+        return recipe;
+    };
     if (request.source == ProxySource::automatic) {
         // As render() decides: a light field of the view's field makes other views (the view's
         // proxies filling in where it knows nothing of a ray), unless the frame needs
@@ -898,22 +924,19 @@ FrameRecipe Explorer::recipe(const ExploreRequest& request) {
         const std::string field = archive_->entry(request.step, request.view).field;
         const LightField* light_field =
             recipe.synthesised ? load_light_field(request.step, field, {0}) : nullptr;
-        const bool edits = request.transfer_function.has_value() || !request.opacity_scales.empty();
         const bool needs_attenuation = edits || request.enhancement.has_value();
         if (light_field && !(needs_attenuation && !light_field->settings.attenuation)) {
-            // The client reconstructs the light field's colour and first-hit depth, then lights
-            // (through the front surface's normals) and occludes them. Edits, enhancement and
-            // the lighting of an attenuation light field (light_volume of its reconstructed a_j)
-            // stay the server's.
+            // The client reconstructs the light field's colour and first-hit depth; where
+            // render() reconstructs its a_j and mean depths (edits, lighting, enhancement of an
+            // attenuation light field) those too, then edits, lights (through the mean depths,
+            // else the first hit's normals), occludes and enhances.
             recipe.light_field = true;
-            if (needs_attenuation || (request.lighting && light_field->settings.attenuation)) {
-                recipe.why_not = "the light field's attenuation makes this frame";
-                return recipe;
-            }
+            recipe.light_field_attenuation =
+                light_field->settings.attenuation &&
+                (edits || request.lighting.has_value() || request.enhancement.has_value());
             recipe.colour_source = ColourSource::captured;
-            add_lighting_and_occlusion();
-            recipe.drawable = true;
-            return recipe;
+            if (edits && !add_edit(*light_field->intervals)) return recipe;
+            return finish();
         }
     }
     if (request.ambient_occlusion && single->depth_layers.empty()) {
@@ -923,32 +946,16 @@ FrameRecipe Explorer::recipe(const ExploreRequest& request) {
     }
     recipe.fill_radius_pixels = request.synthesis.hole_fill_radius_pixels;
     // The rest as Explorer::render's proxies_frame and finish_frame decide it.
-    const TransferFunction stored_tf = archive_->transfer_function(request.step, request.view);
-    const TransferFunction& shown_tf =
-        request.transfer_function ? *request.transfer_function : stored_tf;
     recipe.stored_rendering =
         !recipe.synthesised && shows_stored_rendering(*single, asks_stored_tf(request, stored_tf),
                                                       scales_any_opacity(request), request);
-    const ColourModel* model = single->colour_model ? &*single->colour_model : nullptr;
     if (recipe.stored_rendering) {
         recipe.opacity_scales.assign(static_cast<std::size_t>(single->intervals->count()), 1.0);
         recipe.colour_source = ColourSource::stored;
-    } else {
-        EditPlan plan = plan_edit(request, stored_tf, shown_tf, *single->intervals, model, where);
-        if (plan.use_model) {
-            recipe.why_not = "the colour model predicts this frame's colours";
-            return recipe;
-        }
-        recipe.opacity_scales = std::move(plan.scales);
-        recipe.opacity_edited = plan.opacity_edited;
-        recipe.colours = std::move(plan.colours);
-        recipe.colour_source = ColourSource::recompose;
+    } else if (!add_edit(*single->intervals)) {
+        return recipe;
     }
-    add_lighting_and_occlusion();
-    if (request.enhancement) validate(*request.enhancement);
-    recipe.enhancement = request.enhancement;
-    recipe.drawable = true;
-    return recipe;
+    return finish();
 }
 
 std::ostream& operator<<(std::ostream& out, const ExploreRequest& request) {

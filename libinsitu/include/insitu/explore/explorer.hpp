@@ -123,15 +123,18 @@ struct FrameRecipe {
     bool synthesised = false;
     int fill_radius_pixels = 0;
     /// The step's light field makes this view (source auto, another view than the stored one):
-    /// the client reconstructs it (colour and first-hit depth) and applies the lights and
-    /// occlusion below; no edit terms. Set also where it is not drawable, to say why.
+    /// the client reconstructs it (colour and first-hit depth) and applies the terms below.
     bool light_field = false;
+    /// It reconstructs the light field's a_j and mean depths too (an attenuation light field,
+    /// for edits, lighting through them, or enhancement), in the light field's intervals.
+    bool light_field_attenuation = false;
     /// The stored rendering is the colour (the run's own function, unedited; steps 4-5 skipped).
     bool stored_rendering = false;
     std::vector<double> opacity_scales;  ///< s_j as estimate_attenuation applies them; all 1: none
     bool opacity_edited = false;         ///< some s_j != 1
     std::vector<float> colours;          ///< L RGB triples of the shown function (recolour)
-    ColourSource colour_source = ColourSource::recompose;  ///< stored or recompose, as drawn
+    /// stored, captured (a light field's own colour) or recompose, as drawn
+    ColourSource colour_source = ColourSource::recompose;
     /// Lights as the kernels take them (relighting.cl illuminate): direction toward the light,
     /// normalised, or (0, 0, 0) for a headlight (the client puts -forward of its camera there).
     std::optional<LightingSettings> lighting;
