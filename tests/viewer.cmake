@@ -109,6 +109,17 @@ function(viewer_browser_test suite name)
                        TIMEOUT 180)
 endfunction()
 
+# The colour model's frames drawn by the page (WebGL2 through chromium's SwiftShader):
+# colour_model.test.mjs edits opacity on the archive above, which has a model, and compares the
+# canvas with `insitu-view render`.
+add_test(NAME viewer.colour_model
+         COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/colour_model.test.mjs
+         WORKING_DIRECTORY ${viewer_tests_dir})
+set_tests_properties(viewer.colour_model PROPERTIES
+                     FIXTURES_REQUIRED viewer_archive
+                     ENVIRONMENT "${viewer_environment}"
+                     TIMEOUT 180)
+
 # The browser's own frames (WebGL2 through chromium's SwiftShader), on an archive with a light
 # field of 42 cameras at 128^2: webgl.test.mjs compares orbit views (also relit and occluded)
 # with `insitu-view render --source lightfield` and checks the fallback without WebGL2.

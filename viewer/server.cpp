@@ -771,6 +771,10 @@ private:
                                          {"inverse_depth_scale", ao.inverse_depth_scale},
                                          {"inverse_neighbours", ao.inverse_neighbours}};
         }
+        if (recipe.model_clusters > 0) {
+            body["colour_model"] = {{"clusters", recipe.model_clusters},
+                                    {"table", recipe.model_table}};
+        }
         if (recipe.enhancement) {
             body["enhancement"] = {{"lambda", recipe.enhancement->lambda},
                                    {"gamma", recipe.enhancement->gamma}};

@@ -18,6 +18,9 @@
 #include <vector>
 
 #include "explore_options.hpp"
+#include "insitu/archive/archive.hpp"
+#include "insitu/explore/colour_model.hpp"
+#include "insitu/explore/transfer_function_edit.hpp"
 #include "insitu/instrument.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
@@ -475,6 +478,46 @@ TEST_F(ExplorerTest, TheRecipeHoldsTheTermsRenderApplies) {
     bad_enhancement.enhancement = EnhancementSettings{1.0, 0.0};
     testing::expect_error_naming<InvalidArgument>([&] { explorer.recipe(bad_enhancement); },
                                                   "enhancement gamma = 0");
+}
+
+// With a colour model, an opacity edit of the stored colours is the model's (as render()
+// decides for "auto"): the recipe carries its table, which predicts render()'s colours.
+TEST_F(ExplorerTest, TheRecipeCarriesTheColourModelThatPredictsTheFrame) {
+    const TransferFunction tf = *config_.transfer_function;
+    std::vector<ControlPoint> points = tf.rows().front().points;
+    for (ControlPoint& point : points) point.rgba.a = std::min(1.0f, 2.0f * point.rgba.a);
+    config_.training_transfer_functions = {TransferFunction(points, tf.unit_length())};
+    write_steps({1});
+    Explorer explorer(config_.archive);
+    ExploreRequest edited;
+    edited.step = 1;
+    edited.opacity_scales = {{2, 0.5}};
+    const FrameRecipe recipe = explorer.recipe(edited);
+    const ExploreFrame frame = explorer.render(edited);
+    ASSERT_EQ(frame.colour_source, ColourSource::model);
+    EXPECT_TRUE(recipe.drawable) << recipe.why_not;
+    EXPECT_EQ(recipe.colour_source, ColourSource::model);
+    ASSERT_GT(recipe.model_clusters, 0);
+    const ColourModel model =
+        ColourModel::from_table(kIntervals, recipe.model_clusters, recipe.model_table);
+    // The table predicts the frame from its edited attenuation (estimated as render() does).
+    const ArchiveReader reader(config_.archive);
+    const ProxyFrame stored = reader.load(1, 0);
+    const Image edited_attenuation =
+        estimate_attenuation(stored.attenuation, stored.mean_depth,
+                             stored.optical_depth.channels > 0 ? &stored.optical_depth : nullptr,
+                             recipe.opacity_scales, *ComputeDevice::shared());
+    const Image predicted = model.predict(edited_attenuation);
+    ASSERT_EQ(predicted.pixels.size(), frame.colour.pixels.size());
+    for (std::size_t i = 0; i < predicted.pixels.size(); ++i) {
+        ASSERT_NEAR(predicted.pixels[i], frame.colour.pixels[i], 1e-6f) << i;
+    }
+    // Recolouring is recomposed (the model knows only the stored colours).
+    for (ControlPoint& point : points) point.rgba = glm::vec4(1.0f, 0.5f, 0.0f, point.rgba.a);
+    ExploreRequest recoloured = edited;
+    recoloured.transfer_function = TransferFunction(points, tf.unit_length());
+    EXPECT_EQ(explorer.recipe(recoloured).colour_source, ColourSource::recompose);
+    EXPECT_EQ(explorer.recipe(recoloured).model_clusters, 0);
 }
 
 TEST_F(ExplorerTest, StepsWrittenLaterAppearAfterRefresh) {

@@ -1,9 +1,45 @@
-// The terms of a frame's last pass (proxy_frame.frag.glsl: lights, occlusion, enhancement, the
-// camera they are seen from) as a recipe (/api/recipe) gives them, set the same way whether
-// the pass finishes the view's proxies (proxy_renderer.js) or a light field's reconstruction
-// (light_field_renderer.js).
+// The terms of a frame's last pass (proxy_frame.frag.glsl: the colour model, lights,
+// occlusion, enhancement, the camera they are seen from) as a recipe (/api/recipe) gives them,
+// set the same way whether the pass finishes the view's proxies (proxy_renderer.js) or a light
+// field's reconstruction (light_field_renderer.js).
+
+import { nearestTexture } from './webgl.js';
 
 export const MAX_LIGHTS = 16;  // kMaxLights (relighting.hpp)
+
+/// The colour model's table, uploaded to a texture of its own on one unit once per table.
+export class ColourModelTable {
+  constructor(gl, unit) {
+    this.gl = gl;
+    this.unit = unit;
+    this.texture = null;
+    this.table = null;  // the recipe's table now in the texture
+  }
+
+  /// Sets uModel and, for a recipe the model colours (recipe.colour_model: {clusters, table}),
+  /// its texture and uniforms.
+  use(u, recipe) {
+    const gl = this.gl;
+    const model = recipe.colour_source === 'model' ? recipe.colour_model : null;
+    gl.uniform1i(u('uModel'), model ? 1 : 0);
+    gl.uniform1i(u('uModelTable'), this.unit);
+    if (!this.texture) {
+      this.texture = nearestTexture(gl, this.unit, gl.TEXTURE_2D);
+      gl.texImage2D(gl.TEXTURE_2D, 0, gl.R32F, 1, 1, 0, gl.RED, gl.FLOAT, new Float32Array(1));
+    }
+    gl.activeTexture(gl.TEXTURE0 + this.unit);
+    gl.bindTexture(gl.TEXTURE_2D, this.texture);
+    if (!model) return;
+    if (this.table !== model.table) {
+      const rowFloats = model.table.length / model.clusters;
+      gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+      gl.texImage2D(gl.TEXTURE_2D, 0, gl.R32F, rowFloats, model.clusters, 0, gl.RED, gl.FLOAT,
+        Float32Array.from(model.table));
+      this.table = model.table;
+    }
+    gl.uniform1i(u('uModelClusters'), model.clusters);
+  }
+}
 
 /// Sets the uniforms (`u`: name -> location) of `recipe`'s lights, occlusion and enhancement for
 /// `camera` (camera.js) drawn at width x height.

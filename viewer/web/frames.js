@@ -35,7 +35,7 @@ function atStoredView(options) {
 }
 
 // Whether the browser may draw this frame from the view's single-perspective proxies; the
-// frame's recipe then says whether it does (the colour model, for one, is the server's).
+// frame's recipe then says whether it does.
 function proxiesInBrowser() {
   return Boolean(viewer.gpu && viewer.gpu.proxyRenderer && $('gpu-toggle').checked &&
     state.info && state.info.camera);

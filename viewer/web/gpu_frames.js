@@ -7,7 +7,7 @@
 //  * the stored view and other views from its single-perspective proxies (proxy_renderer.js),
 //    with recolouring, opacity edits, relighting, ambient occlusion and enhancement, as the
 //    frame's recipe (/api/recipe) says.
-// The colour model's frames stay with the server's frames.
+// Frames of the colour model are drawn here too: the recipe carries its table.
 
 import { reorbit } from './camera.js';
 import { DRAG_FRAME_MS, FrameCost } from './frame_cost.js';

@@ -9,7 +9,7 @@
 // canvas. The C++ Explorer stays the reference; tests/viewer/webgl.test.mjs holds the two to a
 // stated PSNR.
 
-import { setFrameTerms } from './frame_terms.js';
+import { ColourModelTable, setFrameTerms } from './frame_terms.js';
 import { drawOutputs, proxyProgram, proxySources } from './proxy_renderer.js';
 import {
   attachTargets, buildProgram, frameContext, gpuFinished, layerTargets, readCanvas, shaderText,
@@ -24,7 +24,7 @@ const TABLE_WIDTH = 1024;  // rows of the 1D tables, as the shader reads them
 // what edits read and write in the target camera.
 const UNIT = {
   sourceAttenuation: 8, sourceMeanDepth: 9, basisColour: 5, basisDepth: 6, none: 7,
-  samples: 10, attenuation: 11, meanDepth: 12, edited: 13,
+  samples: 10, attenuation: 11, meanDepth: 12, edited: 13, modelTable: 14,
 };
 // The samples pass writes colour, depth and three cameras' samples.
 const SAMPLE_OUTPUTS = 5;
@@ -57,6 +57,7 @@ export class LightFieldRenderer {
     this.vertexArray = gl.createVertexArray();
     this.framebuffer = gl.createFramebuffer();
     this.targets = null;         // {width, height, ...}: the textures of a frame's basis
+    this.modelTable = new ColourModelTable(gl, UNIT.modelTable);
   }
 
   /// Whether this GPU finishes frames here: lights and occlusion; with `attenuation`, edits and
@@ -379,7 +380,7 @@ export class LightFieldRenderer {
   }
 
   /// The frame into the canvas (proxy_frame.frag.glsl): the light field's colour, or with an
-  /// edit sum_j c_j a'_j; lit through the mean depths of a' where the light field has
+  /// edit sum_j c_j a'_j or the colour model's prediction; lit through the mean depths of a' where the light field has
   /// attenuation, else through the first hit's normals; occluded on the first hit's depth;
   /// enhanced on a'.
   finishFrame(recipe, camera, attenuation) {
@@ -399,6 +400,7 @@ export class LightFieldRenderer {
     colours.set((recipe.colours || []).slice(0, colours.length));
     gl.uniform3fv(u('uColours'), colours);
     gl.uniform1i(u('uFrontSurfaceLighting'), attenuation ? 0 : 1);
+    this.modelTable.use(u, recipe);
     setFrameTerms(gl, u, recipe, camera, camera.width, camera.height);
     this.drawQuad();
   }

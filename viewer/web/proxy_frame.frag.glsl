@@ -1,7 +1,9 @@
 // The stored view's frame from its single-perspective proxies, per pixel: Explorer::render's
 // steps 5-7 (libinsitu/include/insitu/explore/explorer.hpp) as the reference kernels compute
 // them, with the frame's terms from /api/recipe (FrameRecipe):
-//  5. colour: the stored rendering, or sum_j c_j a'_j (recolour, transfer_function_edit.cl);
+//  5. colour: the stored rendering, or sum_j c_j a'_j (recolour, transfer_function_edit.cl), or
+//     the colour model's prediction from a' (uModel; colour_model.cl: the nearest centroid,
+//     Eq. 10, then c = c0 + J (a' - a0), Eq. 8, clamped to [0, alpha]);
 //  6. lighting: colour.rgb *= lit.rgb / lit.a, lit = light_volume of a' with white interval
 //     colours (relighting.cl, normals from each interval's mean depth); or, for a light field's
 //     colours without attenuation (uFrontSurfaceLighting), relighting.cl's shade through the
@@ -22,6 +24,9 @@ uniform sampler2D uFrontDepth;      // front-most depth (layers, or a light fiel
 uniform int uIntervals;
 uniform bool uStoredRendering;
 uniform vec3 uColours[MAX_INTERVALS];
+uniform bool uModel;
+uniform sampler2D uModelTable;  // row k: a0 (L), c0 (RGB), J (3 x L, row-major by component)
+uniform int uModelClusters;
 // The camera as camera_axes() packs it: forward, right, up, and (half width, half height,
 // 1 for perspective / 0 for orthographic).
 uniform vec3 uForward;
@@ -51,6 +56,43 @@ float editedAttenuation(ivec2 p, int j) {
 
 bool inside(ivec2 p) {
   return p.x >= 0 && p.y >= 0 && p.x < uImageSize.x && p.y < uImageSize.y;
+}
+
+// --- colour_model.cl predict_colour ---
+float modelEntry(int cluster, int i) {
+  return texelFetch(uModelTable, ivec2(i, cluster), 0).r;
+}
+
+vec4 predictColour(ivec2 p) {
+  float a[MAX_INTERVALS];
+  float alpha = 0.0;
+  for (int j = 0; j < uIntervals; ++j) {
+    a[j] = editedAttenuation(p, j);
+    alpha += a[j];
+  }
+  if (!(alpha > 0.0)) return vec4(0.0);
+  int best = 0;
+  float bestDistance = kInfinity;
+  for (int k = 0; k < uModelClusters; ++k) {
+    float distance = 0.0;
+    for (int j = 0; j < uIntervals; ++j) {
+      float d = a[j] - modelEntry(k, j);
+      distance += d * d;
+    }
+    if (distance < bestDistance) {
+      bestDistance = distance;
+      best = k;
+    }
+  }
+  vec3 colour;
+  for (int ch = 0; ch < 3; ++ch) {
+    float c = modelEntry(best, uIntervals + ch);
+    for (int j = 0; j < uIntervals; ++j) {
+      c += modelEntry(best, uIntervals + 3 + ch * uIntervals + j) * (a[j] - modelEntry(best, j));
+    }
+    colour[ch] = clamp(c, 0.0, alpha);
+  }
+  return vec4(colour, alpha);
 }
 
 // --- relighting.cl: pixel frames, finite differences and silhouettes ---
@@ -284,6 +326,8 @@ void main() {
   vec4 colour = vec4(0.0);
   if (uStoredRendering) {
     colour = texelFetch(uRendering, p, 0);
+  } else if (uModel) {
+    colour = predictColour(p);
   } else {
     for (int j = 0; j < uIntervals; ++j) colour += editedAttenuation(p, j) * vec4(uColours[j], 1.0);
   }

@@ -12,7 +12,7 @@
 // PSNR.
 
 import { boundingSphereIn, localMap, storedCamera } from './camera.js';
-import { MAX_LIGHTS, setFrameTerms } from './frame_terms.js';
+import { ColourModelTable, MAX_LIGHTS, setFrameTerms } from './frame_terms.js';
 import {
   attachTargets, buildProgram, frameContext, gpuFinished, layerTargets, readCanvas, shaderText,
   TextureSet,
@@ -27,7 +27,7 @@ const SPLAT_MARGIN = 2;        // pixels around the synthesised target (splat_at
 const UNIT = {
   attenuation: 0, meanDepth: 1, opticalDepth: 2, layers: 3, rendering: 4, frontDepth: 5,
   edited: 6, sourceTotal: 7, synthesisedAttenuation: 8, synthesisedMeanDepth: 9, splat: 10,
-  synthesisedFrontDepth: 11, transmittance: 12,
+  synthesisedFrontDepth: 11, transmittance: 12, modelTable: 13,
 };
 const MAX_LAYERS = 32;         // kMaxSynthesisLayers (view_synthesis.cpp)
 
@@ -113,6 +113,7 @@ export class ProxyRenderer {
     this.pointArray = gl.createVertexArray();
     this.pointBuffer = gl.createBuffer();
     this.loaded = null;         // {header, maxIntervals, groups}
+    this.modelTable = new ColourModelTable(gl, UNIT.modelTable);
   }
 
   /// The program of `kind` for arrays of `maxIntervals`; `packed`: a synthesised view's inputs.
@@ -484,6 +485,7 @@ export class ProxyRenderer {
     colours.set(recipe.colours.slice(0, 3 * maxIntervals));
     gl.uniform3fv(u('uColours'), colours);
     gl.uniform1i(u('uFrontSurfaceLighting'), 0);
+    this.modelTable.use(u, recipe);
     setFrameTerms(gl, u, recipe, camera, width, height);
     this.drawQuad();
   }

@@ -897,18 +897,17 @@ FrameRecipe Explorer::recipe(const ExploreRequest& request) {
     const ColourModel* model = single->colour_model ? &*single->colour_model : nullptr;
     const bool edits = request.transfer_function.has_value() || !request.opacity_scales.empty();
     // An edit's terms over `intervals` (the view's, or the light field's), as finish_frame plans
-    // them; false where the colour model predicts the frame (the client cannot).
+    // them: recomposed from the shown function's colours, or predicted by the colour model.
     const auto add_edit = [&](const IntervalSet& intervals) {
         EditPlan plan = plan_edit(request, stored_tf, shown_tf, intervals, model, where);
-        if (plan.use_model) {
-            recipe.why_not = "the colour model predicts this frame's colours";
-            return false;
-        }
         recipe.opacity_scales = std::move(plan.scales);
         recipe.opacity_edited = plan.opacity_edited;
         recipe.colours = std::move(plan.colours);
-        recipe.colour_source = ColourSource::recompose;
-        return true;
+        recipe.colour_source = plan.use_model ? ColourSource::model : ColourSource::recompose;
+        if (plan.use_model) {
+            recipe.model_clusters = model->clusters();
+            recipe.model_table = model->table();
+        }
     };
     const auto finish = [&] {
         add_lighting_and_occlusion();
@@ -935,7 +934,7 @@ FrameRecipe Explorer::recipe(const ExploreRequest& request) {
                 light_field->settings.attenuation &&
                 (edits || request.lighting.has_value() || request.enhancement.has_value());
             recipe.colour_source = ColourSource::captured;
-            if (edits && !add_edit(*light_field->intervals)) return recipe;
+            if (edits) add_edit(*light_field->intervals);
             return finish();
         }
     }
@@ -952,8 +951,8 @@ FrameRecipe Explorer::recipe(const ExploreRequest& request) {
     if (recipe.stored_rendering) {
         recipe.opacity_scales.assign(static_cast<std::size_t>(single->intervals->count()), 1.0);
         recipe.colour_source = ColourSource::stored;
-    } else if (!add_edit(*single->intervals)) {
-        return recipe;
+    } else {
+        add_edit(*single->intervals);
     }
     return finish();
 }

@@ -114,8 +114,8 @@ struct FrameRecipe {
     /// Whether the client can draw the frame as render() makes it: from the view's
     /// single-perspective proxies with attenuation (and, for occlusion, depth layers), or from
     /// the step's light field (`light_field`), with a colour the terms below determine; else
-    /// `why_not` says what the client cannot draw (another source, the light field's
-    /// attenuation, the colour model) and the client asks for the frame instead.
+    /// `why_not` says what the client cannot draw (another source, ambient occlusion without
+    /// layers) and the client asks for the frame instead.
     bool drawable = false;
     std::string why_not;
     /// Another view than the stored one: its attenuation (and, for occlusion, its layers) are
@@ -133,8 +133,12 @@ struct FrameRecipe {
     std::vector<double> opacity_scales;  ///< s_j as estimate_attenuation applies them; all 1: none
     bool opacity_edited = false;         ///< some s_j != 1
     std::vector<float> colours;          ///< L RGB triples of the shown function (recolour)
-    /// stored, captured (a light field's own colour) or recompose, as drawn
+    /// stored, captured (a light field's own colour), recompose or model, as drawn
     ColourSource colour_source = ColourSource::recompose;
+    /// For colour_source model: the colour model's K and table (ColourModel::table), which
+    /// predicts the colour from a' (seed 000 Eqs. 8 and 10).
+    int model_clusters = 0;
+    std::vector<float> model_table;
     /// Lights as the kernels take them (relighting.cl illuminate): direction toward the light,
     /// normalised, or (0, 0, 0) for a headlight (the client puts -forward of its camera there).
     std::optional<LightingSettings> lighting;
