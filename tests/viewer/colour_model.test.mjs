@@ -64,11 +64,12 @@ test('the colour model predicts the page\'s frames as it does the engine\'s', as
   assert.equal(recipe.colour_model.table.length,
     recipe.colour_model.clusters * (4 * (info.intervals.length - 1) + 3));
 
-  const orbit = await step('opacity edit (model), 20 degree orbit', 'synthesised view', async () => {
+  const orbitBy20 = async () => {
     await page.fill('#azimuth', String(Math.round(info.azimuth + 20)));
     await page.fill('#elevation', String(Math.round(info.elevation)));
     await page.dispatchEvent('#elevation', 'change');
-  });
+  };
+  const orbit = await step('opacity edit (model), 20 degree orbit', 'synthesised view', orbitBy20);
   assert.equal(orbit.colourSource, 'model');
   await step('... relit', 'synthesised view', () => page.check('#light-on'));
 

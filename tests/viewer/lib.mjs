@@ -263,7 +263,9 @@ export function serverAndBrowser(binary, archive) {
   });
   after(async () => {
     if (session.browser) await session.browser.close();
-    if (session.server) assert.equal(await stopServer(session.server), 0, 'serve exits 0 on SIGTERM');
+    if (session.server) {
+      assert.equal(await stopServer(session.server), 0, 'serve exits 0 on SIGTERM');
+    }
   });
   return session;
 }

@@ -380,9 +380,9 @@ export class LightFieldRenderer {
   }
 
   /// The frame into the canvas (proxy_frame.frag.glsl): the light field's colour, or with an
-  /// edit sum_j c_j a'_j or the colour model's prediction; lit through the mean depths of a' where the light field has
-  /// attenuation, else through the first hit's normals; occluded on the first hit's depth;
-  /// enhanced on a'.
+  /// edit sum_j c_j a'_j or the colour model's prediction; lit through the mean depths of a'
+  /// where the light field has attenuation, else through the first hit's normals; occluded on
+  /// the first hit's depth; enhanced on a'.
   finishFrame(recipe, camera, attenuation) {
     const gl = this.gl;
     const groups = attenuation ? this.loaded.groups : 1;
