@@ -734,6 +734,8 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
     };
     // A candidate's proxies as compute_field makes them, and what its accuracy is measured with.
     struct CandidateProxies {
+        int count = 0;
+        IntervalMode mode = IntervalMode::uniform;
         ViewRecord view;
         std::vector<double> scales;
         std::vector<float> colours;
@@ -741,12 +743,11 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
     };
     // Encodes the candidate at `precision`, reads it back as a reader would, and measures the
     // held-out edit in every measured view.
-    const auto measure = [&](const CandidateProxies& proxies, int count, IntervalMode mode,
-                             StoragePrecision precision) {
+    const auto measure = [&](const CandidateProxies& proxies, StoragePrecision precision) {
         BudgetRecord candidate;
         candidate.field = plan.name;
-        candidate.intervals = count;
-        candidate.interval_mode = mode;
+        candidate.intervals = proxies.count;
+        candidate.interval_mode = proxies.mode;
         candidate.precision = precision;
         StepRecord record;
         record.field = plan.name;
@@ -796,6 +797,8 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
         const auto start = Clock::now();
         ProxyFrame frame = renderer->render(camera, request);
         CandidateProxies proxies;
+        proxies.count = count;
+        proxies.mode = mode;
         proxies.pass_ms = 1e3 * seconds_since(start);
         proxies.scales = opacity_scales(plan.transfer_function, held_out, *request.intervals);
         proxies.colours = interval_colours(held_out, *request.intervals);
@@ -805,7 +808,7 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
         proxies.view.view = view;
         proxies.view.transfer_function = plan.transfer_function;
         proxies.view.single = std::move(frame);
-        measured.push_back(measure(proxies, count, mode, first_precision));
+        measured.push_back(measure(proxies, first_precision));
         const BudgetRecord& candidate = measured.back();
         if (budget.chooses_precision && affordable(candidate) &&
             candidate.psnr_db > most_accurate_db) {
@@ -814,12 +817,7 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
         }
     }
     if (most_accurate && std::none_of(measured.begin(), measured.end(), meets)) {
-        const auto of_it = std::find_if(measured.begin(), measured.end(), [&](const auto& c) {
-            return affordable(c) && c.psnr_db == most_accurate_db;
-        });
-        const int count = of_it->intervals;
-        const IntervalMode mode = of_it->interval_mode;
-        measured.push_back(measure(*most_accurate, count, mode, StoragePrecision::single));
+        measured.push_back(measure(*most_accurate, StoragePrecision::single));
     }
     // With an accuracy asked: the cheapest (bytes, then time) that meets every limit. Else (or
     // without one: only cost limits) the cheapest of the affordable ones within
