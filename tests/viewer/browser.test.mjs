@@ -189,6 +189,12 @@ test('the page walks through steps, orbit, opacity, colour, AO and the mask', as
   const expectedMask = decodePng(cli.mask);
   assert.equal(differingSamples(served, expectedMask), 0, 'mask equals render --mask');
   assert.ok(served.data.some((c) => c < 255), 'a synthesised view has untrusted pixels');
+  const overlaid = await page.evaluate(() => ({ from: window.insituViewer.maskFrom,
+    confidence: Array.from(window.insituViewer.maskConfidence) }));
+  assert.equal(overlaid.from, 'server');
+  assert.equal(overlaid.confidence.length, served.width * served.height);
+  assert.ok(overlaid.confidence.every((c, p) => c === served.data[p * served.channels]),
+    'the overlay shows the served mask');
 
   // The trusted range is measured and drawn.
   await page.waitForSelector('#trusted-range', { state: 'attached', timeout: 20000 });

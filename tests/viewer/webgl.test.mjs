@@ -9,8 +9,8 @@ import assert from 'node:assert/strict';
 import { after, before, test } from 'node:test';
 
 import {
-  CHROMIUM, env, lightFieldFrameMatches, loadPlaywright, makeWorkDir, openViewerPage,
-  startServer, stopServer, waitForSettledFrame, WEBGL_ARGS,
+  CHROMIUM, decodePng, env, lightFieldFrameMatches, loadPlaywright, makeWorkDir, openViewerPage,
+  renderWithCli, startServer, stopServer, waitForSettledFrame, WEBGL_ARGS,
 } from './lib.mjs';
 
 const binary = env('INSITU_VIEW');
@@ -88,6 +88,34 @@ test('orbit views drawn with WebGL2 match insitu-view render --source lightfield
   const occluded = await compareWithCli(page, 'relit + AO');
   assert.ok(occluded.image.data.some((v, i) => v !== relit.image.data[i]), 'occlusion shows');
   results.push(`relit + AO: ${occluded.psnr.toFixed(1)} dB`);
+
+  // The confidence overlay of a light-field frame: reconstructed by the page as well, against
+  // `render --mask` from the light field (8-bit grey).
+  const masks = await page.evaluate(() => window.insituViewer.maskCount || 0);
+  await page.check('#mask-toggle');
+  await page.waitForFunction((n) => (window.insituViewer.maskCount || 0) > n, masks);
+  const overlay = await page.evaluate(() => ({ from: window.insituViewer.maskFrom,
+    confidence: Array.from(window.insituViewer.maskConfidence),
+    options: window.insituViewer.displayed.options }));
+  assert.equal(overlay.from, 'browser', 'the page computes a light-field frame\'s confidence');
+  const expectedMask = decodePng(renderWithCli(binary, archive,
+    { ...overlay.options, source: 'lightfield' }, workDir).mask);
+  assert.equal(overlay.confidence.length, expectedMask.width * expectedMask.height);
+  let worst = 0;
+  let sum = 0;
+  let untrusted = 0;
+  overlay.confidence.forEach((c, p) => {
+    const d = Math.abs(c - expectedMask.data[p * expectedMask.channels]);
+    worst = Math.max(worst, d);
+    sum += d;
+    if (c < 128) ++untrusted;
+  });
+  const meanDifference = sum / overlay.confidence.length;
+  results.push(`confidence: mean difference ${meanDifference.toFixed(3)}, at most ${worst} of 255`);
+  assert.ok(untrusted > 0, 'some pixels are not trusted');
+  // Measured: at most 1 of 255 apart (float against double, then 8 bits).
+  assert.ok(meanDifference < 0.05 && worst <= 2,
+    `confidence against render --mask: mean ${meanDifference}, worst ${worst}`);
   console.log(`WebGL2 light field vs insitu-view render: ${results.join(', ')}`);
   const opened = await page.evaluate(() => window.insituViewer.gpu.lastOpen);
   console.log(`step opened in ${(opened.downloadMs + opened.uploadMs).toFixed(0)} ms ` +

@@ -242,27 +242,51 @@ export async function updateMask() {
   const canvas = $('mask-overlay');
   canvas.hidden = !state.mask;
   if (!state.mask || !viewer.displayed) return;
-  const options = viewer.displayed.options;
-  // A frame drawn here from the light field has the light field's confidence; one of the stored
-  // view has the engine's (its edits' trust included).
-  const source = viewer.displayed.drawnFrom === 'light field' ? { source: 'lightfield' } : {};
-  const response = await fetch('api/mask',
-    { method: 'POST', body: new URLSearchParams({ ...options, ...source, session }) });
-  if (!response.ok || !sameOptions(options, viewer.displayed.options)) return;
-  const bitmap = await createImageBitmap(await response.blob());
-  canvas.width = bitmap.width;
-  canvas.height = bitmap.height;
-  const context = canvas.getContext('2d', { willReadFrequently: true });
-  context.drawImage(bitmap, 0, 0);
+  const displayed = viewer.displayed;
+  const options = displayed.options;
+  let confidence = null;  // per pixel as the mask PNG holds it (sRGB-encoded), rows from the top
+  let width = 0;
+  let height = 0;
+  if (displayed.drawnFrom === 'light field' && displayed.colourSource === 'captured') {
+    // Unedited, the frame's confidence is the light field's, which the page reconstructs too.
+    const entry = state.timeline[state.stepIndex];
+    confidence = await viewer.gpu.lightFieldConfidence(entry.step, state.view, state.info.camera,
+      Number(options.azimuth), Number(options.elevation));
+    [width, height] = state.info.camera.size;
+    viewer.maskFrom = 'browser';
+  }
+  if (!confidence) {
+    // Else the engine's mask of the frame shown (its edits' trust included); a frame drawn here
+    // from the light field has the light field's confidence.
+    const source = displayed.drawnFrom === 'light field' ? { source: 'lightfield' } : {};
+    const response = await fetch('api/mask',
+      { method: 'POST', body: new URLSearchParams({ ...options, ...source, session }) });
+    if (!response.ok) return;
+    const bitmap = await createImageBitmap(await response.blob());
+    ({ width, height } = bitmap);
+    const scratch = document.createElement('canvas');
+    scratch.width = width;
+    scratch.height = height;
+    const context = scratch.getContext('2d', { willReadFrequently: true });
+    context.drawImage(bitmap, 0, 0);
+    const grey = context.getImageData(0, 0, width, height).data;
+    confidence = new Uint8Array(width * height);
+    for (let p = 0; p < confidence.length; ++p) confidence[p] = grey[4 * p];
+    viewer.maskFrom = 'server';
+  }
+  if (!sameOptions(options, viewer.displayed.options)) return;
+  canvas.width = width;
+  canvas.height = height;
+  const context = canvas.getContext('2d');
   // Untrusted pixels in red, as opaque as they are untrusted; trusted ones clear.
-  const pixels = context.getImageData(0, 0, canvas.width, canvas.height);
-  for (let i = 0; i < pixels.data.length; i += 4) {
-    const untrusted = 255 - pixels.data[i];
-    pixels.data[i] = 255;
-    pixels.data[i + 1] = 40;
-    pixels.data[i + 2] = 40;
-    pixels.data[i + 3] = Math.round(untrusted * 0.7);
+  const pixels = context.createImageData(width, height);
+  for (let p = 0; p < confidence.length; ++p) {
+    pixels.data[4 * p] = 255;
+    pixels.data[4 * p + 1] = 40;
+    pixels.data[4 * p + 2] = 40;
+    pixels.data[4 * p + 3] = Math.round((255 - confidence[p]) * 0.7);
   }
   context.putImageData(pixels, 0, 0);
+  viewer.maskConfidence = confidence;  // for tests
   viewer.maskCount = (viewer.maskCount || 0) + 1;
 }

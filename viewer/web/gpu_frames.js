@@ -114,6 +114,21 @@ export class GpuFrames {
     return { milliseconds, uploadMs, preview: coarse, size: camera.size };
   }
 
+  /// The confidence (bytes as the mask PNGs hold it, rows from the top) of the reconstruction of
+  /// (step, view) from `storedCamera` reorbited to the angles, in full; null without a light
+  /// field.
+  async lightFieldConfidence(step, view, storedCamera, azimuthDeg, elevationDeg) {
+    const key = `${step}/${view}`;
+    const { lightField } = await this.lightField(step, view);
+    if (!lightField) return null;
+    if (this.uploaded !== key) {
+      this.renderer.load(lightField);
+      this.uploaded = key;
+    }
+    return this.renderer.confidence(reorbit(storedCamera, azimuthDeg, elevationDeg),
+      FULL_SEARCH_STEPS);
+  }
+
   lightField(step, view) {
     return cached(this.cache, `${step}/${view}`, () => fetchLightField(step, view))
       .then(({ value, downloadMs }) => ({ lightField: value, downloadMs }));

@@ -23,7 +23,9 @@
 // The JS side prepends #version, MAX_SEGMENTS, for 8-bit depth DEPTH_CODES, BASIS for the
 // basis of a lit, occluded or edited frame (premultiplied linear RGBA and depth, into textures
 // that proxy_edit.frag.glsl and proxy_frame.frag.glsl finish) rather than the canvas's sRGB,
-// SAMPLES, or ATTENUATION and OUTPUTS with draw_buffers.glsl; and srgb.glsl.
+// SAMPLES, or ATTENUATION and OUTPUTS with draw_buffers.glsl; CONFIDENCE for the per-pixel
+// confidence (the header's, sRGB-encoded as the mask PNGs are) in the red channel instead of the
+// colour; and srgb.glsl.
 precision highp float;
 precision highp int;
 precision highp sampler2D;
@@ -58,6 +60,8 @@ uniform float uScales[MAX_SEGMENTS];
 uniform vec3 uCenter;
 uniform float uBoundingRadius;
 uniform float uCameraRadius;
+uniform float uCameraSpacing;  // mean angle between neighbouring icosphere vertices (radians)
+uniform float uDepthThreshold; // the light field's first-hit opacity
 
 // The target camera (Camera::ray).
 uniform bool uPerspective;
@@ -88,7 +92,7 @@ layout(location = 4) out vec4 outSample2;
 #else
 out vec4 outColour;
 #endif
-#ifdef BASIS
+#if defined(BASIS) || defined(CONFIDENCE)
 const bool kWholeRayHits = true;
 #else
 const bool kWholeRayHits = false;  // only a single segment reads them
@@ -321,8 +325,9 @@ void main() {
 }
 #else
 void main() {
-#ifdef BASIS
-  // Texel row y holds image row y (rows from the top), as the frame pass reads its textures.
+#if defined(BASIS) || defined(CONFIDENCE)
+  // Texel row y holds image row y (rows from the top), as the frame pass (and the confidence's
+  // read-back) reads its textures.
   vec2 pixel = gl_FragCoord.xy;
 #else
   // gl_FragCoord's y runs up; the image's rows run down.
@@ -339,6 +344,9 @@ void main() {
   outSample0 = vec4(0.0);
   outSample1 = vec4(0.0);
   outSample2 = vec4(0.0);
+#endif
+#ifdef CONFIDENCE
+  outColour = vec4(1.0);  // nothing can be where the ray misses the bounding sphere
 #endif
 
   vec2 chord = sphereChord(origin, direction, uBoundingRadius);
@@ -366,6 +374,9 @@ void main() {
     presentWeight += aroundWeights[i];
     ++present;
   }
+#ifdef CONFIDENCE
+  outColour = vec4(0.0, 0.0, 0.0, 1.0);  // nothing known of this ray
+#endif
   if (present == 0) return;
 
   RigCamera cameras[3];
@@ -379,6 +390,10 @@ void main() {
 
   vec3 colour = vec3(0.0);
   float transmittance = 1.0;
+  float unscaledTransmittance = 1.0;
+  // Each camera's own colour of the ray: its segments read and composited, unscaled.
+  vec4 cameraColour[3] = vec4[3](vec4(0.0), vec4(0.0), vec4(0.0));
+  float cameraTransmittance[3] = float[3](1.0, 1.0, 1.0);
   for (int s = 0; s < uSegments; ++s) {
     vec4 blended = vec4(0.0);
     float segmentWeight = 0.0;
@@ -387,8 +402,11 @@ void main() {
       float hit = uSegments > 1 ? firstHit(cameras[i], layer, origin, direction, t0, t1) : hits[i];
       vec2 map = project(cameras[i], origin + (hit >= 0.0 ? hit : tCentre) * direction);
       if (hit < 0.0 && recorded(storedDistance(layer, map))) continue;  // passes it by
-      blended += weights[i] * bilinear(slots[i] * uSegments + s, map);
+      vec4 read = bilinear(slots[i] * uSegments + s, map);
+      blended += weights[i] * read;
       segmentWeight += weights[i];
+      cameraColour[i].rgb += cameraTransmittance[i] * read.rgb;
+      cameraTransmittance[i] *= 1.0 - clamp(read.a, 0.0, 1.0);
     }
     if (segmentWeight > 0.0) blended /= segmentWeight;
     float alpha = clamp(blended.a, 0.0, 1.0);
@@ -400,8 +418,52 @@ void main() {
     }
     colour += transmittance * colourFactor * blended.rgb;
     transmittance *= 1.0 - scaledAlpha;
+    unscaledTransmittance *= 1.0 - alpha;
   }
   float a = 1.0 - transmittance;
+#ifdef CONFIDENCE
+  // The header's confidence: present weight x consensus x depth agreement x angular closeness
+  // x colour agreement (light_field_reconstruction.cpp's confidence()).
+  float hitWeight = 0.0, hitT = 0.0;
+  for (int i = 0; i < present; ++i) {
+    if (hits[i] < 0.0) continue;
+    hitWeight += weights[i];
+    hitT += weights[i] * hits[i];
+  }
+  if (hitWeight > 0.0) hitT /= hitWeight;
+  float consensus = 1.0 - unscaledTransmittance >= uDepthThreshold ? hitWeight : 1.0;
+  float agreement = 1.0;
+  float angle = 0.0;
+  vec4 meanColour = vec4(0.0);
+  float spread2 = 0.0, tolerance = 0.0;
+  for (int i = 0; i < present; ++i) {
+    vec3 readPoint = origin + (hits[i] >= 0.0 ? hits[i] : tCentre) * direction;
+    vec3 seen = readPoint - cameras[i].eye;
+    float distance = length(seen);
+    if (hits[i] >= 0.0) {
+      float w = weights[i] / hitWeight;
+      spread2 += w * (hits[i] - hitT) * (hits[i] - hitT);
+      tolerance += w * depthTolerance(distance, project(cameras[i], readPoint), 2.0);
+    }
+    angle += weights[i] * acos(clamp(dot(seen / distance, direction), -1.0, 1.0));
+    cameraColour[i].a = 1.0 - cameraTransmittance[i];
+    meanColour += weights[i] * cameraColour[i];
+  }
+  if (hitWeight > 0.0) agreement = exp(-spread2 / (tolerance * tolerance));
+  float relative = angle / uCameraSpacing;
+  float angular = exp(-0.5 * relative * relative);
+  float colourSpread2 = 0.0;
+  for (int i = 0; i < present; ++i) {
+    vec4 off = abs(cameraColour[i] - meanColour);
+    float worst = max(max(off.r, off.g), max(off.b, off.a));
+    colourSpread2 += weights[i] * worst * worst;
+  }
+  float colourAgreement = exp(-colourSpread2 / (0.2 * 0.2));  // kColourAgreement
+  float confidence = presentWeight * consensus * agreement * angular * colourAgreement;
+  // Encoded as the mask PNGs hold it (write_png's sRGB), so the overlay reads both alike.
+  outColour = vec4(linearToSrgb(vec3(confidence)).r, 0.0, 0.0, 1.0);
+  return;
+#endif
 #ifdef BASIS
   outColour = vec4(colour, a);
   float hitWeight = 0.0, hitT = 0.0;

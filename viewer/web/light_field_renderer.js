@@ -12,8 +12,8 @@
 import { ColourModelTable, setFrameTerms } from './frame_terms.js';
 import { drawOutputs, proxyProgram, proxySources } from './proxy_renderer.js';
 import {
-  attachTargets, buildProgram, frameContext, gpuFinished, layerTargets, readCanvas, shaderText,
-  TextureSet,
+  attachTargets, buildProgram, frameContext, gpuFinished, layerTargets, nearestTexture, readCanvas,
+  shaderText, TextureSet,
 } from './webgl.js';
 
 export { webgl2Available } from './webgl.js';
@@ -24,7 +24,7 @@ const TABLE_WIDTH = 1024;  // rows of the 1D tables, as the shader reads them
 // what edits read and write in the target camera.
 const UNIT = {
   sourceAttenuation: 8, sourceMeanDepth: 9, basisColour: 5, basisDepth: 6, none: 7,
-  samples: 10, attenuation: 11, meanDepth: 12, edited: 13, modelTable: 14,
+  samples: 10, attenuation: 11, meanDepth: 12, edited: 13, modelTable: 14, confidence: 15,
 };
 // The samples pass writes colour, depth and three cameras' samples.
 const SAMPLE_OUTPUTS = 5;
@@ -70,12 +70,12 @@ export class LightFieldRenderer {
   }
 
   /// `mode`: 'canvas' (sRGB into the canvas), 'basis' (colour and depth), 'samples' (and the
-  /// cameras' samples) or 'attenuation' (a_j and mean depth from those).
+  /// cameras' samples), 'attenuation' (a_j and mean depth from those) or 'confidence'.
   program(depthBits, maxSegments, mode) {
     const key = `${depthBits}/${maxSegments}/${mode}`;
     if (this.programs.has(key)) return this.programs.get(key);
     const defines = { canvas: '', basis: '#define BASIS\n',
-      samples: '#define BASIS\n#define SAMPLES\n',
+      samples: '#define BASIS\n#define SAMPLES\n', confidence: '#define CONFIDENCE\n',
       attenuation: `#define ATTENUATION\n#define OUTPUTS ${this.outputs}\n` }[mode];
     const prefix = `#version 300 es\n#define MAX_SEGMENTS ${maxSegments}\n` +
       (depthBits === 8 ? '#define DEPTH_CODES\n' : '') + defines;
@@ -213,6 +213,8 @@ export class LightFieldRenderer {
       gl.uniform3fv(uniform('uCenter'), header.center);
       gl.uniform1f(uniform('uBoundingRadius'), header.bounding_radius);
       gl.uniform1f(uniform('uCameraRadius'), header.camera_radius);
+      gl.uniform1f(uniform('uCameraSpacing'), cameraSpacing(header));
+      gl.uniform1f(uniform('uDepthThreshold'), header.depth_threshold);
     };
     this.loaded = { header, maxSegments, groups, hasAttenuation, setUp, prepared: new Map() };
     this.prepared('canvas');
@@ -274,10 +276,41 @@ export class LightFieldRenderer {
     attachTargets(gl, [], this.outputs);
     if (attenuation) {
       this.reconstructAttenuation(camera);
-      this.editAttenuation(recipe);
+      // Without an opacity edit a' = a: the frame pass reads a itself (a pass fewer).
+      if (recipe.opacity_edited) this.editAttenuation(recipe);
     }
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     this.finishFrame(recipe, camera, attenuation);
+  }
+
+  /// The reconstruction's per-pixel confidence for `camera`, as reconstruct_light_field's, from
+  /// `searchSteps` of the coarse depth search: bytes as the mask PNGs hold it (sRGB-encoded),
+  /// rows from the top. The canvas is left as it is.
+  confidence(camera, searchSteps) {
+    if (!this.loaded) throw new Error('no light field loaded');
+    const gl = this.gl;
+    const { width, height } = camera;
+    const target = nearestTexture(gl, UNIT.confidence, gl.TEXTURE_2D);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA8, width, height, 0, gl.RGBA, gl.UNSIGNED_BYTE, null);
+    this.textures.bind();
+    gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, target, 0);
+    gl.drawBuffers([gl.COLOR_ATTACHMENT0]);
+    gl.viewport(0, 0, width, height);
+    const { program, uniform } = this.prepared('confidence');
+    gl.useProgram(program);
+    gl.uniform1fv(uniform('uScales'), new Float32Array(this.loaded.maxSegments).fill(1));
+    gl.uniform1i(uniform('uSearchSteps'), searchSteps);
+    this.cameraUniforms(uniform, camera);
+    this.drawQuad();
+    const rgba = new Uint8Array(width * height * 4);
+    gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, rgba);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, null, 0);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    gl.deleteTexture(target);
+    const confidence = new Uint8Array(width * height);
+    for (let p = 0; p < confidence.length; ++p) confidence[p] = rgba[4 * p];
+    return confidence;
   }
 
   cameraUniforms(uniform, camera) {
@@ -354,7 +387,7 @@ export class LightFieldRenderer {
   }
 
   /// a' (proxy_edit.frag.glsl, packed inputs without optical depth, as the Explorer edits a
-  /// light field's a_j), or a copy of a without an opacity edit.
+  /// light field's a_j).
   editAttenuation(recipe) {
     const gl = this.gl;
     const { header, groups } = this.loaded;
@@ -365,10 +398,10 @@ export class LightFieldRenderer {
     gl.uniform1i(edit.uniform('uMeanDepth'), UNIT.meanDepth);
     gl.uniform1i(edit.uniform('uOpticalDepth'), UNIT.none);
     gl.uniform1i(edit.uniform('uHasOpticalDepth'), 0);
-    gl.uniform1i(edit.uniform('uCopy'), recipe.opacity_edited ? 0 : 1);
+    gl.uniform1i(edit.uniform('uCopy'), 0);
     gl.uniform1i(edit.uniform('uIntervals'), intervals);
     const scales = new Float32Array(4 * groups).fill(1);
-    (recipe.opacity_scales || []).forEach((s, j) => { scales[j] = s; });
+    recipe.opacity_scales.forEach((s, j) => { scales[j] = s; });
     gl.uniform1fv(edit.uniform('uScales'), scales);
     for (let first = 0; first < intervals; first += 4 * this.outputs) {
       gl.uniform1i(edit.uniform('uFirst'), first);
@@ -391,7 +424,8 @@ export class LightFieldRenderer {
     gl.useProgram(frame.program);
     gl.uniform1i(u('uRendering'), UNIT.basisColour);
     gl.uniform1i(u('uFrontDepth'), UNIT.basisDepth);
-    gl.uniform1i(u('uEdited'), attenuation ? UNIT.edited : UNIT.none);
+    const edited = recipe.opacity_edited ? UNIT.edited : UNIT.attenuation;
+    gl.uniform1i(u('uEdited'), attenuation ? edited : UNIT.none);
     gl.uniform1i(u('uMeanDepth'), attenuation ? UNIT.meanDepth : UNIT.none);
     gl.uniform1i(u('uIntervals'), attenuation ? this.loaded.header.intervals : 0);
     // Unedited, the colour is the light field's own.
@@ -414,4 +448,19 @@ export class LightFieldRenderer {
   finish() {
     return gpuFinished(this.gl);
   }
+}
+
+/// The mean angle between neighbouring icosphere vertices (radians), as the reconstruction's
+/// angular closeness divides by it (camera_spacing_rad).
+function cameraSpacing(header) {
+  let sum = 0;
+  for (const triangle of header.triangles) {
+    for (let e = 0; e < 3; ++e) {
+      const a = header.vertices[triangle[e]];
+      const b = header.vertices[triangle[(e + 1) % 3]];
+      const dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+      sum += Math.acos(Math.min(1, Math.max(-1, dot)));
+    }
+  }
+  return sum / (3 * header.triangles.length);
 }
