@@ -109,16 +109,19 @@ function(viewer_browser_test suite name)
                        TIMEOUT 180)
 endfunction()
 
-# The colour model's frames drawn by the page (WebGL2 through chromium's SwiftShader):
-# colour_model.test.mjs edits opacity on the archive above, which has a model, and compares the
-# canvas with `insitu-view render`.
-add_test(NAME viewer.colour_model
-         COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/colour_model.test.mjs
-         WORKING_DIRECTORY ${viewer_tests_dir})
-set_tests_properties(viewer.colour_model PROPERTIES
-                     FIXTURES_REQUIRED viewer_archive
-                     ENVIRONMENT "${viewer_environment}"
-                     TIMEOUT 180)
+# Frames the page draws (WebGL2 through chromium's SwiftShader) on the archive above, which has a
+# colour model and no light field: colour_model.test.mjs edits opacity and compares the canvas
+# with `insitu-view render`; confidence.test.mjs compares the page's confidence overlay with
+# `render --mask`.
+foreach(suite IN ITEMS colour_model confidence)
+  add_test(NAME viewer.${suite}
+           COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/${suite}.test.mjs
+           WORKING_DIRECTORY ${viewer_tests_dir})
+  set_tests_properties(viewer.${suite} PROPERTIES
+                       FIXTURES_REQUIRED viewer_archive
+                       ENVIRONMENT "${viewer_environment}"
+                       TIMEOUT 180)
+endforeach()
 
 # The browser's own frames (WebGL2 through chromium's SwiftShader), on an archive with a light
 # field of 42 cameras at 128^2: webgl.test.mjs compares orbit views (also relit and occluded)

@@ -124,7 +124,7 @@ async function drawProxies(options, dragging) {
     return;
   }
   viewer.gpu.drawProxies(entry.step, state.view, recipe, Number(options.azimuth),
-    Number(options.elevation), dragging)
+    Number(options.elevation), dragging, unedited(options))
     .then((timing) => {
       if (!timing) {
         serverFrame(options);
@@ -238,22 +238,32 @@ async function display(options, png, headers, roundTripMs) {
   await updateMask();
 }
 
+// Whether the options ask for no edit (so no edit's trust enters the frame's confidence).
+function unedited(options) {
+  return !options.tf && !options['opacity-scale'];
+}
+
 export async function updateMask() {
   const canvas = $('mask-overlay');
   canvas.hidden = !state.mask;
   if (!state.mask || !viewer.displayed) return;
   const displayed = viewer.displayed;
+  // A preview keeps the overlay it has: the full frame follows once the pointer rests.
+  if (displayed.preview) return;
   const options = displayed.options;
   let confidence = null;  // per pixel as the mask PNG holds it (sRGB-encoded), rows from the top
-  let width = 0;
-  let height = 0;
-  if (displayed.drawnFrom === 'light field' && displayed.colourSource === 'captured') {
-    // Unedited, the frame's confidence is the light field's, which the page reconstructs too.
-    const entry = state.timeline[state.stepIndex];
-    confidence = await viewer.gpu.lightFieldConfidence(entry.step, state.view, state.info.camera,
-      Number(options.azimuth), Number(options.elevation));
-    [width, height] = state.info.camera.size;
-    viewer.maskFrom = 'browser';
+  let [width, height] = state.info ? state.info.camera.size : [0, 0];
+  if (displayed.gpu && unedited(options)) {
+    // Unedited, the frame's confidence is its source's, which the page reconstructs too: the
+    // light field's, or the view synthesis's (1 everywhere at the stored view).
+    if (displayed.drawnFrom === 'light field') {
+      const entry = state.timeline[state.stepIndex];
+      confidence = await viewer.gpu.lightFieldConfidence(entry.step, state.view,
+        state.info.camera, Number(options.azimuth), Number(options.elevation));
+    } else {
+      confidence = viewer.gpu.proxyConfidence();
+    }
+    if (confidence) viewer.maskFrom = 'browser';
   }
   if (!confidence) {
     // Else the engine's mask of the frame shown (its edits' trust included); a frame drawn here

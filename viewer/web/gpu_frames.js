@@ -76,9 +76,11 @@ export class GpuFrames {
 
   /// Draws (step, view) from its single-perspective proxies with `recipe` (/api/recipe,
   /// drawable): the stored view, or for a synthesised recipe the view at the orbit angles; while
-  /// `dragging`, at the size the frame budget allows. Resolves to the frame's timing, or null
-  /// when the view has no attenuation proxies.
-  async drawProxies(step, view, recipe, azimuthDeg, elevationDeg, dragging = false) {
+  /// `dragging`, at the size the frame budget allows; a full frame `withConfidence` (unedited)
+  /// keeps its confidence for proxyConfidence. Resolves to the frame's timing, or null when the
+  /// view has no attenuation proxies.
+  async drawProxies(step, view, recipe, azimuthDeg, elevationDeg, dragging = false,
+    withConfidence = false) {
     const { proxies, downloadMs } = await this.proxies(step, view);
     if (!proxies) return null;
     let uploadMs = 0;
@@ -107,7 +109,8 @@ export class GpuFrames {
     const camera = renderer.loaded.header.camera;
     const target = recipe.synthesised ? reorbit(camera, azimuthDeg, elevationDeg) : null;
     const started = performance.now();
-    renderer.render(coarse ? previewRecipe(recipe, divisor) : recipe, target);
+    renderer.render(coarse ? previewRecipe(recipe, divisor) : recipe, target,
+      withConfidence && !coarse);
     await renderer.finish();
     const milliseconds = performance.now() - started;
     cost.record(coarse, milliseconds, camera.size[0] * camera.size[1]);
@@ -127,6 +130,12 @@ export class GpuFrames {
     }
     return this.renderer.confidence(reorbit(storedCamera, azimuthDeg, elevationDeg),
       FULL_SEARCH_STEPS);
+  }
+
+  /// The confidence of the last full frame drawn from the view's proxies withConfidence
+  /// (ProxyRenderer.confidenceBytes), or null.
+  proxyConfidence() {
+    return this.proxyRenderer ? this.proxyRenderer.confidenceBytes() : null;
   }
 
   lightField(step, view) {

@@ -27,7 +27,7 @@ const SPLAT_MARGIN = 2;        // pixels around the synthesised target (splat_at
 const UNIT = {
   attenuation: 0, meanDepth: 1, opticalDepth: 2, layers: 3, rendering: 4, frontDepth: 5,
   edited: 6, sourceTotal: 7, synthesisedAttenuation: 8, synthesisedMeanDepth: 9, splat: 10,
-  synthesisedFrontDepth: 11, transmittance: 12, modelTable: 13,
+  synthesisedFrontDepth: 11, transmittance: 12, modelTable: 13, confidence: 14,
 };
 const MAX_LAYERS = 32;         // kMaxSynthesisLayers (view_synthesis.cpp)
 
@@ -56,6 +56,8 @@ export async function proxySources() {
     frame: [fullscreen, srgb + frame],
     splat: [synthesis + splatVertex, synthesis + splatFragment],
     resolve: [fullscreen, synthesis + targetRay + drawBuffers + resolve],
+    resolveConfidence: [fullscreen,
+      `#define CONFIDENCE\n${srgb}${synthesis}${targetRay}${drawBuffers}${resolve}`],
     resolveLayers: [fullscreen, synthesis + targetRay + resolveLayers],
   };
 }
@@ -181,6 +183,9 @@ export class ProxyRenderer {
     const front = image(UNIT.frontDepth);
     const total = image(UNIT.sourceTotal);
     const synthesisedFront = image(UNIT.synthesisedFrontDepth);
+    // A synthesised view's confidence, as the mask PNGs hold it (rendered when asked for).
+    const confidence = this.texture(UNIT.confidence, gl.TEXTURE_2D);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA8, width, height, 0, gl.RGBA, gl.UNSIGNED_BYTE, null);
     // Four intervals to a layer.
     const groups = Math.ceil(intervals / 4);
     const layers = Math.max(groups, 1);
@@ -205,6 +210,7 @@ export class ProxyRenderer {
       [proxies.layers, header.layers]], width * height);
     // The shaders' arrays are sized to the step's intervals, rounded up to a group of four.
     this.loaded = { header, maxIntervals: 4 * groups, groups, edited, synthesisedAttenuation,
+      confidence, confidenceOf: null,
       synthesisedMeanDepth, synthesisedFront, splat, pointRuns, hasOpticalDepth: Boolean(proxies.opticalDepth) };
 
     const { program, uniform } = this.program('load', this.loaded.maxIntervals);
@@ -292,7 +298,7 @@ export class ProxyRenderer {
 
   /// Step 3 for another view: the stored view's attenuation seen from `target` (camera.js),
   /// into the synthesised textures (packed), with holes up to `fillRadius` pixels filled.
-  synthesise(target, fillRadius) {
+  synthesise(target, fillRadius, withConfidence) {
     const gl = this.gl;
     const { header, maxIntervals, groups } = this.loaded;
     const { width, height, intervals } = header;
@@ -325,7 +331,42 @@ export class ProxyRenderer {
       this.drawInto(targets);
     }
     this.attach([]);
+    if (withConfidence) {
+      // The same resolve for the confidence: the splat is still there.
+      const pass = this.program('resolveConfidence', maxIntervals);
+      gl.useProgram(pass.program);
+      gl.uniform1i(pass.uniform('uSplat'), UNIT.splat);
+      gl.uniform1i(pass.uniform('uSourceTotal'), UNIT.sourceTotal);
+      gl.uniform1i(pass.uniform('uIntervals'), intervals);
+      this.targetRayUniforms(pass.uniform, target, fillRadius);
+      gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D,
+        this.loaded.confidence, 0);
+      gl.drawBuffers([gl.COLOR_ATTACHMENT0]);
+      this.drawQuad();
+      gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, null, 0);
+    }
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+  }
+
+  /// The confidence of the last frame drawn `withConfidence` (render), as the mask PNGs hold it
+  /// (bytes, sRGB-encoded, rows from the top): 1 everywhere for the stored view, the synthesis's
+  /// for another view; null where that frame was not drawn so.
+  confidenceBytes() {
+    const gl = this.gl;
+    const loaded = this.loaded;
+    if (!loaded || !loaded.confidenceOf) return null;
+    const { width, height } = loaded.header;
+    const bytes = new Uint8Array(width * height);
+    if (loaded.confidenceOf === 'stored view') return bytes.fill(255);
+    const rgba = new Uint8Array(width * height * 4);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, loaded.confidence,
+      0);
+    gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, rgba);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, null, 0);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    for (let p = 0; p < bytes.length; ++p) bytes[p] = rgba[4 * p];
+    return bytes;
   }
 
   /// The maps between the stored camera and `target` (camera.js) that synthesis needs.
@@ -427,8 +468,10 @@ export class ProxyRenderer {
   }
 
   /// Draws the loaded view with `recipe` (/api/recipe, drawable) into the canvas: the stored
-  /// view, or for a synthesised recipe the view from `target` (camera.js, the stored size).
-  render(recipe, target) {
+  /// view, or for a synthesised recipe the view from `target` (camera.js, the stored size);
+  /// `withConfidence` (the caller's word that the frame is unedited: no edit's trust applies)
+  /// keeps the frame's confidence for confidenceBytes.
+  render(recipe, target, withConfidence = false) {
     if (!this.loaded) throw new Error('no proxies loaded');
     const gl = this.gl;
     const { header, maxIntervals, groups, edited } = this.loaded;
@@ -436,8 +479,10 @@ export class ProxyRenderer {
     this.textures.bind();
     const synthesised = Boolean(recipe.synthesised);
     const camera = synthesised ? target : storedCamera(header.camera);
+    this.loaded.confidenceOf = withConfidence ? (synthesised ? 'synthesised view' : 'stored view')
+      : null;
     if (synthesised) {
-      this.synthesise(target, recipe.fill_radius);
+      this.synthesise(target, recipe.fill_radius, withConfidence);
       if (recipe.ambient_occlusion) this.synthesiseFrontDepth(target, recipe.fill_radius);
     }
 

@@ -6,8 +6,11 @@
 // point of its ray (inside the bounding sphere, at half a source pixel per step) lies on a
 // transparent source ray. Writes 4 OUTPUTS of the 2L values per draw: group g (four intervals)
 // of a' for g < G, of the mean depths for g >= G (G = L / 4 rounded up), groups OUTPUTS uPart
-// .. OUTPUTS (uPart + 1) - 1. The JS side prepends #version, MAX_INTERVALS, OUTPUTS,
-// view_synthesis.glsl, target_ray.glsl and draw_buffers.glsl.
+// .. OUTPUTS (uPart + 1) - 1. With CONFIDENCE it writes the pixel's confidence instead (1 where
+// something landed or the ray is proven empty, 1 / (1 + distance) where filled from a
+// neighbour, 0 in a hole), sRGB-encoded into out0's red as the mask PNGs hold it. The JS side
+// prepends #version, MAX_INTERVALS, OUTPUTS, view_synthesis.glsl, target_ray.glsl and
+// draw_buffers.glsl (and for CONFIDENCE, srgb.glsl).
 precision highp sampler2D;
 precision highp sampler2DArray;
 
@@ -42,10 +45,11 @@ bool rayProvenEmpty(ivec2 p) {
 }
 
 // nearest_surrounding: the nearest pixel within the fill radius that received anything, on a
-// line of four directions with contributions on both sides; (-1, -1) where none.
-ivec2 nearestSurrounding(ivec2 p) {
+// line of four directions with contributions on both sides, and its distance in steps; (-1, -1)
+// where none.
+ivec2 nearestSurrounding(ivec2 p, out int bestStep) {
   ivec2 best = ivec2(-1);
-  int bestStep = 0;
+  bestStep = 0;
   for (int k = 0; k < 4; ++k) {
     ivec2 direction = ivec2(k == 1 ? 0 : 1, k == 0 ? 0 : (k == 3 ? -1 : 1));
     ivec2 found[2] = ivec2[2](ivec2(-1), ivec2(-1));
@@ -80,7 +84,19 @@ void main() {
     meanDepth[j] = kInfinity;
   }
   ivec2 from = landedAny(p) ? p : ivec2(-1);
-  if (from.x < 0 && !rayProvenEmpty(p)) from = nearestSurrounding(p);
+  float confidence = 1.0;
+  if (from.x < 0 && !rayProvenEmpty(p)) {
+    int steps;
+    from = nearestSurrounding(p, steps);
+    confidence = from.x >= 0 ? 1.0 / (1.0 + float(steps)) : 0.0;
+  }
+#ifdef CONFIDENCE
+  vec4 confidenceOutputs[OUTPUTS];
+  for (int k = 0; k < OUTPUTS; ++k) confidenceOutputs[k] = vec4(0.0);
+  confidenceOutputs[0] = vec4(linearToSrgb(vec3(confidence)).r, 0.0, 0.0, 1.0);
+  writeOutputs(confidenceOutputs);
+  return;
+#endif
   if (from.x >= 0) {
     // What landed, in target depth order (depth, then interval: insertByDepth); each entry
     // read once, not once per place in the order.
