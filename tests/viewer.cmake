@@ -58,7 +58,11 @@ add_test(NAME viewer.frame_cost
          WORKING_DIRECTORY ${viewer_tests_dir})
 set_tests_properties(viewer.frame_cost PROPERTIES TIMEOUT 60)
 
-foreach(suite IN ITEMS browser api)
+# Also on this archive, which has a colour model and no light field, frames the page draws
+# (WebGL2 through chromium's SwiftShader): colour_model.test.mjs edits opacity and compares the
+# canvas with `insitu-view render`; confidence.test.mjs compares the page's confidence overlay
+# with `render --mask`.
+foreach(suite IN ITEMS browser api colour_model confidence)
   add_test(NAME viewer.${suite}
            COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/${suite}.test.mjs
            WORKING_DIRECTORY ${viewer_tests_dir})
@@ -66,7 +70,7 @@ foreach(suite IN ITEMS browser api)
   set_tests_properties(viewer.${suite} PROPERTIES
                        FIXTURES_REQUIRED viewer_archive
                        ENVIRONMENT "${viewer_environment}"
-                       TIMEOUT 120)
+                       TIMEOUT 180)
 endforeach()
 
 # The 40^3 Gray-Scott run archived at steps 300 and 600 (half the image covered by then) in
@@ -108,20 +112,6 @@ function(viewer_browser_test suite name)
                        ENVIRONMENT "${environment}"
                        TIMEOUT 180)
 endfunction()
-
-# Frames the page draws (WebGL2 through chromium's SwiftShader) on the archive above, which has a
-# colour model and no light field: colour_model.test.mjs edits opacity and compares the canvas
-# with `insitu-view render`; confidence.test.mjs compares the page's confidence overlay with
-# `render --mask`.
-foreach(suite IN ITEMS colour_model confidence)
-  add_test(NAME viewer.${suite}
-           COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/${suite}.test.mjs
-           WORKING_DIRECTORY ${viewer_tests_dir})
-  set_tests_properties(viewer.${suite} PROPERTIES
-                       FIXTURES_REQUIRED viewer_archive
-                       ENVIRONMENT "${viewer_environment}"
-                       TIMEOUT 180)
-endforeach()
 
 # The browser's own frames (WebGL2 through chromium's SwiftShader), on an archive with a light
 # field of 42 cameras at 128^2: webgl.test.mjs compares orbit views (also relit and occluded)
