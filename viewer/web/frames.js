@@ -1,9 +1,9 @@
 // Frames: at most one in flight; a control moved meanwhile is drawn once that one is done (the
-// server also coalesces, per session). Orbit views of a step with a light field (lit and
-// occluded too), and the view's proxies' frames where their recipe allows (/api/recipe), are
-// drawn here by WebGL2 (gpu_frames.js); every other frame is the server's exploration engine's
-// PNG. The confidence overlay is the engine's
-// mask of the frame shown.
+// server also coalesces, per session). Orbit views of a step with a light field (edited, lit
+// and occluded too), and the view's proxies' frames where their recipe allows (/api/recipe),
+// are drawn here by WebGL2 (gpu_frames.js); every other frame is the server's exploration
+// engine's PNG. The confidence overlay of an unedited frame drawn here is the page's own (its
+// source's confidence); any other is the engine's mask of the frame shown.
 import { $, FPS_WINDOW_MS, errorText, session, showError, state, viewer } from './page.js';
 import { currentOptions, sameOptions } from './explore_options.js';
 import { schedulePlay } from './timeline.js';
@@ -162,8 +162,9 @@ function showCanvas(canvas) {
   $('gpu-frame').hidden = !canvas;
 }
 
-// A frame from the step's light field; with a `recipe` (/api/recipe, light_field), lit and
-// occluded as it says. Without a light field here after all, the server's frame.
+// A frame from the step's light field; with a `recipe` (/api/recipe, light_field), edited, lit,
+// occluded and enhanced as it says. Where the page cannot (no light field here after all, or a
+// GPU without what that takes), the server's frame.
 function drawInBrowser(options, dragging, recipe = null) {
   const entry = state.timeline[state.stepIndex];
   viewer.gpu.draw(entry.step, state.view, state.info.camera, Number(options.azimuth),
