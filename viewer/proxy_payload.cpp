@@ -67,6 +67,9 @@ std::string proxy_payload(const ProxyFrame& frame, std::int64_t step, int view,
     // Where stored, estimate_attenuation reads each interval's transmittance from it.
     const bool optical_depth = frame.optical_depth.channels > 0;
     if (optical_depth) check_image(frame.optical_depth, camera, intervals, "optical depth");
+    // Where stored, an edit's trust reads how often each ray re-entered an interval.
+    const bool interleaving = frame.interleaving.channels == 2;
+    if (interleaving) check_image(frame.interleaving, camera, 2, "interleaving");
 
     std::vector<PlaneGroup> groups;
     groups.push_back({"attenuation", planar(frame.attenuation)});
@@ -78,6 +81,7 @@ std::string proxy_payload(const ProxyFrame& frame, std::int64_t step, int view,
     groups.push_back(std::move(layers));
     if (rendering) groups.push_back({"rendering", frame.rendering.pixels});
     if (optical_depth) groups.push_back({"optical_depth", planar(frame.optical_depth)});
+    if (interleaving) groups.push_back({"interleaving", planar(frame.interleaving)});
 
     json planes = json::object();
     std::size_t offset = 0;
@@ -98,6 +102,7 @@ std::string proxy_payload(const ProxyFrame& frame, std::int64_t step, int view,
                       {"layers", frame.depth_layers.size()},
                       {"rendering", rendering},
                       {"optical_depth", optical_depth},
+                      {"interleaving", interleaving},
                       {"planes", planes}};
     std::string out = payload_opening("insituPX", kProxyPayloadVersion, header);
     const std::size_t data_start = out.size();

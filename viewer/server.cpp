@@ -771,6 +771,10 @@ private:
                                          {"inverse_depth_scale", ao.inverse_depth_scale},
                                          {"inverse_neighbours", ao.inverse_neighbours}};
         }
+        if (!recipe.colour_spread.empty()) {
+            body["trust"] = {{"colour_spread", recipe.colour_spread},
+                             {"attenuation_resolution", recipe.attenuation_resolution}};
+        }
         if (recipe.model_clusters > 0) {
             body["colour_model"] = {{"clusters", recipe.model_clusters},
                                     {"table", recipe.model_table}};

@@ -10,8 +10,8 @@ import assert from 'node:assert/strict';
 import { test } from 'node:test';
 
 import {
-  browserFrameMatches, differingSamples, env, makeWorkDir, openViewerPage, serverAndBrowser,
-  waitForSettledFrame,
+  browserFrameMatches, decodePng, differingSamples, env, makeWorkDir, openViewerPage,
+  renderWithCli, serverAndBrowser, waitForSettledFrame,
 } from './lib.mjs';
 
 const binary = env('INSITU_VIEW');
@@ -71,6 +71,22 @@ test('the colour model predicts the page\'s frames as it does the engine\'s', as
   };
   const orbit = await step('opacity edit (model), 20 degree orbit', 'synthesised view', orbitBy20);
   assert.equal(orbit.colourSource, 'model');
+  // Its trust, computed by the page too (the model's departure from recomposition included),
+  // against render --mask.
+  const masks = await page.evaluate(() => window.insituViewer.maskCount || 0);
+  await page.check('#mask-toggle');
+  await page.waitForFunction((n) => (window.insituViewer.maskCount || 0) > n, masks);
+  const overlay = await page.evaluate(() => ({ from: window.insituViewer.maskFrom,
+    confidence: Array.from(window.insituViewer.maskConfidence) }));
+  assert.equal(overlay.from, 'browser');
+  const mask = decodePng(renderWithCli(binary, archive, orbit.options, workDir).mask);
+  let worst = 0;
+  overlay.confidence.forEach((c, p) => {
+    worst = Math.max(worst, Math.abs(c - mask.data[p * mask.channels]));
+  });
+  results.push(`the model's trust within ${worst} of 255 of render --mask`);
+  assert.ok(worst <= 3, `the model frame's trust: ${worst} of 255 from render --mask`);
+  await page.uncheck('#mask-toggle');
   await step('... relit', 'synthesised view', () => page.check('#light-on'));
 
   // A recolouring: the model knows only the stored colours, so the frame is recomposed.

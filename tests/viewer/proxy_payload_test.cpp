@@ -120,6 +120,28 @@ TEST(ProxyPayload, HoldsEveryPlaneExactlyInItsPrecision) {
     }
 }
 
+// The interleaving proxy (re-entries and their light per pixel), where stored, goes as two
+// planes: an edit's trust reads it.
+TEST(ProxyPayload, CarriesTheInterleavingWhereStored) {
+    ProxyFrame frame = small_frame();
+    EXPECT_FALSE(decode(proxy_payload(frame, 1, 0, "f")).header.at("interleaving").get<bool>());
+    frame.interleaving = Image(6, 4, 2);
+    for (std::size_t i = 0; i < frame.interleaving.pixels.size(); ++i) {
+        frame.interleaving.pixels[i] = i % 2 == 0 ? static_cast<float>(i % 3) : 0.25f * i;
+    }
+    const Decoded decoded = decode(proxy_payload(frame, 1, 0, "f"));
+    EXPECT_TRUE(decoded.header.at("interleaving").get<bool>());
+    for (std::size_t p = 0; p < 24; ++p) {
+        for (int c = 0; c < 2; ++c) {
+            EXPECT_EQ(value(decoded, "interleaving", c * 24 + p),
+                      frame.interleaving.pixels[2 * p + c]);
+        }
+    }
+    frame.interleaving = Image(5, 4, 2);
+    testing::expect_error_naming<InvalidArgument>([&] { proxy_payload(frame, 1, 0, "f"); },
+                                                  "interleaving is 5x4x2");
+}
+
 TEST(ProxyPayload, RefusesFramesItCannotCarry) {
     ProxyFrame multi = small_frame();
     multi.multi_perspective = true;

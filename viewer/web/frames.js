@@ -2,8 +2,9 @@
 // server also coalesces, per session). Orbit views of a step with a light field (edited, lit
 // and occluded too), and the view's proxies' frames where their recipe allows (/api/recipe),
 // are drawn here by WebGL2 (gpu_frames.js); every other frame is the server's exploration
-// engine's PNG. The confidence overlay of an unedited frame drawn here is the page's own (its
-// source's confidence); any other is the engine's mask of the frame shown.
+// engine's PNG. The confidence overlay of a frame drawn here is the page's own (its source's
+// confidence, an edit's trust on top), except for edits through a light field: the engine's
+// mask of the frame shown.
 import { $, FPS_WINDOW_MS, errorText, session, showError, state, viewer } from './page.js';
 import { currentOptions, sameOptions } from './explore_options.js';
 import { schedulePlay } from './timeline.js';
@@ -124,7 +125,7 @@ async function drawProxies(options, dragging) {
     return;
   }
   viewer.gpu.drawProxies(entry.step, state.view, recipe, Number(options.azimuth),
-    Number(options.elevation), dragging, unedited(options))
+    Number(options.elevation), dragging, true, !unedited(options))
     .then((timing) => {
       if (!timing) {
         serverFrame(options);
@@ -254,10 +255,11 @@ export async function updateMask() {
   const options = displayed.options;
   let confidence = null;  // per pixel as the mask PNG holds it (sRGB-encoded), rows from the top
   let [width, height] = state.info ? state.info.camera.size : [0, 0];
-  if (displayed.gpu && unedited(options)) {
-    // Unedited, the frame's confidence is its source's, which the page reconstructs too: the
-    // light field's, or the view synthesis's (1 everywhere at the stored view).
-    if (displayed.drawnFrom === 'light field') {
+  const fromLightField = displayed.drawnFrom === 'light field';
+  if (displayed.gpu && (unedited(options) || !fromLightField)) {
+    // The page reconstructs the frame's confidence too: the light field's (unedited), or the
+    // view synthesis's (1 everywhere at the stored view) with an edit's trust on top.
+    if (fromLightField) {
       const entry = state.timeline[state.stepIndex];
       confidence = await viewer.gpu.lightFieldConfidence(entry.step, state.view,
         state.info.camera, Number(options.azimuth), Number(options.elevation));
@@ -267,8 +269,8 @@ export async function updateMask() {
     if (confidence) viewer.maskFrom = 'browser';
   }
   if (!confidence) {
-    // Else the engine's mask of the frame shown (its edits' trust included); a frame drawn here
-    // from the light field has the light field's confidence.
+    // Else the engine's mask of the frame shown (an edit's trust through a light field included);
+    // a frame drawn here from the light field has the light field's confidence.
     const source = displayed.drawnFrom === 'light field' ? { source: 'lightfield' } : {};
     const response = await fetch('api/mask',
       { method: 'POST', body: new URLSearchParams({ ...options, ...source, session }) });

@@ -76,11 +76,11 @@ export class GpuFrames {
 
   /// Draws (step, view) from its single-perspective proxies with `recipe` (/api/recipe,
   /// drawable): the stored view, or for a synthesised recipe the view at the orbit angles; while
-  /// `dragging`, at the size the frame budget allows; a full frame `withConfidence` (unedited)
-  /// keeps its confidence for proxyConfidence. Resolves to the frame's timing, or null when the
+  /// `dragging`, at the size the frame budget allows; a full frame `withConfidence` keeps its
+  /// confidence for proxyConfidence (with an edit's trust where `edited`). Resolves to the frame's timing, or null when the
   /// view has no attenuation proxies.
   async drawProxies(step, view, recipe, azimuthDeg, elevationDeg, dragging = false,
-    withConfidence = false) {
+    withConfidence = false, edited = false) {
     const { proxies, downloadMs } = await this.proxies(step, view);
     if (!proxies) return null;
     let uploadMs = 0;
@@ -110,7 +110,7 @@ export class GpuFrames {
     const target = recipe.synthesised ? reorbit(camera, azimuthDeg, elevationDeg) : null;
     const started = performance.now();
     renderer.render(coarse ? previewRecipe(recipe, divisor) : recipe, target,
-      withConfidence && !coarse);
+      withConfidence && !coarse, edited);
     await renderer.finish();
     const milliseconds = performance.now() - started;
     cost.record(coarse, milliseconds, camera.size[0] * camera.size[1]);

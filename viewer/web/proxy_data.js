@@ -9,7 +9,7 @@ const MAGIC = 'insituPX';
 const VERSION = 1;
 
 /// Parses a payload (ArrayBuffer): {header, attenuation, meanDepth, layers, rendering,
-/// opticalDepth, bytes}; each plane {type: 'half' | 'float', values: Uint16Array | Float32Array}
+/// opticalDepth, interleaving, bytes}; each plane {type: 'half' | 'float', values: Uint16Array | Float32Array}
 /// or null where the view stores none.
 export function parseProxies(buffer) {
   const { header, start } = readPayloadHeader(buffer, MAGIC, VERSION, 'proxy payload');
@@ -27,6 +27,7 @@ export function parseProxies(buffer) {
     layers: plane('layers', header.layers * pixels),
     rendering: header.rendering ? plane('rendering', 4 * pixels) : null,
     opticalDepth: header.optical_depth ? plane('optical_depth', header.intervals * pixels) : null,
+    interleaving: header.interleaving ? plane('interleaving', 2 * pixels) : null,
     bytes: buffer.byteLength,
   };
 }
@@ -79,6 +80,7 @@ export function coarserProxies(proxies, divisor) {
     layers: sample(proxies.layers, header.layers),
     rendering: sample(proxies.rendering, 1, 4),
     opticalDepth: sample(proxies.opticalDepth, header.intervals),
+    interleaving: sample(proxies.interleaving, 2),
     bytes: proxies.bytes,
   };
 }

@@ -11,7 +11,10 @@
 //     relighting.cl ambient_occlusion) of the front depth;
 //  7. depth-aware enhancement (Eq. 11, enhancement.cl) on the gradients of a'.
 // a' comes from proxy_edit.frag.glsl; a synthesised view's mean depths come packed (PACKED, see
-// there). The JS side prepends #version, MAX_INTERVALS, MAX_LIGHTS, PACKED and srgb.glsl.
+// there). With TRUST the pass writes the edited frame's confidence instead (edit_error and
+// edit_confidence of transfer_function_edit.cpp, on top of the view's own confidence). The JS
+// side prepends #version, MAX_INTERVALS, MAX_LIGHTS, PACKED, TRUST, srgb.glsl and
+// view_synthesis.glsl (kInfinity, finite, insertByDepth).
 precision highp float;
 precision highp int;
 precision highp sampler2D;
@@ -45,10 +48,22 @@ uniform int uOcclusionRadius;
 uniform vec3 uOcclusionTerms;  // strength, 1 / depth scale, 1 / neighbour count
 uniform bool uEnhance;
 uniform vec2 uEnhanceLaw;      // lambda, gamma
+#ifdef TRUST
+uniform sampler2DArray uStored;        // a before the edit, as uMeanDepth packs it
+uniform sampler2DArray uOpticalDepth;  // layer j: tau_j (the stored view's, uHasOpticalDepth)
+uniform sampler2DArray uInterleaving;  // layers 0, 1: re-entries, their light (uHasInterleaving)
+uniform bool uHasOpticalDepth;
+uniform bool uHasInterleaving;
+uniform float uScales[MAX_INTERVALS];
+uniform float uSpread[MAX_INTERVALS];  // interval_colour_spread of the shown function
+uniform float uResolution;             // the stored a_j's absolute error
+uniform bool uUnrecoverable;           // some scale reaches kUnrecoverableOpacityScale
+uniform bool uHasBaseConfidence;
+uniform sampler2D uBaseConfidence;     // the view's own confidence, sRGB-encoded (else 1)
+#endif
 
 out vec4 outColour;
 
-const float kInfinity = uintBitsToFloat(0x7f800000u);
 
 float editedAttenuation(ivec2 p, int j) {
   return texelFetch(uEdited, ivec3(p, j / 4), 0)[j % 4];
@@ -126,10 +141,6 @@ const int kCentral = 0;
 const int kForward = 1;
 const int kBackward = -1;
 const int kNone = 2;
-
-bool finite(float x) {
-  return !isinf(x) && !isnan(x);
-}
 
 int differenceKind(float before, float centre, float after, float jump) {
   bool hasBefore = finite(before);
@@ -320,6 +331,114 @@ float gradientSum(ivec2 p) {
   return sum;
 }
 
+#ifdef TRUST
+// --- transfer_function_edit.cpp edit_error, per pixel ---
+float storedAttenuation(ivec2 p, int j) {
+#ifdef PACKED
+  return texelFetch(uStored, ivec3(p, j / 4), 0)[j % 4];
+#else
+  return texelFetch(uStored, ivec3(p, j), 0).r;
+#endif
+}
+
+float powScale(float t, float s) {
+  return t > 0.0 ? exp2(s * log2(t)) : 0.0;
+}
+
+// inferred_transmittance: t_j from tau_j where stored, else from the walk.
+float inferredTransmittance(ivec2 p, float a, float transmittance, int j) {
+  if (uHasOpticalDepth) return exp(-max(0.0, texelFetch(uOpticalDepth, ivec3(p, j), 0).r));
+  if (!(transmittance > 0.0)) return 1.0;
+  float behind = transmittance - a;
+  return behind > 1e-6 ? clamp(behind / transmittance, 0.0, 1.0) : 0.0;  // EDIT_OPAQUE_LIGHT
+}
+
+// recompose_in_order: the edit's colour had the ray met the intervals of `order` in that order
+// (reversed: nearest last), one run each.
+vec3 recomposeInOrder(ivec2 p, float a[MAX_INTERVALS], int order[MAX_INTERVALS], int count,
+                      bool reversed) {
+  vec3 rgb = vec3(0.0);
+  float transmittance = 1.0, editedTransmittance = 1.0;
+  for (int i = 0; i < count; ++i) {
+    int j = order[reversed ? count - 1 - i : i];
+    float t = inferredTransmittance(p, a[j], transmittance, j);
+    float s = uScales[j];
+    float edited = s > 0.0 ? powScale(t, s) : 1.0;
+    rgb += editedTransmittance * (1.0 - edited) * uColours[j];
+    transmittance *= t;
+    editedTransmittance *= edited;
+  }
+  return rgb;
+}
+
+float editError(ivec2 p) {
+  if (uUnrecoverable) return 1.0;
+  float a[MAX_INTERVALS];
+  int order[MAX_INTERVALS];
+  float depth[MAX_INTERVALS];
+  int count = 0;
+  float light = 0.0;
+  for (int j = 0; j < uIntervals; ++j) {
+    a[j] = storedAttenuation(p, j);
+    light += a[j];
+    if (!(a[j] > 0.0)) continue;
+    float z = meanDepth(p, j);
+    insertByDepth(order, depth, count, j, isnan(z) ? kInfinity : z);
+  }
+  float total = 0.0;
+  // Precision: t_j is known only to within the resolution over T (or tau's relative error).
+  float transmittance = 1.0, editedTransmittance = 1.0;
+  for (int i = 0; i < count; ++i) {
+    int j = order[i];
+    float s = uScales[j];
+    float t = inferredTransmittance(p, a[j], transmittance, j);
+    float uncertainty = 0.0;
+    if (uHasOpticalDepth) {
+      uncertainty = t * max(0.0, texelFetch(uOpticalDepth, ivec3(p, j), 0).r) * uResolution;
+    } else if (transmittance > 0.0) {
+      uncertainty = uResolution / transmittance;
+    }
+    if (s > 0.0 && uncertainty > 0.0) {
+      total += editedTransmittance * abs(powScale(min(1.0, t + uncertainty), s) - powScale(t, s));
+    }
+    transmittance *= t;
+    editedTransmittance *= s > 0.0 ? powScale(t, s) : 1.0;
+  }
+  // The recolouring spread.
+  for (int j = 0; j < uIntervals; ++j) total += editedAttenuation(p, j) * uSpread[j];
+  // Interleaving: the share of light in re-entered runs times the two run orders' difference.
+  if (uHasInterleaving && count > 1 && texelFetch(uInterleaving, ivec3(p, 0), 0).r > 0.0) {
+    float share = light > 0.0 ? min(1.0, texelFetch(uInterleaving, ivec3(p, 1), 0).r / light)
+                              : 0.0;
+    vec3 difference = abs(recomposeInOrder(p, a, order, count, false) -
+                          recomposeInOrder(p, a, order, count, true));
+    total += share * max(difference.r, max(difference.g, difference.b));
+  }
+  // The colour model's departure from recomposition (add_model_departure).
+  if (uModel) {
+    vec4 recomposed = vec4(0.0);
+    for (int j = 0; j < uIntervals; ++j) recomposed.rgb += editedAttenuation(p, j) * uColours[j];
+    vec3 departure = abs(predictColour(p).rgb - recomposed.rgb);
+    total += max(departure.r, max(departure.g, departure.b));
+  }
+  return total;
+}
+
+float srgbToLinear(float x) {
+  return x <= 0.04045 ? x / 12.92 : pow((x + 0.055) / 1.055, 2.4);
+}
+
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);  // texel row y is image row y (read back as the mask)
+  float error = editError(p);
+  // edit_confidence: 1 - error / (2 kEditErrorTolerance), 0 for NaN.
+  float confidence = isnan(error) ? 0.0 : clamp(1.0 - error / 0.2, 0.0, 1.0);
+  if (uHasBaseConfidence) {
+    confidence = min(confidence, srgbToLinear(texelFetch(uBaseConfidence, p, 0).r));
+  }
+  outColour = vec4(linearToSrgb(vec3(confidence)).r, 0.0, 0.0, 1.0);
+}
+#else
 void main() {
   // The canvas's rows run up; the image's run down.
   ivec2 p = ivec2(int(gl_FragCoord.x), uImageSize.y - 1 - int(gl_FragCoord.y));
@@ -346,3 +465,4 @@ void main() {
   }
   outColour = pngSample(colour);
 }
+#endif

@@ -14,8 +14,8 @@
 import { boundingSphereIn, localMap, storedCamera } from './camera.js';
 import { ColourModelTable, MAX_LIGHTS, setFrameTerms } from './frame_terms.js';
 import {
-  attachTargets, buildProgram, frameContext, gpuFinished, layerTargets, readCanvas, shaderText,
-  TextureSet,
+  attachTargets, buildProgram, frameContext, gpuFinished, layerTargets, nearestTexture,
+  readCanvas, shaderText, TextureSet,
 } from './webgl.js';
 
 // Draw buffers a pass writes at most: 8 halve the draws of 16 intervals where the GPU has them
@@ -27,9 +27,10 @@ const SPLAT_MARGIN = 2;        // pixels around the synthesised target (splat_at
 const UNIT = {
   attenuation: 0, meanDepth: 1, opticalDepth: 2, layers: 3, rendering: 4, frontDepth: 5,
   edited: 6, sourceTotal: 7, synthesisedAttenuation: 8, synthesisedMeanDepth: 9, splat: 10,
-  synthesisedFrontDepth: 11, transmittance: 12, modelTable: 13, confidence: 14,
+  synthesisedFrontDepth: 11, transmittance: 12, modelTable: 13, confidence: 14, interleaving: 15,
 };
 const MAX_LAYERS = 32;         // kMaxSynthesisLayers (view_synthesis.cpp)
+const UNRECOVERABLE_OPACITY_SCALE = 1e6;  // kUnrecoverableOpacityScale (transfer_function_edit.hpp)
 
 const programsOf = new WeakMap();  // WebGL2 context -> its programs
 
@@ -53,7 +54,8 @@ export async function proxySources() {
     load: [fullscreen, load],
     transmittance: [fullscreen, synthesis + drawBuffers + transmittance],
     edit: [fullscreen, synthesis + drawBuffers + edit],
-    frame: [fullscreen, srgb + frame],
+    frame: [fullscreen, srgb + synthesis + frame],
+    trust: [fullscreen, `#define TRUST\n${srgb}${synthesis}${frame}`],
     splat: [synthesis + splatVertex, synthesis + splatFragment],
     resolve: [fullscreen, synthesis + targetRay + drawBuffers + resolve],
     resolveConfidence: [fullscreen,
@@ -125,6 +127,8 @@ export class ProxyRenderer {
 
   release() {
     this.textures.release();
+    if (this.trust) this.gl.deleteTexture(this.trust);
+    this.trust = null;
     this.loaded = null;
   }
 
@@ -166,6 +170,7 @@ export class ProxyRenderer {
     this.planes(UNIT.attenuation, proxies.attenuation, width, height, intervals);
     this.planes(UNIT.meanDepth, proxies.meanDepth, width, height, intervals);
     this.planes(UNIT.opticalDepth, proxies.opticalDepth, width, height, intervals);
+    this.planes(UNIT.interleaving, proxies.interleaving, width, height, 2);
     this.planes(UNIT.layers, proxies.layers, width, height, header.layers);
     this.texture(UNIT.rendering, gl.TEXTURE_2D);
     if (proxies.rendering) {
@@ -183,7 +188,12 @@ export class ProxyRenderer {
     const front = image(UNIT.frontDepth);
     const total = image(UNIT.sourceTotal);
     const synthesisedFront = image(UNIT.synthesisedFrontDepth);
-    // A synthesised view's confidence, as the mask PNGs hold it (rendered when asked for).
+    // An edited frame's confidence (the trust pass's target: written, never sampled, so kept
+    // out of the set, which binds its textures to their units before every frame), and a
+    // synthesised view's, as the mask PNGs hold them (rendered when asked for).
+    this.trust = nearestTexture(gl, UNIT.confidence, gl.TEXTURE_2D);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA8, width, height, 0, gl.RGBA, gl.UNSIGNED_BYTE, null);
+    const trust = this.trust;
     const confidence = this.texture(UNIT.confidence, gl.TEXTURE_2D);
     gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA8, width, height, 0, gl.RGBA, gl.UNSIGNED_BYTE, null);
     // Four intervals to a layer.
@@ -210,7 +220,7 @@ export class ProxyRenderer {
       [proxies.layers, header.layers]], width * height);
     // The shaders' arrays are sized to the step's intervals, rounded up to a group of four.
     this.loaded = { header, maxIntervals: 4 * groups, groups, edited, synthesisedAttenuation,
-      confidence, confidenceOf: null,
+      confidence, trust, confidenceOf: null, hasInterleaving: Boolean(proxies.interleaving),
       synthesisedMeanDepth, synthesisedFront, splat, pointRuns, hasOpticalDepth: Boolean(proxies.opticalDepth) };
 
     const { program, uniform } = this.program('load', this.loaded.maxIntervals);
@@ -360,8 +370,8 @@ export class ProxyRenderer {
     if (loaded.confidenceOf === 'stored view') return bytes.fill(255);
     const rgba = new Uint8Array(width * height * 4);
     gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
-    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, loaded.confidence,
-      0);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D,
+      loaded.confidenceOf === 'edited' ? this.trust : loaded.confidence, 0);
     gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, rgba);
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, null, 0);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
@@ -469,9 +479,9 @@ export class ProxyRenderer {
 
   /// Draws the loaded view with `recipe` (/api/recipe, drawable) into the canvas: the stored
   /// view, or for a synthesised recipe the view from `target` (camera.js, the stored size);
-  /// `withConfidence` (the caller's word that the frame is unedited: no edit's trust applies)
-  /// keeps the frame's confidence for confidenceBytes.
-  render(recipe, target, withConfidence = false) {
+  /// `withConfidence` keeps the frame's confidence for confidenceBytes, with the edit's trust
+  /// where the caller says the frame is `editedFrame`.
+  render(recipe, target, withConfidence = false, editedFrame = false) {
     if (!this.loaded) throw new Error('no proxies loaded');
     const gl = this.gl;
     const { header, maxIntervals, groups, edited } = this.loaded;
@@ -479,8 +489,8 @@ export class ProxyRenderer {
     this.textures.bind();
     const synthesised = Boolean(recipe.synthesised);
     const camera = synthesised ? target : storedCamera(header.camera);
-    this.loaded.confidenceOf = withConfidence ? (synthesised ? 'synthesised view' : 'stored view')
-      : null;
+    this.loaded.confidenceOf = !withConfidence ? null
+      : editedFrame ? 'edited' : (synthesised ? 'synthesised view' : 'stored view');
     if (synthesised) {
       this.synthesise(target, recipe.fill_radius, withConfidence);
       if (recipe.ambient_occlusion) this.synthesiseFrontDepth(target, recipe.fill_radius);
@@ -533,6 +543,55 @@ export class ProxyRenderer {
     this.modelTable.use(u, recipe);
     setFrameTerms(gl, u, recipe, camera, width, height);
     this.drawQuad();
+    if (withConfidence && editedFrame) this.editTrust(recipe, camera, synthesised);
+  }
+
+  /// An edited frame's confidence into the trust texture: edit_confidence of edit_error over
+  /// the unedited a (the stored view's, with its optical depth and interleaving where stored;
+  /// or the synthesised one), a' and the recipe's trust terms, at most the view's own
+  /// confidence (the synthesis's; 1 at the stored view), as Explorer::render's finish_frame.
+  editTrust(recipe, camera, synthesised) {
+    const gl = this.gl;
+    const { header, maxIntervals, hasOpticalDepth, hasInterleaving } = this.loaded;
+    const { width, height, intervals } = header;
+    const pass = this.program('trust', maxIntervals, synthesised);
+    const u = pass.uniform;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, this.trust, 0);
+    gl.drawBuffers([gl.COLOR_ATTACHMENT0]);
+    gl.viewport(0, 0, width, height);
+    gl.useProgram(pass.program);
+    gl.uniform1i(u('uEdited'), UNIT.edited);
+    gl.uniform1i(u('uStored'), synthesised ? UNIT.synthesisedAttenuation : UNIT.attenuation);
+    gl.uniform1i(u('uMeanDepth'), synthesised ? UNIT.synthesisedMeanDepth : UNIT.meanDepth);
+    gl.uniform1i(u('uRendering'), UNIT.rendering);
+    gl.uniform1i(u('uFrontDepth'), UNIT.frontDepth);
+    gl.uniform1i(u('uOpticalDepth'), UNIT.opticalDepth);
+    gl.uniform1i(u('uInterleaving'), UNIT.interleaving);
+    gl.uniform1i(u('uHasOpticalDepth'), hasOpticalDepth && !synthesised ? 1 : 0);
+    gl.uniform1i(u('uHasInterleaving'), hasInterleaving && !synthesised ? 1 : 0);
+    gl.uniform1i(u('uBaseConfidence'), UNIT.confidence);
+    gl.uniform1i(u('uHasBaseConfidence'), synthesised ? 1 : 0);
+    gl.uniform1i(u('uIntervals'), intervals);
+    const perInterval = (values, fill) => {
+      const array = new Float32Array(maxIntervals).fill(fill);
+      (values || []).slice(0, maxIntervals).forEach((v, j) => { array[j] = v; });
+      return array;
+    };
+    gl.uniform1fv(u('uScales'), perInterval(recipe.opacity_scales, 1));
+    gl.uniform1i(u('uUnrecoverable'),
+      recipe.opacity_scales.some((s) => s >= UNRECOVERABLE_OPACITY_SCALE) ? 1 : 0);
+    const trust = recipe.trust || { colour_spread: [], attenuation_resolution: 0 };
+    gl.uniform1fv(u('uSpread'), perInterval(trust.colour_spread, 0));
+    gl.uniform1f(u('uResolution'), trust.attenuation_resolution);
+    const colours = new Float32Array(3 * maxIntervals);
+    colours.set(recipe.colours.slice(0, 3 * maxIntervals));
+    gl.uniform3fv(u('uColours'), colours);
+    this.modelTable.use(u, recipe);
+    setFrameTerms(gl, u, recipe, camera, width, height);
+    this.drawQuad();
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, null, 0);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
   }
 
   readPixels() {

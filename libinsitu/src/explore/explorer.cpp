@@ -904,6 +904,8 @@ FrameRecipe Explorer::recipe(const ExploreRequest& request) {
         recipe.opacity_edited = plan.opacity_edited;
         recipe.colours = std::move(plan.colours);
         recipe.colour_source = plan.use_model ? ColourSource::model : ColourSource::recompose;
+        recipe.colour_spread = interval_colour_spread(shown_tf, intervals);
+        recipe.attenuation_resolution = stored_attenuation_resolution();
         if (plan.use_model) {
             recipe.model_clusters = model->clusters();
             recipe.model_table = model->table();

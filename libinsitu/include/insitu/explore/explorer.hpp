@@ -139,6 +139,10 @@ struct FrameRecipe {
     /// predicts the colour from a' (seed 000 Eqs. 8 and 10).
     int model_clusters = 0;
     std::vector<float> model_table;
+    /// For an edit, what its trust (edit_error) needs besides the proxies: each interval's
+    /// colour spread under the shown function and the stored a_j's resolution.
+    std::vector<float> colour_spread;
+    double attenuation_resolution = 0.0;
     /// Lights as the kernels take them (relighting.cl illuminate): direction toward the light,
     /// normalised, or (0, 0, 0) for a headlight (the client puts -forward of its camera there).
     std::optional<LightingSettings> lighting;
