@@ -10,8 +10,8 @@ import assert from 'node:assert/strict';
 import { test } from 'node:test';
 
 import {
-  browserFrameMatches, decodePng, differingSamples, env, makeWorkDir, openViewerPage,
-  renderWithCli, serverAndBrowser, waitForSettledFrame,
+  browserFrameMatches, differingSamples, env, makeWorkDir, openViewerPage, overlayAgainstCli,
+  serverAndBrowser, waitForSettledFrame,
 } from './lib.mjs';
 
 const binary = env('INSITU_VIEW');
@@ -73,17 +73,8 @@ test('the colour model predicts the page\'s frames as it does the engine\'s', as
   assert.equal(orbit.colourSource, 'model');
   // Its trust, computed by the page too (the model's departure from recomposition included),
   // against render --mask.
-  const masks = await page.evaluate(() => window.insituViewer.maskCount || 0);
-  await page.check('#mask-toggle');
-  await page.waitForFunction((n) => (window.insituViewer.maskCount || 0) > n, masks);
-  const overlay = await page.evaluate(() => ({ from: window.insituViewer.maskFrom,
-    confidence: Array.from(window.insituViewer.maskConfidence) }));
-  assert.equal(overlay.from, 'browser');
-  const mask = decodePng(renderWithCli(binary, archive, orbit.options, workDir).mask);
-  let worst = 0;
-  overlay.confidence.forEach((c, p) => {
-    worst = Math.max(worst, Math.abs(c - mask.data[p * mask.channels]));
-  });
+  const { from, worst } = await overlayAgainstCli(page, binary, archive, workDir);
+  assert.equal(from, 'browser');
   results.push(`the model's trust within ${worst} of 255 of render --mask`);
   assert.ok(worst <= 3, `the model frame's trust: ${worst} of 255 from render --mask`);
   await page.uncheck('#mask-toggle');

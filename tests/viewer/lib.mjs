@@ -269,3 +269,26 @@ export function serverAndBrowser(binary, archive) {
   });
   return session;
 }
+
+/// Turns the page's confidence overlay on, waits for it, and compares its bytes with the mask
+/// `insitu-view render --mask` writes for the displayed frame's options and `cliOptions`:
+/// {from ('browser' or 'server'), differing, worst (of 255)}. The overlay is left on.
+export async function overlayAgainstCli(page, binary, archive, workDir, cliOptions = {}) {
+  const masks = await page.evaluate(() => window.insituViewer.maskCount || 0);
+  await page.check('#mask-toggle');
+  await page.waitForFunction((n) => (window.insituViewer.maskCount || 0) > n, masks);
+  const overlay = await page.evaluate(() => ({ from: window.insituViewer.maskFrom,
+    confidence: Array.from(window.insituViewer.maskConfidence),
+    options: window.insituViewer.displayed.options }));
+  const mask = decodePng(renderWithCli(binary, archive, { ...overlay.options, ...cliOptions },
+    workDir).mask);
+  assert.equal(overlay.confidence.length, mask.width * mask.height);
+  let worst = 0;
+  let differing = 0;
+  overlay.confidence.forEach((c, p) => {
+    const d = Math.abs(c - mask.data[p * mask.channels]);
+    worst = Math.max(worst, d);
+    if (d > 0) ++differing;
+  });
+  return { from: overlay.from, differing, worst };
+}

@@ -11,8 +11,8 @@ import assert from 'node:assert/strict';
 import { test } from 'node:test';
 
 import {
-  differingSamples, env, lightFieldFrameMatches, makeWorkDir, openViewerPage, serverAndBrowser,
-  waitForSettledFrame,
+  differingSamples, env, lightFieldFrameMatches, makeWorkDir, openViewerPage, overlayAgainstCli,
+  serverAndBrowser, waitForSettledFrame,
 } from './lib.mjs';
 
 const binary = env('INSITU_VIEW');
@@ -70,6 +70,15 @@ test('edits, lights and enhancement through an attenuation light field match ren
   assert.equal(recipe.light_field, true, 'the light field makes the orbit view');
   assert.equal(recipe.light_field_attenuation, true, 'from its reconstructed attenuation');
   assert.equal(recipe.opacity_edited, true);
+  // The edit's trust on the reconstruction's confidence, computed by the page, against
+  // render --mask from the light field.
+  const { from, differing, worst } =
+    await overlayAgainstCli(page, binary, archive, workDir, { source: 'lightfield' });
+  assert.equal(from, 'browser');
+  results.push(`the edit's trust: ${differing} bytes differ from render --mask, by at most ${worst}`);
+  assert.ok(worst <= 3 && differing <= 0.01 * 160 * 160,
+    `the edit's trust: ${differing} bytes differ from render --mask, by at most ${worst}`);
+  await page.uncheck('#mask-toggle');
 
   const relit = await step('edited, relit', () => page.check('#light-on'));
   assert.ok(differingSamples(relit, edited) > 0, 'the lighting shows');

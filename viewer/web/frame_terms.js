@@ -41,6 +41,29 @@ export class ColourModelTable {
   }
 }
 
+const UNRECOVERABLE_OPACITY_SCALE = 1e6;  // kUnrecoverableOpacityScale (transfer_function_edit.hpp)
+
+/// Sets the trust pass's (proxy_frame.frag.glsl TRUST) terms of an edit's `recipe` over
+/// `intervals`, in arrays of `maxIntervals`: scales, colours, the colour spreads, the stored a_j's
+/// resolution, whether a scale is past recovery.
+export function setEditTrustTerms(gl, u, recipe, intervals, maxIntervals) {
+  const perInterval = (values, fill) => {
+    const array = new Float32Array(maxIntervals).fill(fill);
+    (values || []).slice(0, maxIntervals).forEach((v, j) => { array[j] = v; });
+    return array;
+  };
+  gl.uniform1i(u('uIntervals'), intervals);
+  gl.uniform1fv(u('uScales'), perInterval(recipe.opacity_scales, 1));
+  gl.uniform1i(u('uUnrecoverable'),
+    (recipe.opacity_scales || []).some((s) => s >= UNRECOVERABLE_OPACITY_SCALE) ? 1 : 0);
+  const trust = recipe.trust || { colour_spread: [], attenuation_resolution: 0 };
+  gl.uniform1fv(u('uSpread'), perInterval(trust.colour_spread, 0));
+  gl.uniform1f(u('uResolution'), trust.attenuation_resolution);
+  const colours = new Float32Array(3 * maxIntervals);
+  colours.set((recipe.colours || []).slice(0, 3 * maxIntervals));
+  gl.uniform3fv(u('uColours'), colours);
+}
+
 /// Sets the uniforms (`u`: name -> location) of `recipe`'s lights, occlusion and enhancement for
 /// `camera` (camera.js) drawn at width x height.
 export function setFrameTerms(gl, u, recipe, camera, width, height) {

@@ -3,8 +3,7 @@
 // and occluded too), and the view's proxies' frames where their recipe allows (/api/recipe),
 // are drawn here by WebGL2 (gpu_frames.js); every other frame is the server's exploration
 // engine's PNG. The confidence overlay of a frame drawn here is the page's own (its source's
-// confidence, an edit's trust on top), except for edits through a light field: the engine's
-// mask of the frame shown.
+// confidence, an edit's trust on top); of any other, the engine's mask of the frame shown.
 import { $, FPS_WINDOW_MS, errorText, session, showError, state, viewer } from './page.js';
 import { currentOptions, sameOptions } from './explore_options.js';
 import { schedulePlay } from './timeline.js';
@@ -169,7 +168,7 @@ function showCanvas(canvas) {
 function drawInBrowser(options, dragging, recipe = null) {
   const entry = state.timeline[state.stepIndex];
   viewer.gpu.draw(entry.step, state.view, state.info.camera, Number(options.azimuth),
-    Number(options.elevation), state.segmentScales.slice(), dragging, recipe)
+    Number(options.elevation), state.segmentScales.slice(), dragging, recipe, !unedited(options))
     .then((timing) => {
       if (!timing) {
         serverFrame(options);
@@ -255,11 +254,12 @@ export async function updateMask() {
   const options = displayed.options;
   let confidence = null;  // per pixel as the mask PNG holds it (sRGB-encoded), rows from the top
   let [width, height] = state.info ? state.info.camera.size : [0, 0];
-  const fromLightField = displayed.drawnFrom === 'light field';
-  if (displayed.gpu && (unedited(options) || !fromLightField)) {
-    // The page reconstructs the frame's confidence too: the light field's (unedited), or the
-    // view synthesis's (1 everywhere at the stored view) with an edit's trust on top.
-    if (fromLightField) {
+  if (displayed.gpu) {
+    // The page reconstructs the frame's confidence too: the light field's or the view
+    // synthesis's (1 everywhere at the stored view), with an edit's trust on top.
+    if (displayed.drawnFrom === 'light field' && !unedited(options)) {
+      confidence = viewer.gpu.lightFieldTrust();
+    } else if (displayed.drawnFrom === 'light field') {
       const entry = state.timeline[state.stepIndex];
       confidence = await viewer.gpu.lightFieldConfidence(entry.step, state.view,
         state.info.camera, Number(options.azimuth), Number(options.elevation));
@@ -269,8 +269,8 @@ export async function updateMask() {
     if (confidence) viewer.maskFrom = 'browser';
   }
   if (!confidence) {
-    // Else the engine's mask of the frame shown (an edit's trust through a light field included);
-    // a frame drawn here from the light field has the light field's confidence.
+    // Else (a GPU that could not) the engine's mask of the frame shown; a frame drawn here from
+    // the light field has the light field's confidence.
     const source = displayed.drawnFrom === 'light field' ? { source: 'lightfield' } : {};
     const response = await fetch('api/mask',
       { method: 'POST', body: new URLSearchParams({ ...options, ...source, session }) });

@@ -117,6 +117,12 @@ export class GpuFrames {
     return { milliseconds, uploadMs, preview: coarse, size: camera.size };
   }
 
+  /// The confidence of an edited light-field frame drawn withTrust (LightFieldRenderer
+  /// trustBytes), or null.
+  lightFieldTrust() {
+    return this.renderer.trustBytes();
+  }
+
   /// The confidence (bytes as the mask PNGs hold it, rows from the top) of the reconstruction of
   /// (step, view) from `storedCamera` reorbited to the angles, in full; null without a light
   /// field.
@@ -160,7 +166,7 @@ export class GpuFrames {
   /// occlusion; while `dragging`, at the size the frame budget allows. Resolves to the frame's
   /// timing, or null without a light field.
   async draw(step, view, storedCamera, azimuthDeg, elevationDeg, segmentScales, dragging = false,
-    recipe = null) {
+    recipe = null, withTrust = false) {
     const key = `${step}/${view}`;
     const { lightField, downloadMs } = await this.lightField(step, view);
     if (!lightField) return null;
@@ -189,7 +195,8 @@ export class GpuFrames {
     const started = performance.now();
     this.renderer.render(reorbit({ ...storedCamera, size }, azimuthDeg, elevationDeg),
       segmentScales, preview ? PREVIEW_SEARCH_STEPS : FULL_SEARCH_STEPS,
-      finished ? (preview ? previewRecipe(recipe, divisor) : recipe) : null);
+      finished ? (preview ? previewRecipe(recipe, divisor) : recipe) : null,
+      withTrust && !preview);
     await this.renderer.finish();
     const milliseconds = performance.now() - started;
     cost.record(preview, milliseconds, size[0] * size[1]);

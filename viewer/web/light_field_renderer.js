@@ -9,7 +9,7 @@
 // canvas. The C++ Explorer stays the reference; tests/viewer/webgl.test.mjs holds the two to a
 // stated PSNR.
 
-import { ColourModelTable, setFrameTerms } from './frame_terms.js';
+import { ColourModelTable, setEditTrustTerms, setFrameTerms } from './frame_terms.js';
 import { drawOutputs, proxyProgram, proxySources } from './proxy_renderer.js';
 import {
   attachTargets, buildProgram, frameContext, gpuFinished, layerTargets, nearestTexture, readCanvas,
@@ -225,7 +225,7 @@ export class LightFieldRenderer {
   /// LightFieldReconstructionSettings::search_steps); with a `recipe` (/api/recipe,
   /// light_field), finished as it says: edited (light_field_attenuation), lit, occluded and
   /// enhanced. Resizes the canvas to the camera's image.
-  render(camera, segmentScales, searchSteps, recipe = null) {
+  render(camera, segmentScales, searchSteps, recipe = null, withTrust = false) {
     if (!this.loaded) throw new Error('no light field loaded');
     const gl = this.gl;
     const { maxSegments } = this.loaded;
@@ -281,6 +281,63 @@ export class LightFieldRenderer {
     }
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     this.finishFrame(recipe, camera, attenuation);
+    this.trusted = null;
+    if (withTrust && attenuation && recipe.colour_source !== 'captured') {
+      this.editTrust(recipe, camera, searchSteps);
+    }
+  }
+
+  /// An edited frame's confidence (edit_error and edit_confidence over the reconstructed a and
+  /// a', at most the reconstruction's confidence, as finish_frame), kept for trustBytes.
+  editTrust(recipe, camera, searchSteps) {
+    const gl = this.gl;
+    const { header, groups } = this.loaded;
+    const { width, height } = camera;
+    const { confidence, trust } = this.targets;
+    // The reconstruction's confidence, into its texture.
+    gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, confidence, 0);
+    gl.drawBuffers([gl.COLOR_ATTACHMENT0]);
+    gl.viewport(0, 0, width, height);
+    const reconstruction = this.prepared('confidence');
+    gl.useProgram(reconstruction.program);
+    gl.uniform1fv(reconstruction.uniform('uScales'),
+      new Float32Array(this.loaded.maxSegments).fill(1));
+    gl.uniform1i(reconstruction.uniform('uSearchSteps'), searchSteps);
+    this.cameraUniforms(reconstruction.uniform, camera);
+    this.drawQuad();
+    // The edit's trust on top.
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, trust, 0);
+    const pass = proxyProgram(gl, this.proxySources, 'trust', 4 * groups, true);
+    const u = pass.uniform;
+    gl.useProgram(pass.program);
+    gl.uniform1i(u('uEdited'), recipe.opacity_edited ? UNIT.edited : UNIT.attenuation);
+    gl.uniform1i(u('uStored'), UNIT.attenuation);
+    gl.uniform1i(u('uMeanDepth'), UNIT.meanDepth);
+    gl.uniform1i(u('uRendering'), UNIT.basisColour);
+    gl.uniform1i(u('uFrontDepth'), UNIT.basisDepth);
+    gl.uniform1i(u('uOpticalDepth'), UNIT.none);
+    gl.uniform1i(u('uInterleaving'), UNIT.none);
+    gl.uniform1i(u('uHasOpticalDepth'), 0);
+    gl.uniform1i(u('uHasInterleaving'), 0);
+    gl.uniform1i(u('uBaseConfidence'), UNIT.confidence);
+    gl.uniform1i(u('uHasBaseConfidence'), 1);
+    setEditTrustTerms(gl, u, recipe, header.intervals, 4 * groups);
+    this.modelTable.use(u, recipe);
+    setFrameTerms(gl, u, recipe, camera, width, height);
+    this.drawQuad();
+    const rgba = new Uint8Array(width * height * 4);
+    gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, rgba);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, null, 0);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    this.trusted = new Uint8Array(width * height);
+    for (let p = 0; p < this.trusted.length; ++p) this.trusted[p] = rgba[4 * p];
+  }
+
+  /// The last frame's confidence where it was drawn withTrust (bytes as the mask PNGs hold
+  /// them, rows from the top), else null.
+  trustBytes() {
+    return this.trusted || null;
   }
 
   /// The reconstruction's per-pixel confidence for `camera`, as reconstruct_light_field's, from
@@ -339,8 +396,13 @@ export class LightFieldRenderer {
     }
     const image = (unit, format) => {
       const texture = this.texture(unit, gl.TEXTURE_2D);
-      gl.texImage2D(gl.TEXTURE_2D, 0, format, width, height, 0,
-        format === gl.RGBA32F ? gl.RGBA : gl.RED, gl.FLOAT, null);
+      if (format === gl.RGBA8) {
+        gl.texImage2D(gl.TEXTURE_2D, 0, format, width, height, 0, gl.RGBA, gl.UNSIGNED_BYTE,
+          null);
+      } else {
+        gl.texImage2D(gl.TEXTURE_2D, 0, format, width, height, 0,
+          format === gl.RGBA32F ? gl.RGBA : gl.RED, gl.FLOAT, null);
+      }
       return texture;
     };
     const layers = (unit, count) => {
@@ -353,12 +415,16 @@ export class LightFieldRenderer {
       depth: image(UNIT.basisDepth, gl.R32F) };
     const groups = this.loaded.groups;
     if (this.loaded.hasAttenuation && this.outputs >= SAMPLE_OUTPUTS) {
+      // An edited frame's confidence: the reconstruction's (sampled by the trust pass), and the
+      // trust pass's target (never sampled: on the samples' unit, as a 2D texture beside that
+      // array).
       Object.assign(targets, { samples: layers(UNIT.samples, 3),
         attenuation: layers(UNIT.attenuation, groups), meanDepth: layers(UNIT.meanDepth, groups),
-        edited: layers(UNIT.edited, groups) });
+        edited: layers(UNIT.edited, groups), confidence: image(UNIT.confidence, gl.RGBA8),
+        trust: image(UNIT.samples, gl.RGBA8) });
     }
     targets.all = [targets.colour, targets.depth, targets.samples, targets.attenuation,
-      targets.meanDepth, targets.edited].filter(Boolean);
+      targets.meanDepth, targets.edited, targets.confidence, targets.trust].filter(Boolean);
     this.targets = targets;
   }
 

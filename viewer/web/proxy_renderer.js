@@ -12,7 +12,7 @@
 // PSNR.
 
 import { boundingSphereIn, localMap, storedCamera } from './camera.js';
-import { ColourModelTable, MAX_LIGHTS, setFrameTerms } from './frame_terms.js';
+import { ColourModelTable, MAX_LIGHTS, setEditTrustTerms, setFrameTerms } from './frame_terms.js';
 import {
   attachTargets, buildProgram, frameContext, gpuFinished, layerTargets, nearestTexture,
   readCanvas, shaderText, TextureSet,
@@ -30,7 +30,6 @@ const UNIT = {
   synthesisedFrontDepth: 11, transmittance: 12, modelTable: 13, confidence: 14, interleaving: 15,
 };
 const MAX_LAYERS = 32;         // kMaxSynthesisLayers (view_synthesis.cpp)
-const UNRECOVERABLE_OPACITY_SCALE = 1e6;  // kUnrecoverableOpacityScale (transfer_function_edit.hpp)
 
 const programsOf = new WeakMap();  // WebGL2 context -> its programs
 
@@ -572,21 +571,7 @@ export class ProxyRenderer {
     gl.uniform1i(u('uHasInterleaving'), hasInterleaving && !synthesised ? 1 : 0);
     gl.uniform1i(u('uBaseConfidence'), UNIT.confidence);
     gl.uniform1i(u('uHasBaseConfidence'), synthesised ? 1 : 0);
-    gl.uniform1i(u('uIntervals'), intervals);
-    const perInterval = (values, fill) => {
-      const array = new Float32Array(maxIntervals).fill(fill);
-      (values || []).slice(0, maxIntervals).forEach((v, j) => { array[j] = v; });
-      return array;
-    };
-    gl.uniform1fv(u('uScales'), perInterval(recipe.opacity_scales, 1));
-    gl.uniform1i(u('uUnrecoverable'),
-      recipe.opacity_scales.some((s) => s >= UNRECOVERABLE_OPACITY_SCALE) ? 1 : 0);
-    const trust = recipe.trust || { colour_spread: [], attenuation_resolution: 0 };
-    gl.uniform1fv(u('uSpread'), perInterval(trust.colour_spread, 0));
-    gl.uniform1f(u('uResolution'), trust.attenuation_resolution);
-    const colours = new Float32Array(3 * maxIntervals);
-    colours.set(recipe.colours.slice(0, 3 * maxIntervals));
-    gl.uniform3fv(u('uColours'), colours);
+    setEditTrustTerms(gl, u, recipe, intervals, maxIntervals);
     this.modelTable.use(u, recipe);
     setFrameTerms(gl, u, recipe, camera, width, height);
     this.drawQuad();
