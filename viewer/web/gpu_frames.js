@@ -77,8 +77,8 @@ export class GpuFrames {
   /// Draws (step, view) from its single-perspective proxies with `recipe` (/api/recipe,
   /// drawable): the stored view, or for a synthesised recipe the view at the orbit angles; while
   /// `dragging`, at the size the frame budget allows; a full frame `withConfidence` keeps its
-  /// confidence for proxyConfidence (with an edit's trust where `edited`). Resolves to the frame's timing, or null when the
-  /// view has no attenuation proxies.
+  /// confidence for proxyConfidence (with an edit's trust where `edited`). Resolves to the
+  /// frame's timing, or null when the view has no attenuation proxies.
   async drawProxies(step, view, recipe, azimuthDeg, elevationDeg, dragging = false,
     withConfidence = false, edited = false) {
     const { proxies, downloadMs } = await this.proxies(step, view);
@@ -162,9 +162,11 @@ export class GpuFrames {
   }
 
   /// Draws (step, view) from `storedCamera` (Camera::to_json) reorbited to the angles, with
-  /// per-segment opacity scales and, given a `recipe` (/api/recipe, light_field), its lights and
-  /// occlusion; while `dragging`, at the size the frame budget allows. Resolves to the frame's
-  /// timing, or null without a light field.
+  /// per-segment opacity scales and, given a `recipe` (/api/recipe, light_field), its edit,
+  /// lights, occlusion and enhancement; while `dragging`, at the size the frame budget allows; a
+  /// full edited frame `withTrust` keeps its confidence for lightFieldTrust (that takes one more
+  /// reconstruction, of the confidence). Resolves to the frame's timing, or null without a light
+  /// field.
   async draw(step, view, storedCamera, azimuthDeg, elevationDeg, segmentScales, dragging = false,
     recipe = null, withTrust = false) {
     const key = `${step}/${view}`;
