@@ -13,7 +13,7 @@ import { ColourModelTable, setEditTrustTerms, setFrameTerms } from './frame_term
 import { drawOutputs, proxyProgram, proxySources } from './proxy_renderer.js';
 import {
   attachTargets, buildProgram, frameContext, gpuFinished, layerTargets, nearestTexture, readCanvas,
-  shaderText, TextureSet,
+  readRedBytes, shaderText, TextureSet,
 } from './webgl.js';
 
 export { webgl2Available } from './webgl.js';
@@ -294,19 +294,8 @@ export class LightFieldRenderer {
     const { header, groups } = this.loaded;
     const { width, height } = camera;
     const { confidence, trust } = this.targets;
-    // The reconstruction's confidence, into its texture.
-    gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
-    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, confidence, 0);
-    gl.drawBuffers([gl.COLOR_ATTACHMENT0]);
-    gl.viewport(0, 0, width, height);
-    const reconstruction = this.prepared('confidence');
-    gl.useProgram(reconstruction.program);
-    gl.uniform1fv(reconstruction.uniform('uScales'),
-      new Float32Array(this.loaded.maxSegments).fill(1));
-    gl.uniform1i(reconstruction.uniform('uSearchSteps'), searchSteps);
-    this.cameraUniforms(reconstruction.uniform, camera);
-    this.drawQuad();
-    // The edit's trust on top.
+    // The reconstruction's confidence, into its texture; the edit's trust on top.
+    this.drawConfidence(confidence, camera, searchSteps);
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, trust, 0);
     const pass = proxyProgram(gl, this.proxySources, 'trust', 4 * groups, true);
     const u = pass.uniform;
@@ -326,12 +315,25 @@ export class LightFieldRenderer {
     this.modelTable.use(u, recipe);
     setFrameTerms(gl, u, recipe, camera, width, height);
     this.drawQuad();
-    const rgba = new Uint8Array(width * height * 4);
-    gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, rgba);
+    this.trusted = readRedBytes(gl, width, height);
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, null, 0);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    this.trusted = new Uint8Array(width * height);
-    for (let p = 0; p < this.trusted.length; ++p) this.trusted[p] = rgba[4 * p];
+  }
+
+  /// The reconstruction's confidence for `camera` (CONFIDENCE) into the RGBA8 texture `target`,
+  /// attached to this renderer's framebuffer, which stays bound.
+  drawConfidence(target, camera, searchSteps) {
+    const gl = this.gl;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, target, 0);
+    gl.drawBuffers([gl.COLOR_ATTACHMENT0]);
+    gl.viewport(0, 0, camera.width, camera.height);
+    const { program, uniform } = this.prepared('confidence');
+    gl.useProgram(program);
+    gl.uniform1fv(uniform('uScales'), new Float32Array(this.loaded.maxSegments).fill(1));
+    gl.uniform1i(uniform('uSearchSteps'), searchSteps);
+    this.cameraUniforms(uniform, camera);
+    this.drawQuad();
   }
 
   /// The last frame's confidence where it was drawn withTrust (bytes as the mask PNGs hold
@@ -350,23 +352,11 @@ export class LightFieldRenderer {
     const target = nearestTexture(gl, UNIT.confidence, gl.TEXTURE_2D);
     gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA8, width, height, 0, gl.RGBA, gl.UNSIGNED_BYTE, null);
     this.textures.bind();
-    gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
-    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, target, 0);
-    gl.drawBuffers([gl.COLOR_ATTACHMENT0]);
-    gl.viewport(0, 0, width, height);
-    const { program, uniform } = this.prepared('confidence');
-    gl.useProgram(program);
-    gl.uniform1fv(uniform('uScales'), new Float32Array(this.loaded.maxSegments).fill(1));
-    gl.uniform1i(uniform('uSearchSteps'), searchSteps);
-    this.cameraUniforms(uniform, camera);
-    this.drawQuad();
-    const rgba = new Uint8Array(width * height * 4);
-    gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, rgba);
+    this.drawConfidence(target, camera, searchSteps);
+    const confidence = readRedBytes(gl, width, height);
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, null, 0);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     gl.deleteTexture(target);
-    const confidence = new Uint8Array(width * height);
-    for (let p = 0; p < confidence.length; ++p) confidence[p] = rgba[4 * p];
     return confidence;
   }
 

@@ -15,7 +15,7 @@ import { boundingSphereIn, localMap, storedCamera } from './camera.js';
 import { ColourModelTable, MAX_LIGHTS, setEditTrustTerms, setFrameTerms } from './frame_terms.js';
 import {
   attachTargets, buildProgram, frameContext, gpuFinished, layerTargets, nearestTexture,
-  readCanvas, shaderText, TextureSet,
+  readCanvas, readRedBytes, shaderText, TextureSet,
 } from './webgl.js';
 
 // Draw buffers a pass writes at most: 8 halve the draws of 16 intervals where the GPU has them
@@ -365,16 +365,13 @@ export class ProxyRenderer {
     const loaded = this.loaded;
     if (!loaded || !loaded.confidenceOf) return null;
     const { width, height } = loaded.header;
-    const bytes = new Uint8Array(width * height);
-    if (loaded.confidenceOf === 'stored view') return bytes.fill(255);
-    const rgba = new Uint8Array(width * height * 4);
+    if (loaded.confidenceOf === 'stored view') return new Uint8Array(width * height).fill(255);
     gl.bindFramebuffer(gl.FRAMEBUFFER, this.framebuffer);
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D,
       loaded.confidenceOf === 'edited' ? this.trust : loaded.confidence, 0);
-    gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, rgba);
+    const bytes = readRedBytes(gl, width, height);
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, null, 0);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    for (let p = 0; p < bytes.length; ++p) bytes[p] = rgba[4 * p];
     return bytes;
   }
 

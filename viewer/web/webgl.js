@@ -128,6 +128,16 @@ export function layerTargets(texture, first, layers, outputs) {
   return targets;
 }
 
+/// The red channel of the bound framebuffer's first width x height RGBA8 texels, row by row as
+/// the texture holds them (a confidence pass writes its bytes there).
+export function readRedBytes(gl, width, height) {
+  const rgba = new Uint8Array(width * height * 4);
+  gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, rgba);
+  const red = new Uint8Array(width * height);
+  for (let p = 0; p < red.length; ++p) red[p] = rgba[4 * p];
+  return red;
+}
+
 /// The canvas's RGBA bytes, rows from the top (as a PNG holds them).
 export function readCanvas(gl, canvas) {
   const { width, height } = canvas;
