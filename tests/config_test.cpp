@@ -241,7 +241,7 @@ TEST(InstrumentConfig, ToJsonEmitsEveryKeyAndRoundTrips) {
     }
     EXPECT_EQ(json["layers"], "auto");
     EXPECT_EQ(json["proxies"],
-              nlohmann::json({"depth", "attenuation", "rendering", "interleaving"}));
+              nlohmann::json({"depth", "attenuation", "rendering", "interleaving", "entry_depth"}));
 
     InstrumentConfig custom;
     custom.fields = {"u", "v"};

@@ -70,6 +70,9 @@ std::string proxy_payload(const ProxyFrame& frame, std::int64_t step, int view,
     // Where stored, an edit's trust reads how often each ray re-entered an interval.
     const bool interleaving = frame.interleaving.channels == 2;
     if (interleaving) check_image(frame.interleaving, camera, 2, "interleaving");
+    // Where stored, an edit's trust orders the intervals by where each first took light too.
+    const bool entry_depth = frame.entry_depth.channels > 0;
+    if (entry_depth) check_image(frame.entry_depth, camera, intervals, "entry depth");
 
     std::vector<PlaneGroup> groups;
     groups.push_back({"attenuation", planar(frame.attenuation)});
@@ -82,6 +85,7 @@ std::string proxy_payload(const ProxyFrame& frame, std::int64_t step, int view,
     if (rendering) groups.push_back({"rendering", frame.rendering.pixels});
     if (optical_depth) groups.push_back({"optical_depth", planar(frame.optical_depth)});
     if (interleaving) groups.push_back({"interleaving", planar(frame.interleaving)});
+    if (entry_depth) groups.push_back({"entry_depth", planar(frame.entry_depth)});
 
     json planes = json::object();
     std::size_t offset = 0;
@@ -103,6 +107,7 @@ std::string proxy_payload(const ProxyFrame& frame, std::int64_t step, int view,
                       {"rendering", rendering},
                       {"optical_depth", optical_depth},
                       {"interleaving", interleaving},
+                      {"entry_depth", entry_depth},
                       {"planes", planes}};
     std::string out = payload_opening("insituPX", kProxyPayloadVersion, header);
     const std::size_t data_start = out.size();

@@ -773,7 +773,9 @@ private:
         }
         if (!recipe.colour_spread.empty()) {
             body["trust"] = {{"colour_spread", recipe.colour_spread},
-                             {"attenuation_resolution", recipe.attenuation_resolution}};
+                             {"attenuation_resolution", recipe.attenuation_resolution},
+                             {"stored_colours", recipe.stored_colours},
+                             {"stored_colour_spread", recipe.stored_colour_spread}};
         }
         if (recipe.model_clusters > 0) {
             body["colour_model"] = {{"clusters", recipe.model_clusters},

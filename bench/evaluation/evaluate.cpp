@@ -351,20 +351,36 @@ struct ColourSetup {
     ProxyFrame frame;
     std::vector<Image> training_attenuation;
     std::vector<Image> training_colour;
+    /// The stored view's ground truth, as the archive's "rendering" (the recolouring trust's
+    /// measure at the stored function).
+    Image rendering;
+    /// Which proxies the edit trust reads: "interleaving" is the trust before the entry depth
+    /// (it ignores the entry depth and the rendering), "default" what the Instrument stores,
+    /// "optical_depth" that with tau_j (which the estimate then uses too).
+    std::string trust_proxies = "default";
 };
 
 ColourSetup colour_setup(ProxyRenderer& renderer, const Scene& scene, int image, int intervals,
-                         const std::vector<TfSpec>& training, const TfSpec& stored = {}) {
+                         const std::vector<TfSpec>& training, const TfSpec& stored = {},
+                         bool optical_depth = false) {
     ColourSetup setup;
     setup.scene = &scene;
     setup.camera = Camera::orbit(stored_view(image), renderer.volume().bounds);
     setup.stored_tf = make_tf(scene, stored);
     ProxyRequest request = proxy_request(scene, setup.stored_tf, intervals, 1);
     request.depth_layers = false;
-    request.interleaving = true;  // what the edit trust reads, as the Instrument stores it
+    // What the edit trust reads, as the Instrument stores it.
+    request.interleaving = true;
+    request.entry_depth = true;
+    request.optical_depth = optical_depth;
     setup.intervals = *request.intervals;
     setup.frame = renderer.render(setup.camera, request);
+    if (optical_depth) setup.trust_proxies = "optical_depth";
+    setup.rendering =
+        renderer.render_ground_truth(setup.camera, setup.stored_tf, truth_settings()).rgba;
     request.interleaving = false;
+    request.entry_depth = false;
+    request.optical_depth = false;
     for (const TfSpec& spec : training) {
         const TransferFunction tf = make_tf(scene, spec);
         request.transfer_function = tf;
@@ -390,7 +406,9 @@ ColourModel fit_model(const ColourSetup& setup, int training, int clusters) {
 /// (seed 000 §6.3 step 1).
 Image edited_attenuation(const ColourSetup& setup, const TransferFunction& edited) {
     const std::vector<double> scales = opacity_scales(setup.stored_tf, edited, setup.intervals);
-    return estimate_attenuation(setup.frame.attenuation, setup.frame.mean_depth, nullptr, scales);
+    const Image* tau =
+        setup.frame.optical_depth.channels > 0 ? &setup.frame.optical_depth : nullptr;
+    return estimate_attenuation(setup.frame.attenuation, setup.frame.mean_depth, tau, scales);
 }
 
 /// The trust the Explorer gives an edit of the stored view (transfer_function_edit.hpp), for
@@ -401,10 +419,17 @@ Image edit_trust(const ColourSetup& setup, const TransferFunction& edited, const
     trust.attenuation = &setup.frame.attenuation;
     trust.mean_depth = &setup.frame.mean_depth;
     trust.interleaving = &setup.frame.interleaving;
+    if (setup.frame.optical_depth.channels > 0) trust.optical_depth = &setup.frame.optical_depth;
     trust.edited_attenuation = &a_edited;
     trust.scales = opacity_scales(setup.stored_tf, edited, setup.intervals);
     trust.colours = interval_colours(edited, setup.intervals);
     trust.colour_spread = interval_colour_spread(edited, setup.intervals);
+    if (setup.trust_proxies != "interleaving") {
+        trust.entry_depth = &setup.frame.entry_depth;
+        trust.stored_rendering = &setup.rendering;
+        trust.stored_colours = interval_colours(setup.stored_tf, setup.intervals);
+        trust.stored_colour_spread = interval_colour_spread(setup.stored_tf, setup.intervals);
+    }
     trust.attenuation_resolution = kFloatAttenuationResolution;  // frames straight from the pass
     Image error = edit_error(trust);
     if (model_prediction) add_model_departure(error, *model_prediction, recomposed);
@@ -507,29 +532,37 @@ void section_colour(const Scene& scene, const Options& options, int image) {
     // range (the training functions span scales 0.2..1 per band).
     {
         Csv csv(fs::path(options.out) / "opacity_scale.csv",
-                std::string("scene,scale,in_training_range,method,psnr,ssim,max_abs,") +
+                std::string("scene,proxies,scale,in_training_range,method,psnr,ssim,max_abs,") +
                     kEditMaskColumns);
-        const ColourModel model = fit_model(setup, 3, 24);
-        const std::vector<double> scales =
-            options.smoke
-                ? std::vector<double>{1.0 / 16, 1.0, 16.0}
-                : std::vector<double>{1.0 / 64, 1.0 / 16, 1.0 / 4, 0.5, 1.0, 2.0, 4.0, 16.0, 64.0};
-        for (const double s : scales) {
-            TfSpec spec;
-            spec.scale = s;
-            const TransferFunction edited = make_tf(scene, spec);
-            const Image truth =
-                renderer.render_ground_truth(setup.camera, edited, truth_settings()).rgba;
-            const Image a = edited_attenuation(setup, edited);
-            const Image by_model = model.predict(a);
-            const Image by_recompose = recolour(a, interval_colours(edited, setup.intervals));
-            for (const bool model_used : {true, false}) {
-                const auto [err, mask] =
-                    judge_edit(setup, edited, truth, a, by_model, by_recompose, model_used);
-                csv.row(scene.name, s, (s >= 0.2 && s <= 1.0) ? 1 : 0,
-                        model_used ? "model" : "recompose", err.psnr, err.ssim, err.max_abs,
-                        mask.high_error_fraction(), mask.flagged_fraction(),
-                        mask.good_flagged_fraction());
+        ColourSetup before = setup;
+        before.trust_proxies = "interleaving";
+        const ColourSetup with_tau =
+            colour_setup(renderer, scene, image, 16, training_specs(3), {}, true);
+        for (const ColourSetup* variant :
+             std::initializer_list<const ColourSetup*>{&before, &setup, &with_tau}) {
+            const ColourModel model = fit_model(*variant, 3, 24);
+            const std::vector<double> scales =
+                options.smoke ? std::vector<double>{1.0 / 16, 1.0, 16.0}
+                              : std::vector<double>{1.0 / 64, 1.0 / 16, 1.0 / 4, 0.5, 1.0,
+                                                    2.0,      4.0,      16.0,    64.0};
+            for (const double s : scales) {
+                TfSpec spec;
+                spec.scale = s;
+                const TransferFunction edited = make_tf(scene, spec);
+                const Image truth =
+                    renderer.render_ground_truth(variant->camera, edited, truth_settings()).rgba;
+                const Image a = edited_attenuation(*variant, edited);
+                const Image by_model = model.predict(a);
+                const Image by_recompose =
+                    recolour(a, interval_colours(edited, variant->intervals));
+                for (const bool model_used : {true, false}) {
+                    const auto [err, mask] =
+                        judge_edit(*variant, edited, truth, a, by_model, by_recompose, model_used);
+                    csv.row(scene.name, variant->trust_proxies, s, (s >= 0.2 && s <= 1.0) ? 1 : 0,
+                            model_used ? "model" : "recompose", err.psnr, err.ssim, err.max_abs,
+                            mask.high_error_fraction(), mask.flagged_fraction(),
+                            mask.good_flagged_fraction());
+                }
             }
         }
     }
@@ -594,24 +627,27 @@ void section_occlusion(const Options& options, int size, int image) {
     edit.low_scale = 0.3;
     const TransferFunction edited = make_tf(scene, edit);
     Csv csv(fs::path(options.out) / "occlusion.csv",
-            std::string("training,method,psnr,ssim,max_abs,") + kEditMaskColumns);
-    for (const bool occluded : {true, false}) {
-        const ColourSetup setup =
-            colour_setup(renderer, scene, image, 16, occluded ? occluding : training_specs(3));
-        const Image truth =
-            renderer.render_ground_truth(setup.camera, edited, truth_settings()).rgba;
-        const Image a = edited_attenuation(setup, edited);
-        const Image by_model = fit_model(setup, 3, 24).predict(a);
-        const Image by_recompose = recolour(a, interval_colours(edited, setup.intervals));
-        for (const bool model_used : {true, false}) {
-            const auto [err, mask] =
-                judge_edit(setup, edited, truth, a, by_model, by_recompose, model_used);
-            csv.row(occluded ? "inner_occluded" : "inner_visible",
-                    model_used ? "model" : "recompose", err.psnr, err.ssim, err.max_abs,
-                    mask.high_error_fraction(), mask.flagged_fraction(),
-                    mask.good_flagged_fraction());
+            std::string("proxies,training,method,psnr,ssim,max_abs,") + kEditMaskColumns);
+    for (const char* proxies : {"interleaving", "default", "optical_depth"})
+        for (const bool occluded : {true, false}) {
+            ColourSetup setup =
+                colour_setup(renderer, scene, image, 16, occluded ? occluding : training_specs(3),
+                             {}, std::string(proxies) == "optical_depth");
+            setup.trust_proxies = proxies;
+            const Image truth =
+                renderer.render_ground_truth(setup.camera, edited, truth_settings()).rgba;
+            const Image a = edited_attenuation(setup, edited);
+            const Image by_model = fit_model(setup, 3, 24).predict(a);
+            const Image by_recompose = recolour(a, interval_colours(edited, setup.intervals));
+            for (const bool model_used : {true, false}) {
+                const auto [err, mask] =
+                    judge_edit(setup, edited, truth, a, by_model, by_recompose, model_used);
+                csv.row(proxies, occluded ? "inner_occluded" : "inner_visible",
+                        model_used ? "model" : "recompose", err.psnr, err.ssim, err.max_abs,
+                        mask.high_error_fraction(), mask.flagged_fraction(),
+                        mask.good_flagged_fraction());
+            }
         }
-    }
     std::printf("occlusion: done\n");
 }
 

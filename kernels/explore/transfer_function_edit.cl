@@ -50,15 +50,14 @@ __kernel void estimate_attenuation(__global const float* attenuation,
         depth[at] = key;
     }
 
-    float transmittance = 1.0f;         // T: stored, in front of the current interval
+    float transmittance = 1.0f;         // T: inferred, in front of the current interval
     float edited_transmittance = 1.0f;  // T': after the edit
     for (int i = 0; i < count; ++i) {
         const int j = order[i];
         const float a = attenuation[base + (uint)j];
+        const float s = scales[j];
         float t;
-        if (has_optical_depth) {
-            t = exp(-fmax(optical_depth[base + (uint)j], 0.0f));
-        } else if (transmittance > 0.0f) {
+        if (transmittance > 0.0f) {
             // a_j = T (1 - t_j) for a contiguous run, so T t_j = T - a_j is the light left behind
             // it. Below EDIT_OPAQUE_LIGHT that is float rounding of sums of a (an opaque run):
             // snapping it to 0 keeps the run opaque under s < 1, where t^s would magnify the
@@ -68,13 +67,21 @@ __kernel void estimate_attenuation(__global const float* attenuation,
         } else {
             t = 1.0f;
         }
-        const float s = scales[j];
+        const float inferred = t;
+        if (has_optical_depth) {
+            // optical_depth_weight(s): thinning by 1/4 or more takes tau_j's t_j, by 1/2 or less
+            // the inferred one.
+            const float w = s > 0.0f ? clamp(-log2(s) - 1.0f, 0.0f, 1.0f) : 1.0f;
+            if (w > 0.0f) {
+                t = (1.0f - w) * t + w * exp(-fmax(optical_depth[base + (uint)j], 0.0f));
+            }
+        }
         // t^s, written as exp2(s log2 t): PoCL's pow() is several times slower, and for t in
         // [0, 1] the two agree to a few ulp (t = 0 gives exp2(-inf) = 0). A removed interval
         // (s = 0) passes all light.
         const float edited = s > 0.0f ? exp2(s * log2(t)) : 1.0f;
         attenuation_out[base + (uint)j] = edited_transmittance * (1.0f - edited);
-        transmittance *= t;
+        transmittance *= inferred;
         edited_transmittance *= edited;
     }
 }

@@ -49,23 +49,21 @@ inline void store_segments(int wanted, __global float4* rgba_out, __global float
     }
 }
 
-__kernel void render_proxies(__global const float* volume, int4 dims, float4 origin_world,
-                             float4 inv_spacing, float4 box_lower, float4 box_upper,
-                             float4 data_offset, float4 owned_lower, float4 owned_upper,
-                             __global const float4* tf_table, int2 tf_bins, float4 tf_domain,
-                             float4 cam_position, float4 cam_forward, float4 cam_right,
-                             float4 cam_up, float4 cam_half_extent, int2 size, float4 march,
-                             int wanted, int layer_count, __global const float* isovalues,
-                             int interval_count, float uniform_interval_scale,
-                             __global const float* interval_edges, __global float* depth_out,
-                             __global float* distortion_out,
-                             __global float* attenuation_out,  // always given when accumulating
-                             __global float* mean_depth_out, __global float* optical_depth_out,
-                             __global float* interleaving_out, int segment_rule, int segment_count,
-                             __global const float* segment_thresholds, float depth_threshold,
-                             __global float4* segment_rgba_out, __global float* segment_depth_out,
-                             __global float* first_hit_out, __global const uchar* skippable_blocks,
-                             int4 block_counts, int block_size, __global float* fragment_out) {
+__kernel void render_proxies(
+    __global const float* volume, int4 dims, float4 origin_world, float4 inv_spacing,
+    float4 box_lower, float4 box_upper, float4 data_offset, float4 owned_lower, float4 owned_upper,
+    __global const float4* tf_table, int2 tf_bins, float4 tf_domain, float4 cam_position,
+    float4 cam_forward, float4 cam_right, float4 cam_up, float4 cam_half_extent, int2 size,
+    float4 march, int wanted, int layer_count, __global const float* isovalues, int interval_count,
+    float uniform_interval_scale, __global const float* interval_edges, __global float* depth_out,
+    __global float* distortion_out,
+    __global float* attenuation_out,  // always given when accumulating
+    __global float* mean_depth_out, __global float* optical_depth_out,
+    __global float* interleaving_out, __global float* entry_depth_out, int segment_rule,
+    int segment_count, __global const float* segment_thresholds, float depth_threshold,
+    __global float4* segment_rgba_out, __global float* segment_depth_out,
+    __global float* first_hit_out, __global const uchar* skippable_blocks, int4 block_counts,
+    int block_size, __global float* fragment_out) {
     const int x = get_global_id(0);
     const int y = get_global_id(1);
     if (x >= size.x || y >= size.y) return;
@@ -98,6 +96,7 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
     const bool want_mean_depth = (wanted & WANT_MEAN_DEPTH) != 0;
     const bool want_optical_depth = (wanted & WANT_OPTICAL_DEPTH) != 0;
     const bool want_interleaving = (wanted & WANT_INTERLEAVING) != 0;
+    const bool want_entry_depth = (wanted & WANT_ENTRY_DEPTH) != 0;
     const bool want_segments =
         (wanted & (WANT_SEGMENT_RGBA | WANT_SEGMENT_DEPTH | WANT_FIRST_HIT_DEPTH)) != 0;
     // Segments split at the layers' crossings need them found even where depth layers are not
@@ -109,8 +108,8 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
     for (int l = 0; l < layer_count; ++l) layer_t[l] = INFINITY;
     int layers_found = 0;
     // Mean and optical depth need the same accumulation, even when a_j is not stored.
-    const bool accumulate =
-        want_attenuation || want_mean_depth || want_optical_depth || want_interleaving;
+    const bool accumulate = want_attenuation || want_mean_depth || want_optical_depth ||
+                            want_interleaving || want_entry_depth;
     // Interleaving: the interval of the last sample that contributed; how many times a
     // contributing sample fell in an interval that already holds light but is not that one (the
     // ray left the interval and came back), and the light of those re-entered runs. Scalars
@@ -122,11 +121,13 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
     __global float* attenuation = attenuation_out + pixel * interval_count;
     __global float* weighted_depth = mean_depth_out + pixel * interval_count;
     __global float* optical_depth = optical_depth_out + pixel * interval_count;
+    __global float* entry_depth = entry_depth_out + pixel * interval_count;
     if (accumulate) {
         for (int j = 0; j < interval_count; ++j) {
             attenuation[j] = 0.0f;
             if (want_mean_depth) weighted_depth[j] = 0.0f;
             if (want_optical_depth) optical_depth[j] = 0.0f;
+            if (want_entry_depth) entry_depth[j] = INFINITY;
         }
     }
 
@@ -235,6 +236,10 @@ __kernel void render_proxies(__global const float* volume, int4 dims, float4 ori
                         reentering = attenuation[j] > 0.0f;
                         if (reentering) reentries += 1.0f;
                         last_interval = j;
+                    }
+                    // Entry depth: where the interval first took light (its first run's front).
+                    if (want_entry_depth && !(attenuation[j] > 0.0f)) {
+                        entry_depth[j] = sample_depth(&ray, t);
                     }
                     const float weight = absorb(&transmittance, alpha);  // seed 000 Eq. 7
                     if (reentering) reentered += weight;
@@ -355,9 +360,10 @@ typedef struct {
 inline void accumulate_lanes(intp contributes, floatp value, floatp weight, floatp depth,
                              floatp alpha, int gx, int gy, int2 size, int interval_count,
                              float uniform_interval_scale, __global const float* interval_edges,
-                             bool want_mean_depth, bool want_optical_depth,
+                             bool want_mean_depth, bool want_optical_depth, bool want_entry_depth,
                              __global float* attenuation_out, __global float* mean_depth_out,
-                             __global float* optical_depth_out, PacketInterleaving* interleaving) {
+                             __global float* optical_depth_out, __global float* entry_depth_out,
+                             PacketInterleaving* interleaving) {
     for (int lane = 0; lane < PACKET_LANES; ++lane) {
         if (!LANE_INT(contributes, lane)) continue;
         const int2 pixel_xy = packet_pixel(gx, gy, lane);
@@ -376,6 +382,9 @@ inline void accumulate_lanes(intp contributes, floatp value, floatp weight, floa
             LANE_INT(interleaving->last_interval, lane) = j;
         }
         const float w = LANE(weight, lane);
+        if (want_entry_depth && !(attenuation_out[index] > 0.0f)) {
+            entry_depth_out[index] = LANE(depth, lane);
+        }
         if (LANE_INT(interleaving->reentering, lane)) LANE(interleaving->reentered, lane) += w;
         attenuation_out[index] += w;
         if (want_mean_depth) mean_depth_out[index] += w * LANE(depth, lane);
@@ -420,8 +429,9 @@ __kernel void render_proxies_packets(
     float4 march, int wanted, int layer_count, __global const float* isovalues, int interval_count,
     float uniform_interval_scale, __global const float* interval_edges, __global float* depth_out,
     __global float* distortion_out, __global float* attenuation_out, __global float* mean_depth_out,
-    __global float* optical_depth_out, __global float* interleaving_out, int segment_rule,
-    int segment_count, __global const float* segment_thresholds, float depth_threshold,
+    __global float* optical_depth_out, __global float* interleaving_out,
+    __global float* entry_depth_out, int segment_rule, int segment_count,
+    __global const float* segment_thresholds, float depth_threshold,
     __global float4* segment_rgba_out, __global float* segment_depth_out,
     __global float* first_hit_out, __global const uchar* skippable_blocks, int4 block_counts,
     int block_size, __global float* fragment_out) {
@@ -437,8 +447,9 @@ __kernel void render_proxies_packets(
     const bool want_mean_depth = (wanted & WANT_MEAN_DEPTH) != 0;
     const bool want_optical_depth = (wanted & WANT_OPTICAL_DEPTH) != 0;
     const bool want_interleaving = (wanted & WANT_INTERLEAVING) != 0;
+    const bool want_entry_depth = (wanted & WANT_ENTRY_DEPTH) != 0;
     const bool accumulate = (wanted & WANT_ATTENUATION) != 0 || want_mean_depth ||
-                            want_optical_depth || want_interleaving;
+                            want_optical_depth || want_interleaving || want_entry_depth;
     // Segments here are the whole ray or opacity thresholds (the host sends layer segments to
     // render_proxies). The whole ray is one segment composited from T = 1, the ray itself, so
     // its depth is the first hit; opacity segments are composited on their own beside the ray,
@@ -461,6 +472,7 @@ __kernel void render_proxies_packets(
             attenuation_out[base + j] = 0.0f;
             if (want_mean_depth) mean_depth_out[base + j] = 0.0f;
             if (want_optical_depth) optical_depth_out[base + j] = 0.0f;
+            if (want_entry_depth) entry_depth_out[base + j] = INFINITY;
         }
     }
 
@@ -554,8 +566,8 @@ __kernel void render_proxies_packets(
                 transmittance *= 1.0f - a;
                 accumulate_lanes(contributes, value, weight, depth, a, gx, gy, size, interval_count,
                                  uniform_interval_scale, interval_edges, want_mean_depth,
-                                 want_optical_depth, attenuation_out, mean_depth_out,
-                                 optical_depth_out, &interleaving);
+                                 want_optical_depth, want_entry_depth, attenuation_out,
+                                 mean_depth_out, optical_depth_out, entry_depth_out, &interleaving);
                 accumulating &= ~(contributes & (1.0f - transmittance >= stop_opacity));
             }
             // The whole ray, then the opacity segment (none unless asked for).

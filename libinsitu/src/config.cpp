@@ -143,7 +143,8 @@ constexpr Choice<bool ProxySelection::*> kProxies[] = {
     {"multi_attenuation", &ProxySelection::multi_attenuation},
     {"optical_depth", &ProxySelection::optical_depth},
     {"rendering", &ProxySelection::rendering},
-    {"interleaving", &ProxySelection::interleaving}};
+    {"interleaving", &ProxySelection::interleaving},
+    {"entry_depth", &ProxySelection::entry_depth}};
 
 /// "a, b or c".
 template <typename Value, std::size_t N>

@@ -794,6 +794,7 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
         request.march.step_voxels = config.step_voxels;
         request.depth_layers = config.proxies.depth;
         request.interleaving = config.proxies.interleaving;
+        request.entry_depth = config.proxies.entry_depth;
         const auto start = Clock::now();
         ProxyFrame frame = renderer->render(camera, request);
         CandidateProxies proxies;
@@ -1015,6 +1016,8 @@ void Instrument::Impl::compute_field(const FieldPlan& plan, StepRecord& record,
         // ProxyRequest::interleaving): distributed archives carry no interleaving, and the
         // Explorer's edit trust then goes without that term.
         march.interleaving = false;
+        march.entry_depth =
+            false;  // likewise: the first interval a block sees may not be the ray's
         std::optional<ProxyFrame> partial;
         if (plan.has_block) {
             failure.guard([&] {
@@ -1049,6 +1052,7 @@ void Instrument::Impl::compute_field(const FieldPlan& plan, StepRecord& record,
     single.mean_depth = config.proxies.attenuation;
     single.optical_depth = config.proxies.optical_depth;
     single.interleaving = config.proxies.attenuation && config.proxies.interleaving;
+    single.entry_depth = config.proxies.attenuation && config.proxies.entry_depth;
     // The colour model maps the stored attenuation to colour, so it is fitted only where that
     // attenuation is stored. Training renderings are rendered when the model or the archive
     // needs them, and stored only on request ("keep_training_images").

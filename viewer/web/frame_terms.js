@@ -45,7 +45,8 @@ const UNRECOVERABLE_OPACITY_SCALE = 1e6;  // kUnrecoverableOpacityScale (transfe
 
 /// Sets the trust pass's (proxy_frame.frag.glsl TRUST) terms of an edit's `recipe` over
 /// `intervals`, in arrays of `maxIntervals`: scales, colours, the colour spreads, the stored a_j's
-/// resolution, whether a scale is past recovery.
+/// resolution, whether a scale is past recovery, and the run's own function's colours and
+/// spreads (which measure the recolouring term where the stored rendering is drawn from).
 export function setEditTrustTerms(gl, u, recipe, intervals, maxIntervals) {
   const perInterval = (values, fill) => {
     const array = new Float32Array(maxIntervals).fill(fill);
@@ -59,9 +60,14 @@ export function setEditTrustTerms(gl, u, recipe, intervals, maxIntervals) {
   const trust = recipe.trust || { colour_spread: [], attenuation_resolution: 0 };
   gl.uniform1fv(u('uSpread'), perInterval(trust.colour_spread, 0));
   gl.uniform1f(u('uResolution'), trust.attenuation_resolution);
-  const colours = new Float32Array(3 * maxIntervals);
-  colours.set((recipe.colours || []).slice(0, 3 * maxIntervals));
-  gl.uniform3fv(u('uColours'), colours);
+  const triples = (values) => {
+    const array = new Float32Array(3 * maxIntervals);
+    array.set((values || []).slice(0, 3 * maxIntervals));
+    return array;
+  };
+  gl.uniform3fv(u('uColours'), triples(recipe.colours));
+  gl.uniform3fv(u('uStoredColours'), triples(trust.stored_colours));
+  gl.uniform1fv(u('uStoredSpread'), perInterval(trust.stored_colour_spread, 0));
 }
 
 /// Sets the uniforms (`u`: name -> location) of `recipe`'s lights, occlusion and enhancement for

@@ -307,8 +307,11 @@ export class LightFieldRenderer {
     gl.uniform1i(u('uFrontDepth'), UNIT.basisDepth);
     gl.uniform1i(u('uOpticalDepth'), UNIT.none);
     gl.uniform1i(u('uInterleaving'), UNIT.none);
+    gl.uniform1i(u('uEntryDepth'), UNIT.none);
     gl.uniform1i(u('uHasOpticalDepth'), 0);
     gl.uniform1i(u('uHasInterleaving'), 0);
+    gl.uniform1i(u('uHasEntryDepth'), 0);
+    gl.uniform1i(u('uHasStoredRendering'), 0);
     gl.uniform1i(u('uBaseConfidence'), UNIT.confidence);
     gl.uniform1i(u('uHasBaseConfidence'), 1);
     setEditTrustTerms(gl, u, recipe, header.intervals, 4 * groups);

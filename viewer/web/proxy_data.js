@@ -9,7 +9,7 @@ const MAGIC = 'insituPX';
 const VERSION = 1;
 
 /// Parses a payload (ArrayBuffer): {header, attenuation, meanDepth, layers, rendering,
-/// opticalDepth, interleaving, bytes}; each plane {type: 'half' | 'float', values: Uint16Array | Float32Array}
+/// opticalDepth, interleaving, entryDepth, bytes}; each plane {type: 'half' | 'float', values: Uint16Array | Float32Array}
 /// or null where the view stores none.
 export function parseProxies(buffer) {
   const { header, start } = readPayloadHeader(buffer, MAGIC, VERSION, 'proxy payload');
@@ -28,6 +28,7 @@ export function parseProxies(buffer) {
     rendering: header.rendering ? plane('rendering', 4 * pixels) : null,
     opticalDepth: header.optical_depth ? plane('optical_depth', header.intervals * pixels) : null,
     interleaving: header.interleaving ? plane('interleaving', 2 * pixels) : null,
+    entryDepth: header.entry_depth ? plane('entry_depth', header.intervals * pixels) : null,
     bytes: buffer.byteLength,
   };
 }
@@ -81,6 +82,7 @@ export function coarserProxies(proxies, divisor) {
     rendering: sample(proxies.rendering, 1, 4),
     opticalDepth: sample(proxies.opticalDepth, header.intervals),
     interleaving: sample(proxies.interleaving, 2),
+    entryDepth: sample(proxies.entryDepth, header.intervals),
     bytes: proxies.bytes,
   };
 }

@@ -52,26 +52,29 @@ void main() {
       float key = isnan(z) ? kInfinity : z;
       insertByDepth(order, depth, count, j, key);
     }
-    // 2-4. t_j from the walk (or tau_j), t_j' = t_j^s_j, a_j' = T' (1 - t_j').
+    // 2-4. t_j from the walk (blended with tau_j's for thinning), t_j' = t_j^s_j,
+    // a_j' = T' (1 - t_j').
     float transmittance = 1.0;
     float editedTransmittance = 1.0;
     for (int i = 0; i < count; ++i) {
       int j = order[i];
-      float t;
-      if (uHasOpticalDepth) {
-        t = exp(-max(texelFetch(uOpticalDepth, ivec3(pixel, j), 0).r, 0.0));
-      } else if (transmittance > 0.0) {
+      float s = uScales[j];
+      float t = 1.0;
+      if (transmittance > 0.0) {
         float behind = transmittance - a[j];
         t = behind > kOpaqueLight ? clamp(behind / transmittance, 0.0, 1.0) : 0.0;
-      } else {
-        t = 1.0;
       }
-      float s = uScales[j];
+      float inferred = t;
+      if (uHasOpticalDepth) {
+        // optical_depth_weight(s): strong thinning takes t_j from tau_j.
+        float w = s > 0.0 ? clamp(-log2(s) - 1.0, 0.0, 1.0) : 1.0;
+        if (w > 0.0) t = (1.0 - w) * t + w * exp(-max(texelFetch(uOpticalDepth, ivec3(pixel, j), 0).r, 0.0));
+      }
       // exp2(s log2 t) as the reference writes t^s; log2(0) is undefined in GLSL, and t = 0
       // gives 0 there (exp2(-inf)).
       float tEdited = s > 0.0 ? (t > 0.0 ? exp2(s * log2(t)) : 0.0) : 1.0;
       edited[j] = editedTransmittance * (1.0 - tEdited);
-      transmittance *= t;
+      transmittance *= inferred;
       editedTransmittance *= tEdited;
     }
   }

@@ -52,8 +52,15 @@ uniform vec2 uEnhanceLaw;      // lambda, gamma
 uniform sampler2DArray uStored;        // a before the edit, as uMeanDepth packs it
 uniform sampler2DArray uOpticalDepth;  // layer j: tau_j (the stored view's, uHasOpticalDepth)
 uniform sampler2DArray uInterleaving;  // layers 0, 1: re-entries, their light (uHasInterleaving)
+uniform sampler2DArray uEntryDepth;    // layer j: where interval j first took light (uHasEntryDepth)
 uniform bool uHasOpticalDepth;
 uniform bool uHasInterleaving;
+uniform bool uHasEntryDepth;
+// The stored view's rendering (uRendering) with the run's own function's interval colours and
+// spreads: the recolouring term's measure (edit_error).
+uniform bool uHasStoredRendering;
+uniform vec3 uStoredColours[MAX_INTERVALS];
+uniform float uStoredSpread[MAX_INTERVALS];
 uniform float uScales[MAX_INTERVALS];
 uniform float uSpread[MAX_INTERVALS];  // interval_colour_spread of the shown function
 uniform float uResolution;             // the stored a_j's absolute error
@@ -345,30 +352,56 @@ float powScale(float t, float s) {
   return t > 0.0 ? exp2(s * log2(t)) : 0.0;
 }
 
-// inferred_transmittance: t_j from tau_j where stored, else from the walk.
-float inferredTransmittance(ivec2 p, float a, float transmittance, int j) {
-  if (uHasOpticalDepth) return exp(-max(0.0, texelFetch(uOpticalDepth, ivec3(p, j), 0).r));
+// inferred_transmittance: t_j from the walk, T the transmittance inferred in front of it.
+float inferredTransmittance(float a, float transmittance) {
   if (!(transmittance > 0.0)) return 1.0;
   float behind = transmittance - a;
   return behind > 1e-6 ? clamp(behind / transmittance, 0.0, 1.0) : 0.0;  // EDIT_OPAQUE_LIGHT
 }
 
+float opticalDepthOf(ivec2 p, int j) {
+  return max(0.0, texelFetch(uOpticalDepth, ivec3(p, j), 0).r);
+}
+
+// optical_depth_weight and thinning_weight (transfer_function_edit.cpp).
+float opticalDepthWeight(float s) {
+  return s > 0.0 ? clamp(-log2(s) - 1.0, 0.0, 1.0) : 1.0;
+}
+float thinningWeight(float s) {
+  return s > 0.0 ? clamp(-log2(s), 0.0, 1.0) : 1.0;
+}
+
+// TransmittanceFrom: the estimator's rule, a_j alone, the trust's thinning alternative.
+const int FROM_ESTIMATOR = 0;
+const int FROM_ATTENUATION = 1;
+const int FROM_THINNING = 2;
+
 // recompose_in_order: the edit's colour had the ray met the intervals of `order` in that order
 // (reversed: nearest last), one run each.
 vec3 recomposeInOrder(ivec2 p, float a[MAX_INTERVALS], int order[MAX_INTERVALS], int count,
-                      bool reversed) {
+                      bool reversed, int from) {
   vec3 rgb = vec3(0.0);
-  float transmittance = 1.0, editedTransmittance = 1.0;
+  float inferredInFront = 1.0, editedTransmittance = 1.0;
   for (int i = 0; i < count; ++i) {
     int j = order[reversed ? count - 1 - i : i];
-    float t = inferredTransmittance(p, a[j], transmittance, j);
     float s = uScales[j];
+    float inferred = inferredTransmittance(a[j], inferredInFront);
+    float t = inferred;
+    if (uHasOpticalDepth && from != FROM_ATTENUATION) {
+      float w = from == FROM_THINNING ? thinningWeight(s) : opticalDepthWeight(s);
+      t = (1.0 - w) * inferred + w * exp(-opticalDepthOf(p, j));
+    }
     float edited = s > 0.0 ? powScale(t, s) : 1.0;
     rgb += editedTransmittance * (1.0 - edited) * uColours[j];
-    transmittance *= t;
+    inferredInFront *= inferred;
     editedTransmittance *= edited;
   }
   return rgb;
+}
+
+float largestDifference(vec3 x, vec3 y) {
+  vec3 d = abs(x - y);
+  return max(d.r, max(d.g, d.b));
 }
 
 float editError(ivec2 p) {
@@ -377,49 +410,84 @@ float editError(ivec2 p) {
   int order[MAX_INTERVALS];
   float depth[MAX_INTERVALS];
   int count = 0;
-  float light = 0.0;
+  float light = 0.0, thick = 0.0, thin = 0.0;
   for (int j = 0; j < uIntervals; ++j) {
     a[j] = storedAttenuation(p, j);
     light += a[j];
+    float octaves = uScales[j] > 0.0 ? log2(uScales[j]) : -kInfinity;
+    thick += a[j] * clamp(octaves / 2.0, 0.0, 1.0);
+    thin += a[j] * thinningWeight(uScales[j]);
     if (!(a[j] > 0.0)) continue;
     float z = meanDepth(p, j);
     insertByDepth(order, depth, count, j, isnan(z) ? kInfinity : z);
   }
   float total = 0.0;
-  // Precision: t_j is known only to within the resolution over T (or tau's relative error).
+  // Precision: t_j (as the estimator takes it) is known only to within the resolution over T,
+  // or tau's relative error.
   float transmittance = 1.0, editedTransmittance = 1.0;
   for (int i = 0; i < count; ++i) {
     int j = order[i];
     float s = uScales[j];
-    float t = inferredTransmittance(p, a[j], transmittance, j);
+    float inferred = inferredTransmittance(a[j], transmittance);
+    float w = uHasOpticalDepth ? opticalDepthWeight(s) : 0.0;
+    float tau = uHasOpticalDepth ? opticalDepthOf(p, j) : 0.0;
+    float fromTau = uHasOpticalDepth ? exp(-tau) : 0.0;
+    float t = (1.0 - w) * inferred + w * fromTau;
     float uncertainty = 0.0;
-    if (uHasOpticalDepth) {
-      uncertainty = t * max(0.0, texelFetch(uOpticalDepth, ivec3(p, j), 0).r) * uResolution;
-    } else if (transmittance > 0.0) {
-      uncertainty = uResolution / transmittance;
-    }
+    if (w > 0.0) uncertainty += w * fromTau * tau * uResolution;
+    if (w < 1.0 && transmittance > 0.0) uncertainty += (1.0 - w) * uResolution / transmittance;
     if (s > 0.0 && uncertainty > 0.0) {
       total += editedTransmittance * abs(powScale(min(1.0, t + uncertainty), s) - powScale(t, s));
     }
-    transmittance *= t;
+    transmittance *= inferred;
     editedTransmittance *= s > 0.0 ? powScale(t, s) : 1.0;
   }
-  // The recolouring spread.
-  for (int j = 0; j < uIntervals; ++j) total += editedAttenuation(p, j) * uSpread[j];
-  // Interleaving: the share of light in re-entered runs times the two run orders' difference.
-  if (uHasInterleaving && count > 1 && texelFetch(uInterleaving, ivec3(p, 0), 0).r > 0.0) {
+  // The recolouring spread: its bound, or what recolouring missed at the stored function
+  // scaled by how the bound changes.
+  float bound = 0.0;
+  for (int j = 0; j < uIntervals; ++j) bound += editedAttenuation(p, j) * uSpread[j];
+  if (uHasStoredRendering) {
+    float storedBound = 0.0;
+    vec3 rgb = vec3(0.0);
+    for (int j = 0; j < uIntervals; ++j) {
+      storedBound += a[j] * uStoredSpread[j];
+      rgb += a[j] * uStoredColours[j];
+    }
+    float missed = largestDifference(rgb, texelFetch(uRendering, p, 0).rgb);
+    if (storedBound > 1e-3) bound = min(bound, missed * bound / storedBound);  // kCalibratedSpreadFloor
+  }
+  total += bound;
+  if (uHasEntryDepth && count > 1 && light > 0.0) {
+    // Order: the shown estimate against the entry-depth order (thickening) and, with tau, the
+    // two estimates of thinning against each other.
+    vec3 shown = recomposeInOrder(p, a, order, count, false, FROM_ESTIMATOR);
+    if (thick > 0.0) {
+      int entryOrder[MAX_INTERVALS];
+      float entry[MAX_INTERVALS];
+      int entries = 0;
+      for (int i = 0; i < count; ++i) {
+        float e = texelFetch(uEntryDepth, ivec3(p, order[i]), 0).r;
+        insertByDepth(entryOrder, entry, entries, order[i], isnan(e) ? kInfinity : e);
+      }
+      vec3 other = recomposeInOrder(p, a, entryOrder, entries, false, FROM_ATTENUATION);
+      total += thick / light * largestDifference(other, shown);
+    }
+    if (uHasOpticalDepth && thin > 0.0) {
+      total += largestDifference(recomposeInOrder(p, a, order, count, false, FROM_THINNING),
+                                 recomposeInOrder(p, a, order, count, false, FROM_ATTENUATION));
+    }
+  } else if (uHasInterleaving && count > 1 && texelFetch(uInterleaving, ivec3(p, 0), 0).r > 0.0) {
+    // Interleaving: the share of light in re-entered runs times the two run orders' difference.
     float share = light > 0.0 ? min(1.0, texelFetch(uInterleaving, ivec3(p, 1), 0).r / light)
                               : 0.0;
-    vec3 difference = abs(recomposeInOrder(p, a, order, count, false) -
-                          recomposeInOrder(p, a, order, count, true));
-    total += share * max(difference.r, max(difference.g, difference.b));
+    total += share * largestDifference(recomposeInOrder(p, a, order, count, false, FROM_ESTIMATOR),
+                                       recomposeInOrder(p, a, order, count, true, FROM_ESTIMATOR));
   }
   // The colour model's departure from recomposition (add_model_departure).
   if (uModel) {
     vec4 recomposed = vec4(0.0);
     for (int j = 0; j < uIntervals; ++j) recomposed.rgb += editedAttenuation(p, j) * uColours[j];
-    vec3 departure = abs(predictColour(p).rgb - recomposed.rgb);
-    total += max(departure.r, max(departure.g, departure.b));
+    total += largestDifference(predictColour(p).rgb, recomposed.rgb);
   }
   return total;
 }

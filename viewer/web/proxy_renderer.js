@@ -28,6 +28,7 @@ const UNIT = {
   attenuation: 0, meanDepth: 1, opticalDepth: 2, layers: 3, rendering: 4, frontDepth: 5,
   edited: 6, sourceTotal: 7, synthesisedAttenuation: 8, synthesisedMeanDepth: 9, splat: 10,
   synthesisedFrontDepth: 11, transmittance: 12, modelTable: 13, confidence: 14, interleaving: 15,
+  entryDepth: 16,
 };
 const MAX_LAYERS = 32;         // kMaxSynthesisLayers (view_synthesis.cpp)
 
@@ -170,6 +171,7 @@ export class ProxyRenderer {
     this.planes(UNIT.meanDepth, proxies.meanDepth, width, height, intervals);
     this.planes(UNIT.opticalDepth, proxies.opticalDepth, width, height, intervals);
     this.planes(UNIT.interleaving, proxies.interleaving, width, height, 2);
+    this.planes(UNIT.entryDepth, proxies.entryDepth, width, height, intervals);
     this.planes(UNIT.layers, proxies.layers, width, height, header.layers);
     this.texture(UNIT.rendering, gl.TEXTURE_2D);
     if (proxies.rendering) {
@@ -220,6 +222,7 @@ export class ProxyRenderer {
     // The shaders' arrays are sized to the step's intervals, rounded up to a group of four.
     this.loaded = { header, maxIntervals: 4 * groups, groups, edited, synthesisedAttenuation,
       confidence, trust, confidenceOf: null, hasInterleaving: Boolean(proxies.interleaving),
+      hasEntryDepth: Boolean(proxies.entryDepth), hasRendering: Boolean(proxies.rendering),
       synthesisedMeanDepth, synthesisedFront, splat, pointRuns, hasOpticalDepth: Boolean(proxies.opticalDepth) };
 
     const { program, uniform } = this.program('load', this.loaded.maxIntervals);
@@ -543,12 +546,14 @@ export class ProxyRenderer {
   }
 
   /// An edited frame's confidence into the trust texture: edit_confidence of edit_error over
-  /// the unedited a (the stored view's, with its optical depth and interleaving where stored;
+  /// the unedited a (the stored view's, with its optical depth, interleaving, entry depth and
+  /// rendering where stored;
   /// or the synthesised one), a' and the recipe's trust terms, at most the view's own
   /// confidence (the synthesis's; 1 at the stored view), as Explorer::render's finish_frame.
   editTrust(recipe, camera, synthesised) {
     const gl = this.gl;
-    const { header, maxIntervals, hasOpticalDepth, hasInterleaving } = this.loaded;
+    const { header, maxIntervals, hasOpticalDepth, hasInterleaving, hasEntryDepth, hasRendering } =
+      this.loaded;
     const { width, height, intervals } = header;
     const pass = this.program('trust', maxIntervals, synthesised);
     const u = pass.uniform;
@@ -566,6 +571,10 @@ export class ProxyRenderer {
     gl.uniform1i(u('uInterleaving'), UNIT.interleaving);
     gl.uniform1i(u('uHasOpticalDepth'), hasOpticalDepth && !synthesised ? 1 : 0);
     gl.uniform1i(u('uHasInterleaving'), hasInterleaving && !synthesised ? 1 : 0);
+    gl.uniform1i(u('uEntryDepth'), UNIT.entryDepth);
+    gl.uniform1i(u('uHasEntryDepth'), hasEntryDepth && !synthesised ? 1 : 0);
+    const storedColours = recipe.trust && (recipe.trust.stored_colours || []).length > 0;
+    gl.uniform1i(u('uHasStoredRendering'), hasRendering && !synthesised && storedColours ? 1 : 0);
     gl.uniform1i(u('uBaseConfidence'), UNIT.confidence);
     gl.uniform1i(u('uHasBaseConfidence'), synthesised ? 1 : 0);
     setEditTrustTerms(gl, u, recipe, intervals, maxIntervals);

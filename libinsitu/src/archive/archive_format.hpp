@@ -6,6 +6,7 @@
 // so names stay unique even when a tool flattens the parts into one channel list:
 //   part "depth"              depth.layer0 .. depth.layer<K-1>                        FLOAT
 //   part "attenuation"        attenuation.a00 .., attenuation.zmean00 .., attenuation.tau00 ..,
+//                             attenuation.zentry00 .. (entry depth, when present),
 //                             attenuation.reentries, .reentered (interleaving, when present:
 //                             re-entries per pixel and the attenuation they added)
 //   part "train<k>"           train<k>.R, .G, .B, .A  (a training rendering, premultiplied)
@@ -76,6 +77,7 @@ inline constexpr const char* kLayerChannel = ".layer";
 inline constexpr const char* kAttenuationChannel = ".a";
 inline constexpr const char* kMeanDepthChannel = ".zmean";
 inline constexpr const char* kOpticalDepthChannel = ".tau";
+inline constexpr const char* kEntryDepthChannel = ".zentry";
 inline constexpr const char* kReentriesChannel = ".reentries";  // interleaving, one per part
 inline constexpr const char* kReenteredChannel = ".reentered";
 inline constexpr const char* kRgbaChannels[4] = {".R", ".G", ".B", ".A"};

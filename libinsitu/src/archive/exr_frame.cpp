@@ -117,11 +117,13 @@ std::vector<PartSource> frame_parts(const ProxyFrame& frame, const ViewRecord& v
     if (multi) layers_part(kDistortionPart, frame.distortion_layers);
 
     PartSource attenuation{part_name(kAttenuationPart, multi), {}, {}};
-    const Image* interval_images[3] = {&frame.attenuation, &frame.mean_depth, &frame.optical_depth};
-    const char* interval_suffixes[3] = {kAttenuationChannel, kMeanDepthChannel,
-                                        kOpticalDepthChannel};
+    // The entry depth orders intervals as the mean depth does, so it is stored as compactly.
+    const Image* interval_images[4] = {&frame.attenuation, &frame.mean_depth, &frame.optical_depth,
+                                       &frame.entry_depth};
+    const char* interval_suffixes[4] = {kAttenuationChannel, kMeanDepthChannel,
+                                        kOpticalDepthChannel, kEntryDepthChannel};
     int interval_count = -1;
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < 4; ++i) {
         const Image& image = *interval_images[i];
         if (image.pixels.empty()) continue;
         if (interval_count >= 0 && image.channels != interval_count) {
@@ -460,20 +462,23 @@ std::vector<Image> read_layers(Imf::InputPart& part, const PartContext& where) {
     return layers;
 }
 
-/// a_j, and z-mean and tau when present, of an "attenuation" part.
+/// a_j, and z-mean, tau and z-entry when present, of an "attenuation" part.
 void read_attenuation(Imf::InputPart& part, ProxyFrame& frame, const PartContext& where) {
     const Imf::ChannelList& channels = part.header().channels();
-    const char* suffixes[3] = {kAttenuationChannel, kMeanDepthChannel, kOpticalDepthChannel};
-    Image* targets[3] = {&frame.attenuation, &frame.mean_depth, &frame.optical_depth};
-    int counts[3];
+    constexpr int kKinds = 4;
+    const char* suffixes[kKinds] = {kAttenuationChannel, kMeanDepthChannel, kOpticalDepthChannel,
+                                    kEntryDepthChannel};
+    Image* targets[kKinds] = {&frame.attenuation, &frame.mean_depth, &frame.optical_depth,
+                              &frame.entry_depth};
+    int counts[kKinds];
     std::vector<std::string> names;
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < kKinds; ++i) {
         auto name_of = [&](int j) { return interval_channel(where.part, suffixes[i], j); };
         counts[i] = count_channels(channels, name_of);
         for (int j = 0; j < counts[i]; ++j) names.push_back(name_of(j));
     }
-    const int intervals = std::max({counts[0], counts[1], counts[2]});
-    for (int i = 0; i < 3; ++i) {
+    const int intervals = std::max({counts[0], counts[1], counts[2], counts[3]});
+    for (int i = 0; i < kKinds; ++i) {
         if (counts[i] != 0 && counts[i] != intervals) {
             where.error("channels \"" + where.part + suffixes[i] +
                         "..\": " + std::to_string(counts[i]) + " intervals, expected " +
@@ -493,7 +498,7 @@ void read_attenuation(Imf::InputPart& part, ProxyFrame& frame, const PartContext
     }
     const Image all = read_channels(part, names, where);
     int first = 0;
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < kKinds; ++i) {
         if (counts[i] == 0) continue;
         *targets[i] = channel_range(all, first, counts[i]);
         first += counts[i];
@@ -715,9 +720,9 @@ ProxyFrame decode_frame(const std::vector<char>& bytes, const std::string& path,
     try {
         check_headers(bytes, path, [&limits](const std::string& part) {
             // The model is a (4 L + 3) x K table (archive_format.hpp); every other part is an
-            // image of the view, with at most attenuation, mean depth and optical depth (three
+            // image of the view, with at most attenuation, mean, optical and entry depth (four
             // channels per interval) and the two interleaving channels.
-            constexpr long long kMaxChannels = 3ll * kMaxIntervals + 2;
+            constexpr long long kMaxChannels = 4ll * kMaxIntervals + 2;
             if (part == kModelPart) {
                 return PartLimits{4ll * kMaxIntervals + 3, kMaxColourModelClusters, kMaxChannels,
                                   "the largest model"};

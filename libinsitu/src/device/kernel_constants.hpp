@@ -28,6 +28,10 @@ constexpr int kWantFragment = 256;
 /// "interleaving" proxy: where it is 0, every interval is one contiguous run and opacity edits
 /// are exact; insitu/explore/transfer_function_edit.hpp).
 constexpr int kWantInterleaving = 512;
+/// Per pixel and interval, the depth of the first sample that gave the interval light (the
+/// "entry_depth" proxy: where its first run begins; the edit trust compares the intervals in
+/// that order with the mean-depth order, transfer_function_edit.hpp).
+constexpr int kWantEntryDepth = 1024;
 /// Floats per pixel of that record (kernels/render/proxy_renderer.cl writes them).
 constexpr int kFragmentChannels = 9;
 
@@ -51,7 +55,7 @@ struct KernelConstant {
 
 /// Every constant passed to the kernels. Private arrays are sized by the MAX_* limits, so they
 /// bound each work-item's private memory.
-inline constexpr std::array<KernelConstant, 18> kKernelConstants{{
+inline constexpr std::array<KernelConstant, 19> kKernelConstants{{
     {"MAX_LAYERS", kMaxLayers},        // depth layers per pass (layer_t[] in the proxy kernel)
     {"MAX_INTERVALS", kMaxIntervals},  // intensity intervals (a[] in colour model, edits)
     {"MAX_LIGHTS", kMaxLights},        // lights per relighting call (half_vectors[])
@@ -65,6 +69,7 @@ inline constexpr std::array<KernelConstant, 18> kKernelConstants{{
     {"WANT_FIRST_HIT_DEPTH", kWantFirstHitDepth},
     {"WANT_FRAGMENT", kWantFragment},
     {"WANT_INTERLEAVING", kWantInterleaving},
+    {"WANT_ENTRY_DEPTH", kWantEntryDepth},
     {"FRAGMENT_CHANNELS", kFragmentChannels},
     {"SEGMENTS_WHOLE_RAY", kSegmentsWholeRay},
     {"SEGMENTS_LAYERS", kSegmentsLayers},
@@ -79,8 +84,8 @@ static_assert(kMaxLights >= 1 && kMaxLights <= 64, "half_vectors[] is a private 
 // The wanted bits must be distinct powers of two.
 static_assert((kWantDepth | kWantDistortion | kWantAttenuation | kWantMeanDepth |
                kWantOpticalDepth | kWantSegmentRgba | kWantSegmentDepth | kWantFirstHitDepth |
-               kWantFragment | kWantInterleaving) == 1023,
-              "wanted bits are the ten distinct low bits");
+               kWantFragment | kWantInterleaving | kWantEntryDepth) == 2047,
+              "wanted bits are the eleven distinct low bits");
 static_assert(kSegmentsWholeRay != kSegmentsLayers && kSegmentsLayers != kSegmentsOpacity &&
                   kSegmentsWholeRay != kSegmentsOpacity,
               "the kernel tells the segment rules apart by these values");

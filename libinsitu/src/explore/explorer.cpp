@@ -344,6 +344,10 @@ struct FrameBasis {
     /// The stored view's interleaving counts; null for synthesised views (not re-projected) and
     /// archives without them: the edit trust then leaves that term out.
     const Image* interleaving = nullptr;
+    /// Likewise the stored view's entry depths, and its exact rendering (the recolouring
+    /// term's measure at the run's own function).
+    const Image* entry_depth = nullptr;
+    const Image* stored_rendering = nullptr;
     /// How exactly the archive stores a_j (EditTrustInputs::attenuation_resolution).
     double attenuation_resolution = kHalfAttenuationResolution;
     const IntervalSet* intervals = nullptr;  ///< with attenuation
@@ -487,6 +491,12 @@ void finish_frame(FrameBasis basis, const ExploreRequest& request,
             trust.mean_depth = &basis.mean_depth;
             trust.optical_depth = basis.optical_depth;
             trust.interleaving = basis.interleaving;
+            trust.entry_depth = basis.entry_depth;
+            if (basis.stored_rendering && !stored_tf.is_2d()) {
+                trust.stored_rendering = basis.stored_rendering;
+                trust.stored_colours = interval_colours(stored_tf, *basis.intervals);
+                trust.stored_colour_spread = interval_colour_spread(stored_tf, *basis.intervals);
+            }
             trust.edited_attenuation = opacity_edited ? &basis.attenuation : nullptr;
             trust.scales = scales;
             trust.colours = colours;
@@ -740,6 +750,8 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
             basis.mean_depth = single->mean_depth;
             if (single->optical_depth.channels > 0) basis.optical_depth = &single->optical_depth;
             if (single->interleaving.channels == 2) basis.interleaving = &single->interleaving;
+            if (single->entry_depth.channels > 0) basis.entry_depth = &single->entry_depth;
+            if (single->rendering.channels == 4) basis.stored_rendering = &single->rendering;
         } else if (attenuation_source) {
             SynthesisedAttenuation synthesised =
                 synthesise_attenuation(*attenuation_source, target, request.synthesis, device);
@@ -906,6 +918,10 @@ FrameRecipe Explorer::recipe(const ExploreRequest& request) {
         recipe.colour_source = plan.use_model ? ColourSource::model : ColourSource::recompose;
         recipe.colour_spread = interval_colour_spread(shown_tf, intervals);
         recipe.attenuation_resolution = stored_attenuation_resolution();
+        if (!stored_tf.is_2d()) {
+            recipe.stored_colours = interval_colours(stored_tf, intervals);
+            recipe.stored_colour_spread = interval_colour_spread(stored_tf, intervals);
+        }
         if (plan.use_model) {
             recipe.model_clusters = model->clusters();
             recipe.model_table = model->table();

@@ -157,6 +157,11 @@ Image recolour(const Image& attenuation, const std::vector<float>& colours, Comp
     return output.download(device, "recolour: colour");
 }
 
+double optical_depth_weight(double scale) {
+    if (!(scale > 0.0)) return 1.0;
+    return std::clamp(-std::log2(scale) - 1.0, 0.0, 1.0);
+}
+
 Image estimate_attenuation(const Image& attenuation, const Image& mean_depth,
                            const Image* optical_depth, const std::vector<double>& scales,
                            ComputeDevice& device) {
@@ -238,32 +243,46 @@ void check_trust_image(const Image* image, const Image& reference, int channels,
     }
 }
 
-/// Interval j's transmittance t_j as estimate_attenuation infers it (its definition, step 2), T
-/// the stored transmittance in front of it; `tau` may be null.
-double inferred_transmittance(double a_j, double transmittance, const float* tau, int j) {
-    if (tau) return std::exp(-std::max(0.0, double(tau[j])));
+/// Interval j's transmittance t_j inferred from the walk (estimate_attenuation's definition,
+/// step 2), T the transmittance inferred in front of it.
+double inferred_transmittance(double a_j, double transmittance) {
     if (!(transmittance > 0.0)) return 1.0;
     const double behind = transmittance - a_j;
     return behind > kFloatAttenuationResolution ? std::clamp(behind / transmittance, 0.0, 1.0)
                                                 : 0.0;
 }
 
+/// Where t_j comes from in a recomposition: the estimator's rule (optical_depth_weight), a_j
+/// alone, or the edit trust's thinning alternative (tau_j's t_j by the thinning weight).
+enum class TransmittanceFrom { estimator, attenuation, thinning };
+
+/// The thinning weight of the edit trust (edit_error): 0 at s >= 1, 1 at s <= 1/2.
+double thinning_weight(double scale) {
+    return scale > 0.0 ? std::clamp(-std::log2(scale), 0.0, 1.0) : 1.0;
+}
+
 /// estimate_attenuation's walk over the intervals in the order [first, last) of (depth, index)
 /// pairs, recomposed with `colours` into rgb: the edit's colour if the ray met the intervals
-/// in that order, one run each.
+/// in that order, one run each. `tau` may be null (then t_j always comes from a_j).
 template <typename Iterator>
-void recompose_in_order(const float* a, const float* tau, const std::vector<double>& scales,
-                        const std::vector<float>& colours, Iterator first, Iterator last,
-                        double* rgb) {
+void recompose_in_order(const float* a, const float* tau, TransmittanceFrom from,
+                        const std::vector<double>& scales, const std::vector<float>& colours,
+                        Iterator first, Iterator last, double* rgb) {
     rgb[0] = rgb[1] = rgb[2] = 0.0;
-    double transmittance = 1.0, edited_transmittance = 1.0;
+    double inferred_in_front = 1.0, edited_transmittance = 1.0;
     for (Iterator entry = first; entry != last; ++entry) {
         const int j = entry->second;
-        const double t = inferred_transmittance(a[j], transmittance, tau, j);
+        const double inferred = inferred_transmittance(a[j], inferred_in_front);
+        double t = inferred;
+        if (tau && from != TransmittanceFrom::attenuation) {
+            const double w = from == TransmittanceFrom::thinning ? thinning_weight(scales[j])
+                                                                 : optical_depth_weight(scales[j]);
+            t = (1.0 - w) * inferred + w * std::exp(-std::max(0.0, double(tau[j])));
+        }
         const double edited = scales[j] > 0.0 ? std::pow(t, scales[j]) : 1.0;
         const double a_edited = edited_transmittance * (1.0 - edited);
         for (int c = 0; c < 3; ++c) rgb[c] += a_edited * colours[3 * j + c];
-        transmittance *= t;
+        inferred_in_front *= inferred;
         edited_transmittance *= edited;
     }
 }
@@ -282,6 +301,16 @@ Image edit_error(const EditTrustInputs& inputs) {
     check_trust_image(inputs.optical_depth, stored, intervals, "optical depth");
     check_trust_image(inputs.edited_attenuation, stored, intervals, "edited attenuation");
     check_trust_image(inputs.interleaving, stored, 2, "interleaving");
+    check_trust_image(inputs.entry_depth, stored, intervals, "entry depth");
+    check_trust_image(inputs.stored_rendering, stored, 4, "stored rendering");
+    const bool calibrated = inputs.stored_rendering && !inputs.colour_spread.empty();
+    if (calibrated &&
+        (inputs.stored_colours.size() != 3 * L || inputs.stored_colour_spread.size() != L)) {
+        fail<InvalidArgument>("edit_error: ", inputs.stored_colours.size(),
+                              " stored colour values and ", inputs.stored_colour_spread.size(),
+                              " stored spreads for ", intervals, " intervals (expected ",
+                              3 * intervals, " and ", intervals, ")");
+    }
     const std::vector<double> scales =
         inputs.scales.empty() ? std::vector<double>(L, 1.0) : inputs.scales;
     if (scales.size() != L || inputs.colours.size() != 3 * L ||
@@ -301,8 +330,16 @@ Image edit_error(const EditTrustInputs& inputs) {
         std::fill(error.pixels.begin(), error.pixels.end(), 1.0f);
         return error;
     }
-    std::vector<std::pair<float, int>> order;
+    // The order terms' weights per interval (edit_error's definition, in the header).
+    std::vector<double> thickening(L), thinning(L);
+    for (std::size_t j = 0; j < L; ++j) {
+        const double octaves = scales[j] > 0.0 ? std::log2(scales[j]) : -INFINITY;
+        thickening[j] = std::clamp(octaves / 2.0, 0.0, 1.0);
+        thinning[j] = thinning_weight(scales[j]);
+    }
+    std::vector<std::pair<float, int>> order, entry_order;
     order.reserve(L);
+    entry_order.reserve(L);
     for (std::size_t p = 0; p < stored.pixel_count(); ++p) {
         const float* a = &stored.pixels[p * L];
         const float* a_edited = &edited.pixels[p * L];
@@ -322,23 +359,89 @@ Image edit_error(const EditTrustInputs& inputs) {
         for (const auto& [depth, j] : order) {
             (void)depth;
             const double s = scales[j];
-            const double t = inferred_transmittance(a[j], transmittance, tau, j);
-            // Stored tau is known relatively, a_j absolutely (so t_j to within res / T).
+            // t_j as the estimator takes it. Stored tau is known relatively, a_j absolutely (so
+            // its t_j to within res / T); a blend of the two, as uncertain as its parts.
+            const double inferred = inferred_transmittance(a[j], transmittance);
+            const double w = tau ? optical_depth_weight(s) : 0.0;
+            const double from_tau = tau ? std::exp(-std::max(0.0, double(tau[j]))) : 0.0;
+            const double t = (1.0 - w) * inferred + w * from_tau;
             double uncertainty = 0.0;
-            if (tau) {
-                uncertainty = t * std::max(0.0, double(tau[j])) * resolution;
-            } else if (transmittance > 0.0) {
-                uncertainty = resolution / transmittance;
-            }
+            if (w > 0.0) uncertainty += w * from_tau * std::max(0.0, double(tau[j])) * resolution;
+            if (w < 1.0 && transmittance > 0.0)
+                uncertainty += (1.0 - w) * resolution / transmittance;
             if (s > 0.0 && uncertainty > 0.0) {
                 const double high = std::min(1.0, t + uncertainty);
                 total += edited_transmittance * std::abs(std::pow(high, s) - std::pow(t, s));
             }
-            transmittance *= t;
+            transmittance *= inferred;
             edited_transmittance *= s > 0.0 ? std::pow(t, s) : 1.0;
         }
+        if (!inputs.colour_spread.empty()) {
+            double bound = 0.0;
+            for (std::size_t j = 0; j < L; ++j) bound += a_edited[j] * inputs.colour_spread[j];
+            if (calibrated) {
+                // What recolouring missed at the stored function, where the truth is known.
+                double stored_bound = 0.0, missed = 0.0;
+                double rgb[3] = {0.0, 0.0, 0.0};
+                for (std::size_t j = 0; j < L; ++j) {
+                    stored_bound += a[j] * inputs.stored_colour_spread[j];
+                    for (int c = 0; c < 3; ++c) rgb[c] += a[j] * inputs.stored_colours[3 * j + c];
+                }
+                const float* rendering = &inputs.stored_rendering->pixels[4 * p];
+                for (int c = 0; c < 3; ++c)
+                    missed = std::max(missed, std::abs(rgb[c] - rendering[c]));
+                if (stored_bound > kCalibratedSpreadFloor) {
+                    bound = std::min(bound, missed * bound / stored_bound);
+                }
+            }
+            total += bound;
+        }
+        double light = 0.0, thick = 0.0, thin = 0.0;
         for (std::size_t j = 0; j < L; ++j) {
-            if (!inputs.colour_spread.empty()) total += a_edited[j] * inputs.colour_spread[j];
+            light += a[j];
+            thick += a[j] * thickening[j];
+            thin += a[j] * thinning[j];
+        }
+        if (inputs.entry_depth && order.size() > 1 && light > 0.0) {
+            // Order: the shown estimate against the entry-depth order (thickening) and, with
+            // tau, against the estimate from a_j alone (thinning).
+            double shown[3], other[3];
+            recompose_in_order(a, tau, TransmittanceFrom::estimator, scales, inputs.colours,
+                               order.begin(), order.end(), shown);
+            auto departure = [&](const double* from) {
+                double worst = 0.0;
+                for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(from[c] - shown[c]));
+                return worst;
+            };
+            if (thick > 0.0) {
+                const float* entry = &inputs.entry_depth->pixels[p * L];
+                entry_order.clear();
+                for (const auto& [depth, j] : order) {
+                    (void)depth;
+                    entry_order.emplace_back(std::isnan(entry[j]) ? INFINITY : entry[j], j);
+                }
+                std::stable_sort(entry_order.begin(), entry_order.end(),
+                                 [](const auto& x, const auto& y) { return x.first < y.first; });
+                recompose_in_order(a, tau, TransmittanceFrom::attenuation, scales, inputs.colours,
+                                   entry_order.begin(), entry_order.end(), other);
+                total += thick / light * departure(other);
+            }
+            if (tau && thin > 0.0) {
+                // The two estimates of thinning disagree by this much; the estimator takes one
+                // or the other (or between) by s_j, and either may be the wrong one.
+                double from_attenuation[3];
+                recompose_in_order(a, tau, TransmittanceFrom::attenuation, scales, inputs.colours,
+                                   order.begin(), order.end(), from_attenuation);
+                recompose_in_order(a, tau, TransmittanceFrom::thinning, scales, inputs.colours,
+                                   order.begin(), order.end(), other);
+                double worst = 0.0;
+                for (int c = 0; c < 3; ++c) {
+                    worst = std::max(worst, std::abs(other[c] - from_attenuation[c]));
+                }
+                total += worst;
+            }
+            error.pixels[p] = static_cast<float>(total);
+            continue;
         }
         // Interleaving: where the ray re-entered intervals, the one-run-per-interval order the
         // estimator assumed holds only for the light of first runs. The estimate in the reverse
@@ -348,13 +451,12 @@ Image edit_error(const EditTrustInputs& inputs) {
         const float* interleaving =
             inputs.interleaving ? &inputs.interleaving->pixels[2 * p] : nullptr;
         if (interleaving && interleaving[0] > 0.0f && order.size() > 1) {
-            double light = 0.0;
-            for (std::size_t j = 0; j < L; ++j) light += a[j];
             const double share = light > 0.0 ? std::min(1.0, interleaving[1] / light) : 0.0;
             double forward[3], backward[3];
-            recompose_in_order(a, tau, scales, inputs.colours, order.begin(), order.end(), forward);
-            recompose_in_order(a, tau, scales, inputs.colours, order.rbegin(), order.rend(),
-                               backward);
+            recompose_in_order(a, tau, TransmittanceFrom::estimator, scales, inputs.colours,
+                               order.begin(), order.end(), forward);
+            recompose_in_order(a, tau, TransmittanceFrom::estimator, scales, inputs.colours,
+                               order.rbegin(), order.rend(), backward);
             double worst = 0.0;
             for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(forward[c] - backward[c]));
             total += share * worst;

@@ -24,7 +24,7 @@ namespace {
 
 bool accumulates(const ProxyRequest& request) {
     return request.attenuation || request.mean_depth || request.optical_depth ||
-           request.interleaving;
+           request.interleaving || request.entry_depth;
 }
 
 bool wants_segments(const ProxyRequest& request) {
@@ -111,8 +111,9 @@ int segment_count(const ProxyRequest& request) {
 struct ProxyRenderer::DeviceState {
     cl::Kernel kernel, packet_kernel;  // one ray per work-item; ray packets
     detail::DeviceMemory table, isovalues, edges, thresholds, depth_out, distortion_out,
-        attenuation_out, mean_depth_out, optical_depth_out, interleaving_out, segment_rgba_out,
-        segment_depth_out, first_hit_out, skippable, fragment_out, block_ranges_out;
+        attenuation_out, mean_depth_out, optical_depth_out, interleaving_out, entry_depth_out,
+        segment_rgba_out, segment_depth_out, first_hit_out, skippable, fragment_out,
+        block_ranges_out;
     cl::Kernel block_ranges;  ///< kernels/render/empty_space.cl
     /// Block ranges of the uploaded volume, rescanned when its generation changes.
     detail::BlockRanges blocks;
@@ -203,6 +204,7 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     if (request.segment_depth) wanted |= detail::kWantSegmentDepth;
     if (request.first_hit_depth) wanted |= detail::kWantFirstHitDepth;
     if (request.interleaving) wanted |= detail::kWantInterleaving;
+    if (request.entry_depth) wanted |= detail::kWantEntryDepth;
     const bool partial = volume.region.has_value();
     if (partial) {
         // A block sees its own part of each ray: a run that the block's neighbour interrupts
@@ -211,6 +213,11 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
             fail<InvalidArgument>(
                 "interleaving counts are not composited across blocks: a block of a distributed "
                 "run cannot know which intervals the ray met in front of it");
+        }
+        if (request.entry_depth) {
+            fail<InvalidArgument>(
+                "entry depths are not composited across blocks: a block of a distributed run "
+                "cannot know which intervals the ray met in front of it");
         }
         // A segment's and the first hit's opacity thresholds depend on the opacity in front of
         // the block, which a block does not know.
@@ -247,6 +254,8 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     const cl::Buffer optical_depth_out =
         output(state_->optical_depth_out, request.optical_depth, interval_count);
     const cl::Buffer interleaving_out = output(state_->interleaving_out, request.interleaving, 2);
+    const cl::Buffer entry_depth_out =
+        output(state_->entry_depth_out, request.entry_depth, interval_count);
     const cl::Buffer segment_rgba_out =
         output(state_->segment_rgba_out, request.segment_rgba, 4 * segments);
     const cl::Buffer segment_depth_out =
@@ -340,7 +349,7 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
         detail::camera_args(camera), detail::image_size(camera), march, static_cast<cl_int>(wanted),
         static_cast<cl_int>(layer_count), isovalue_buffer, static_cast<cl_int>(interval_count),
         static_cast<cl_float>(uniform_scale), edge_buffer, depth_out, distortion_out,
-        attenuation_out, mean_depth_out, optical_depth_out, interleaving_out,
+        attenuation_out, mean_depth_out, optical_depth_out, interleaving_out, entry_depth_out,
         static_cast<cl_int>(request.segments), static_cast<cl_int>(segments), threshold_buffer,
         static_cast<cl_float>(request.first_hit_threshold), segment_rgba_out, segment_depth_out,
         first_hit_out, skippable_buffer, block_counts, block_voxels, fragment_out);
@@ -370,6 +379,7 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     if (request.optical_depth) {
         frame.optical_depth = fetch_channels(optical_depth_out, "optical depth");
     }
+    if (request.entry_depth) frame.entry_depth = fetch_channels(entry_depth_out, "entry depth");
     if (request.segment_rgba) {
         fetch(segment_rgba_out, 4 * segments, "segment RGBA");
         frame.segment_rgba = planes_to_images(planar, width, height, segments, 4);
@@ -404,6 +414,7 @@ std::ostream& operator<<(std::ostream& out, const ProxyRequest& request) {
     if (request.mean_depth) out << "mean depth, ";
     if (request.optical_depth) out << "optical depth, ";
     if (request.interleaving) out << "interleaving, ";
+    if (request.entry_depth) out << "entry depth, ";
     if (wants_segments(request)) {
         out << segment_count(request) << " segments (" << to_string(request.segments);
         if (request.segments == SegmentRule::opacity) {
@@ -443,6 +454,7 @@ std::ostream& operator<<(std::ostream& out, const ProxyFrame& frame) {
     image("mean depth", frame.mean_depth);
     image("optical depth", frame.optical_depth);
     image("interleaving", frame.interleaving);
+    image("entry depth", frame.entry_depth);
     images("segment RGBA", frame.segment_rgba);
     images("segment depth", frame.segment_depth);
     image("first-hit depth", frame.first_hit_depth);

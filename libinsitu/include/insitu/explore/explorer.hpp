@@ -140,9 +140,13 @@ struct FrameRecipe {
     int model_clusters = 0;
     std::vector<float> model_table;
     /// For an edit, what its trust (edit_error) needs besides the proxies: each interval's
-    /// colour spread under the shown function and the stored a_j's resolution.
+    /// colour spread under the shown function and the stored a_j's resolution; and the run's
+    /// own function's interval colours and spreads, with which the recolouring term is measured
+    /// on the stored rendering (EditTrustInputs::stored_rendering; empty for 2D functions).
     std::vector<float> colour_spread;
     double attenuation_resolution = 0.0;
+    std::vector<float> stored_colours;
+    std::vector<float> stored_colour_spread;
     /// Lights as the kernels take them (relighting.cl illuminate): direction toward the light,
     /// normalised, or (0, 0, 0) for a headlight (the client puts -forward of its camera there).
     std::optional<LightingSettings> lighting;

@@ -46,16 +46,18 @@ Image recolour(const Image& attenuation, const std::vector<float>& colours,
 
 /// a' after scaling interval j's extinction by scales[j] (>= 0, finite). `mean_depth` orders the
 /// intervals along each ray; `optical_depth` (may be null) gives each interval's own
-/// transmittance exactly instead of inferring it from a. L-channel result.
+/// transmittance exactly, which thinning edits use instead of inferring it from a (step 2).
+/// L-channel result.
 ///
 /// Estimator, per pixel:
 ///  1. Order the intervals with a_j > 0 by their mean depth z̄_j, front to back (ties by index).
-///  2. Walk them, keeping T = prod of t over the intervals in front (T = 1 at the camera):
-///     t_j = exp(-tau_j) when optical depth is given, else t_j = 1 - a_j / T, computed as
-///     (T - a_j) / T and clamped to [0, 1]; t_j = 0 where the light left behind the run,
-///     T - a_j, is below 1e-6 (float rounding of an opaque run: under s_j < 1 the rounding would
-///     otherwise leak light, 1e-7^0.25 = 0.02); t_j = 1 where T = 0 (nothing behind an opaque
-///     front was recorded).
+///  2. Walk them, keeping T = prod of t over the intervals in front (T = 1 at the camera) and
+///     inferring t_j = 1 - a_j / T, computed as (T - a_j) / T and clamped to [0, 1]; t_j = 0
+///     where the light left behind the run, T - a_j, is below 1e-6 (float rounding of an opaque
+///     run: under s_j < 1 the rounding would otherwise leak light, 1e-7^0.25 = 0.02); t_j = 1
+///     where T = 0 (nothing behind an opaque front was recorded). With optical depth, the edit
+///     takes (1 - w) t_j + w exp(-tau_j), w = optical_depth_weight(s_j), and T still walks the
+///     inferred t_j.
 ///  3. Edit: t_j' = t_j^s_j (t_j' = 1 for s_j = 0, also where t_j = 0).
 ///  4. Recompose: a_j' = T' (1 - t_j'), T' = prod of t' over the intervals in front.
 /// Intervals with a_j = 0 keep a_j' = 0: what an opaque front hid cannot be recovered.
@@ -64,12 +66,21 @@ Image recolour(const Image& attenuation, const std::vector<float>& colours,
 /// extinction by s_j turns t_j into t_j^s_j); approximate when runs interleave, e.g. a ray that
 /// enters and leaves a shell, whose front and back runs share one a_j and one mean depth.
 /// Inferring t_j from a divides by T, so rounding grows as 1/T behind dense fronts, and t^s
-/// magnifies it where t is small and s < 1; optical depth avoids both.
+/// magnifies it where t is small and s < 1; optical depth avoids both. But exp(-tau_j) treats
+/// an interval's runs as one, which is wrong for s near 1 (where a itself is exact) wherever the
+/// runs interleave; hence the weight.
 /// Scales 0 and kUnrecoverableOpacityScale give finite, defined results.
 /// InvalidArgument names a size, channel or scale that does not fit.
 Image estimate_attenuation(const Image& attenuation, const Image& mean_depth,
                            const Image* optical_depth, const std::vector<double>& scales,
                            ComputeDevice& device = *ComputeDevice::shared());
+
+/// How much of t_j a thinning edit by s takes from the optical depth: 0 for s >= 1/2, 1 for
+/// s <= 1/4, linear in log2(s) between. bench/RESULTS.md ("Where the methods fail") measures the
+/// two sources on Gray-Scott, where runs interleave at most pixels: at s = 1/2, exp(-tau_j) gets
+/// 835 pixels wrong by > 0.1 against 8 for the inferred t_j; at s = 1/4, 41 against 371; at
+/// 1/16, 0 against 135.
+double optical_depth_weight(double scale);
 
 /// Trust for transfer-function edits (issue 17): a per-pixel estimate of how far an edited frame
 /// can be from the ground truth, from what the proxies know. Each term bounds one way the edit
@@ -80,6 +91,9 @@ struct EditTrustInputs {
     const Image* optical_depth = nullptr;  ///< may be null (then t_j is inferred from a_j)
     /// ProxyFrame::interleaving (2 channels); null = unknown, and its term is left out.
     const Image* interleaving = nullptr;
+    /// ProxyFrame::entry_depth (L channels); null = unknown (then the interleaving term stands
+    /// in for the two order terms below).
+    const Image* entry_depth = nullptr;
     const Image* edited_attenuation = nullptr;  ///< a'_j; null = no opacity edit (a' = a)
     std::vector<double> scales;                 ///< s_j as applied; empty = all 1
     /// Interval colours the frame is recomposed with (interval_colours of the shown function),
@@ -89,10 +103,20 @@ struct EditTrustInputs {
     /// Absolute error of a stored a_j: kHalfAttenuationResolution for half archives,
     /// kFloatAttenuationResolution for float ones and frames straight from the renderer.
     double attenuation_resolution = 0.0;
+    /// The stored view's exact rendering (RGBA, the run's own function) with that function's
+    /// interval colours and spreads: what recolouring the stored a_j actually missed there,
+    /// which scales the recolouring term. Null/empty = unknown (the term is then its bound).
+    const Image* stored_rendering = nullptr;
+    std::vector<float> stored_colours;
+    std::vector<float> stored_colour_spread;
 };
 /// Half rounds a_j in [0.5, 1) by up to 2^-12; T = 1 - sum_j a_j adds a few such roundings.
 inline constexpr double kHalfAttenuationResolution = 1.0 / 2048.0;
 inline constexpr double kFloatAttenuationResolution = 1e-6;  // EDIT_OPAQUE_LIGHT
+/// Below this recolouring bound at the stored function (sum_j a_j spread_j), what recolouring
+/// missed there says nothing about the edit (the stored colours are constant per interval, or
+/// the pixel is nearly empty), and the recolouring term stays its bound.
+inline constexpr double kCalibratedSpreadFloor = 1e-3;
 
 /// Per interval, the largest deviation (max over RGB) of `tf`'s colour from interval j's
 /// emission colour (interval_colours) over the values in j where the opacity is > 0: the most a
@@ -108,12 +132,27 @@ std::vector<float> interval_colour_spread(const TransferFunction& tf, const Inte
 ///    T' the edited transmittance in front. Large where s < 1 thins a front that was opaque in
 ///    the store: what lay behind it was never recorded (t = 0 shows as "opaque", 1e-8^(1/64) =
 ///    0.75);
-///  * interleaving: where the ray re-entered an interval (interleaving > 0) the estimator's
-///    one-run-per-interval order is wrong, and the edit's change sum_j |a'_j - a_j| can land in
-///    the wrong intervals: weighted by the spread of the present intervals' colours when every
-///    present interval has the same scale (the total opacity is then still exact), else by
-///    their largest colour component;
-///  * recolouring: sum_j a'_j spread_j (the colour inside each interval is not constant);
+///  * order, with the entry depth: where the ray re-entered an interval, the mean depth the
+///    estimator orders by mixes its runs. Two alternatives are measured against the shown
+///    estimate (the max over RGB of the difference):
+///    - thickening (s > 1) turns on each interval's front run, so the frame recomposed from a_j
+///      in entry-depth order is the alternative, weighted by
+///      g_thick = sum_j a_j clamp(log2(s_j) / 2, 0, 1) / sum_j a_j;
+///    - thinning (s < 1) turns on each interval's own transmittance, which optical depth gives
+///      exactly, so where tau_j is stored the recomposition from a_j alone is the alternative
+///      of the tau estimate, weighted by g_thin = sum_j a_j clamp(-log2(s_j), 0, 1) / sum_j a_j.
+///      Without tau the thinning term is unknown and left out.
+///    Both weights are 0 at s = 1, where every order returns a exactly, and reach 1 at
+///    thickening by 4 and thinning by 2, by which bench/RESULTS.md ("Where the methods fail")
+///    finds the truth on the alternative's side;
+///  * interleaving, without the entry depth: where the ray re-entered intervals, the share of
+///    the pixel's light in re-entered runs times the difference between recomposing in
+///    mean-depth order and in its reverse (the other extreme);
+///  * recolouring: sum_j a'_j spread_j bounds what a pixel's own mix of values inside each
+///    interval adds (the colour inside an interval is not constant). With the stored rendering
+///    it is the deviation recolouring actually made there, max_RGB |sum_j c_j a_j - rendering|,
+///    scaled by how the bound changes (sum_j a'_j spread'_j / sum_j a_j spread_j), at most the
+///    bound;
 ///  * an interval the stored function left transparent and the edit does not
 ///    (kUnrecoverableOpacityScale): 1 everywhere, since the proxies never saw those values.
 /// InvalidArgument names an input of the wrong size.

@@ -49,6 +49,10 @@ struct ProxyRequest {
     /// (ProxyFrame::interleaving); needs intervals, and is refused for a block of a distributed
     /// run (a block cannot know what the ray met in front of it).
     bool interleaving = false;
+    /// Per pixel and interval, the depth where the interval first took light
+    /// (ProxyFrame::entry_depth); needs intervals, and is refused for a block of a distributed
+    /// run, as interleaving is.
+    bool entry_depth = false;
     /// Per segment of each ray, RGBA (premultiplied) and first-hit depth; the whole ray's
     /// first-hit depth. Each needs the transfer function.
     bool segment_rgba = false;
@@ -104,6 +108,11 @@ struct ProxyFrame {
     /// every interval is one contiguous run along the ray, the case in which opacity edits are
     /// exact (estimate_attenuation); the edit's trust reads both.
     Image interleaving;
+    /// L channels: the depth of the first sample that gave interval j light, the front of its
+    /// first run; +inf where a_j = 0. With the mean depth it says where an interval that the ray
+    /// re-entered began: opacity edits that thicken the volume turn on the front runs, which the
+    /// mean depth puts too far back (the edit trust compares both orders).
+    Image entry_depth;
     std::vector<Image> segment_rgba;   ///< RGBA each, one per segment, front first
     std::vector<Image> segment_depth;  ///< 1 channel each, one per segment
     Image first_hit_depth;             ///< 1 channel
