@@ -35,7 +35,8 @@ file(WRITE ${viewer_config} [=[
     "unit_length": 1.0}],
  "colour_model": {"clusters": 8},
  "intervals": {"count": 8},
- "proxies": ["depth", "distortion", "attenuation", "multi_attenuation"],
+ "proxies": ["depth", "distortion", "attenuation", "multi_attenuation", "rendering", "interleaving",
+             "entry_depth", "optical_depth"],
  "every": 10}
 ]=])
 
@@ -61,7 +62,8 @@ set_tests_properties(viewer.frame_cost PROPERTIES TIMEOUT 60)
 # Also on this archive, which has a colour model and no light field, frames the page draws
 # (WebGL2 through chromium's SwiftShader): colour_model.test.mjs edits opacity and compares the
 # canvas with `insitu-view render`; confidence.test.mjs compares the page's confidence overlay
-# with `render --mask`.
+# with `render --mask`. The archive stores every proxy an edit's trust and estimate read (the
+# rendering, interleaving, entry and optical depth), so both sides take every term.
 foreach(suite IN ITEMS browser api colour_model confidence)
   add_test(NAME viewer.${suite}
            COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/${suite}.test.mjs

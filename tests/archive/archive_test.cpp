@@ -99,6 +99,7 @@ ProxyFrame single_frame(int width, int height, bool optical_depth, int training)
     frame.attenuation = pattern(width, height, 5, 0.1f, false);
     frame.mean_depth = pattern(width, height, 5, 2.0f, true);
     if (optical_depth) frame.optical_depth = pattern(width, height, 5, 0.7f, false);
+    frame.entry_depth = pattern(width, height, 5, 1.5f, true);
     // Re-entry counts (small integers, which half holds exactly) and the light they added.
     frame.interleaving = Image(width, height, 2);
     for (std::size_t p = 0; p < frame.interleaving.pixel_count(); ++p) {
@@ -212,6 +213,7 @@ void expect_frames_match(const ProxyFrame& expected, const ProxyFrame& actual, b
     expect_images_match(expected.attenuation, actual.attenuation, half, "attenuation");
     expect_images_match(expected.mean_depth, actual.mean_depth, half, "mean depth");
     expect_images_match(expected.optical_depth, actual.optical_depth, half, "optical depth");
+    expect_images_match(expected.entry_depth, actual.entry_depth, half, "entry depth");
     EXPECT_EQ(expected.interleaving.pixels, actual.interleaving.pixels);  // exact in half too
     expect_layers_match(expected.training, actual.training, half, "training");
     expect_images_match(expected.rendering, actual.rendering, half, "rendering");

@@ -389,6 +389,65 @@ TEST(ProxyRenderer, InterleavingCountsTheRayReenteringAnInterval) {
     }
 }
 
+TEST(ProxyRenderer, EntryDepthIsWhereEachIntervalFirstTookLight) {
+    // The shells of InterleavingCountsTheRayReenteringAnInterval: through the centre interval 0
+    // first takes light at the outer shell's front wall, interval 1 only at the inner shell's,
+    // and interval 0's mean depth lies far behind its entry (its runs span the whole ray).
+    const glm::dvec3 centre(20.0);
+    SampledVolume volume = make_nested_shells({41, 41, 41}, {14.0, 5.0}, {0.4, 0.9}, 1.5);
+    ProxyRenderer renderer;
+    renderer.upload(volume.field());
+    ProxyRequest request;
+    request.depth_layers = false;
+    request.entry_depth = true;
+    request.march.step_voxels = 0.25;
+    request.intervals = IntervalSet({0.0, 0.6, 1.0});
+    request.transfer_function =
+        TransferFunction({{0.0, {1, 1, 1, 0}}, {0.05, {1, 1, 1, 0}}, {1.0, {1, 1, 1, 0.3}}});
+    OrbitView view;
+    view.width = view.height = 41;
+    const Camera camera = Camera::orbit(view, renderer.volume().bounds);
+    const Ray central = camera.ray(20.5, 20.5);
+    // Where the central ray meets the outer shell's wall (radius 14 + 1.5 wall) and the inner
+    // shell's (5 + 1.5), as depths.
+    const double outer_front = camera.depth_of(centre - (14.0 + 1.5 * 2) * central.direction);
+    const double inner_front = camera.depth_of(centre - (5.0 + 1.5 * 2) * central.direction);
+    std::vector<float> by_form[2];
+    for (const bool packets : {true, false}) {
+        request.march.ray_packets = packets;
+        const ProxyFrame frame = renderer.render(camera, request);
+        SCOPED_TRACE(packets ? "ray packets" : "one ray per work-item");
+        ASSERT_EQ(frame.entry_depth.channels, 2);
+        ASSERT_EQ(frame.entry_depth.pixel_count(), frame.attenuation.pixel_count());
+        const float entry_0 = frame.entry_depth.at(20, 20, 0);
+        const float entry_1 = frame.entry_depth.at(20, 20, 1);
+        EXPECT_GT(entry_0, outer_front);  // no light before the outer wall
+        EXPECT_LT(entry_0, camera.depth_of(centre) - 14.0 + 1.0);
+        EXPECT_GT(entry_1, inner_front);
+        EXPECT_LT(entry_1, camera.depth_of(centre) - 5.0 + 1.0);
+        EXPECT_GT(frame.mean_depth.at(20, 20, 0) - entry_0, 4.0);
+        for (std::size_t i = 0; i < frame.entry_depth.pixels.size(); ++i) {
+            const float a = frame.attenuation.pixels[i];
+            const float entry = frame.entry_depth.pixels[i];
+            if (a > 0.0f) {
+                EXPECT_LE(entry, frame.mean_depth.pixels[i] + 1e-3f) << i;  // a run starts first
+            } else {
+                EXPECT_TRUE(std::isinf(entry)) << i;
+            }
+        }
+        by_form[packets ? 0 : 1] = frame.entry_depth.pixels;
+    }
+    // Both forms meet the same samples.
+    ASSERT_EQ(by_form[0].size(), by_form[1].size());
+    for (std::size_t i = 0; i < by_form[0].size(); ++i) {
+        if (std::isinf(by_form[0][i]) || std::isinf(by_form[1][i])) {
+            EXPECT_EQ(by_form[0][i], by_form[1][i]) << i;
+        } else {
+            EXPECT_NEAR(by_form[0][i], by_form[1][i], 1e-3) << i;
+        }
+    }
+}
+
 bool any_nan(const Image& image) {
     for (float v : image.pixels) {
         if (std::isnan(v)) return true;

@@ -457,9 +457,22 @@ float editError(ivec2 p) {
     if (storedBound > 1e-3) bound = min(bound, missed * bound / storedBound);  // kCalibratedSpreadFloor
   }
   total += bound;
-  if (uHasEntryDepth && count > 1 && light > 0.0) {
-    // Order: the shown estimate against the entry-depth order (thickening) and, with tau, the
-    // two estimates of thinning against each other.
+  // Interleaving: the share of light in re-entered runs times the two run orders' difference.
+  float interleavingTerm = 0.0;
+  bool interleavingNeeded = !uHasEntryDepth || (!uHasOpticalDepth && thin > 0.0);
+  if (interleavingNeeded && uHasInterleaving && count > 1 &&
+      texelFetch(uInterleaving, ivec3(p, 0), 0).r > 0.0) {
+    float share = light > 0.0 ? min(1.0, texelFetch(uInterleaving, ivec3(p, 1), 0).r / light)
+                              : 0.0;
+    interleavingTerm =
+        share * largestDifference(recomposeInOrder(p, a, order, count, false, FROM_ESTIMATOR),
+                                  recomposeInOrder(p, a, order, count, true, FROM_ESTIMATOR));
+  }
+  if (!uHasEntryDepth) {
+    total += interleavingTerm;
+  } else if (count > 1 && light > 0.0) {
+    // Order: the shown estimate against the entry-depth order (thickening); thinning's two
+    // estimates against each other with tau, else the interleaving term for the thinned light.
     vec3 shown = recomposeInOrder(p, a, order, count, false, FROM_ESTIMATOR);
     if (thick > 0.0) {
       int entryOrder[MAX_INTERVALS];
@@ -475,13 +488,9 @@ float editError(ivec2 p) {
     if (uHasOpticalDepth && thin > 0.0) {
       total += largestDifference(recomposeInOrder(p, a, order, count, false, FROM_THINNING),
                                  recomposeInOrder(p, a, order, count, false, FROM_ATTENUATION));
+    } else if (thin > 0.0) {
+      total += thin / light * interleavingTerm;
     }
-  } else if (uHasInterleaving && count > 1 && texelFetch(uInterleaving, ivec3(p, 0), 0).r > 0.0) {
-    // Interleaving: the share of light in re-entered runs times the two run orders' difference.
-    float share = light > 0.0 ? min(1.0, texelFetch(uInterleaving, ivec3(p, 1), 0).r / light)
-                              : 0.0;
-    total += share * largestDifference(recomposeInOrder(p, a, order, count, false, FROM_ESTIMATOR),
-                                       recomposeInOrder(p, a, order, count, true, FROM_ESTIMATOR));
   }
   // The colour model's departure from recomposition (add_model_departure).
   if (uModel) {

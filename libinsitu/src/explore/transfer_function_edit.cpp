@@ -402,17 +402,34 @@ Image edit_error(const EditTrustInputs& inputs) {
             thick += a[j] * thickening[j];
             thin += a[j] * thinning[j];
         }
-        if (inputs.entry_depth && order.size() > 1 && light > 0.0) {
-            // Order: the shown estimate against the entry-depth order (thickening) and, with
-            // tau, against the estimate from a_j alone (thinning).
+        // Interleaving: where the ray re-entered intervals, the one-run-per-interval order the
+        // estimator assumed holds only for the light of first runs. The estimate in the reverse
+        // order (nearest last) is the other extreme; the light of the re-entered runs, as a
+        // share of the pixel's, says how far towards it the truth may lie. 0 without an opacity
+        // edit: both orders then return a itself.
+        const float* interleaving =
+            inputs.interleaving ? &inputs.interleaving->pixels[2 * p] : nullptr;
+        auto interleaving_term = [&] {
+            if (!interleaving || !(interleaving[0] > 0.0f) || order.size() < 2) return 0.0;
+            const double share = light > 0.0 ? std::min(1.0, interleaving[1] / light) : 0.0;
+            double forward[3], backward[3];
+            recompose_in_order(a, tau, TransmittanceFrom::estimator, scales, inputs.colours,
+                               order.begin(), order.end(), forward);
+            recompose_in_order(a, tau, TransmittanceFrom::estimator, scales, inputs.colours,
+                               order.rbegin(), order.rend(), backward);
+            double worst = 0.0;
+            for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(forward[c] - backward[c]));
+            return share * worst;
+        };
+        if (!inputs.entry_depth) {
+            total += interleaving_term();
+        } else if (order.size() > 1 && light > 0.0) {
+            // Order: the shown estimate against the entry-depth order (thickening); thinning's
+            // two estimates against each other with tau, else the interleaving term for the
+            // thinned share of the light.
             double shown[3], other[3];
             recompose_in_order(a, tau, TransmittanceFrom::estimator, scales, inputs.colours,
                                order.begin(), order.end(), shown);
-            auto departure = [&](const double* from) {
-                double worst = 0.0;
-                for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(from[c] - shown[c]));
-                return worst;
-            };
             if (thick > 0.0) {
                 const float* entry = &inputs.entry_depth->pixels[p * L];
                 entry_order.clear();
@@ -424,7 +441,9 @@ Image edit_error(const EditTrustInputs& inputs) {
                                  [](const auto& x, const auto& y) { return x.first < y.first; });
                 recompose_in_order(a, tau, TransmittanceFrom::attenuation, scales, inputs.colours,
                                    entry_order.begin(), entry_order.end(), other);
-                total += thick / light * departure(other);
+                double worst = 0.0;
+                for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(other[c] - shown[c]));
+                total += thick / light * worst;
             }
             if (tau && thin > 0.0) {
                 // The two estimates of thinning disagree by this much; the estimator takes one
@@ -439,27 +458,9 @@ Image edit_error(const EditTrustInputs& inputs) {
                     worst = std::max(worst, std::abs(other[c] - from_attenuation[c]));
                 }
                 total += worst;
+            } else if (thin > 0.0) {
+                total += thin / light * interleaving_term();
             }
-            error.pixels[p] = static_cast<float>(total);
-            continue;
-        }
-        // Interleaving: where the ray re-entered intervals, the one-run-per-interval order the
-        // estimator assumed holds only for the light of first runs. The estimate in the reverse
-        // order (nearest last) is the other extreme; the light of the re-entered runs, as a
-        // share of the pixel's, says how far towards it the truth may lie. 0 without an opacity
-        // edit: both orders then return a itself.
-        const float* interleaving =
-            inputs.interleaving ? &inputs.interleaving->pixels[2 * p] : nullptr;
-        if (interleaving && interleaving[0] > 0.0f && order.size() > 1) {
-            const double share = light > 0.0 ? std::min(1.0, interleaving[1] / light) : 0.0;
-            double forward[3], backward[3];
-            recompose_in_order(a, tau, TransmittanceFrom::estimator, scales, inputs.colours,
-                               order.begin(), order.end(), forward);
-            recompose_in_order(a, tau, TransmittanceFrom::estimator, scales, inputs.colours,
-                               order.rbegin(), order.rend(), backward);
-            double worst = 0.0;
-            for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(forward[c] - backward[c]));
-            total += share * worst;
         }
         error.pixels[p] = static_cast<float>(total);
     }
