@@ -132,20 +132,34 @@ def light_field_goals(rows, met):
     return out
 
 
+# The proxies an edit's trust reads in the failure sweeps (evaluate.cpp ColourSetup::trust_proxies).
+TRUST_PROXIES = [("interleaving", "interleaving counts only (before the entry depth)"),
+                 ("default", "the default proxies (+ entry depth)"),
+                 ("optical_depth", "+ optical depth")]
+
+
+def proxies_of(r):
+    return r.get("proxies") or "default"
+
+
 def edit_trust_goals(scale, occlusion, met):
-    """The goal row of the edit trust (issue 17): over the failure sweeps, the worst row's share of
-    wrong pixels flagged (rows where any went wrong) and of right ones flagged."""
-    rows = [r for r in scale + occlusion if r.get("good_flagged_fraction")]
-    if not rows:
-        return []
-    wrong = [r for r in rows if num(r, "high_error_fraction") > 0.0]
-    worst_flagged = min((num(r, "flagged_fraction") for r in wrong), default=1.0)
-    worst_good = max(num(r, "good_flagged_fraction") for r in rows)
-    return [["trust for edits < 0.5: share of wrong pixels (error > 0.1) flagged, worst sweep row / of "
-             "right ones flagged, worst row (failure sweeps: opacity scale, occlusion; model and "
-             "recomposition)", "≥ 80 % / ≤ 10 %",
-             "%.0f %% / %.0f %%" % (100 * worst_flagged, 100 * worst_good),
-             met(worst_flagged >= 0.8 and worst_good <= 0.1)]]
+    """The goal rows of the edit trust (issue 17), per set of proxies: over the failure sweeps, the
+    worst row's share of wrong pixels flagged (rows where any went wrong) and of right ones
+    flagged."""
+    goals = []
+    for proxies, label in TRUST_PROXIES[1:]:
+        rows = [r for r in scale + occlusion if r.get("good_flagged_fraction") and proxies_of(r) == proxies]
+        if not rows:
+            continue
+        wrong = [r for r in rows if num(r, "high_error_fraction") > 0.0]
+        worst_flagged = min((num(r, "flagged_fraction") for r in wrong), default=1.0)
+        worst_good = max(num(r, "good_flagged_fraction") for r in rows)
+        goals.append(["trust for edits < 0.5, %s: share of wrong pixels (error > 0.1) flagged, worst "
+                      "sweep row / of right ones flagged, worst row (failure sweeps: opacity scale, "
+                      "occlusion; model and recomposition)" % label, "≥ 80 % / ≤ 10 %",
+                      "%.0f %% / %.0f %%" % (100 * worst_flagged, 100 * worst_good),
+                      met(worst_flagged >= 0.8 and worst_good <= 0.1)])
+    return goals
 
 
 def chart_budget(d, rows):
@@ -369,8 +383,11 @@ def chart_failures(d, scale_rows, interval_rows, occlusion_rows, cluster_rows):
     fig, axes = plt.subplots(1, 4, figsize=(18, 4))
     ax = axes[0]
     for method in ("model", "recompose"):
-        sel = [r for r in scale_rows if r["method"] == method]
-        ax.plot([num(r, "scale") for r in sel], [num(r, "psnr") for r in sel], "o-", label=method)
+        for proxies, style, suffix in (("default", "o-", ""), ("optical_depth", "s--", ", with optical depth")):
+            sel = [r for r in scale_rows if r["method"] == method and proxies_of(r) == proxies]
+            if sel:
+                ax.plot([num(r, "scale") for r in sel], [num(r, "psnr") for r in sel], style,
+                        label=method + suffix)
     ax.axvspan(0.2, 1.0, color="C2", alpha=0.15, label="training range")
     ax.set_xscale("log", base=2)
     ax.set_xlabel("opacity scale on every interval")
@@ -390,6 +407,7 @@ def chart_failures(d, scale_rows, interval_rows, occlusion_rows, cluster_rows):
     ax.set_title("too few intervals", fontsize=10)
     ax.legend(fontsize=7)
     ax = axes[2]
+    occlusion_rows = [r for r in occlusion_rows if proxies_of(r) == "default"]
     labels = ["%s\n%s" % (r["training"].replace("_", " "), r["method"]) for r in occlusion_rows]
     ax.bar(range(len(occlusion_rows)), [num(r, "psnr") for r in occlusion_rows],
            color=["C3" if r["training"] == "inner_occluded" and r["method"] == "model" else "C0" for r in occlusion_rows])
@@ -595,19 +613,37 @@ def write_markdown(d, path, prefix, elapsed):
     lines += ["## Where the methods fail", "", "![failures](%sfailures.png)" % prefix, ""]
     def good(r):
         return "%.2f" % num(r, "good_flagged_fraction") if r.get("good_flagged_fraction") else "n/a"
-    body = [[r["scale"], "yes" if r["in_training_range"] == "1" else "no", r["method"], "%.1f" % num(r, "psnr"),
-             "%.3f" % num(r, "high_error_fraction"), "%.2f" % num(r, "flagged_fraction"), good(r)] for r in scale]
+    def by_proxies(rows, keys):
+        """Rows of the default proxies, each with its interleaving-only and optical-depth twins."""
+        twins = {}
+        for r in rows:
+            twins.setdefault(tuple(r[k] for k in keys), {})[proxies_of(r)] = r
+        return [t for t in twins.values() if "default" in t]
+    def mask(r):
+        return "%.2f / %s" % (num(r, "flagged_fraction"), good(r)) if r else "n/a"
+    def trust_columns(t):
+        tau = t.get("optical_depth")
+        return ["%.1f" % num(t["default"], "psnr"), "%.3f" % num(t["default"], "high_error_fraction"),
+                mask(t.get("interleaving")), mask(t["default"]),
+                "%.1f" % num(tau, "psnr") if tau else "n/a",
+                "%.3f" % num(tau, "high_error_fraction") if tau else "n/a", mask(tau)]
+    trust_header = ["PSNR dB", "high-error px", "flagged / right flagged, interleaving only",
+                    "flagged / right flagged, default (+ entry depth)", "PSNR dB, + optical depth",
+                    "high-error px, + optical depth", "flagged / right flagged, + optical depth"]
+    body = [[t["default"]["scale"], "yes" if t["default"]["in_training_range"] == "1" else "no",
+             t["default"]["method"]] + trust_columns(t)
+            for t in by_proxies(scale, ("scale", "method"))]
     lines += ["Opacity scaled on every interval (pixels off by > 0.1 of full scale; the share of them the "
               "edit's trust flags, trust < 0.5, and the share of right pixels it flags among those either "
-              "image covers; insitu/explore/transfer_function_edit.hpp):", "",
-              table(["scale", "in training range", "method", "PSNR dB", "high-error px", "flagged",
-                     "right px flagged"], body), ""]
-    body = [[r["training"].replace("_", " "), r["method"], "%.1f" % num(r, "psnr"), "%.3f" % num(r, "high_error_fraction"),
-             "%.2f" % num(r, "flagged_fraction"), good(r)] for r in occlusion]
+              "image covers; insitu/explore/transfer_function_edit.hpp). The trust reads the interleaving "
+              "counts alone (as before the entry depth), the default proxies, or these with the optical "
+              "depth, which the estimate then also reads for strong thinning:", "",
+              table(["scale", "in training range", "method"] + trust_header, body), ""]
+    body = [[t["default"]["training"].replace("_", " "), t["default"]["method"]] + trust_columns(t)
+            for t in by_proxies(occlusion, ("training", "method"))]
     lines += ["A feature occluded in every training image (nested shells, the outer one opaque in all "
-              "training functions, then faded by the edit):", "",
-              table(["training images", "method", "PSNR dB", "high-error px", "flagged", "right px flagged"],
-                    body), ""]
+              "training functions, then faded by the edit to 0.3):", "",
+              table(["training images", "method"] + trust_header, body), ""]
     rot_rows = [r for r in rotation if r["scene"] == rot_scene and r["source"] == "multi45"
                 and float(r["angle_deg"]) in (15.0, 30.0, 60.0, 90.0)]
     body = [[r["angle_deg"], "%.4f" % num(r, "depth_corr"), "%.3f" % num(r, "depth_high_error_fraction"),
@@ -676,21 +712,26 @@ def meaning(configs, primary, c15, c30, edit_min, rotation, rot_scene, occlusion
           "%.3f at 15° and %.3f at 30° and keeps falling toward 90°, and the confidence mask flags %.0f%% of the "
           "pixels that went wrong at 90°." % (rot_scene, c15, c30,
                                                100 * num(r90, "depth_flagged_fraction") if r90 else float("nan")))
+    occlusion = [r for r in occlusion if proxies_of(r) == "default"]
     occ = lookup(occlusion, training="inner_occluded", method="model")
-    far = [r for r in scale if r["method"] == "model" and r["in_training_range"] == "0"]
+    far = [r for r in scale if r["method"] == "model" and r["in_training_range"] == "0"
+           and proxies_of(r) == "default"]
     worst_far = min(num(r, "psnr") for r in far) if far else float("nan")
-    far_wrong = [r for r in far if num(r, "high_error_fraction") > 0]
-    flagged = [num(r, "flagged_fraction") for r in far_wrong]
+    thick = [r for r in far if num(r, "scale") > 1 and num(r, "high_error_fraction") > 0]
+    thin = [r for r in far if num(r, "scale") < 1 and num(r, "high_error_fraction") > 0]
     false_alarms = [num(r, "good_flagged_fraction") for r in far if r.get("good_flagged_fraction")]
-    s3 = ("Colour-model failures are no longer silent, but their trust is not yet sharp: a feature "
-          "hidden in every training image drops the model to %.1f dB and the edit's trust flags "
-          "%.0f %% of the pixels that went wrong; opacity scaled far outside the training range "
-          "falls to %.1f dB, and the trust flags %.0f-%.0f %% of the wrong pixels while also "
-          "flagging up to %.0f %% of the right ones." % (
+    def span(rows):
+        values = [100 * num(r, "flagged_fraction") for r in rows]
+        return "%.0f-%.0f %%" % (min(values), max(values)) if values else "n/a"
+    s3 = ("Colour-model failures are no longer silent: a feature hidden in every training image drops "
+          "the model to %.1f dB and the edit's trust flags %.0f %% of the pixels that went wrong; "
+          "opacity scaled far outside the training range falls to %.1f dB, and with the entry depth "
+          "the trust flags %s of the wrong pixels of thickening edits while flagging at most %.0f %% "
+          "of the right ones, but only %s of those of thinning edits, which need the optical "
+          "depth." % (
               num(occ, "psnr") if occ else float("nan"),
-              100 * num(occ, "flagged_fraction") if occ else float("nan"), worst_far,
-              100 * min(flagged, default=float("nan")), 100 * max(flagged, default=float("nan")),
-              100 * max(false_alarms, default=float("nan"))))
+              100 * num(occ, "flagged_fraction") if occ else float("nan"), worst_far, span(thick),
+              100 * max(false_alarms, default=float("nan")), span(thin)))
     return " ".join([s1, s2, s3])
 
 
