@@ -9,7 +9,7 @@
 //                                 "unit_length": 1.0},
 //  "training_transfer_functions": [],
 //  "layers": "auto", "intervals": {"count": 16, "mode": "uniform"},
-//  "proxies": ["depth", "attenuation", "rendering", "interleaving"], "step": 1.0,
+//  "proxies": ["depth", "attenuation", "rendering", "interleaving", "entry_depth"], "step": 1.0,
 //  "every": 10,
 //  "archive": "run.cdb", "precision": "half", "compression": "zip",
 //  "writer": {"queue": 4, "when_full": "block"},
@@ -78,7 +78,12 @@ struct ProxySelection {
     bool distortion = false;         ///< "distortion": multi-perspective depth + distortion layers
     bool attenuation = true;         ///< "attenuation": a_j and mean depth, single perspective
     bool multi_attenuation = false;  ///< "multi_attenuation": the same from the distortion camera
-    bool optical_depth = false;      ///< "optical_depth": tau_j as well
+    /// "optical_depth": tau_j as well. Edits that thin an interval by 4 or more take its
+    /// transmittance from it, and the edit trust needs it to measure thinning. Off by default:
+    /// bench/RESULTS.md ("Where the methods fail") finds it scene-dependent, 38.8 -> 58.8 dB for
+    /// opacity / 16 on Gray-Scott but 47.5 -> 36.4 dB for the nested shells' outer one faded to
+    /// 0.3, for 35 % more bytes (Gray-Scott 64^3, 300 steps at 256^2: 31.7 -> 42.7 MB).
+    bool optical_depth = false;
     /// "rendering": the stored view's ground truth with the run's function in half RGBA (the
     /// preview costs that pass anyway), so the Explorer returns that view exactly (issue 17).
     bool rendering = true;
