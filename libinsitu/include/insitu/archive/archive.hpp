@@ -15,7 +15,8 @@
 //   previews/step000010_view0.png    ground-truth rendering of the configured transfer function
 //
 // EXR parts (channel names start with the part name; libinsitu/src/archive/archive_format.hpp):
-//   depth (depth.layer0..), attenuation (attenuation.a00.., .zmean00.., .tau00..),
+//   depth (depth.layer0..), attenuation (attenuation.a00.., .zmean00.., .tau00.., .zentry00..,
+//   .reentries, .reentered),
 //   train0.. (train0.R/G/B/A), model (model.table: the colour model of seed 000 §6.2, one row
 //   of (4 L + 3) floats per cluster, with libinsitu.model_{intervals, clusters, layout,
 //   training_transfer_functions}), multi.depth (multi.depth.layer0..), multi.distortion
