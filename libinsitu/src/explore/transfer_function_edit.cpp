@@ -252,6 +252,11 @@ double inferred_transmittance(double a_j, double transmittance) {
                                                 : 0.0;
 }
 
+/// max over RGB of |x - y|.
+double largest_difference(const double* x, const double* y) {
+    return std::max({std::abs(x[0] - y[0]), std::abs(x[1] - y[1]), std::abs(x[2] - y[2])});
+}
+
 /// Where t_j comes from in a recomposition: the estimator's rule (optical_depth_weight), a_j
 /// alone, or the edit trust's thinning alternative (tau_j's t_j by the thinning weight).
 enum class TransmittanceFrom { estimator, attenuation, thinning };
@@ -417,9 +422,7 @@ Image edit_error(const EditTrustInputs& inputs) {
                                order.begin(), order.end(), forward);
             recompose_in_order(a, tau, TransmittanceFrom::estimator, scales, inputs.colours,
                                order.rbegin(), order.rend(), backward);
-            double worst = 0.0;
-            for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(forward[c] - backward[c]));
-            return share * worst;
+            return share * largest_difference(forward, backward);
         };
         if (!inputs.entry_depth) {
             total += interleaving_term();
@@ -441,9 +444,7 @@ Image edit_error(const EditTrustInputs& inputs) {
                                  [](const auto& x, const auto& y) { return x.first < y.first; });
                 recompose_in_order(a, tau, TransmittanceFrom::attenuation, scales, inputs.colours,
                                    entry_order.begin(), entry_order.end(), other);
-                double worst = 0.0;
-                for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(other[c] - shown[c]));
-                total += thick / light * worst;
+                total += thick / light * largest_difference(other, shown);
             }
             if (tau && thin > 0.0) {
                 // The two estimates of thinning disagree by this much; the estimator takes one
@@ -453,11 +454,7 @@ Image edit_error(const EditTrustInputs& inputs) {
                                    order.begin(), order.end(), from_attenuation);
                 recompose_in_order(a, tau, TransmittanceFrom::thinning, scales, inputs.colours,
                                    order.begin(), order.end(), other);
-                double worst = 0.0;
-                for (int c = 0; c < 3; ++c) {
-                    worst = std::max(worst, std::abs(other[c] - from_attenuation[c]));
-                }
-                total += worst;
+                total += largest_difference(other, from_attenuation);
             } else if (thin > 0.0) {
                 total += thin / light * interleaving_term();
             }

@@ -139,15 +139,19 @@ std::vector<float> interval_colour_spread(const TransferFunction& tf, const Inte
 ///      in entry-depth order is the alternative, weighted by
 ///      g_thick = sum_j a_j clamp(log2(s_j) / 2, 0, 1) / sum_j a_j;
 ///    - thinning (s < 1) turns on each interval's own transmittance, which optical depth gives
-///      exactly, so where tau_j is stored the recomposition from a_j alone is the alternative
-///      of the tau estimate, weighted by g_thin = sum_j a_j clamp(-log2(s_j), 0, 1) / sum_j a_j.
-///      Without tau the thinning term is unknown and left out.
-///    Both weights are 0 at s = 1, where every order returns a exactly, and reach 1 at
+///      exactly where runs do not interleave, and a_j's inference where they do near s = 1.
+///      Where tau_j is stored the two estimates are compared: the recomposition from a_j alone
+///      against the one whose t_j takes a share clamp(-log2(s_j), 0, 1) from exp(-tau_j) (the
+///      estimator takes either, or a blend, by optical_depth_weight, and either may be wrong).
+///      Without tau: the interleaving term below, weighted by the thinned share of the light,
+///      g_thin = sum_j a_j clamp(-log2(s_j), 0, 1) / sum_j a_j.
+///    The weights are 0 at s = 1, where every order returns a exactly, and reach 1 at
 ///    thickening by 4 and thinning by 2, by which bench/RESULTS.md ("Where the methods fail")
 ///    finds the truth on the alternative's side;
-///  * interleaving, without the entry depth: where the ray re-entered intervals, the share of
-///    the pixel's light in re-entered runs times the difference between recomposing in
-///    mean-depth order and in its reverse (the other extreme);
+///  * interleaving, without the entry depth (and for thinning, as above): where the ray
+///    re-entered intervals, the share of the pixel's light in re-entered runs times the
+///    difference between recomposing in mean-depth order and in its reverse (the other
+///    extreme);
 ///  * recolouring: sum_j a'_j spread_j bounds what a pixel's own mix of values inside each
 ///    interval adds (the colour inside an interval is not constant). With the stored rendering
 ///    it is the deviation recolouring actually made there, max_RGB |sum_j c_j a_j - rendering|,
