@@ -68,7 +68,8 @@ void main() {
       if (uHasOpticalDepth) {
         // optical_depth_weight(s): strong thinning takes t_j from tau_j.
         float w = s > 0.0 ? clamp(-log2(s) - 1.0, 0.0, 1.0) : 1.0;
-        if (w > 0.0) t = (1.0 - w) * t + w * exp(-max(texelFetch(uOpticalDepth, ivec3(pixel, j), 0).r, 0.0));
+        float tau = max(texelFetch(uOpticalDepth, ivec3(pixel, j), 0).r, 0.0);
+        if (w > 0.0) t = (1.0 - w) * t + w * exp(-tau);
       }
       // exp2(s log2 t) as the reference writes t^s; log2(0) is undefined in GLSL, and t = 0
       // gives 0 there (exp2(-inf)).

@@ -52,7 +52,7 @@ uniform vec2 uEnhanceLaw;      // lambda, gamma
 uniform sampler2DArray uStored;        // a before the edit, as uMeanDepth packs it
 uniform sampler2DArray uOpticalDepth;  // layer j: tau_j (the stored view's, uHasOpticalDepth)
 uniform sampler2DArray uInterleaving;  // layers 0, 1: re-entries, their light (uHasInterleaving)
-uniform sampler2DArray uEntryDepth;    // layer j: where interval j first took light (uHasEntryDepth)
+uniform sampler2DArray uEntryDepth;    // layer j: where j first took light (uHasEntryDepth)
 uniform bool uHasOpticalDepth;
 uniform bool uHasInterleaving;
 uniform bool uHasEntryDepth;
@@ -454,7 +454,8 @@ float editError(ivec2 p) {
       rgb += a[j] * uStoredColours[j];
     }
     float missed = largestDifference(rgb, texelFetch(uRendering, p, 0).rgb);
-    if (storedBound > 1e-3) bound = min(bound, missed * bound / storedBound);  // kCalibratedSpreadFloor
+    // kCalibratedSpreadFloor
+    if (storedBound > 1e-3) bound = min(bound, missed * bound / storedBound);
   }
   total += bound;
   // Interleaving: the share of light in re-entered runs times the two run orders' difference.
