@@ -1016,8 +1016,8 @@ void Instrument::Impl::compute_field(const FieldPlan& plan, StepRecord& record,
         // ProxyRequest::interleaving): distributed archives carry no interleaving, and the
         // Explorer's edit trust then goes without that term.
         march.interleaving = false;
-        march.entry_depth =
-            false;  // likewise: the first interval a block sees may not be the ray's
+        // Likewise the entry depth: the first interval a block sees may not be the ray's.
+        march.entry_depth = false;
         std::optional<ProxyFrame> partial;
         if (plan.has_block) {
             failure.guard([&] {
