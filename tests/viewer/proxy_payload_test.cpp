@@ -142,6 +142,26 @@ TEST(ProxyPayload, CarriesTheInterleavingWhereStored) {
                                                   "interleaving is 5x4x2");
 }
 
+// The entry depth (where each interval first took light), where stored, goes as one plane per
+// interval like the mean depth: an edit's trust orders the intervals by it too.
+TEST(ProxyPayload, CarriesTheEntryDepthWhereStored) {
+    ProxyFrame frame = small_frame();
+    EXPECT_FALSE(decode(proxy_payload(frame, 1, 0, "f")).header.at("entry_depth").get<bool>());
+    frame.entry_depth = frame.mean_depth;
+    for (float& depth : frame.entry_depth.pixels) depth -= 0.5f;  // +inf stays +inf
+    const Decoded decoded = decode(proxy_payload(frame, 1, 0, "f"));
+    EXPECT_TRUE(decoded.header.at("entry_depth").get<bool>());
+    for (std::size_t p = 0; p < 24; ++p) {
+        for (int j = 0; j < 3; ++j) {
+            EXPECT_EQ(value(decoded, "entry_depth", j * 24 + p),
+                      frame.entry_depth.pixels[3 * p + j]);
+        }
+    }
+    frame.entry_depth = Image(6, 4, 2);
+    testing::expect_error_naming<InvalidArgument>([&] { proxy_payload(frame, 1, 0, "f"); },
+                                                  "entry depth is 6x4x2");
+}
+
 TEST(ProxyPayload, RefusesFramesItCannotCarry) {
     ProxyFrame multi = small_frame();
     multi.multi_perspective = true;
