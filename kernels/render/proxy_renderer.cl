@@ -237,11 +237,12 @@ __kernel void render_proxies(
                         if (reentering) reentries += 1.0f;
                         last_interval = j;
                     }
-                    // Entry depth: where the interval first took light (its first run's front).
-                    if (want_entry_depth && !(attenuation[j] > 0.0f)) {
+                    const float weight = absorb(&transmittance, alpha);  // seed 000 Eq. 7
+                    // Entry depth: where the interval first took light (its first run's front;
+                    // none where T has underflowed and the weight is 0).
+                    if (want_entry_depth && weight > 0.0f && !(attenuation[j] > 0.0f)) {
                         entry_depth[j] = sample_depth(&ray, t);
                     }
-                    const float weight = absorb(&transmittance, alpha);  // seed 000 Eq. 7
                     if (reentering) reentered += weight;
                     attenuation[j] += weight;
                     if (want_mean_depth) weighted_depth[j] += weight * sample_depth(&ray, t);
@@ -382,7 +383,7 @@ inline void accumulate_lanes(intp contributes, floatp value, floatp weight, floa
             LANE_INT(interleaving->last_interval, lane) = j;
         }
         const float w = LANE(weight, lane);
-        if (want_entry_depth && !(attenuation_out[index] > 0.0f)) {
+        if (want_entry_depth && w > 0.0f && !(attenuation_out[index] > 0.0f)) {
             entry_depth_out[index] = LANE(depth, lane);
         }
         if (LANE_INT(interleaving->reentering, lane)) LANE(interleaving->reentered, lane) += w;
