@@ -471,14 +471,18 @@ struct TrustPixel {
         interleaving.pixels = {reentries, reentered};
         for (std::size_t j = 0; j < a.size(); ++j) mean_depth.pixels[j] = float(j + 1);
     }
-    /// edit_error with `scales`, the interval colours `colours` and no colour spread.
+    /// edit_error with `scales`, the interval colours `colours` and no colour spread; with the
+    /// entry and optical depths given (each may be null), which the estimate reads too.
     float error(const std::vector<double>& scales, const std::vector<float>& colours,
-                double resolution = kFloatAttenuationResolution) const {
-        const Image edited = estimate_attenuation(attenuation, mean_depth, nullptr, scales);
+                double resolution = kFloatAttenuationResolution, const Image* entry_depth = nullptr,
+                const Image* optical_depth = nullptr) const {
+        const Image edited = estimate_attenuation(attenuation, mean_depth, optical_depth, scales);
         EditTrustInputs trust;
         trust.attenuation = &attenuation;
         trust.mean_depth = &mean_depth;
+        trust.optical_depth = optical_depth;
         trust.interleaving = &interleaving;
+        trust.entry_depth = entry_depth;
         trust.edited_attenuation = &edited;
         trust.scales = scales;
         trust.colours = colours;
@@ -581,19 +585,8 @@ struct OrderedTrustPixel : TrustPixel {
         tau.pixels = std::move(optical_depths);
     }
     float error(const std::vector<double>& scales, bool with_tau = false) const {
-        const Image* optical_depth = with_tau ? &tau : nullptr;
-        const Image edited = estimate_attenuation(attenuation, mean_depth, optical_depth, scales);
-        EditTrustInputs trust;
-        trust.attenuation = &attenuation;
-        trust.mean_depth = &mean_depth;
-        trust.optical_depth = optical_depth;
-        trust.interleaving = &interleaving;
-        trust.entry_depth = &entry;
-        trust.edited_attenuation = &edited;
-        trust.scales = scales;
-        trust.colours = kRedBlue;
-        trust.attenuation_resolution = kFloatAttenuationResolution;
-        return edit_error(trust).pixels[0];
+        return TrustPixel::error(scales, kRedBlue, kFloatAttenuationResolution, &entry,
+                                 with_tau ? &tau : nullptr);
     }
 };
 

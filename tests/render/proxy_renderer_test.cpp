@@ -338,26 +338,41 @@ TEST(ProxyRenderer, NestedShellsEachLayerFindsItsOwnShellBehindTranslucentOnes) 
     EXPECT_NEAR(frame.mean_depth.at(20, 20, 3), camera.depth_of(centre), radii[2] + 2.0);
 }
 
+/// Two nested shells in a 41^3 grid about (20, 20, 20): the outer one (radius 14, peak 0.4)
+/// only in interval 0 of [0, 0.6, 1], the inner one (radius 5, peak 0.9) rising through interval
+/// 0 into interval 1 and back on each of its walls; the attenuation pass of a 41^2 orbit view,
+/// without depth layers.
+struct TwoShells {
+    const glm::dvec3 centre{20.0};
+    SampledVolume volume = make_nested_shells({41, 41, 41}, {14.0, 5.0}, {0.4, 0.9}, 1.5);
+    ProxyRenderer renderer;
+    ProxyRequest request;
+    Camera camera;
+    TwoShells() {
+        renderer.upload(volume.field());
+        request.depth_layers = false;
+        request.march.step_voxels = 0.25;
+        request.intervals = IntervalSet({0.0, 0.6, 1.0});
+        request.transfer_function =
+            TransferFunction({{0.0, {1, 1, 1, 0}}, {0.05, {1, 1, 1, 0}}, {1.0, {1, 1, 1, 0.3}}});
+        OrbitView view;
+        view.width = view.height = 41;
+        camera = Camera::orbit(view, renderer.volume().bounds);
+    }
+};
+
 TEST(ProxyRenderer, InterleavingCountsTheRayReenteringAnInterval) {
     // Two nested shells: the outer one (peak 0.4) only in interval 0, the inner one (peak 0.9)
     // rising through interval 0 into interval 1 and back on each of its two walls. Through the
     // centre the contributing samples run 0 (outer), 0 1 0 (front wall), 1 0 (back wall), 0
     // (outer): intervals re-entered three times. A ray crossing only the outer shell meets
     // interval 0 twice with transparent space between: one run, no re-entry.
-    const glm::dvec3 centre(20.0);
-    SampledVolume volume = make_nested_shells({41, 41, 41}, {14.0, 5.0}, {0.4, 0.9}, 1.5);
-    ProxyRenderer renderer;
-    renderer.upload(volume.field());
-    ProxyRequest request;
-    request.depth_layers = false;
+    TwoShells shells;
+    const glm::dvec3& centre = shells.centre;
+    ProxyRenderer& renderer = shells.renderer;
+    ProxyRequest& request = shells.request;
+    const Camera& camera = shells.camera;
     request.interleaving = true;
-    request.march.step_voxels = 0.25;
-    request.intervals = IntervalSet({0.0, 0.6, 1.0});
-    request.transfer_function =
-        TransferFunction({{0.0, {1, 1, 1, 0}}, {0.05, {1, 1, 1, 0}}, {1.0, {1, 1, 1, 0.3}}});
-    OrbitView view;
-    view.width = view.height = 41;
-    const Camera camera = Camera::orbit(view, renderer.volume().bounds);
     for (const bool packets : {true, false}) {
         request.march.ray_packets = packets;
         const ProxyFrame frame = renderer.render(camera, request);
@@ -390,23 +405,15 @@ TEST(ProxyRenderer, InterleavingCountsTheRayReenteringAnInterval) {
 }
 
 TEST(ProxyRenderer, EntryDepthIsWhereEachIntervalFirstTookLight) {
-    // The shells of InterleavingCountsTheRayReenteringAnInterval: through the centre interval 0
+    // The shells of TwoShells: through the centre interval 0
     // first takes light at the outer shell's front wall, interval 1 only at the inner shell's,
     // and interval 0's mean depth lies far behind its entry (its runs span the whole ray).
-    const glm::dvec3 centre(20.0);
-    SampledVolume volume = make_nested_shells({41, 41, 41}, {14.0, 5.0}, {0.4, 0.9}, 1.5);
-    ProxyRenderer renderer;
-    renderer.upload(volume.field());
-    ProxyRequest request;
-    request.depth_layers = false;
+    TwoShells shells;
+    const glm::dvec3& centre = shells.centre;
+    ProxyRenderer& renderer = shells.renderer;
+    ProxyRequest& request = shells.request;
+    const Camera& camera = shells.camera;
     request.entry_depth = true;
-    request.march.step_voxels = 0.25;
-    request.intervals = IntervalSet({0.0, 0.6, 1.0});
-    request.transfer_function =
-        TransferFunction({{0.0, {1, 1, 1, 0}}, {0.05, {1, 1, 1, 0}}, {1.0, {1, 1, 1, 0.3}}});
-    OrbitView view;
-    view.width = view.height = 41;
-    const Camera camera = Camera::orbit(view, renderer.volume().bounds);
     const Ray central = camera.ray(20.5, 20.5);
     // Where the central ray meets the outer shell's wall (radius 14 + 1.5 wall) and the inner
     // shell's (5 + 1.5), as depths.

@@ -474,8 +474,8 @@ float editError(ivec2 p) {
   } else if (count > 1 && light > 0.0) {
     // Order: the shown estimate against the entry-depth order (thickening); thinning's two
     // estimates against each other with tau, else the interleaving term for the thinned light.
-    vec3 shown = recomposeInOrder(p, a, order, count, false, FROM_ESTIMATOR);
     if (thick > 0.0) {
+      vec3 shown = recomposeInOrder(p, a, order, count, false, FROM_ESTIMATOR);
       int entryOrder[MAX_INTERVALS];
       float entry[MAX_INTERVALS];
       int entries = 0;

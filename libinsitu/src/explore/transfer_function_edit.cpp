@@ -266,6 +266,11 @@ double thinning_weight(double scale) {
     return scale > 0.0 ? std::clamp(-std::log2(scale), 0.0, 1.0) : 1.0;
 }
 
+/// t_j taking a share w from tau_j's transmittance and the rest from the inferred one.
+double blended_transmittance(double inferred, double tau_j, double w) {
+    return (1.0 - w) * inferred + w * std::exp(-std::max(0.0, tau_j));
+}
+
 /// estimate_attenuation's walk over the intervals in the order [first, last) of (depth, index)
 /// pairs, recomposed with `colours` into rgb: the edit's colour if the ray met the intervals
 /// in that order, one run each. `tau` may be null (then t_j always comes from a_j).
@@ -282,7 +287,7 @@ void recompose_in_order(const float* a, const float* tau, TransmittanceFrom from
         if (tau && from != TransmittanceFrom::attenuation) {
             const double w = from == TransmittanceFrom::thinning ? thinning_weight(scales[j])
                                                                  : optical_depth_weight(scales[j]);
-            t = (1.0 - w) * inferred + w * std::exp(-std::max(0.0, double(tau[j])));
+            t = blended_transmittance(inferred, tau[j], w);
         }
         const double edited = scales[j] > 0.0 ? std::pow(t, scales[j]) : 1.0;
         const double a_edited = edited_transmittance * (1.0 - edited);
@@ -368,10 +373,12 @@ Image edit_error(const EditTrustInputs& inputs) {
             // its t_j to within res / T); a blend of the two, as uncertain as its parts.
             const double inferred = inferred_transmittance(a[j], transmittance);
             const double w = tau ? optical_depth_weight(s) : 0.0;
-            const double from_tau = tau ? std::exp(-std::max(0.0, double(tau[j]))) : 0.0;
-            const double t = (1.0 - w) * inferred + w * from_tau;
+            const double t = tau ? blended_transmittance(inferred, tau[j], w) : inferred;
             double uncertainty = 0.0;
-            if (w > 0.0) uncertainty += w * from_tau * std::max(0.0, double(tau[j])) * resolution;
+            if (w > 0.0) {
+                const double tau_j = std::max(0.0, double(tau[j]));
+                uncertainty += w * std::exp(-tau_j) * tau_j * resolution;
+            }
             if (w < 1.0 && transmittance > 0.0)
                 uncertainty += (1.0 - w) * resolution / transmittance;
             if (s > 0.0 && uncertainty > 0.0) {
@@ -430,10 +437,11 @@ Image edit_error(const EditTrustInputs& inputs) {
             // Order: the shown estimate against the entry-depth order (thickening); thinning's
             // two estimates against each other with tau, else the interleaving term for the
             // thinned share of the light.
-            double shown[3], other[3];
-            recompose_in_order(a, tau, TransmittanceFrom::estimator, scales, inputs.colours,
-                               order.begin(), order.end(), shown);
+            double other[3];
             if (thick > 0.0) {
+                double shown[3];
+                recompose_in_order(a, tau, TransmittanceFrom::estimator, scales, inputs.colours,
+                                   order.begin(), order.end(), shown);
                 const float* entry = &inputs.entry_depth->pixels[p * L];
                 entry_order.clear();
                 for (const auto& [depth, j] : order) {
