@@ -620,6 +620,31 @@ TEST(InstrumentConfig, BudgetParsesValidatesAndRoundTrips) {
     EXPECT_FALSE(
         InstrumentConfig::from_json_text(R"({"budget": {"choose": ["intervals"]}})", nullptr)
             .budget->chooses_precision);
+    // "size" likewise: chosen by default, kept where any view (top level or a field's own)
+    // gives its "size", unless "choose" names it.
+    EXPECT_TRUE(config.budget->chooses_size);
+    EXPECT_TRUE(again.budget->chooses_size);
+    EXPECT_FALSE(
+        InstrumentConfig::from_json_text(
+            R"({"views": [{"azimuth": 10}, {"size": [64, 64]}], "budget": {"psnr_db": 40}})",
+            nullptr)
+            .budget->chooses_size);
+    EXPECT_FALSE(InstrumentConfig::from_json_text(
+                     R"({"fields": [{"name": "v", "views": [{"size": [300, 200]}]}],
+                         "budget": {"psnr_db": 40}})",
+                     nullptr)
+                     .budget->chooses_size);
+    EXPECT_TRUE(InstrumentConfig::from_json_text(
+                    R"({"views": [{"azimuth": 10}], "budget": {"psnr_db": 40}})", nullptr)
+                    .budget->chooses_size);
+    const InstrumentConfig size_only = InstrumentConfig::from_json_text(
+        R"({"views": [{"size": [512, 512]}], "budget": {"choose": ["size"]}})", nullptr);
+    EXPECT_TRUE(size_only.budget->chooses_size);
+    EXPECT_FALSE(size_only.budget->chooses_intervals);
+    EXPECT_FALSE(size_only.budget->chooses_precision);
+    EXPECT_TRUE(InstrumentConfig::from_json(size_only.to_json(), nullptr).budget->chooses_size);
+    EXPECT_FALSE(
+        InstrumentConfig::from_json(precision_only.to_json(), nullptr).budget->chooses_size);
     EXPECT_EQ(to_string(StoragePrecision::single), "float");
     EXPECT_EQ(parse_storage_precision("half"), StoragePrecision::half);
     EXPECT_THROW(parse_storage_precision("double"), InvalidArgument);

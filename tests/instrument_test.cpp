@@ -617,7 +617,8 @@ TEST_F(InstrumentTest, AnErrorBudgetChoosesTheCheapestIntervalsThatMeetIt) {
     strict.chooses_precision = false;
     std::vector<BudgetRecord> alone;
     for (const int count : kBudgetIntervalCounts) {
-        for (const IntervalMode mode : {IntervalMode::uniform, IntervalMode::histogram_equalized}) {
+        for (const IntervalMode mode : {IntervalMode::uniform, IntervalMode::histogram_equalized,
+                                        IntervalMode::opacity_adaptive}) {
             InstrumentConfig config = small_config(
                 directory_ / ("alone_" + std::to_string(count) + to_string(mode) + ".cdb"), 48);
             config.interval_count = count;
@@ -669,6 +670,64 @@ TEST_F(InstrumentTest, AnErrorBudgetChoosesTheCheapestIntervalsThatMeetIt) {
     const ArchiveReader given = run(directory_ / "given.cdb", easy, 16, nullptr);
     EXPECT_EQ(given.budget(0).at(0).intervals, 16);
     EXPECT_EQ(given.load(0, 0).intervals->count(), 16);
+}
+
+// "choose": ["size"]: the views stored at half their width and height are measured as shown at
+// the asked size (enlarged bilinearly) against its ground truth. An easy budget takes the
+// quarter of the bytes, and the writer stores every view so; an accuracy that only the asked
+// size reaches keeps it (measured at the smaller size's own resolution it would not); a budget
+// that may not choose the size, or a view too small to halve, keeps the asked size.
+TEST_F(InstrumentTest, AnErrorBudgetChoosesTheSizeOfTheViewsItArchives) {
+    const auto run = [&](const std::string& name, BudgetConfig budget, int image,
+                         std::string* log) {
+        InstrumentConfig config = small_config(directory_ / name, image);
+        config.interval_count = 8;
+        budget.chooses_intervals = false;
+        budget.chooses_precision = false;
+        config.budget = budget;
+        return run_with_budget(config, volume_, 2, log);
+    };
+    BudgetConfig easy;
+    easy.psnr_db = 1.0;
+    std::string log;
+    const ArchiveReader halved = run("halved.cdb", easy, 2 * kBudgetMinViewSide, &log);
+    for (std::int64_t step = 0; step < 2; ++step) {
+        const BudgetRecord choice = halved.budget(step).at(0);
+        EXPECT_EQ(choice.size_divisor, 2) << "step " << step;
+        EXPECT_TRUE(choice.met);
+        const ProxyFrame frame = halved.load(step, 0);
+        EXPECT_EQ(frame.camera.width(), kBudgetMinViewSide);
+        EXPECT_EQ(frame.camera.height(), kBudgetMinViewSide);
+        EXPECT_EQ(frame.rendering.width, kBudgetMinViewSide);
+    }
+    EXPECT_THAT(log, HasSubstr("1/2 of each side chosen"));
+
+    // What the full size costs, and what each size achieves in the stored view alone.
+    BudgetConfig stored_view = easy;
+    stored_view.rotations_deg = {};
+    stored_view.chooses_size = false;
+    const BudgetRecord full =
+        run("full.cdb", stored_view, 2 * kBudgetMinViewSide, nullptr).budget(0).at(0);
+    EXPECT_EQ(full.size_divisor, 1);
+    EXPECT_GT(full.bytes, 2.0 * halved.budget(0).at(0).bytes);
+    stored_view.chooses_size = true;
+    const BudgetRecord half_stored =
+        run("half_stored.cdb", stored_view, 2 * kBudgetMinViewSide, nullptr).budget(0).at(0);
+    ASSERT_EQ(half_stored.size_divisor, 2);
+    // Enlarging loses detail the asked size keeps: an accuracy between the two keeps it.
+    ASSERT_LT(half_stored.psnr_db + 1.0, full.psnr_db);
+    BudgetConfig accurate = stored_view;
+    accurate.psnr_db = 0.5 * (half_stored.psnr_db + full.psnr_db);
+    const BudgetRecord kept =
+        run("kept.cdb", accurate, 2 * kBudgetMinViewSide, nullptr).budget(0).at(0);
+    EXPECT_EQ(kept.size_divisor, 1);
+    EXPECT_TRUE(kept.met);
+    EXPECT_DOUBLE_EQ(kept.psnr_db, full.psnr_db);
+
+    // Too small to halve (a side would fall below kBudgetMinViewSide): the asked size.
+    const BudgetRecord small =
+        run("small.cdb", easy, 2 * kBudgetMinViewSide - 2, nullptr).budget(0).at(0);
+    EXPECT_EQ(small.size_divisor, 1);
 }
 
 // "rotations": the PSNR a budget asks is the least over the stored view and views turned in

@@ -162,6 +162,13 @@ def edit_trust_goals(scale, occlusion, met):
     return goals
 
 
+def size_label(row):
+    """' 1/2' for a budget step stored at half each side; '' at the asked size (and in CSVs
+    written before the budget chose the size)."""
+    divisor = row.get("size_divisor") or "1"
+    return "" if divisor == "1" else " 1/%s" % divisor
+
+
 def chart_budget(d, rows):
     """The error budget over a Gray-Scott run: per archived step the PSNR asked, what the budget
     measured in situ and what the archive achieves; its bytes per step beside the default's."""
@@ -579,9 +586,10 @@ def write_markdown(d, path, prefix, elapsed):
                   "halved), the worst achieved over the archived steps (measured here through the "
                   "Explorer against the ground truth, the least of the stored view and the views "
                   "turned 20 degrees either way, as the budget measures it; the stored view's own "
-                  "beside it), the steps that met it, the intervals and precision chosen, the mean "
-                  "bytes and in-situ time per step and the budget checks' own time; 'default' is "
-                  "the fixed 16 uniform intervals in half.", ""]
+                  "beside it), the steps that met it, the intervals, precision and size chosen "
+                  "(1/2: each side halved, shown enlarged against the truth at the asked 256²), "
+                  "the mean bytes and in-situ time per step and the budget checks' own time; "
+                  "'default' is the fixed 16 uniform intervals in half at the asked size.", ""]
         body = []
         for run in sorted({r["run"] for r in budget}, key=lambda n: (n != "default", n)):
             sel = [r for r in budget if r["run"] == run]
@@ -594,13 +602,13 @@ def write_markdown(d, path, prefix, elapsed):
             body.append([run.replace("_", " "), "%.0f" % asked if math.isfinite(asked) else "-",
                          "%.1f" % min(achieved), "%.1f" % min(stored),
                          "%d / %d" % (met_steps, len(sel)),
-                         ", ".join(sorted({"%s %s %s" % (r["intervals"], r["mode"], r["precision"])
-                                           for r in sel})),
+                         ", ".join(sorted({"%s %s %s%s" % (r["intervals"], r["mode"], r["precision"],
+                                                           size_label(r)) for r in sel})),
                          "%.2f" % (sum(num(r, "bytes") for r in sel) / len(sel) / 1e6),
                          "%.0f" % (sum(ms) / len(ms)) if ms else "-",
                          "%.1f-%.1f" % (min(checks), max(checks)) if checks else "-"])
         lines += [table(["run", "asked dB", "worst achieved dB", "stored view's worst dB",
-                         "steps met", "intervals, precision", "MB / step", "budget's ms / step",
+                         "steps met", "intervals, precision, size", "MB / step", "budget's ms / step",
                          "check s"], body), ""]
     lines += ["## Storage (Fig. 15a)", "", "![storage](%sstorage.png)" % prefix, ""]
     meas = [r for r in storage if r["kind"] == "measured_half_zip"]

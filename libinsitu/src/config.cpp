@@ -317,9 +317,36 @@ const Key<ColourModelConfig> kColourModelKeys[] = {
 
 // "budget": {"psnr_db", "bytes_per_step", "ms_per_step", "check_every", "rotations",
 // "choose"}.
-enum class BudgetChoice { intervals, precision };
+enum class BudgetChoice { intervals, precision, size };
 constexpr Choice<BudgetChoice> kBudgetChoices[] = {{"intervals", BudgetChoice::intervals},
-                                                   {"precision", BudgetChoice::precision}};
+                                                   {"precision", BudgetChoice::precision},
+                                                   {"size", BudgetChoice::size}};
+// The BudgetConfig member each "choose" entry sets.
+bool BudgetConfig::*chooses(BudgetChoice choice) {
+    switch (choice) {
+        case BudgetChoice::intervals:
+            return &BudgetConfig::chooses_intervals;
+        case BudgetChoice::precision:
+            return &BudgetConfig::chooses_precision;
+        case BudgetChoice::size:
+            return &BudgetConfig::chooses_size;
+    }
+    return &BudgetConfig::chooses_intervals;
+}
+// Whether the configuration gives a view's "size" itself, at the top level or in a field's
+// own views: the budget then keeps every view's size (explicit settings win).
+bool gives_view_size(const json& document) {
+    const auto any_sized = [](const json& views) {
+        return views.is_array() && std::any_of(views.begin(), views.end(), [](const json& view) {
+                   return view.is_object() && view.contains("size");
+               });
+    };
+    if (document.contains("views") && any_sized(document["views"])) return true;
+    if (!document.contains("fields") || !document["fields"].is_array()) return false;
+    return std::any_of(document["fields"].begin(), document["fields"].end(), [&](const json& f) {
+        return f.is_object() && f.contains("views") && any_sized(f["views"]);
+    });
+}
 const Key<BudgetConfig> kBudgetKeys[] = {
     {"psnr_db",
      [](const json& value, const std::string& key, BudgetConfig& budget, Unknown&) {
@@ -353,20 +380,16 @@ const Key<BudgetConfig> kBudgetKeys[] = {
     {"choose",
      [](const json& value, const std::string& key, BudgetConfig& budget, Unknown&) {
          require_array(value, key);
-         budget.chooses_intervals = false;
-         budget.chooses_precision = false;
+         for (const auto& [name, choice] : kBudgetChoices) budget.*chooses(choice) = false;
          for (std::size_t i = 0; i < value.size(); ++i) {
-             const BudgetChoice choice = choose(value[i], element_key(key, i), kBudgetChoices);
-             (choice == BudgetChoice::intervals ? budget.chooses_intervals
-                                                : budget.chooses_precision) = true;
+             budget.*chooses(choose(value[i], element_key(key, i), kBudgetChoices)) = true;
          }
      },
      [](const BudgetConfig& budget) {
          json chosen = json::array();
-         if (budget.chooses_intervals)
-             chosen.push_back(name_of(BudgetChoice::intervals, kBudgetChoices));
-         if (budget.chooses_precision)
-             chosen.push_back(name_of(BudgetChoice::precision, kBudgetChoices));
+         for (const auto& [name, choice] : kBudgetChoices) {
+             if (budget.*chooses(choice)) chosen.push_back(name);
+         }
          return chosen;
      }},
 };
@@ -753,6 +776,7 @@ InstrumentConfig InstrumentConfig::from_json(const nlohmann::json& document,
     if (config.budget && !document["budget"].contains("choose")) {
         if (document.contains("intervals")) config.budget->chooses_intervals = false;
         if (document.contains("precision")) config.budget->chooses_precision = false;
+        if (gives_view_size(document)) config.budget->chooses_size = false;
     }
     config.validate();
     if (unknown_keys != nullptr) {

@@ -310,7 +310,8 @@ struct Instrument::Impl {
     /// Measures every candidate on the field's first view and picks the cheapest that meets
     /// the budget (see BudgetConfig).
     BudgetRecord check_budget(const FieldPlan& plan) const;
-    /// "budget: field "v" 8 uniform intervals chosen, half chosen at 3 check(s); last measured
+    /// "budget: field "v" 8 uniform intervals chosen, half chosen, full size chosen at 3
+    /// check(s); last measured
     /// 41.2 dB (asked >= 40) in its worst of 3 views, azimuth +20 deg (stored view 44.0 dB),
     /// ...; the check took 35.0 ms".
     std::string budget_summary() const {
@@ -328,6 +329,13 @@ struct Instrument::Impl {
             if (c.precision) {
                 out << ", " << to_string(*c.precision)
                     << (budget.chooses_precision ? " chosen" : " (given)");
+            }
+            if (budget.chooses_size) {
+                out << ", "
+                    << (c.size_divisor == 1
+                            ? std::string("full size")
+                            : "1/" + std::to_string(c.size_divisor) + " of each side")
+                    << " chosen";
             }
             out << " at " << state.checks << " check(s); last measured " << c.psnr_db << " dB";
             if (budget.psnr_db) out << " (asked >= " << *budget.psnr_db << ")";
@@ -633,7 +641,8 @@ Instrument::Impl::FieldPlan Instrument::Impl::plan_field(const Field& field, std
         layers ? *layers : renderer->choose_layers(plan.transfer_function, config.max_auto_layers);
     // A budget that chooses the intervals sets them itself (apply_budget).
     if (!config.budget || !config.budget->chooses_intervals) {
-        plan.intervals = renderer->choose_intervals(config.interval_count, config.interval_mode);
+        plan.intervals = renderer->choose_intervals(config.interval_count, config.interval_mode,
+                                                    &plan.transfer_function);
     }
     if (config.budget) plan.budget = apply_budget(plan);
     return plan;
@@ -670,7 +679,8 @@ BudgetRecord Instrument::Impl::apply_budget(FieldPlan& plan) {
     BudgetRecord choice = state.choice;
     choice.checked = due;
     if (budget.chooses_intervals) {
-        plan.intervals = renderer->choose_intervals(choice.intervals, choice.interval_mode);
+        plan.intervals = renderer->choose_intervals(choice.intervals, choice.interval_mode,
+                                                    &plan.transfer_function);
     }
     return choice;
 }
@@ -709,11 +719,42 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
              renderer->render_ground_truth(turned, held_out, truth_settings).rgba});
     }
 
+    // The sizes measured: the asked one, and each smaller one whose sides stay at least
+    // kBudgetMinViewSide. A smaller size's stored-view rendering (its bytes, its preview's time)
+    // is one more ground-truth pass at that size.
+    struct CandidateSize {
+        int divisor = 1;
+        Camera camera;
+        Image rendering;
+        double preview_ms = 0.0;
+    };
+    std::vector<CandidateSize> sizes;
+    for (const int divisor : kBudgetSizeDivisors) {
+        OrbitView orbit = view.orbit;
+        orbit.width /= divisor;
+        orbit.height /= divisor;
+        if (divisor == 1) {
+            sizes.push_back({1, camera, measured_views.front().truth, preview_ms});
+        } else if (budget.chooses_size && orbit.width >= kBudgetMinViewSide &&
+                   orbit.height >= kBudgetMinViewSide) {
+            CandidateSize size{divisor, Camera::orbit(orbit, plan.bounds), {}, 0.0};
+            const auto start = Clock::now();
+            size.rendering =
+                renderer->render_ground_truth(size.camera, plan.transfer_function, truth_settings)
+                    .rgba;
+            size.preview_ms = 1e3 * seconds_since(start);
+            sizes.push_back(std::move(size));
+        }
+    }
+    // Smallest first: within an interval count the cheaper sizes are measured first.
+    std::reverse(sizes.begin(), sizes.end());
+
     std::vector<std::pair<int, IntervalMode>> candidates;
     if (budget.chooses_intervals) {
         for (const int count : kBudgetIntervalCounts) {
             for (const IntervalMode mode :
-                 {IntervalMode::uniform, IntervalMode::histogram_equalized}) {
+                 {IntervalMode::uniform, IntervalMode::histogram_equalized,
+                  IntervalMode::opacity_adaptive}) {
                 candidates.emplace_back(count, mode);
             }
         }
@@ -736,25 +777,29 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
     struct CandidateProxies {
         int count = 0;
         IntervalMode mode = IntervalMode::uniform;
+        const CandidateSize* size = nullptr;
         ViewRecord view;
         std::vector<double> scales;
         std::vector<float> colours;
         double pass_ms = 0.0;
     };
     // Encodes the candidate at `precision`, reads it back as a reader would, and measures the
-    // held-out edit in every measured view.
+    // held-out edit in every measured view: at the candidate's size (a turned view as the
+    // Explorer turns the stored one, keeping its size), shown at the asked size.
     const auto measure = [&](const CandidateProxies& proxies, StoragePrecision precision) {
         BudgetRecord candidate;
         candidate.field = plan.name;
         candidate.intervals = proxies.count;
         candidate.interval_mode = proxies.mode;
         candidate.precision = precision;
+        candidate.size_divisor = proxies.size->divisor;
+        const Camera& source = proxies.size->camera;
         StepRecord record;
         record.field = plan.name;
         const archive_format::EncodedView encoded = archive_format::encode_view(
             record, proxies.view, precision, config.compression, "budget check");
         candidate.bytes = view_count * static_cast<double>(encoded.bytes.size());
-        candidate.milliseconds = view_count * (proxies.pass_ms + preview_ms);
+        candidate.milliseconds = view_count * (proxies.pass_ms + proxies.size->preview_ms);
         const ProxyFrame stored = archive_format::decode_frame(
             std::vector<char>(encoded.bytes.begin(), encoded.bytes.end()), "budget check",
             encoded.parts, false);
@@ -765,11 +810,17 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
                 edited = estimate_attenuation(stored.attenuation, stored.mean_depth, nullptr,
                                               proxies.scales);
             } else {
-                const SynthesisedAttenuation turned = synthesise_attenuation(stored, target.camera);
+                const Camera turned_camera = source.reorbit(
+                    source.azimuth_deg() + target.azimuth_offset_deg, source.elevation_deg());
+                const SynthesisedAttenuation turned = synthesise_attenuation(stored, turned_camera);
                 edited = estimate_attenuation(turned.attenuation, turned.mean_depth, nullptr,
                                               proxies.scales);
             }
-            const double psnr_db = psnr_rgb_db(target.truth, recolour(edited, proxies.colours));
+            Image shown = recolour(edited, proxies.colours);
+            if (shown.width != target.truth.width || shown.height != target.truth.height) {
+                shown = resize_bilinear(shown, target.truth.width, target.truth.height);
+            }
+            const double psnr_db = psnr_rgb_db(target.truth, shown);
             candidate.views.push_back({target.azimuth_offset_deg, psnr_db});
             candidate.psnr_db = std::min(candidate.psnr_db, psnr_db);
         }
@@ -789,32 +840,37 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
         // The single-perspective pass as compute_field makes it, with these intervals.
         ProxyRequest request;
         request.isovalues = plan.isovalues;
-        request.intervals = renderer->choose_intervals(count, mode);
+        request.intervals = renderer->choose_intervals(count, mode, &plan.transfer_function);
         request.transfer_function = plan.transfer_function;
         request.march.step_voxels = config.step_voxels;
         request.depth_layers = config.proxies.depth;
         request.interleaving = config.proxies.interleaving;
         request.entry_depth = config.proxies.entry_depth;
-        const auto start = Clock::now();
-        ProxyFrame frame = renderer->render(camera, request);
-        CandidateProxies proxies;
-        proxies.count = count;
-        proxies.mode = mode;
-        proxies.pass_ms = 1e3 * seconds_since(start);
-        proxies.scales = opacity_scales(plan.transfer_function, held_out, *request.intervals);
-        proxies.colours = interval_colours(held_out, *request.intervals);
-        // Bytes as the writer stores the view (the rendering is the preview's size).
-        if (config.proxies.rendering) frame.rendering = measured_views.front().truth;
-        proxies.view.field = plan.name;
-        proxies.view.view = view;
-        proxies.view.transfer_function = plan.transfer_function;
-        proxies.view.single = std::move(frame);
-        measured.push_back(measure(proxies, first_precision));
-        const BudgetRecord& candidate = measured.back();
-        if (budget.chooses_precision && affordable(candidate) &&
-            candidate.psnr_db > most_accurate_db) {
-            most_accurate_db = candidate.psnr_db;
-            most_accurate = std::move(proxies);
+        for (const CandidateSize& size : sizes) {
+            const auto start = Clock::now();
+            ProxyFrame frame = renderer->render(size.camera, request);
+            CandidateProxies proxies;
+            proxies.count = count;
+            proxies.mode = mode;
+            proxies.size = &size;
+            proxies.pass_ms = 1e3 * seconds_since(start);
+            proxies.scales = opacity_scales(plan.transfer_function, held_out, *request.intervals);
+            proxies.colours = interval_colours(held_out, *request.intervals);
+            // Bytes as the writer stores the view (the rendering is the preview's size).
+            if (config.proxies.rendering) frame.rendering = size.rendering;
+            proxies.view.field = plan.name;
+            proxies.view.view = view;
+            proxies.view.view.orbit.width = size.camera.width();
+            proxies.view.view.orbit.height = size.camera.height();
+            proxies.view.transfer_function = plan.transfer_function;
+            proxies.view.single = std::move(frame);
+            measured.push_back(measure(proxies, first_precision));
+            const BudgetRecord& candidate = measured.back();
+            if (budget.chooses_precision && affordable(candidate) &&
+                candidate.psnr_db > most_accurate_db) {
+                most_accurate_db = candidate.psnr_db;
+                most_accurate = std::move(proxies);
+            }
         }
     }
     if (most_accurate && std::none_of(measured.begin(), measured.end(), meets)) {
@@ -960,7 +1016,11 @@ Instrument::Impl::FieldPlan Instrument::Impl::plan_distributed_field(
         agree(ranks, failure);
         composite_seconds += seconds_since(start);
         plan.intervals =
-            IntervalSet::from_equalization_histogram(histogram, min, max, config.interval_count);
+            config.interval_mode == IntervalMode::opacity_adaptive
+                ? IntervalSet::opacity_adaptive(histogram, min, max, config.interval_count,
+                                                plan.transfer_function)
+                : IntervalSet::from_equalization_histogram(histogram, min, max,
+                                                           config.interval_count);
     }
     return plan;
 }
@@ -1088,7 +1148,12 @@ void Instrument::Impl::compute_field(const FieldPlan& plan, StepRecord& record,
     preview_settings.step_voxels = config.step_voxels;
     preview_settings.early_termination_opacity = 1.0;
 
-    for (const ViewConfig& view : config.views_of(name)) {
+    // A budget that chooses the size stores every view of the field at its divided size.
+    const int size_divisor =
+        plan.budget && config.budget->chooses_size ? plan.budget->size_divisor : 1;
+    for (ViewConfig view : config.views_of(name)) {
+        view.orbit.width = std::max(1, view.orbit.width / size_divisor);
+        view.orbit.height = std::max(1, view.orbit.height / size_divisor);
         ViewRecord out;
         out.view_index = static_cast<int>(record.views.size());
         out.field = name;

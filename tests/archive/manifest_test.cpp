@@ -118,6 +118,7 @@ TEST(Manifest, BudgetChoicesRoundTripWithInfinitePsnr) {
     choice.milliseconds = 6.5;
     choice.views = {{0.0, std::numeric_limits<double>::infinity()}, {-20.0, 31.5}, {20.0, 33.0}};
     choice.check_milliseconds = 80.25;
+    choice.size_divisor = 2;
     nlohmann::json manifest = empty_manifest();
     manifest["producer"] = "libinsitu test";
     manifest["configuration"] = nlohmann::json::object();
@@ -139,6 +140,7 @@ TEST(Manifest, BudgetChoicesRoundTripWithInfinitePsnr) {
     EXPECT_EQ(back.precision, StoragePrecision::single);
     EXPECT_EQ(back.psnr_db, 31.5);
     EXPECT_EQ(back.check_milliseconds, 80.25);
+    EXPECT_EQ(back.size_divisor, 2);
     ASSERT_EQ(back.views.size(), 3u);
     EXPECT_EQ(back.views[0].azimuth_offset_deg, 0.0);
     EXPECT_TRUE(std::isinf(back.views[0].psnr_db) && back.views[0].psnr_db > 0.0);
@@ -149,16 +151,21 @@ TEST(Manifest, BudgetChoicesRoundTripWithInfinitePsnr) {
     EXPECT_TRUE(std::isinf(exact.psnr_db) && exact.psnr_db > 0.0);
     EXPECT_TRUE(std::isinf(exact.views.at(0).psnr_db));
 
-    // An older entry: no "views", "check_ms" or "precision".
+    // An older entry: no "views", "check_ms", "precision" or "size_divisor".
     nlohmann::json old = budget_entry(choice);
     old.erase("views");
     old.erase("check_ms");
     old.erase("precision");
+    old.erase("size_divisor");
     const BudgetRecord older = budget_from_entry(nlohmann::json::parse(old.dump()));
     EXPECT_TRUE(older.views.empty());
     EXPECT_EQ(older.check_milliseconds, 0.0);
     EXPECT_FALSE(older.precision.has_value());
+    EXPECT_EQ(older.size_divisor, 1);
     EXPECT_EQ(older.psnr_db, 31.5);
+    nlohmann::json no_size = budget_entry(choice);
+    no_size["size_divisor"] = 0;
+    expect_error_naming<ParseError>([&] { budget_from_entry(no_size); }, "size_divisor 0");
     nlohmann::json not_a_list = budget_entry(choice);
     not_a_list["views"] = 5;
     expect_error_naming<ParseError>([&] { budget_from_entry(not_a_list); }, "views 5");

@@ -104,6 +104,34 @@ TEST(Image, PrintsItsSizeAndValueRange) {
     EXPECT_EQ(text.str(), "Image 3x2x4, values in [0.25, 0.75], 1 non-finite");
 }
 
+TEST(Image, ResizeBilinearInterpolatesBetweenPixelCentres) {
+    // A horizontal ramp over 4 pixels, doubled: target centres fall a quarter pixel either side
+    // of the source's, and the borders clamp.
+    Image ramp(4, 1, 2);
+    for (int x = 0; x < 4; ++x) {
+        ramp.at(x, 0, 0) = static_cast<float>(x);
+        ramp.at(x, 0, 1) = 1.0f;
+    }
+    const Image doubled = resize_bilinear(ramp, 8, 3);
+    ASSERT_EQ(doubled.width, 8);
+    ASSERT_EQ(doubled.height, 3);
+    ASSERT_EQ(doubled.channels, 2);
+    const float expected[] = {0.0f, 0.25f, 0.75f, 1.25f, 1.75f, 2.25f, 2.75f, 3.0f};
+    for (int y = 0; y < 3; ++y) {
+        for (int x = 0; x < 8; ++x) {
+            EXPECT_FLOAT_EQ(doubled.at(x, y, 0), expected[x]) << x << ", " << y;
+            EXPECT_FLOAT_EQ(doubled.at(x, y, 1), 1.0f);
+        }
+    }
+    // The same size is the image itself; halving averages pairs of pixels.
+    EXPECT_EQ(resize_bilinear(ramp, 4, 1).pixels, ramp.pixels);
+    const Image halved = resize_bilinear(ramp, 2, 1);
+    EXPECT_FLOAT_EQ(halved.at(0, 0, 0), 0.5f);
+    EXPECT_FLOAT_EQ(halved.at(1, 0, 0), 2.5f);
+    EXPECT_THROW(resize_bilinear(Image(), 2, 2), InvalidArgument);
+    EXPECT_THROW(resize_bilinear(ramp, 0, 2), InvalidArgument);
+}
+
 TEST(Image, LinearToSrgbKnownValues) {
     EXPECT_EQ(linear_to_srgb(0.0f), 0.0f);
     EXPECT_EQ(linear_to_srgb(1.0f), 1.0f);

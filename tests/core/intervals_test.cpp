@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -100,6 +101,56 @@ TEST(IntervalSet, RejectsBadCountsAndEdgesNamingTheValue) {
     EXPECT_THROW(IntervalSet::uniform(0.0, std::nan(""), 4), InvalidArgument);
     EXPECT_THROW(parse_interval_mode("quantile"), InvalidArgument);
     EXPECT_EQ(parse_interval_mode("histogram"), IntervalMode::histogram_equalized);
+    EXPECT_EQ(parse_interval_mode("opacity"), IntervalMode::opacity_adaptive);
+    EXPECT_EQ(parse_interval_mode(to_string(IntervalMode::opacity_adaptive)),
+              IntervalMode::opacity_adaptive);
+}
+
+TEST(IntervalSet, OpacityAdaptiveIntervalsGatherWhereTheFunctionTakesLight) {
+    // Evenly spread values; transparent below 0.5, a ramp to 0.8 opacity above it.
+    std::vector<float> values(100000);
+    for (std::size_t i = 0; i < values.size(); ++i) {
+        values[i] = static_cast<float>(i) / static_cast<float>(values.size() - 1);
+    }
+    const TransferFunction ramp({{0.5, {1, 1, 1, 0}}, {1.0, {1, 1, 1, 0.8f}}});
+    const int count = 8;
+    const IntervalSet intervals = IntervalSet::opacity_adaptive(
+        IntervalSet::equalization_histogram(values, 0.0, 1.0, count), 0.0, 1.0, count, ramp);
+    ASSERT_EQ(intervals.count(), count);
+    EXPECT_EQ(intervals.edges().front(), 0.0);
+    EXPECT_EQ(intervals.edges().back(), 1.0);
+    // The transparent half is one interval: every inner edge lies where the ramp takes light.
+    for (int j = 1; j < count; ++j) EXPECT_GT(intervals.edges()[j], 0.5) << intervals;
+    // Equal shares of the weight n(v) (a(v) + |da/dv| / L): with a = 1.6 (v - 0.5) and
+    // |da/dv| / L = 0.2 over the ramp, edge j sits where 0.8 u^2 + 0.2 u = 0.3 j / L, u = v - 0.5.
+    for (int j = 1; j < count; ++j) {
+        const double share = 0.3 * j / count;
+        const double expected = 0.5 + (-0.2 + std::sqrt(0.04 + 3.2 * share)) / 1.6;
+        EXPECT_NEAR(intervals.edges()[j], expected, 0.01) << "edge " << j << " " << intervals;
+    }
+    // A step in opacity (an edit's handle, a material boundary) draws an edge to it: the
+    // |da/dv| term. Equal counts put no edge within 0.1 of it.
+    const TransferFunction step({{0.0, {1, 1, 1, 0.2f}},
+                                 {0.6, {1, 1, 1, 0.2f}},
+                                 {0.61, {1, 1, 1, 0.6f}},
+                                 {1.0, {1, 1, 1, 0.6f}}});
+    const auto nearest_to_step = [](const IntervalSet& set) {
+        double nearest = 1.0;
+        for (double edge : set.edges()) nearest = std::min(nearest, std::abs(edge - 0.605));
+        return nearest;
+    };
+    const IntervalSet at_step = IntervalSet::opacity_adaptive(
+        IntervalSet::equalization_histogram(values, 0.0, 1.0, 4), 0.0, 1.0, 4, step);
+    const IntervalSet without = IntervalSet::histogram_equalized(values, 0.0, 1.0, 4);
+    EXPECT_LT(nearest_to_step(at_step), 0.05) << at_step;
+    EXPECT_GT(nearest_to_step(without), 0.1) << without;
+    // A function transparent over all the data places its intervals by the samples alone.
+    const TransferFunction clear({{0.0, {1, 1, 1, 0}}, {1.0, {1, 1, 1, 0}}});
+    EXPECT_EQ(
+        IntervalSet::opacity_adaptive(IntervalSet::equalization_histogram(values, 0.0, 1.0, count),
+                                      0.0, 1.0, count, clear)
+            .edges(),
+        IntervalSet::histogram_equalized(values, 0.0, 1.0, count).edges());
 }
 
 TransferFunction tent(double centre, double half_width, float peak) {

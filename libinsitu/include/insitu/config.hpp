@@ -17,7 +17,7 @@
 //  "light_field": {"cameras": 42, "size": 256, "segments": "layers", "attenuation": true,
 //                  "depth_bits": 8, "depth_threshold": 0.3},
 //  "budget": {"psnr_db": 40, "bytes_per_step": 8e6, "ms_per_step": 500, "check_every": 10,
-//             "rotations": [-20, 20], "choose": ["intervals", "precision"]}}
+//             "rotations": [-20, 20], "choose": ["intervals", "precision", "size"]}}
 //
 // Every key is optional; defaults are listed on the members below. Unknown keys (at any level)
 // are collected by name, not silently ignored: an Instrument refuses them unless "strict" is
@@ -126,6 +126,14 @@ struct ColourModelConfig {
 /// The bytes and time are the field's views' single-perspective proxies, rendering and preview
 /// (the multi-perspective, training and light-field passes come on top). Distributed runs
 /// refuse it (its ground truth needs the whole field on one process).
+/// What it leaves as configured, and why: the depth layers and K (the held-out edit's
+/// recomposition reads neither: layers serve relighting and depth, K the colour model, which
+/// only a run with training functions fits); the multi-perspective pass, off by default because
+/// the Explorer reconstructs new views better without it (ProxySelection), so a budget could
+/// only drop one a configuration asks for, and explicit settings win; the light field, whose
+/// camera count and map size the held-out edit's turned views would have to be reconstructed
+/// from at a capture per candidate (42 cameras at 256^2 with attenuation: about 1.4 s and 34 MB
+/// on Gray-Scott, bench/RESULTS.md "Light fields"), which no check every few steps affords.
 struct BudgetConfig {
     /// "psnr_db": the least PSNR, over the stored view and its "rotations", of a held-out edit
     /// (the run's function with every opacity halved, a' = 1 - (1 - a)^0.5) recomposed from
@@ -139,10 +147,10 @@ struct BudgetConfig {
     std::optional<double> ms_per_step;     ///< "ms_per_step": a step's passes' time, > 0
     /// "check_every": archived steps between two checks, >= 1. A check costs one ground-truth
     /// pass per measured view (the stored one and each rotation, once per check) and one proxy
-    /// pass per candidate (kBudgetIntervalCounts x 2 modes), each candidate encoded, read back
-    /// and synthesised into the rotated views once per precision measured, for each field's
-    /// first view; a field more than kBudgetMovedShare of whose values moved since the last
-    /// check (histogram_distance: a reaction front spreading, a shock) is checked at once,
+    /// pass per candidate (kBudgetIntervalCounts x 3 modes x the size divisors), each candidate
+    /// encoded, read back and synthesised into the rotated views once per precision measured, for
+    /// each field's first view; a field more than kBudgetMovedShare of whose values moved since the
+    /// last check (histogram_distance: a reaction front spreading, a shock) is checked at once,
     /// whatever the count.
     int check_every = 10;
     /// "rotations": azimuth offsets (degrees, finite, in (-180, 180]) from the stored view of
@@ -150,18 +158,29 @@ struct BudgetConfig {
     /// only. Default +-20 degrees: a turn the Explorer's synthesis serves (bench/RESULTS.md,
     /// "Depth correlation by proxy source", measures 15 and 30 degrees).
     std::vector<double> rotations_deg{-20.0, 20.0};
-    /// "choose": what the budget may choose: "intervals" (count and mode), which are what the
-    /// recomposition's accuracy and the archive's bytes turn on, and "precision" (the views'
-    /// proxies stored as half or float, measured as read back; light fields keep the run's
-    /// "precision"). Both by default; explicit settings win: a configuration that sets
-    /// "intervals" or "precision" itself keeps it unless "choose" is given and names it.
+    /// "choose": what the budget may choose: "intervals" (count and mode: uniform,
+    /// histogram-equalised or opacity-adaptive), which are what the recomposition's accuracy and
+    /// the archive's bytes turn on; "precision" (the views' proxies stored as half or float,
+    /// measured as read back; light fields keep the run's "precision"); "size" (the views
+    /// stored at their width and height or at half of each, kBudgetSizeDivisors, measured as the
+    /// Explorer shows the smaller one at the asked size: bilinearly enlarged). All three by
+    /// default; explicit settings win: a configuration that sets "intervals", "precision" or
+    /// any view's "size" itself keeps it unless "choose" is given and names it.
     bool chooses_intervals = true;
     bool chooses_precision = true;
+    bool chooses_size = true;
 };
 
-/// Interval counts and modes a budget check measures: L in {4, 8, 16, 32}, uniform and
-/// histogram-equalised.
+/// Interval counts and modes a budget check measures: L in {4, 8, 16, 32}, uniform,
+/// histogram-equalised and opacity-adaptive (IntervalSet::opacity_adaptive).
 inline constexpr int kBudgetIntervalCounts[] = {4, 8, 16, 32};
+/// What a budget that chooses "size" divides the views' width and height by: the asked size,
+/// or a quarter of its pixels (a quarter of the bytes and about a quarter of the passes' time)
+/// where the turned views, which view synthesis limits (bench/RESULTS.md "Error budget over a
+/// Gray-Scott run"), lose little by it. A divisor applies only where both sides stay at least
+/// kBudgetMinViewSide.
+inline constexpr int kBudgetSizeDivisors[] = {1, 2};
+inline constexpr int kBudgetMinViewSide = 64;
 /// PSNR a budget gives up for bytes where it cannot meet its accuracy (or asks none): it takes
 /// the cheapest affordable candidate within this of the most accurate one. About what one
 /// choice's achieved PSNR moves between neighbouring archived steps (0.05-0.35 dB on Gray-Scott,

@@ -191,6 +191,7 @@ nlohmann::json budget_entry(const BudgetRecord& choice) {
                          {"views", std::move(views)},
                          {"check_ms", choice.check_milliseconds}};
     if (choice.precision) entry["precision"] = to_string(*choice.precision);
+    entry["size_divisor"] = choice.size_divisor;
     return entry;
 }
 
@@ -222,6 +223,12 @@ BudgetRecord budget_from_entry(const nlohmann::json& entry) {
         }
     }
     if (entry.contains("check_ms")) choice.check_milliseconds = entry.at("check_ms").get<double>();
+    if (entry.contains("size_divisor")) {
+        choice.size_divisor = entry.at("size_divisor").get<int>();
+        if (choice.size_divisor < 1) {
+            fail<ParseError>("size_divisor ", choice.size_divisor, " is not a positive count");
+        }
+    }
     return choice;
 }
 

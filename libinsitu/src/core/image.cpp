@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <ostream>
+#include <utility>
 
 #include "insitu/error.hpp"
 
@@ -46,6 +47,39 @@ double psnr_rgb_db(const Image& a, const Image& b) {
     const double mse = mse_rgb(a, b);
     if (std::isnan(mse)) return mse;
     return std::min(100.0, -10.0 * std::log10(std::max(mse, 1e-10)));
+}
+
+Image resize_bilinear(const Image& image, int width, int height) {
+    if (image.pixel_count() == 0 || image.channels < 1) {
+        fail<InvalidArgument>("resize_bilinear: empty ", image);
+    }
+    if (width < 1 || height < 1) {
+        fail<InvalidArgument>("resize_bilinear: size ", width, "x", height, " (must be >= 1)");
+    }
+    Image out(width, height, image.channels);
+    // Where the centre of target pixel `x` falls between the source's pixel centres.
+    const auto source = [](int x, int target_size, int source_size) {
+        const double at = (x + 0.5) * source_size / target_size - 0.5;
+        const double clamped = std::clamp(at, 0.0, source_size - 1.0);
+        const int low = std::min(static_cast<int>(clamped), source_size - 1);
+        return std::pair{low, static_cast<float>(clamped - low)};
+    };
+    for (int y = 0; y < height; ++y) {
+        const auto [y0, fy] = source(y, height, image.height);
+        const int y1 = std::min(y0 + 1, image.height - 1);
+        for (int x = 0; x < width; ++x) {
+            const auto [x0, fx] = source(x, width, image.width);
+            const int x1 = std::min(x0 + 1, image.width - 1);
+            for (int c = 0; c < image.channels; ++c) {
+                const float top =
+                    image.at(x0, y0, c) + fx * (image.at(x1, y0, c) - image.at(x0, y0, c));
+                const float bottom =
+                    image.at(x0, y1, c) + fx * (image.at(x1, y1, c) - image.at(x0, y1, c));
+                out.at(x, y, c) = top + fy * (bottom - top);
+            }
+        }
+    }
+    return out;
 }
 
 std::ostream& operator<<(std::ostream& out, const Image& image) {

@@ -5,12 +5,21 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 
+#include "insitu/core/transfer_function.hpp"
 #include "insitu/error.hpp"
 
 namespace insitu {
 
 std::string to_string(IntervalMode mode) {
-    return mode == IntervalMode::uniform ? "uniform" : "histogram";
+    switch (mode) {
+        case IntervalMode::uniform:
+            return "uniform";
+        case IntervalMode::histogram_equalized:
+            return "histogram";
+        case IntervalMode::opacity_adaptive:
+            return "opacity";
+    }
+    return "uniform";
 }
 
 IntervalMode parse_interval_mode(const std::string& text) {
@@ -18,7 +27,8 @@ IntervalMode parse_interval_mode(const std::string& text) {
     if (text == "histogram" || text == "histogram_equalized") {
         return IntervalMode::histogram_equalized;
     }
-    fail<InvalidArgument>("interval mode \"", text, "\" (expected uniform or histogram)");
+    if (text == "opacity" || text == "opacity_adaptive") return IntervalMode::opacity_adaptive;
+    fail<InvalidArgument>("interval mode \"", text, "\" (expected uniform, histogram or opacity)");
 }
 
 namespace {
@@ -122,6 +132,38 @@ IntervalSet IntervalSet::from_equalization_histogram(const std::vector<double>& 
     while (static_cast<int>(edges.size()) < count) edges.push_back(hi);
     edges.push_back(hi);
     return IntervalSet(std::move(edges));
+}
+
+IntervalSet IntervalSet::opacity_adaptive(const std::vector<double>& histogram, double min,
+                                          double max, int count, const TransferFunction& tf) {
+    // The same bins as from_equalization_histogram (which checks the histogram's size).
+    const IntervalSet fallback = uniform(min, max, count);
+    const double lo = fallback.edges_.front();
+    const double hi = fallback.edges_.back();
+    const int bins = static_cast<int>(histogram.size());
+    const auto opacity = [&](double value) {
+        // A 2D function: the most any gradient row lets the value take.
+        float a = 0.0f;
+        for (const TransferRow& row : tf.rows()) {
+            a = std::max(a, tf.evaluate(value, row.gradient_magnitude).a);
+        }
+        return static_cast<double>(a);
+    };
+    std::vector<double> weighted(histogram.size(), 0.0);
+    double total = 0.0;
+    for (int bin = 0; bin < bins; ++bin) {
+        if (histogram[bin] == 0.0) continue;
+        const double lower = between(lo, hi, bin, bins);
+        const double upper = between(lo, hi, bin + 1, bins);
+        // The change across one bin, scaled to an interval's width (range / count): what an
+        // interval there would have to stand for, in the same units as the opacity itself.
+        const double weight = opacity(0.5 * lower + 0.5 * upper) +
+                              std::abs(opacity(upper) - opacity(lower)) * bins / count;
+        weighted[bin] = histogram[bin] * weight;
+        total += weighted[bin];
+    }
+    if (!(total > 0.0)) return from_equalization_histogram(histogram, min, max, count);
+    return from_equalization_histogram(weighted, min, max, count);
 }
 
 bool IntervalSet::is_uniform() const {

@@ -135,13 +135,24 @@ void ProxyRenderer::upload(const Field& field) {
     renderer_.upload(field);
 }
 
-IntervalSet ProxyRenderer::choose_intervals(int count, IntervalMode mode) const {
+IntervalSet ProxyRenderer::choose_intervals(int count, IntervalMode mode,
+                                            const TransferFunction* tf) const {
     const DeviceVolume& volume = renderer_.volume();
     // An empty (all-NaN) field still gets a defined partition, of [0, 0] widened.
     const double min = volume.range.empty() ? 0.0 : volume.range.min;
     const double max = volume.range.empty() ? 0.0 : volume.range.max;
-    if (mode == IntervalMode::uniform) return IntervalSet::uniform(min, max, count);
-    return IntervalSet::histogram_equalized(volume.host_values, min, max, count);
+    switch (mode) {
+        case IntervalMode::uniform:
+            return IntervalSet::uniform(min, max, count);
+        case IntervalMode::histogram_equalized:
+            return IntervalSet::histogram_equalized(volume.host_values, min, max, count);
+        case IntervalMode::opacity_adaptive:
+            if (!tf) fail<InvalidArgument>("opacity-adaptive intervals need a transfer function");
+            return IntervalSet::opacity_adaptive(
+                IntervalSet::equalization_histogram(volume.host_values, min, max, count), min, max,
+                count, *tf);
+    }
+    fail<InvalidArgument>("interval mode ", static_cast<int>(mode));
 }
 
 std::vector<double> ProxyRenderer::choose_layers(const TransferFunction& tf, int max_layers) const {

@@ -53,6 +53,9 @@ struct BudgetRecord {
     /// The views' proxies' storage precision; none in archives written before the budget chose
     /// it (the run's "precision" then).
     std::optional<StoragePrecision> precision;
+    /// The field's views stored at their configured width and height divided by this (rounded
+    /// down; one of kBudgetSizeDivisors); 1 in archives written before the budget chose size.
+    int size_divisor = 1;
     bool checked = false;       ///< measured at this step; otherwise the last check's choice, kept
     bool met = false;           ///< the choice met every limit the budget gives
     double psnr_db = 0.0;       ///< the held-out edit's PSNR with the choice: the least of views

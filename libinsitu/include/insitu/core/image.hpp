@@ -43,6 +43,11 @@ double mse_rgb(const Image& a, const Image& b);
 /// error budget measures in situ.
 double psnr_rgb_db(const Image& a, const Image& b);
 
+/// `image` resampled to `width` x `height` by bilinear interpolation between pixel centres
+/// (clamped at the borders), every channel alike: how a display shows a smaller image at a
+/// larger size, which an error budget that chooses the image size measures. InvalidArgument
+/// for an empty image or a size below 1.
+Image resize_bilinear(const Image& image, int width, int height);
 /// Linear -> sRGB transfer curve for one component in [0, 1] (IEC 61966-2-1).
 float linear_to_srgb(float linear);
 

@@ -10,9 +10,15 @@
 
 namespace insitu {
 
-enum class IntervalMode { uniform, histogram_equalized };
+class TransferFunction;
+
+/// How a count of intervals is placed over a field's value range: equal widths, equal shares of
+/// the field's samples, or equal shares of the light the transfer function lets them take
+/// (IntervalSet::opacity_adaptive).
+enum class IntervalMode { uniform, histogram_equalized, opacity_adaptive };
 std::string to_string(IntervalMode mode);
-/// "uniform" or "histogram" / "histogram_equalized"; InvalidArgument names other text.
+/// "uniform", "histogram" / "histogram_equalized" or "opacity" / "opacity_adaptive";
+/// InvalidArgument names other text.
 IntervalMode parse_interval_mode(const std::string& text);
 
 constexpr int kMaxIntervals = 64;
@@ -37,6 +43,19 @@ public:
     /// distributed run: the same intervals as from all their values at once.
     static IntervalSet from_equalization_histogram(const std::vector<double>& histogram, double min,
                                                    double max, int count);
+
+    /// Intervals adaptive to where the opacity is and where it changes: quantiles of the
+    /// equalization `histogram` (as above, or the ranks' sum) with each bin weighted by
+    /// a(centre) + |da/dv| (max - min) / count of `tf` (the most of its gradient rows), i.e. by
+    /// how much light its samples can take plus how much the opacity changes across an
+    /// interval's width there (where an edit's handle or a material boundary is). Transparent value
+    /// ranges, whose a_j an edit cannot scale (there is no light recorded to scale), collapse
+    /// into few intervals and the intervals concentrate where the recomposition's per-interval
+    /// scale and colour must stand for the most light (seed 000 §6.1 partitions uniformly; the
+    /// error budget measures which placement meets its accuracy with fewer intervals). Falls
+    /// back to histogram_equalized() where no sample takes light.
+    static IntervalSet opacity_adaptive(const std::vector<double>& histogram, double min,
+                                        double max, int count, const TransferFunction& tf);
 
     int count() const { return static_cast<int>(edges_.size()) - 1; }
     const std::vector<double>& edges() const { return edges_; }

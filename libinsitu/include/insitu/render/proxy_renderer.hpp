@@ -145,9 +145,11 @@ public:
     /// refused for a block. See VolumeRenderer::set_region.
     void set_region(std::optional<MarchRegion> region) { renderer_.set_region(std::move(region)); }
 
-    /// Intervals over the values actually present in the uploaded field: uniform, or
-    /// histogram-equalised over its samples.
-    IntervalSet choose_intervals(int count, IntervalMode mode) const;
+    /// Intervals over the values actually present in the uploaded field: uniform,
+    /// histogram-equalised over its samples, or adaptive to `tf`'s opacity over them
+    /// (IntervalSet::opacity_adaptive; InvalidArgument without `tf`).
+    IntervalSet choose_intervals(int count, IntervalMode mode,
+                                 const TransferFunction* tf = nullptr) const;
     /// Layers chosen from the data: the peaks of `tf`'s opacity inside the uploaded field's value
     /// range (see opacity_peaks in insitu/core/layers.hpp).
     std::vector<double> choose_layers(const TransferFunction& tf, int max_layers) const;
