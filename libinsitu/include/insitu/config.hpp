@@ -271,10 +271,14 @@ struct InstrumentConfig {
     std::optional<TransferFunction> transfer_function;
     std::vector<TransferFunction> training_transfer_functions;  ///< default none
     /// "layers": explicit isovalues, or "auto" (empty here) = opacity peaks, at most max_layers.
-    std::optional<std::vector<double>> layers;           ///< nullopt = "auto"
-    int max_auto_layers = 4;                             ///< "max_layers"
-    int interval_count = 16;                             ///< "intervals": {"count": ..}
-    IntervalMode interval_mode = IntervalMode::uniform;  ///< "intervals": {"mode": ..}
+    std::optional<std::vector<double>> layers;  ///< nullopt = "auto"
+    int max_auto_layers = 4;                    ///< "max_layers"
+    int interval_count = 16;                    ///< "intervals": {"count": ..}
+    /// "intervals": {"mode": "uniform" | "histogram" | "opacity"} (IntervalMode). Uniform by
+    /// default: no placement wins at every step of the evaluation's budget runs (bench/RESULTS.md
+    /// "Error budget over a Gray-Scott run" picks each of the three at some step), and uniform
+    /// edges depend on the value range alone, not on the function an edit replaces.
+    IntervalMode interval_mode = IntervalMode::uniform;
     ProxySelection proxies;
     double step_voxels = 1.0;  ///< "step": ray step in voxels
     /// "every": emit on steps divisible by N; or "steps": an explicit list. Default 10 with the
