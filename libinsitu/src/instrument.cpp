@@ -311,9 +311,8 @@ struct Instrument::Impl {
     /// the budget (see BudgetConfig).
     BudgetRecord check_budget(const FieldPlan& plan) const;
     /// "budget: field "v" 8 uniform intervals chosen, half chosen, full size chosen at 3
-    /// check(s); last measured
-    /// 41.2 dB (asked >= 40) in its worst of 3 views, azimuth +20 deg (stored view 44.0 dB),
-    /// ...; the check took 35.0 ms".
+    /// check(s); last measured 41.2 dB (asked >= 40) in its worst of 3 views, azimuth +20 deg
+    /// (stored view 44.0 dB), ...; the check took 35.0 ms".
     std::string budget_summary() const {
         const BudgetConfig& budget = *config.budget;
         std::ostringstream out;
