@@ -645,6 +645,29 @@ TEST(InstrumentConfig, BudgetParsesValidatesAndRoundTrips) {
     EXPECT_TRUE(InstrumentConfig::from_json(size_only.to_json(), nullptr).budget->chooses_size);
     EXPECT_FALSE(
         InstrumentConfig::from_json(precision_only.to_json(), nullptr).budget->chooses_size);
+    // "light_field" likewise: chosen by default, kept where the "light_field" object gives
+    // its "cameras" or "size", unless "choose" names it.
+    EXPECT_TRUE(config.budget->chooses_light_field);
+    EXPECT_TRUE(
+        InstrumentConfig::from_json_text(
+            R"({"light_field": {"attenuation": false}, "budget": {"psnr_db": 30}})", nullptr)
+            .budget->chooses_light_field);
+    for (const char* given : {R"({"cameras": 162})", R"({"size": 128})"}) {
+        const std::string text =
+            std::string(R"({"light_field": )") + given + R"(, "budget": {"psnr_db": 30}})";
+        EXPECT_FALSE(InstrumentConfig::from_json_text(text, nullptr).budget->chooses_light_field)
+            << text;
+    }
+    const InstrumentConfig light_field_only = InstrumentConfig::from_json_text(
+        R"({"light_field": {"cameras": 162}, "budget": {"choose": ["light_field"]}})", nullptr);
+    EXPECT_TRUE(light_field_only.budget->chooses_light_field);
+    EXPECT_FALSE(light_field_only.budget->chooses_size);
+    const InstrumentConfig light_field_again =
+        InstrumentConfig::from_json(light_field_only.to_json(), nullptr);
+    EXPECT_TRUE(light_field_again.budget->chooses_light_field);
+    EXPECT_FALSE(light_field_again.budget->chooses_intervals);
+    EXPECT_FALSE(
+        InstrumentConfig::from_json(size_only.to_json(), nullptr).budget->chooses_light_field);
     EXPECT_EQ(to_string(StoragePrecision::single), "float");
     EXPECT_EQ(parse_storage_precision("half"), StoragePrecision::half);
     EXPECT_THROW(parse_storage_precision("double"), InvalidArgument);

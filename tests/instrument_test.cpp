@@ -832,6 +832,81 @@ TEST_F(InstrumentTest, AnErrorBudgetChoosesThePrecisionOfTheViewsItArchives) {
     EXPECT_FALSE(kept.met);
 }
 
+// With a "light_field", the budget chooses its camera count and map size too: each rig measured
+// in the budget's views, reconstructed from the cameras those views read, against the run's own
+// function (a light field without attenuation shows nothing else), within what the views left.
+// The cheapest rig meets an easy accuracy; an accuracy between the cheapest's and the best's
+// takes a costlier rig that meets it; the archive stores the rig chosen, and a configuration
+// that gives the cameras keeps them.
+TEST_F(InstrumentTest, AnErrorBudgetChoosesTheLightFieldsCamerasAndMapSize) {
+    const auto run = [&](const std::string& name, BudgetConfig budget, bool given_cameras,
+                         std::string* log) {
+        InstrumentConfig config = small_config(directory_ / name, 48);
+        config.interval_count = 8;
+        LightFieldSettings light_field;
+        light_field.attenuation = false;
+        light_field.size = 2 * kBudgetMinLightFieldSide;  // measured at 128^2 and 64^2
+        config.light_field = light_field;
+        budget.chooses_intervals = false;
+        budget.chooses_precision = false;
+        budget.chooses_size = false;
+        budget.chooses_light_field = !given_cameras;
+        config.budget = budget;
+        return run_with_budget(config, volume_, 1, log);
+    };
+    BudgetConfig easy;
+    easy.psnr_db = 1.0;
+    std::string log;
+    const ArchiveReader cheap_run = run("cheap.cdb", easy, false, &log);
+    const BudgetRecord cheap = cheap_run.budget(0).at(0);
+    ASSERT_TRUE(cheap.light_field.has_value());
+    EXPECT_EQ(cheap.light_field->cameras, 12);
+    EXPECT_EQ(cheap.light_field->size, kBudgetMinLightFieldSide);
+    EXPECT_TRUE(cheap.light_field->met);
+    EXPECT_GT(cheap.light_field->bytes, 0.0);
+    EXPECT_THAT(log, HasSubstr("light field 12 cameras at 64^2 chosen"));
+    const LightField stored = cheap_run.load_light_field(0, "f");
+    EXPECT_EQ(stored.rig.camera_count(), 12);
+    EXPECT_EQ(stored.rig.map_size(), kBudgetMinLightFieldSide);
+    EXPECT_EQ(stored.cameras.size(), 12u);
+
+    // No accuracy asked, bytes to spare: the most accurate rig (within the tolerance), which
+    // the cheapest is not on this scene.
+    BudgetConfig spare;
+    spare.bytes_per_step = 1e12;
+    const BudgetRecord best = run("best.cdb", spare, false, nullptr).budget(0).at(0);
+    ASSERT_TRUE(best.light_field.has_value());
+    ASSERT_GT(best.light_field->psnr_db, cheap.light_field->psnr_db + 1.0);
+    EXPECT_GT(best.light_field->bytes, cheap.light_field->bytes);
+    BudgetConfig between;
+    between.psnr_db = 0.5 * (cheap.light_field->psnr_db + best.light_field->psnr_db);
+    const ArchiveReader between_run = run("between.cdb", between, false, nullptr);
+    const BudgetRecord met = between_run.budget(0).at(0);
+    ASSERT_TRUE(met.light_field.has_value());
+    EXPECT_TRUE(met.light_field->met);
+    EXPECT_GE(met.light_field->psnr_db, *between.psnr_db);
+    EXPECT_GT(met.light_field->bytes, cheap.light_field->bytes);
+    EXPECT_LE(met.light_field->bytes, best.light_field->bytes);
+    const LightField between_field = between_run.load_light_field(0, "f");
+    EXPECT_EQ(between_field.rig.camera_count(), met.light_field->cameras);
+    EXPECT_EQ(between_field.rig.map_size(), met.light_field->size);
+
+    // Bytes the views alone use up: the cheapest rig, said not met.
+    BudgetConfig starved = between;
+    starved.bytes_per_step = cheap.bytes;
+    const BudgetRecord short_of_bytes = run("starved.cdb", starved, false, nullptr).budget(0).at(0);
+    ASSERT_TRUE(short_of_bytes.light_field.has_value());
+    EXPECT_FALSE(short_of_bytes.light_field->met);
+    EXPECT_EQ(short_of_bytes.light_field->cameras, 12);
+    EXPECT_EQ(short_of_bytes.light_field->size, kBudgetMinLightFieldSide);
+
+    // Explicit settings win: the configured rig, nothing chosen.
+    const ArchiveReader given = run("given.cdb", easy, true, nullptr);
+    EXPECT_FALSE(given.budget(0).at(0).light_field.has_value());
+    EXPECT_EQ(given.load_light_field(0, "f").rig.camera_count(), 42);
+    EXPECT_EQ(given.load_light_field(0, "f").rig.map_size(), 2 * kBudgetMinLightFieldSide);
+}
+
 TEST_F(InstrumentTest, MissingFieldIsAnErrorNamingIt) {
     Instrument instrument(small_config(archive(), 16), quiet());
     SampledVolume other = small_volume(8);

@@ -317,10 +317,11 @@ const Key<ColourModelConfig> kColourModelKeys[] = {
 
 // "budget": {"psnr_db", "bytes_per_step", "ms_per_step", "check_every", "rotations",
 // "choose"}.
-enum class BudgetChoice { intervals, precision, size };
+enum class BudgetChoice { intervals, precision, size, light_field };
 constexpr Choice<BudgetChoice> kBudgetChoices[] = {{"intervals", BudgetChoice::intervals},
                                                    {"precision", BudgetChoice::precision},
-                                                   {"size", BudgetChoice::size}};
+                                                   {"size", BudgetChoice::size},
+                                                   {"light_field", BudgetChoice::light_field}};
 // The BudgetConfig member each "choose" entry sets.
 bool BudgetConfig::*chooses(BudgetChoice choice) {
     switch (choice) {
@@ -330,6 +331,8 @@ bool BudgetConfig::*chooses(BudgetChoice choice) {
             return &BudgetConfig::chooses_precision;
         case BudgetChoice::size:
             return &BudgetConfig::chooses_size;
+        case BudgetChoice::light_field:
+            return &BudgetConfig::chooses_light_field;
     }
     return &BudgetConfig::chooses_intervals;
 }
@@ -777,6 +780,12 @@ InstrumentConfig InstrumentConfig::from_json(const nlohmann::json& document,
         if (document.contains("intervals")) config.budget->chooses_intervals = false;
         if (document.contains("precision")) config.budget->chooses_precision = false;
         if (gives_view_size(document)) config.budget->chooses_size = false;
+        const json* light_field =
+            document.contains("light_field") ? &document["light_field"] : nullptr;
+        if (light_field && light_field->is_object() &&
+            (light_field->contains("cameras") || light_field->contains("size"))) {
+            config.budget->chooses_light_field = false;
+        }
     }
     config.validate();
     if (unknown_keys != nullptr) {

@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "archive/exr_frame.hpp"
+#include "archive/light_field_exr.hpp"
 #include "archive/writer_thread.hpp"
 #include "insitu/archive/archive.hpp"
 #include "insitu/core/camera.hpp"
@@ -26,6 +27,7 @@
 #include "insitu/core/layers.hpp"
 #include "insitu/error.hpp"
 #include "insitu/explore/colour_model.hpp"
+#include "insitu/explore/light_field_reconstruction.hpp"
 #include "insitu/explore/transfer_function_edit.hpp"
 #include "insitu/explore/view_synthesis.hpp"
 #include "insitu/parallel/compositing.hpp"
@@ -310,6 +312,12 @@ struct Instrument::Impl {
     /// Measures every candidate on the field's first view and picks the cheapest that meets
     /// the budget (see BudgetConfig).
     BudgetRecord check_budget(const FieldPlan& plan) const;
+    /// The light field's camera count and map size (BudgetConfig::chooses_light_field), with the
+    /// views' choice made: measured in the budget's views (`targets`, with the held-out edit's
+    /// truth in each), within what the views left of the bytes and time.
+    BudgetRecord::LightFieldChoice check_light_field_budget(
+        const FieldPlan& plan, const BudgetRecord& views,
+        const std::vector<std::pair<Camera, const Image*>>& targets) const;
     /// "budget: field "v" 8 uniform intervals chosen, half chosen, full size chosen at 3
     /// check(s); last measured 41.2 dB (asked >= 40) in its worst of 3 views, azimuth +20 deg
     /// (stored view 44.0 dB), ...; the check took 35.0 ms".
@@ -353,6 +361,13 @@ struct Instrument::Impl {
             out << ", " << c.milliseconds << " ms per step";
             if (budget.ms_per_step) out << " (<= " << share * *budget.ms_per_step << ")";
             out << (c.met ? ", met" : ", NOT met: the closest candidate");
+            if (const auto& light_field = c.light_field) {
+                out << "; light field " << light_field->cameras << " cameras at "
+                    << light_field->size << "^2 chosen, " << light_field->psnr_db << " dB, "
+                    << light_field->bytes / 1e6 << " MB, " << light_field->milliseconds
+                    << " ms per step"
+                    << (light_field->met ? ", met" : ", NOT met: the closest candidate");
+            }
             out << "; the check took " << c.check_milliseconds << " ms";
             separator = "; ";
         }
@@ -661,6 +676,44 @@ TransferFunction halved_opacity(const TransferFunction& tf) {
 
 }  // namespace
 
+namespace {
+
+/// The budget's rule over the candidates it measured (BudgetConfig): with an accuracy asked, the
+/// cheapest that meets every limit; else (or where none does) the cheapest affordable one within
+/// kBudgetPsnrTolerance of the most accurate affordable one; else the cheapest. `measured` is
+/// not empty.
+template <typename Candidate, typename Affordable, typename Accurate, typename Cheaper>
+const Candidate* choose_candidate(const std::vector<Candidate>& measured, bool accuracy_asked,
+                                  const Affordable& affordable, const Accurate& accurate,
+                                  const Cheaper& cheaper) {
+    const Candidate* chosen = nullptr;
+    for (const Candidate& c : measured) {
+        if (accuracy_asked && affordable(c) && accurate(c) && (!chosen || cheaper(c, *chosen))) {
+            chosen = &c;
+        }
+    }
+    if (!chosen) {
+        double best_db = -std::numeric_limits<double>::infinity();
+        for (const Candidate& c : measured) {
+            if (affordable(c)) best_db = std::max(best_db, c.psnr_db);
+        }
+        for (const Candidate& c : measured) {
+            if (affordable(c) && c.psnr_db >= best_db - kBudgetPsnrTolerance &&
+                (!chosen || cheaper(c, *chosen))) {
+                chosen = &c;
+            }
+        }
+    }
+    if (!chosen) {
+        for (const Candidate& c : measured) {
+            if (!chosen || cheaper(c, *chosen)) chosen = &c;
+        }
+    }
+    return chosen;
+}
+
+}  // namespace
+
 BudgetRecord Instrument::Impl::apply_budget(FieldPlan& plan) {
     const BudgetConfig& budget = *config.budget;
     const auto [found, fresh] = budget_state.try_emplace(plan.name);
@@ -878,33 +931,134 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
     // With an accuracy asked: the cheapest (bytes, then time) that meets every limit. Else (or
     // without one: only cost limits) the cheapest of the affordable ones within
     // kBudgetPsnrTolerance of the most accurate; else the cheapest.
-    const auto cheaper = [](const BudgetRecord& a, const BudgetRecord& b) {
-        return a.bytes < b.bytes || (a.bytes == b.bytes && a.milliseconds < b.milliseconds);
-    };
-    const BudgetRecord* chosen = nullptr;
-    for (const BudgetRecord& c : measured) {
-        if (budget.psnr_db && meets(c) && (!chosen || cheaper(c, *chosen))) chosen = &c;
-    }
-    if (!chosen) {
-        double best_db = -std::numeric_limits<double>::infinity();
-        for (const BudgetRecord& c : measured) {
-            if (affordable(c)) best_db = std::max(best_db, c.psnr_db);
-        }
-        for (const BudgetRecord& c : measured) {
-            if (affordable(c) && c.psnr_db >= best_db - kBudgetPsnrTolerance &&
-                (!chosen || cheaper(c, *chosen))) {
-                chosen = &c;
-            }
-        }
-    }
-    if (!chosen) {
-        for (const BudgetRecord& c : measured) {
-            if (!chosen || cheaper(c, *chosen)) chosen = &c;
-        }
-    }
+    const BudgetRecord* chosen = choose_candidate(
+        measured, budget.psnr_db.has_value(), affordable, accurate,
+        [](const BudgetRecord& a, const BudgetRecord& b) {
+            return a.bytes < b.bytes || (a.bytes == b.bytes && a.milliseconds < b.milliseconds);
+        });
     BudgetRecord choice = *chosen;
     choice.met = affordable(choice) && accurate(choice);
+    if (config.light_field && budget.chooses_light_field) {
+        std::vector<std::pair<Camera, const Image*>> targets;
+        for (const MeasuredView& target : measured_views) {
+            targets.emplace_back(target.camera, &target.truth);
+        }
+        choice.light_field = check_light_field_budget(plan, choice, targets);
+    }
     choice.check_milliseconds = 1e3 * seconds_since(check_start);
+    return choice;
+}
+
+BudgetRecord::LightFieldChoice Instrument::Impl::check_light_field_budget(
+    const FieldPlan& plan, const BudgetRecord& views,
+    const std::vector<std::pair<Camera, const Image*>>& targets) const {
+    using Choice = BudgetRecord::LightFieldChoice;
+    const BudgetConfig& budget = *config.budget;
+    const LightFieldSettings& asked = *config.light_field;
+    const double share = 1.0 / static_cast<double>(config.fields.size());
+    // The views came first: the light field gets what they left.
+    const auto affordable = [&](const Choice& c) {
+        return (!budget.bytes_per_step ||
+                views.bytes + c.bytes <= share * *budget.bytes_per_step) &&
+               (!budget.ms_per_step ||
+                views.milliseconds + c.milliseconds <= share * *budget.ms_per_step);
+    };
+    const auto accurate = [&](const Choice& c) {
+        return !budget.psnr_db || c.psnr_db >= *budget.psnr_db;
+    };
+
+    // What the light field shows is measured: an attenuation light field carries the held-out
+    // edit (through its reconstructed a_j, as the Explorer edits), one without shows the run's
+    // own function only, so that is its truth (one more ground-truth pass per view).
+    LightFieldRequest request;
+    request.settings = asked;
+    request.transfer_function = plan.transfer_function;
+    request.isovalues = plan.isovalues;
+    request.march.step_voxels = config.step_voxels;
+    const TransferFunction held_out = halved_opacity(plan.transfer_function);
+    std::vector<double> scales;
+    std::vector<float> colours;
+    std::vector<Image> own_truths;
+    if (asked.attenuation) {
+        request.intervals = renderer->choose_intervals(views.intervals, views.interval_mode,
+                                                       &plan.transfer_function);
+        scales = opacity_scales(plan.transfer_function, held_out, *request.intervals);
+        colours = interval_colours(held_out, *request.intervals);
+    } else {
+        RenderSettings truth_settings;
+        truth_settings.step_voxels = config.step_voxels;
+        truth_settings.early_termination_opacity = 1.0;
+        for (const auto& target : targets) {
+            own_truths.push_back(
+                renderer->render_ground_truth(target.first, plan.transfer_function, truth_settings)
+                    .rgba);
+        }
+    }
+    const archive_format::LightFieldEncoding encoding =
+        archive_format::light_field_encoding(config.precision, config.compression);
+
+    // Cheapest first (cameras x pixels per map, what bytes and capture time grow with).
+    std::vector<std::pair<int, int>> candidates;  // (cameras, size)
+    for (const int cameras : kBudgetLightFieldCameraCounts) {
+        for (const int divisor : kBudgetLightFieldSizeDivisors) {
+            const int size = asked.size / divisor;
+            if (divisor > 1 && size < kBudgetMinLightFieldSide) continue;
+            candidates.emplace_back(cameras, size);
+        }
+    }
+    std::stable_sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
+        return double(a.first) * a.second * a.second < double(b.first) * b.second * b.second;
+    });
+    std::vector<Choice> measured;
+    for (const auto& [cameras, size] : candidates) {
+        const LightFieldRig rig = LightFieldRig::around(plan.bounds, cameras, size);
+        // Only the cameras the measured views read: they reconstruct those views exactly as the
+        // whole rig does.
+        std::set<int> seen;
+        for (const auto& target : targets) {
+            for (const int k : light_field_cameras_seen(rig, target.first)) seen.insert(k);
+        }
+        request.settings.cameras = cameras;
+        request.settings.size = size;
+        request.cameras.assign(seen.begin(), seen.end());
+        const auto start = Clock::now();
+        LightFieldRecord record{plan.name, capture_light_field(*renderer, rig, request)};
+        const double whole_rig = static_cast<double>(cameras) / static_cast<double>(seen.size());
+        Choice candidate;
+        candidate.cameras = cameras;
+        candidate.size = size;
+        candidate.milliseconds = 1e3 * seconds_since(start) * whole_rig;
+        StepRecord step;
+        step.field = plan.name;
+        candidate.bytes = static_cast<double>(archive_format::encode_light_field(
+                                                  step, record, encoding, "budget check")
+                                                  .bytes.size()) *
+                          whole_rig;
+        LightFieldReconstructionSettings settings;
+        settings.attenuation = asked.attenuation;
+        candidate.psnr_db = std::numeric_limits<double>::infinity();
+        for (std::size_t v = 0; v < targets.size(); ++v) {
+            const LightFieldReconstruction seen_view =
+                reconstruct_light_field(record.light_field, targets[v].first, settings);
+            const Image shown =
+                asked.attenuation
+                    ? recolour(estimate_attenuation(seen_view.attenuation, seen_view.mean_depth,
+                                                    nullptr, scales),
+                               colours)
+                    : seen_view.rgba;
+            const Image& truth = asked.attenuation ? *targets[v].second : own_truths[v];
+            candidate.psnr_db = std::min(candidate.psnr_db, psnr_rgb_db(truth, shown));
+        }
+        measured.push_back(candidate);
+        // Cheapest first: the first that meets the budget is the one to take.
+        if (budget.psnr_db && affordable(candidate) && accurate(candidate)) break;
+    }
+    // As for the views (measured cheapest first, so a candidate that met is the last one).
+    const Choice* chosen =
+        choose_candidate(measured, budget.psnr_db.has_value(), affordable, accurate,
+                         [](const Choice& a, const Choice& b) { return a.bytes < b.bytes; });
+    Choice choice = *chosen;
+    choice.met = affordable(choice) && accurate(choice);
     return choice;
 }
 
@@ -1201,6 +1355,10 @@ void Instrument::Impl::compute_field(const FieldPlan& plan, StepRecord& record,
         INSITU_CHECK(!communicator);
         LightFieldRequest request;
         request.settings = *config.light_field;
+        if (plan.budget && plan.budget->light_field) {
+            request.settings.cameras = plan.budget->light_field->cameras;
+            request.settings.size = plan.budget->light_field->size;
+        }
         request.transfer_function = transfer_function;
         request.isovalues = isovalues;
         if (request.settings.attenuation) request.intervals = intervals;

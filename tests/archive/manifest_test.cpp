@@ -147,6 +147,7 @@ TEST(Manifest, BudgetChoicesRoundTripWithInfinitePsnr) {
     EXPECT_EQ(back.views[1].azimuth_offset_deg, -20.0);
     EXPECT_EQ(back.views[1].psnr_db, 31.5);
     EXPECT_EQ(back.views[2].psnr_db, 33.0);
+    EXPECT_FALSE(back.light_field.has_value());
     const BudgetRecord exact = budget_from_entry(entries[1]);
     EXPECT_TRUE(std::isinf(exact.psnr_db) && exact.psnr_db > 0.0);
     EXPECT_TRUE(std::isinf(exact.views.at(0).psnr_db));
@@ -163,6 +164,22 @@ TEST(Manifest, BudgetChoicesRoundTripWithInfinitePsnr) {
     EXPECT_FALSE(older.precision.has_value());
     EXPECT_EQ(older.size_divisor, 1);
     EXPECT_EQ(older.psnr_db, 31.5);
+    // A light field the budget chose reads back whole; a camera count the rig cannot have is
+    // named.
+    BudgetRecord with_light_field = choice;
+    with_light_field.light_field = BudgetRecord::LightFieldChoice{42, 128, true, 27.5, 3e6, 41.0};
+    const BudgetRecord light_field_back =
+        budget_from_entry(nlohmann::json::parse(budget_entry(with_light_field).dump()));
+    ASSERT_TRUE(light_field_back.light_field.has_value());
+    EXPECT_EQ(light_field_back.light_field->cameras, 42);
+    EXPECT_EQ(light_field_back.light_field->size, 128);
+    EXPECT_TRUE(light_field_back.light_field->met);
+    EXPECT_EQ(light_field_back.light_field->psnr_db, 27.5);
+    EXPECT_EQ(light_field_back.light_field->bytes, 3e6);
+    EXPECT_EQ(light_field_back.light_field->milliseconds, 41.0);
+    nlohmann::json odd_rig = budget_entry(with_light_field);
+    odd_rig["light_field"]["cameras"] = 40;
+    expect_error_naming<InvalidArgument>([&] { budget_from_entry(odd_rig); }, "40");
     nlohmann::json no_size = budget_entry(choice);
     no_size["size_divisor"] = 0;
     expect_error_naming<ParseError>([&] { budget_from_entry(no_size); }, "size_divisor 0");

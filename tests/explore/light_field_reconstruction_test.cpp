@@ -390,6 +390,33 @@ TEST_F(LightFieldReconstruction, MissingCamerasLowerTheConfidenceWhereTheyWereUs
     EXPECT_LT(used_reduced / used, 0.7 * used_full / used);
 }
 
+// light_field_cameras_seen: the cameras a view reads. A light field of only those reconstructs
+// the view exactly as the whole rig does (the error budget captures only them), they are a few
+// of the rig's, and every one of them is read: without it, it is missing.
+TEST_F(LightFieldReconstruction, TheCamerasSeenFromAViewReconstructItAsTheWholeRigDoes) {
+    Scenes& s = *scenes_;
+    const LightFieldRig& rig = s.ball_42.rig;
+    for (const Projection projection : {Projection::orthographic, Projection::perspective}) {
+        const Camera target = target_view(s.ball_bounds(), 30.0, 20.0, projection, 48);
+        const std::vector<int> seen = light_field_cameras_seen(rig, target);
+        ASSERT_FALSE(seen.empty());
+        EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+        EXPECT_LT(seen.size(), static_cast<std::size_t>(rig.camera_count()) / 2);
+        std::set<int> others;
+        for (int k = 0; k < rig.camera_count(); ++k) {
+            if (!std::binary_search(seen.begin(), seen.end(), k)) others.insert(k);
+        }
+        const auto full = reconstruct_light_field(s.ball_42, target, {});
+        const auto partial = reconstruct_light_field(without(s.ball_42, others), target, {});
+        EXPECT_TRUE(partial.missing_cameras.empty());
+        EXPECT_EQ(partial.rgba.pixels, full.rgba.pixels);
+        EXPECT_EQ(partial.confidence.pixels, full.confidence.pixels);
+        const auto short_one =
+            reconstruct_light_field(without(s.ball_42, std::set<int>{seen.front()}), target, {});
+        EXPECT_EQ(short_one.missing_cameras, std::vector<int>{seen.front()});
+    }
+}
+
 TEST_F(LightFieldReconstruction, ACameraThatSeesOnlyASurfaceTheRayPassesByAddsNothingToIt) {
     Scenes& s = *scenes_;
     // Camera 3's depth replaced by a phantom surface just in front of its eye everywhere: every

@@ -414,6 +414,27 @@ TEST(LightFieldCapture, AttenuationLightFieldIsTheProxyPassOfTheCamera) {
     }
 }
 
+// A subset of the rig's cameras (LightFieldRequest::cameras) captures those cameras only, each
+// exactly as the whole rig's capture holds it.
+TEST(LightFieldCapture, ASubsetOfCamerasIsThoseOfTheWholeCapture) {
+    const SampledVolume volume = blobs();
+    ProxyRenderer renderer;
+    renderer.upload(volume.field());
+    const LightFieldRig rig = rig_for(renderer);
+    LightFieldRequest request = request_for(settings_for(SegmentRule::whole_ray), blobs_tf());
+    const LightField whole = capture_light_field(renderer, rig, request);
+    request.cameras = {1, 4, kCameras - 1};
+    const LightField subset = capture_light_field(renderer, rig, request);
+    ASSERT_EQ(subset.cameras.size(), 3u);
+    for (const int k : request.cameras) {
+        const LightFieldImages* images = subset.find(k);
+        ASSERT_NE(images, nullptr) << "camera " << k;
+        EXPECT_EQ(images->segment_rgba.at(0).pixels, whole.find(k)->segment_rgba.at(0).pixels);
+        EXPECT_EQ(images->depth.pixels, whole.find(k)->depth.pixels);
+    }
+    EXPECT_EQ(subset.find(0), nullptr);
+}
+
 TEST(LightFieldCapture, PixelsOffTheMapDiskRecordNothing) {
     const SampledVolume volume = make_constant({32, 32, 32}, 1.0f);  // opaque everywhere
     ProxyRenderer renderer;
@@ -624,6 +645,14 @@ TEST(LightFieldCapture, BadRequestsNameTheValue) {
     other_size.settings.size = 64;
     expect_failure_naming<InvalidArgument>([&] { capture_light_field(renderer, rig, other_size); },
                                            {"size = 64", "32"});
+
+    for (const std::vector<int>& cameras :
+         {std::vector<int>{3, 12}, std::vector<int>{5, 2}, std::vector<int>{-1}}) {
+        LightFieldRequest subset = good;
+        subset.cameras = cameras;
+        expect_failure_naming<InvalidArgument>([&] { capture_light_field(renderer, rig, subset); },
+                                               {"camera " + std::to_string(cameras.back())});
+    }
 
     LightFieldRequest bad_isovalue = request_for(settings_for(SegmentRule::layers), blobs_tf());
     bad_isovalue.isovalues = {0.2, kInf};

@@ -126,14 +126,22 @@ struct ColourModelConfig {
 /// The bytes and time are the field's views' single-perspective proxies, rendering and preview
 /// (the multi-perspective, training and light-field passes come on top). Distributed runs
 /// refuse it (its ground truth needs the whole field on one process).
+/// With a "light_field" (and "choose" allowing it), the budget then chooses its camera count
+/// and map size too (kBudgetLightFieldCameraCounts x kBudgetLightFieldSizeDivisors), within
+/// what the views' choice left of the bytes and time: each candidate rig is measured in the same
+/// views, reconstructed as the Explorer's "lightfield" source does, against the held-out edit's
+/// truth (an attenuation light field, which edits go through) or the run's own function's (one
+/// without: it shows that function only), from a capture of just the cameras those views read
+/// (light_field_cameras_seen: for the stored view and its +-20 degree turns, 8 of 12 cameras
+/// and 21 of 42); its bytes and time are those cameras' scaled to the whole rig. Candidates are
+/// measured cheapest first (cameras x size^2) and the first that meets the accuracy asked is
+/// taken; without one (or where none meets it) the cheapest affordable one within
+/// kBudgetPsnrTolerance of the most accurate affordable one.
 /// What it leaves as configured, and why: the depth layers and K (the held-out edit's
 /// recomposition reads neither: layers serve relighting and depth, K the colour model, which
 /// only a run with training functions fits); the multi-perspective pass, off by default because
 /// the Explorer reconstructs new views better without it (ProxySelection), so a budget could
-/// only drop one a configuration asks for, and explicit settings win; the light field, whose
-/// camera count and map size the held-out edit's turned views would have to be reconstructed
-/// from at a capture per candidate (42 cameras at 256^2 with attenuation: about 1.4 s and 34 MB
-/// on Gray-Scott, bench/RESULTS.md "Light fields"), which no check every few steps affords.
+/// only drop one a configuration asks for, and explicit settings win.
 struct BudgetConfig {
     /// "psnr_db": the least PSNR, over the stored view and its "rotations", of a held-out edit
     /// (the run's function with every opacity halved, a' = 1 - (1 - a)^0.5) recomposed from
@@ -165,11 +173,25 @@ struct BudgetConfig {
     /// stored at their width and height or at half of each, kBudgetSizeDivisors, measured as the
     /// Explorer shows the smaller one at the asked size: bilinearly enlarged). All three by
     /// default; explicit settings win: a configuration that sets "intervals", "precision" or
-    /// any view's "size" itself keeps it unless "choose" is given and names it.
+    /// any view's "size" itself keeps it unless "choose" is given and names it. "light_field"
+    /// (the light field's camera count and map size) likewise.
     bool chooses_intervals = true;
     bool chooses_precision = true;
     bool chooses_size = true;
+    /// "light_field" in "choose": the light field's "cameras" and "size" (where the
+    /// configuration has a "light_field"); a "light_field" object that gives either keeps both.
+    bool chooses_light_field = true;
 };
+
+/// Camera counts a budget that chooses the light field measures: 12 cameras reconstruct
+/// Gray-Scott's random views at 20.9 dB, 42 at 23.8, 162 at 28.3 (256^2 maps, bench/RESULTS.md
+/// "Light fields"); 642 would store 4x 162's bytes and is left to a configuration that asks.
+inline constexpr int kBudgetLightFieldCameraCounts[] = {12, 42, 162};
+/// What it divides the configured map size by: doubling the map gains 0.1-0.6 dB there at 4x
+/// the bytes, so smaller maps are often the better buy. Only sizes of at least
+/// kBudgetMinLightFieldSide are measured.
+inline constexpr int kBudgetLightFieldSizeDivisors[] = {1, 2, 4};
+inline constexpr int kBudgetMinLightFieldSide = 64;
 
 /// Interval counts and modes a budget check measures: L in {4, 8, 16, 32}, uniform,
 /// histogram-equalised and opacity-adaptive (IntervalSet::opacity_adaptive).

@@ -192,6 +192,12 @@ nlohmann::json budget_entry(const BudgetRecord& choice) {
                          {"check_ms", choice.check_milliseconds}};
     if (choice.precision) entry["precision"] = to_string(*choice.precision);
     entry["size_divisor"] = choice.size_divisor;
+    if (const auto& light_field = choice.light_field) {
+        entry["light_field"] = {
+            {"cameras", light_field->cameras}, {"size", light_field->size},
+            {"met", light_field->met},         {"psnr_db", psnr_json(light_field->psnr_db)},
+            {"bytes", light_field->bytes},     {"ms", light_field->milliseconds}};
+    }
     return entry;
 }
 
@@ -228,6 +234,20 @@ BudgetRecord budget_from_entry(const nlohmann::json& entry) {
         if (choice.size_divisor < 1) {
             fail<ParseError>("size_divisor ", choice.size_divisor, " is not a positive count");
         }
+    }
+    // Optional: only where the budget chose a light field.
+    if (entry.contains("light_field")) {
+        const nlohmann::json& chosen = entry.at("light_field");
+        BudgetRecord::LightFieldChoice light_field;
+        light_field.cameras = chosen.at("cameras").get<int>();
+        check_light_field_cameras(light_field.cameras);
+        light_field.size = chosen.at("size").get<int>();
+        check_light_field_map_size(light_field.size);
+        light_field.met = chosen.at("met").get<bool>();
+        light_field.psnr_db = psnr_from_json(chosen.at("psnr_db"));
+        light_field.bytes = chosen.at("bytes").get<double>();
+        light_field.milliseconds = chosen.at("ms").get<double>();
+        choice.light_field = light_field;
     }
     return choice;
 }

@@ -49,6 +49,25 @@ std::optional<std::pair<double, double>> sphere_chord(const Ray& ray, const glm:
     return std::pair{-b - root, -b + root};
 }
 
+// Where a target ray crosses the bounding sphere ([t0, t1], in front of its origin) and the
+// cameras around it; nothing for a ray that misses the sphere (it sees nothing). The line meets
+// the camera sphere (Rc > R, so it does) where it enters it; for a perspective eye between R
+// and Rc that point lies behind the eye, as it should: the cameras there see the ray's
+// direction.
+struct RayNeighbourhood {
+    double t0 = 0.0, t1 = 0.0;
+    CameraNeighbourhood around;
+};
+std::optional<RayNeighbourhood> ray_neighbourhood(const LightFieldRig& rig, const Ray& ray) {
+    const auto chord = sphere_chord(ray, rig.center(), rig.bounding_radius());
+    if (!chord) return std::nullopt;
+    const double t0 = std::max(chord->first, 0.0), t1 = chord->second;
+    if (!(t1 > t0)) return std::nullopt;
+    const double t_entry = sphere_chord(ray, rig.center(), rig.camera_radius())->first;
+    return RayNeighbourhood{
+        t0, t1, rig.cameras_around(ray.origin + t_entry * ray.direction - rig.center())};
+}
+
 // Bilinear taps over pixel centres (x + 1/2), clamped at the map's edges.
 struct Taps {
     std::array<std::size_t, 4> pixel{};
@@ -312,19 +331,13 @@ private:
 
     void pixel(int x, int y, Scratch& scratch) {
         const Ray ray = target_.ray(x + 0.5, y + 0.5);
-        const auto chord = sphere_chord(ray, rig_.center(), rig_.bounding_radius());
-        if (!chord) return;  // the defaults: empty, depth +inf, confidence 1
-        const double t0 = std::max(chord->first, 0.0), t1 = chord->second;
-        if (!(t1 > t0)) return;
+        const std::optional<RayNeighbourhood> crossing = ray_neighbourhood(rig_, ray);
+        if (!crossing) return;  // the defaults: empty, depth +inf, confidence 1
+        const double t0 = crossing->t0, t1 = crossing->t1;
+        const CameraNeighbourhood& around = crossing->around;
         const double t_centre =
             std::clamp(glm::dot(rig_.center() - ray.origin, ray.direction), t0, t1);
         const auto at = [&](double t) { return ray.origin + t * ray.direction; };
-
-        // The line meets the camera sphere (Rc > R, so it does) where it enters it; for a
-        // perspective eye between R and Rc that point lies behind the eye, as it should: the
-        // cameras there see the ray's direction.
-        const double t_entry = sphere_chord(ray, rig_.center(), rig_.camera_radius())->first;
-        const CameraNeighbourhood around = rig_.cameras_around(at(t_entry) - rig_.center());
         std::array<CameraSample, 3> samples;
         int present = 0;
         double present_weight = 0.0;
@@ -559,6 +572,27 @@ private:
 };
 
 }  // namespace
+
+std::vector<int> light_field_cameras_seen(const LightFieldRig& rig, const Camera& target) {
+    std::vector<char> seen(static_cast<std::size_t>(rig.camera_count()), 0);
+    for (int y = 0; y < target.height(); ++y) {
+        for (int x = 0; x < target.width(); ++x) {
+            const auto crossing = ray_neighbourhood(rig, target.ray(x + 0.5, y + 0.5));
+            if (!crossing) continue;
+            for (int i = 0; i < 3; ++i) {
+                const auto n = static_cast<std::size_t>(i);
+                if (crossing->around.weights[n] > 0.0) {
+                    seen[static_cast<std::size_t>(crossing->around.cameras[n])] = 1;
+                }
+            }
+        }
+    }
+    std::vector<int> cameras;
+    for (int k = 0; k < rig.camera_count(); ++k) {
+        if (seen[static_cast<std::size_t>(k)]) cameras.push_back(k);
+    }
+    return cameras;
+}
 
 LightFieldReconstruction reconstruct_light_field(const LightField& light_field,
                                                  const Camera& target,

@@ -94,8 +94,19 @@ LightField capture_light_field(ProxyRenderer& renderer, const LightFieldRig& rig
     validate(proxies);  // names a bad isovalue or interval set before the first camera
     INSITU_CHECK_EQ(segment_count(proxies), segments);
 
-    light_field.cameras.reserve(static_cast<std::size_t>(rig.camera_count()));
-    for (int k = 0; k < rig.camera_count(); ++k) {
+    std::vector<int> cameras = request.cameras;
+    if (cameras.empty()) {
+        for (int k = 0; k < rig.camera_count(); ++k) cameras.push_back(k);
+    }
+    for (std::size_t i = 0; i < cameras.size(); ++i) {
+        if (cameras[i] < 0 || cameras[i] >= rig.camera_count() ||
+            (i > 0 && cameras[i] <= cameras[i - 1])) {
+            fail<InvalidArgument>("light field capture: camera ", cameras[i], " (entry ", i,
+                                  ") is not an increasing index below ", rig.camera_count());
+        }
+    }
+    light_field.cameras.reserve(cameras.size());
+    for (const int k : cameras) {
         ProxyFrame frame = renderer.render(rig.camera(k), proxies);
         LightFieldImages images;
         images.camera = k;

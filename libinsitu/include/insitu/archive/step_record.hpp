@@ -66,6 +66,16 @@ struct BudgetRecord {
     /// The whole check's time (every candidate and view; the check that chose this), or 0 in
     /// older archives.
     double check_milliseconds = 0.0;
+    /// The field's light field, where the budget chose it (BudgetConfig::chooses_light_field).
+    struct LightFieldChoice {
+        int cameras = 0;            ///< one of kLightFieldCameraCounts
+        int size = 0;               ///< map pixels per side
+        bool met = false;           ///< it met the accuracy and what the views left of the costs
+        double psnr_db = 0.0;       ///< least over the measured views, reconstructed from it
+        double bytes = 0.0;         ///< its archived bytes per step, at the check
+        double milliseconds = 0.0;  ///< its capture's time per step, at the check
+    };
+    std::optional<LightFieldChoice> light_field;
 };
 
 /// One field's light field at one timestep (written as one multi-part EXR, a part per camera).

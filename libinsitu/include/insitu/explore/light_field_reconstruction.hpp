@@ -77,4 +77,10 @@ LightFieldReconstruction reconstruct_light_field(const LightField& light_field,
                                                  const Camera& target,
                                                  const LightFieldReconstructionSettings& settings);
 
+/// The cameras of `rig` a reconstruction of `target` reads (step 1: those of weight > 0 around
+/// some pixel's ray), in increasing order. A light field holding only these reconstructs
+/// `target` exactly as the whole one does, which lets the error budget measure a rig by
+/// capturing a few of its cameras (insitu/config.hpp, BudgetConfig).
+std::vector<int> light_field_cameras_seen(const LightFieldRig& rig, const Camera& target);
+
 }  // namespace insitu

@@ -65,6 +65,10 @@ struct LightFieldRequest {
     bool skip_empty_space = true;
     /// Step and table resolution; early termination exact (1.0) as for the proxies.
     RenderSettings march = ProxyRequest{}.march;
+    /// The rig's cameras to capture, in increasing order; empty = every camera. A subset makes
+    /// the partial light field a reader of some cameras gets (the error budget measures a rig
+    /// from the cameras its views read, light_field_cameras_seen).
+    std::vector<int> cameras;
 };
 
 /// Captures every camera of `rig` from the field uploaded to `renderer`. InvalidArgument names
