@@ -1018,6 +1018,9 @@ BudgetRecord::LightFieldChoice Instrument::Impl::check_light_field_budget(
         for (const auto& target : targets) {
             for (const int k : light_field_cameras_seen(rig, target.first)) seen.insert(k);
         }
+        // Orbit views frame the bounds (a perspective eye outside their sphere), so they read
+        // some camera.
+        INSITU_CHECK(!seen.empty());
         request.settings.cameras = cameras;
         request.settings.size = size;
         request.cameras.assign(seen.begin(), seen.end());
