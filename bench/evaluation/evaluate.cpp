@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +19,7 @@
 #include <fstream>
 #include <functional>
 #include <glm/trigonometric.hpp>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -437,11 +439,12 @@ Image edit_trust(const ColourSetup& setup, const TransferFunction& edited, const
     return edit_confidence(error);
 }
 
-/// Columns high_error_fraction, flagged_fraction, good_flagged_fraction of an edit's mask: a
-/// pixel is flagged where the trust is below 1/2, right pixels are counted where either image
-/// covers anything.
+/// Columns high_error_fraction, flagged_fraction, good_flagged_fraction, good_fraction of an
+/// edit's mask: a pixel is flagged where the trust is below 1/2, right pixels are counted where
+/// either image covers anything; the wrong and the counted right pixels as shares of the image
+/// weight the rows when a sweep's pixels are pooled (charts.py).
 constexpr const char* kEditMaskColumns =
-    "high_error_fraction,flagged_fraction,good_flagged_fraction";
+    "high_error_fraction,flagged_fraction,good_flagged_fraction,good_fraction";
 struct EditOutcome {
     ImageErrors errors;
     MaskCoverage mask;
@@ -562,7 +565,8 @@ void section_colour(const Scene& scene, const Options& options, int image) {
                     csv.row(scene.name, variant->trust_proxies, s, (s >= 0.2 && s <= 1.0) ? 1 : 0,
                             model_used ? "model" : "recompose", err.psnr, err.ssim, err.max_abs,
                             mask.high_error_fraction(), mask.flagged_fraction(),
-                            mask.good_flagged_fraction());
+                            mask.good_flagged_fraction(),
+                            double(mask.good_pixels) / double(mask.pixels));
                 }
             }
         }
@@ -646,7 +650,8 @@ void section_occlusion(const Options& options, int size, int image) {
                 csv.row(proxies, occluded ? "inner_occluded" : "inner_visible",
                         model_used ? "model" : "recompose", err.psnr, err.ssim, err.max_abs,
                         mask.high_error_fraction(), mask.flagged_fraction(),
-                        mask.good_flagged_fraction());
+                        mask.good_flagged_fraction(),
+                        double(mask.good_pixels) / double(mask.pixels));
             }
         }
     std::printf("occlusion: done\n");
@@ -659,6 +664,47 @@ void section_occlusion(const Options& options, int size, int image) {
 // ground truth, in the same views (the stored one and the budget's default rotations, +-20
 // degrees of azimuth, synthesised by the Explorer), the least counting; the fixed default
 // (16 uniform intervals, half) beside it.
+
+/// A budget run's configuration: the field v in the stored view at `image`^2, every `every`
+/// steps, into `archive`; with `psnr_db`, a budget asking it, checked every third archived step.
+InstrumentConfig budget_run_config(const fs::path& archive, int image, int every,
+                                   std::optional<double> psnr_db) {
+    InstrumentConfig config;
+    config.fields = {"v"};
+    config.views[0].orbit = stored_view(image);
+    config.every = every;
+    config.archive = archive.string();
+    if (psnr_db) {
+        BudgetConfig budget;
+        budget.psnr_db = psnr_db;
+        budget.check_every = 3;
+        config.budget = budget;
+    }
+    return config;
+}
+
+/// The Gray-Scott mini-app's simulation of `size`^3 for `steps` steps, instrumented by `config`
+/// (errors rethrown): the archived steps' volumes, for their ground truths.
+std::vector<std::pair<std::int64_t, SampledVolume>> run_instrumented_gray_scott(
+    const InstrumentConfig& config, int size, int steps) {
+    InstrumentOptions instrument_options;
+    instrument_options.log = false;
+    instrument_options.rethrow_errors = true;
+    gray_scott::Parameters parameters;
+    parameters.size = size;
+    gray_scott::Simulation simulation(parameters);
+    std::vector<std::pair<std::int64_t, SampledVolume>> archived;
+    Instrument instrument(config, instrument_options);
+    for (int step = 1; step <= steps; ++step) {
+        simulation.step();
+        if (!instrument.selects(step)) continue;
+        SampledVolume volume = bench::gray_scott_volume(simulation);
+        instrument.execute(step, step, {volume.field()});
+        archived.emplace_back(step, std::move(volume));
+    }
+    instrument.finalize();
+    return archived;
+}
 
 void section_budget(const Options& options, const fs::path& scratch) {
     const auto start = std::chrono::steady_clock::now();
@@ -682,35 +728,9 @@ void section_budget(const Options& options, const fs::path& scratch) {
     for (const Run& run : runs) {
         const fs::path archive = scratch / ("budget_" + run.name + ".cdb");
         fs::remove_all(archive);
-        InstrumentConfig config;
-        config.fields = {"v"};
-        config.views[0].orbit = stored_view(image);
-        config.every = every;
-        config.archive = archive.string();
-        if (run.psnr_db) {
-            BudgetConfig budget;
-            budget.psnr_db = run.psnr_db;
-            budget.check_every = 3;
-            config.budget = budget;
-        }
-        InstrumentOptions instrument_options;
-        instrument_options.log = false;
-        instrument_options.rethrow_errors = true;
-        gray_scott::Parameters parameters;
-        parameters.size = size;
-        gray_scott::Simulation simulation(parameters);
-        std::vector<std::pair<std::int64_t, SampledVolume>> archived;
-        {
-            Instrument instrument(config, instrument_options);
-            for (int step = 1; step <= steps; ++step) {
-                simulation.step();
-                if (!instrument.selects(step)) continue;
-                SampledVolume volume = bench::gray_scott_volume(simulation);
-                instrument.execute(step, step, {volume.field()});
-                archived.emplace_back(step, std::move(volume));
-            }
-            instrument.finalize();
-        }
+        const InstrumentConfig config = budget_run_config(archive, image, every, run.psnr_db);
+        const std::vector<std::pair<std::int64_t, SampledVolume>> archived =
+            run_instrumented_gray_scott(config, size, steps);
         Explorer explorer(archive.string());
         ProxyRenderer renderer;
         for (const auto& [step, volume] : archived) {
@@ -769,6 +789,97 @@ void section_budget(const Options& options, const fs::path& scratch) {
     }
     std::printf("budget: %zu runs of Gray-Scott %d^3, %d steps, %.1f s\n", runs.size(), size, steps,
                 ms_since(start) / 1e3);
+}
+
+// The budget's light field over the same Gray-Scott run (issue 17): per archived step the PSNR
+// asked, the rig the budget chose and measured in situ, and what the archive's light field
+// achieves, measured here through the Explorer (source lightfield) against the ground truth of
+// the run's own function, in the budget's views (the stored one and +-20 degrees) and in views
+// it never measured (kFarViews), the least counting; beside it the fixed default rig (42 cameras
+// at 256^2). The views' own settings stay fixed (the budget chooses only the light field), and
+// the light field has no attenuation, so the run's function is what it shows.
+void section_budget_light_field(const Options& options, const fs::path& scratch) {
+    const auto start = std::chrono::steady_clock::now();
+    const int size = options.smoke ? 32 : 64;
+    const int image = options.smoke ? 64 : 256;
+    const int steps = options.smoke ? 40 : 1200;
+    const int every = options.smoke ? 40 : 100;
+    const int map_size = options.smoke ? 64 : LightFieldSettings{}.size;
+    Csv csv(fs::path(options.out) / "budget_light_field.csv",
+            "run,asked_psnr_db,step,cameras,size,checked,met,measured_psnr_db,achieved_psnr_db,"
+            "achieved_far_psnr_db,bytes,ms,check_ms");
+    struct Run {
+        std::string name;
+        std::optional<double> psnr_db;
+    };
+    const std::vector<Run> runs =
+        options.smoke ? std::vector<Run>{{"default", std::nullopt}, {"budget_25", 25.0}}
+                      : std::vector<Run>{{"default", std::nullopt},
+                                         {"budget_20", 20.0},
+                                         {"budget_25", 25.0},
+                                         {"budget_30", 30.0}};
+    // (azimuth offset, elevation) of views no budget check measures: the side, the back, above.
+    constexpr std::array<std::pair<double, double>, 3> kFarViews{
+        {{90.0, 20.0}, {180.0, 20.0}, {30.0, 70.0}}};
+    const std::vector<double> rotations = BudgetConfig{}.rotations_deg;
+    for (const Run& run : runs) {
+        const fs::path archive = scratch / ("budget_light_field_" + run.name + ".cdb");
+        fs::remove_all(archive);
+        InstrumentConfig config = budget_run_config(archive, image, every, run.psnr_db);
+        LightFieldSettings light_field;
+        light_field.attenuation = false;
+        light_field.size = map_size;
+        config.light_field = light_field;
+        if (config.budget) {
+            config.budget->chooses_intervals = config.budget->chooses_precision = false;
+            config.budget->chooses_size = false;
+        }
+        const std::vector<std::pair<std::int64_t, SampledVolume>> archived =
+            run_instrumented_gray_scott(config, size, steps);
+        Explorer explorer(archive.string());
+        ProxyRenderer renderer;
+        for (const auto& [step, volume] : archived) {
+            renderer.upload(volume.field());
+            const TransferFunction stored = explorer.archive().transfer_function(step, 0);
+            RenderSettings settings;
+            settings.early_termination_opacity = 1.0;
+            const auto achieved_at = [&](double azimuth_offset, double elevation) {
+                ExploreRequest request;
+                request.step = step;
+                request.source = ProxySource::lightfield;
+                request.azimuth_deg = config.views[0].orbit.azimuth_deg + azimuth_offset;
+                request.elevation_deg = elevation;
+                const ExploreFrame frame = explorer.render(request);
+                return psnr_db(renderer.render_ground_truth(frame.camera, stored, settings).rgba,
+                               frame.colour);
+            };
+            const double elevation = config.views[0].orbit.elevation_deg;
+            double achieved = achieved_at(0.0, elevation);
+            for (const double rotation : rotations) {
+                achieved = std::min(achieved, achieved_at(rotation, elevation));
+            }
+            double far = std::numeric_limits<double>::infinity();
+            for (const auto& [offset, far_elevation] : kFarViews) {
+                far = std::min(far, achieved_at(offset, far_elevation));
+            }
+            const ArchivedLightField files = explorer.archive().light_fields(step).at(0);
+            const double bytes = static_cast<double>(fs::file_size(files.exr_path));
+            const std::vector<BudgetRecord> choice = explorer.archive().budget(step);
+            if (choice.empty() || !choice.front().light_field) {
+                csv.row(run.name, "", step, files.cameras, files.map_size, 0, 1, "", achieved, far,
+                        bytes, "", "");
+            } else {
+                const BudgetRecord& c = choice.front();
+                const BudgetRecord::LightFieldChoice& chosen = *c.light_field;
+                csv.row(run.name, *run.psnr_db, step, chosen.cameras, chosen.size,
+                        c.checked ? 1 : 0, chosen.met ? 1 : 0, chosen.psnr_db, achieved, far, bytes,
+                        chosen.milliseconds,
+                        c.checked ? std::to_string(c.check_milliseconds) : std::string());
+            }
+        }
+    }
+    std::printf("budget, light field: %zu runs of Gray-Scott %d^3, %d steps, %.1f s\n", runs.size(),
+                size, steps, ms_since(start) / 1e3);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1388,7 +1499,10 @@ int main(int argc, char** argv) {
             section_configurations(all, primary, options, scratch);
         }
         if (options.sections.count("storage")) section_storage(options, scratch);
-        if (options.sections.count("budget")) section_budget(options, scratch);
+        if (options.sections.count("budget")) {
+            section_budget(options, scratch);
+            section_budget_light_field(options, scratch);
+        }
         if (options.sections.count("light_fields")) {
             // The issue's goal scenes: Gray-Scott and Marschner-Lobb.
             section_light_fields({&primary, &analytic[2]}, options, scratch, image);
