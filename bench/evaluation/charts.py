@@ -236,8 +236,8 @@ def chart_budget_light_field(d, rows):
     from it in the budget's views and in views no check measured; its bytes per step beside the
     default rig's."""
     chart_budget_runs(d, rows, "budget_light_field",
-                      "light field PSNR dB, least of the stored view and +-20 deg\n"
-                      "(dashed: far views; dotted: asked; x: measured in situ)",
+                      "light field PSNR dB, least of stored, +-20 deg\n"
+                      "(dashed: far views; x: in situ)",
                       "light-field MB per step (EXR)",
                       lambda sel: ", ".join("%d@%d" % rig for rig in sorted(
                           {(int(r["cameras"]), int(r["size"])) for r in sel})),
