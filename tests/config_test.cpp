@@ -668,6 +668,22 @@ TEST(InstrumentConfig, BudgetParsesValidatesAndRoundTrips) {
     EXPECT_FALSE(light_field_again.budget->chooses_intervals);
     EXPECT_FALSE(
         InstrumentConfig::from_json(size_only.to_json(), nullptr).budget->chooses_light_field);
+    // "colour_model" likewise: chosen by default, kept where "colour_model" gives "clusters".
+    EXPECT_TRUE(config.budget->chooses_colour_model);
+    EXPECT_TRUE(InstrumentConfig::from_json_text(
+                    R"({"colour_model": {"enabled": true}, "budget": {"psnr_db": 30}})", nullptr)
+                    .budget->chooses_colour_model);
+    EXPECT_FALSE(InstrumentConfig::from_json_text(
+                     R"({"colour_model": {"clusters": 8}, "budget": {"psnr_db": 30}})", nullptr)
+                     .budget->chooses_colour_model);
+    EXPECT_TRUE(
+        InstrumentConfig::from_json(
+            InstrumentConfig::from_json_text(
+                R"({"colour_model": {"clusters": 8}, "budget": {"choose": ["colour_model"]}})",
+                nullptr)
+                .to_json(),
+            nullptr)
+            .budget->chooses_colour_model);
     EXPECT_EQ(to_string(StoragePrecision::single), "float");
     EXPECT_EQ(parse_storage_precision("half"), StoragePrecision::half);
     EXPECT_THROW(parse_storage_precision("double"), InvalidArgument);

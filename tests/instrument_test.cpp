@@ -832,6 +832,57 @@ TEST_F(InstrumentTest, AnErrorBudgetChoosesThePrecisionOfTheViewsItArchives) {
     EXPECT_FALSE(kept.met);
 }
 
+// With a colour model fitted (training functions), the budget chooses K too: the held-out edit
+// (opacity halved, the colours kept) is what the Explorer colours by the model, so each K is fitted
+// on the training pairs and measured on it. The fewest clusters meet an easy accuracy, and the
+// archive's model is fitted with them; a configuration that gives "clusters" keeps them.
+TEST_F(InstrumentTest, AnErrorBudgetChoosesTheColourModelsClusters) {
+    const auto with_opacity = [](float opacity) {
+        return TransferFunction(
+            {{0.0, {0, 0, 1, 0}}, {0.2, {0, 0, 1, 0}}, {1.0, {1, 0, 0, opacity}}}, 1.0);
+    };
+    const auto run = [&](const std::string& name, BudgetConfig budget, bool given_clusters,
+                         std::string* log) {
+        InstrumentConfig config = small_config(directory_ / name, 48);
+        config.interval_count = 8;
+        config.training_transfer_functions = {with_opacity(0.2f), with_opacity(0.5f),
+                                              with_opacity(0.9f)};
+        config.colour_model.clusters = 24;
+        budget.chooses_intervals = budget.chooses_precision = budget.chooses_size = false;
+        budget.chooses_colour_model = !given_clusters;
+        config.budget = budget;
+        return run_with_budget(config, volume_, 1, log);
+    };
+    BudgetConfig easy;
+    easy.psnr_db = 1.0;
+    std::string log;
+    const ArchiveReader cheap_run = run("cheap.cdb", easy, false, &log);
+    const BudgetRecord cheap = cheap_run.budget(0).at(0);
+    ASSERT_TRUE(cheap.colour_model.has_value());
+    EXPECT_EQ(cheap.colour_model->clusters, kBudgetColourModelClusters[0]);
+    EXPECT_TRUE(cheap.colour_model->met);
+    EXPECT_GE(cheap.colour_model->psnr_db, 1.0);
+    EXPECT_THAT(log, HasSubstr("colour model K = 4 chosen"));
+    const ProxyFrame frame = cheap_run.load(0, 0);
+    ASSERT_TRUE(frame.colour_model.has_value());
+    EXPECT_LE(frame.colour_model->clusters(), kBudgetColourModelClusters[0]);
+
+    // No accuracy asked, time to spare: the fewest clusters within the tolerance of the most
+    // accurate K, which is measured as the Explorer would show it.
+    BudgetConfig spare;
+    spare.ms_per_step = 1e9;
+    const BudgetRecord best = run("best.cdb", spare, false, nullptr).budget(0).at(0);
+    ASSERT_TRUE(best.colour_model.has_value());
+    EXPECT_TRUE(best.colour_model->met);
+    EXPECT_TRUE(std::isfinite(best.colour_model->psnr_db));
+    EXPECT_GE(best.colour_model->psnr_db + kBudgetPsnrTolerance, cheap.colour_model->psnr_db);
+
+    // Explicit settings win: the configured K, nothing chosen.
+    const ArchiveReader given = run("given.cdb", easy, true, nullptr);
+    EXPECT_FALSE(given.budget(0).at(0).colour_model.has_value());
+    EXPECT_GT(given.load(0, 0).colour_model->clusters(), kBudgetColourModelClusters[0]);
+}
+
 // With a "light_field", the budget chooses its camera count and map size too: each rig measured
 // in the budget's views, reconstructed from the cameras those views read, against the run's own
 // function (a light field without attenuation shows nothing else), within what the views left.

@@ -317,11 +317,12 @@ const Key<ColourModelConfig> kColourModelKeys[] = {
 
 // "budget": {"psnr_db", "bytes_per_step", "ms_per_step", "check_every", "rotations",
 // "choose"}.
-enum class BudgetChoice { intervals, precision, size, light_field };
+enum class BudgetChoice { intervals, precision, size, light_field, colour_model };
 constexpr Choice<BudgetChoice> kBudgetChoices[] = {{"intervals", BudgetChoice::intervals},
                                                    {"precision", BudgetChoice::precision},
                                                    {"size", BudgetChoice::size},
-                                                   {"light_field", BudgetChoice::light_field}};
+                                                   {"light_field", BudgetChoice::light_field},
+                                                   {"colour_model", BudgetChoice::colour_model}};
 // The BudgetConfig member each "choose" entry sets.
 bool BudgetConfig::*chooses(BudgetChoice choice) {
     switch (choice) {
@@ -333,6 +334,8 @@ bool BudgetConfig::*chooses(BudgetChoice choice) {
             return &BudgetConfig::chooses_size;
         case BudgetChoice::light_field:
             return &BudgetConfig::chooses_light_field;
+        case BudgetChoice::colour_model:
+            return &BudgetConfig::chooses_colour_model;
     }
     return &BudgetConfig::chooses_intervals;
 }
@@ -785,6 +788,11 @@ InstrumentConfig InstrumentConfig::from_json(const nlohmann::json& document,
         if (light_field && light_field->is_object() &&
             (light_field->contains("cameras") || light_field->contains("size"))) {
             config.budget->chooses_light_field = false;
+        }
+        const json* colour_model =
+            document.contains("colour_model") ? &document["colour_model"] : nullptr;
+        if (colour_model && colour_model->is_object() && colour_model->contains("clusters")) {
+            config.budget->chooses_colour_model = false;
         }
     }
     config.validate();

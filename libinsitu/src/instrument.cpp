@@ -312,12 +312,31 @@ struct Instrument::Impl {
     /// Measures every candidate on the field's first view and picks the cheapest that meets
     /// the budget (see BudgetConfig).
     BudgetRecord check_budget(const FieldPlan& plan) const;
+    /// Whether the field's views fit the colour model: the training functions apply to it
+    /// (InstrumentConfig::trains), the model is enabled and the attenuation it maps is stored.
+    bool fits_colour_model(const std::string& field) const {
+        return config.trains(field) && !config.training_transfer_functions.empty() &&
+               config.colour_model.enabled && config.proxies.attenuation;
+    }
+    /// A view the budget measures: the stored one (offset 0) or a turn of it in azimuth
+    /// (Camera::reorbit), at the asked size, with the held-out edit's ground truth in it.
+    struct BudgetView {
+        double azimuth_offset_deg = 0.0;
+        Camera camera;
+        Image truth;
+    };
     /// The light field's camera count and map size (BudgetConfig::chooses_light_field), with the
-    /// views' choice made: measured in the budget's views (`targets`, with the held-out edit's
-    /// truth in each), within what the views left of the bytes and time.
+    /// views' choice made: measured in the budget's views, within what the views left of the
+    /// bytes and time.
     BudgetRecord::LightFieldChoice check_light_field_budget(
         const FieldPlan& plan, const BudgetRecord& views,
-        const std::vector<std::pair<Camera, const Image*>>& targets) const;
+        const std::vector<BudgetView>& targets) const;
+    /// The colour model's K (BudgetConfig::chooses_colour_model), with the views' choice made:
+    /// the held-out edit as the Explorer colours it (the model), fitted on the training pairs of
+    /// `source` (the stored view at the size chosen), in the budget's views.
+    BudgetRecord::ColourModelChoice check_colour_model_budget(
+        const FieldPlan& plan, const BudgetRecord& views, const Camera& source,
+        const std::vector<BudgetView>& targets) const;
     /// "budget: field "v" 8 uniform intervals chosen, half chosen, full size chosen at 3
     /// check(s); last measured 41.2 dB (asked >= 40) in its worst of 3 views, azimuth +20 deg
     /// (stored view 44.0 dB), ...; the check took 35.0 ms".
@@ -367,6 +386,11 @@ struct Instrument::Impl {
                     << light_field->bytes / 1e6 << " MB, " << light_field->milliseconds
                     << " ms per step"
                     << (light_field->met ? ", met" : ", NOT met: the closest candidate");
+            }
+            if (const auto& model = c.colour_model) {
+                out << "; colour model K = " << model->clusters << " chosen, " << model->psnr_db
+                    << " dB, fitted in " << model->milliseconds << " ms"
+                    << (model->met ? ", met" : ", NOT met: the closest candidate");
             }
             out << "; the check took " << c.check_milliseconds << " ms";
             separator = "; ";
@@ -752,12 +776,7 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
     truth_settings.early_termination_opacity = 1.0;
     // The measured views' ground truths, once per check: the stored view, then each rotation
     // (turned in azimuth as the Explorer turns a view, Camera::reorbit).
-    struct MeasuredView {
-        double azimuth_offset_deg;
-        Camera camera;
-        Image truth;
-    };
-    std::vector<MeasuredView> measured_views;
+    std::vector<BudgetView> measured_views;
     const auto truth_start = Clock::now();
     measured_views.push_back(
         {0.0, camera, renderer->render_ground_truth(camera, held_out, truth_settings).rgba});
@@ -856,7 +875,7 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
             std::vector<char>(encoded.bytes.begin(), encoded.bytes.end()), "budget check",
             encoded.parts, false);
         candidate.psnr_db = std::numeric_limits<double>::infinity();
-        for (const MeasuredView& target : measured_views) {
+        for (const BudgetView& target : measured_views) {
             Image edited;
             if (&target == &measured_views.front()) {
                 edited = estimate_attenuation(stored.attenuation, stored.mean_depth, nullptr,
@@ -939,19 +958,108 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
     BudgetRecord choice = *chosen;
     choice.met = affordable(choice) && accurate(choice);
     if (config.light_field && budget.chooses_light_field) {
-        std::vector<std::pair<Camera, const Image*>> targets;
-        for (const MeasuredView& target : measured_views) {
-            targets.emplace_back(target.camera, &target.truth);
-        }
-        choice.light_field = check_light_field_budget(plan, choice, targets);
+        choice.light_field = check_light_field_budget(plan, choice, measured_views);
+    }
+    if (fits_colour_model(plan.name) && budget.chooses_colour_model) {
+        const auto size = std::find_if(sizes.begin(), sizes.end(), [&](const CandidateSize& c) {
+            return c.divisor == choice.size_divisor;
+        });
+        INSITU_CHECK(size != sizes.end());
+        choice.colour_model = check_colour_model_budget(plan, choice, size->camera, measured_views);
     }
     choice.check_milliseconds = 1e3 * seconds_since(check_start);
     return choice;
 }
 
+BudgetRecord::ColourModelChoice Instrument::Impl::check_colour_model_budget(
+    const FieldPlan& plan, const BudgetRecord& views, const Camera& source,
+    const std::vector<BudgetView>& targets) const {
+    using Choice = BudgetRecord::ColourModelChoice;
+    const BudgetConfig& budget = *config.budget;
+    const double share = 1.0 / static_cast<double>(config.fields.size());
+    // The fit's time comes on top of the views' passes; its K x L table's bytes are nothing.
+    const auto affordable = [&](const Choice& c) {
+        return !budget.ms_per_step ||
+               views.milliseconds + c.milliseconds <= share * *budget.ms_per_step;
+    };
+    const auto accurate = [&](const Choice& c) {
+        return !budget.psnr_db || c.psnr_db >= *budget.psnr_db;
+    };
+
+    // The training pairs compute_field fits on (attenuation under each training function from
+    // the chosen intervals, and its ground truth), in the stored view at the size chosen.
+    ProxyRequest request;
+    request.isovalues = plan.isovalues;
+    request.intervals =
+        renderer->choose_intervals(views.intervals, views.interval_mode, &plan.transfer_function);
+    request.march.step_voxels = config.step_voxels;
+    request.depth_layers = false;
+    RenderSettings truth_settings;
+    truth_settings.step_voxels = config.step_voxels;
+    truth_settings.early_termination_opacity = 1.0;
+    std::vector<Image> training_attenuation, training_colour;
+    request.mean_depth = false;
+    for (const TransferFunction& tf : config.training_transfer_functions) {
+        request.transfer_function = tf;
+        training_attenuation.push_back(renderer->render(source, request).attenuation);
+        training_colour.push_back(renderer->render_ground_truth(source, tf, truth_settings).rgba);
+    }
+    // The held-out edit's attenuation in each measured view, as the Explorer estimates it (a
+    // turned view synthesised from the stored one's proxies first).
+    request.mean_depth = true;
+    request.transfer_function = plan.transfer_function;
+    const ProxyFrame stored = renderer->render(source, request);
+    const std::vector<double> scales = opacity_scales(
+        plan.transfer_function, halved_opacity(plan.transfer_function), *request.intervals);
+    std::vector<Image> edited;
+    for (const BudgetView& target : targets) {
+        if (target.azimuth_offset_deg == 0.0) {
+            edited.push_back(
+                estimate_attenuation(stored.attenuation, stored.mean_depth, nullptr, scales));
+        } else {
+            const SynthesisedAttenuation turned = synthesise_attenuation(
+                stored, source.reorbit(source.azimuth_deg() + target.azimuth_offset_deg,
+                                       source.elevation_deg()));
+            edited.push_back(
+                estimate_attenuation(turned.attenuation, turned.mean_depth, nullptr, scales));
+        }
+    }
+
+    std::vector<Choice> measured;
+    for (const int clusters : kBudgetColourModelClusters) {
+        ColourModelSettings settings;
+        settings.clusters = clusters;
+        const auto start = Clock::now();
+        const ColourModel model = ColourModel::fit(training_attenuation, training_colour, settings);
+        Choice candidate;
+        candidate.clusters = clusters;
+        candidate.milliseconds = 1e3 * seconds_since(start);
+        candidate.psnr_db = std::numeric_limits<double>::infinity();
+        for (std::size_t v = 0; v < targets.size(); ++v) {
+            Image shown = model.predict(edited[v]);
+            const Image& truth = targets[v].truth;
+            if (shown.width != truth.width || shown.height != truth.height) {
+                shown = resize_bilinear(shown, truth.width, truth.height);
+            }
+            candidate.psnr_db = std::min(candidate.psnr_db, psnr_rgb_db(truth, shown));
+        }
+        measured.push_back(candidate);
+        // Fewest clusters first (the fit's time grows with K): the first that meets it is taken.
+        if (budget.psnr_db && affordable(candidate) && accurate(candidate)) break;
+        // Fewer distinct attenuation vectors than K: a larger K fits the same model.
+        if (model.clusters() < clusters) break;
+    }
+    const Choice* chosen = choose_candidate(
+        measured, budget.psnr_db.has_value(), affordable, accurate,
+        [](const Choice& a, const Choice& b) { return a.milliseconds < b.milliseconds; });
+    Choice choice = *chosen;
+    choice.met = affordable(choice) && accurate(choice);
+    return choice;
+}
+
 BudgetRecord::LightFieldChoice Instrument::Impl::check_light_field_budget(
     const FieldPlan& plan, const BudgetRecord& views,
-    const std::vector<std::pair<Camera, const Image*>>& targets) const {
+    const std::vector<BudgetView>& targets) const {
     using Choice = BudgetRecord::LightFieldChoice;
     const BudgetConfig& budget = *config.budget;
     const LightFieldSettings& asked = *config.light_field;
@@ -988,9 +1096,9 @@ BudgetRecord::LightFieldChoice Instrument::Impl::check_light_field_budget(
         RenderSettings truth_settings;
         truth_settings.step_voxels = config.step_voxels;
         truth_settings.early_termination_opacity = 1.0;
-        for (const auto& target : targets) {
+        for (const BudgetView& target : targets) {
             own_truths.push_back(
-                renderer->render_ground_truth(target.first, plan.transfer_function, truth_settings)
+                renderer->render_ground_truth(target.camera, plan.transfer_function, truth_settings)
                     .rgba);
         }
     }
@@ -1015,8 +1123,8 @@ BudgetRecord::LightFieldChoice Instrument::Impl::check_light_field_budget(
         // Only the cameras the measured views read: they reconstruct those views exactly as the
         // whole rig does.
         std::set<int> seen;
-        for (const auto& target : targets) {
-            for (const int k : light_field_cameras_seen(rig, target.first)) seen.insert(k);
+        for (const BudgetView& target : targets) {
+            for (const int k : light_field_cameras_seen(rig, target.camera)) seen.insert(k);
         }
         // Orbit views frame the bounds (a perspective eye outside their sphere), so they read
         // some camera.
@@ -1042,14 +1150,14 @@ BudgetRecord::LightFieldChoice Instrument::Impl::check_light_field_budget(
         candidate.psnr_db = std::numeric_limits<double>::infinity();
         for (std::size_t v = 0; v < targets.size(); ++v) {
             const LightFieldReconstruction seen_view =
-                reconstruct_light_field(record.light_field, targets[v].first, settings);
+                reconstruct_light_field(record.light_field, targets[v].camera, settings);
             const Image shown =
                 asked.attenuation
                     ? recolour(estimate_attenuation(seen_view.attenuation, seen_view.mean_depth,
                                                     nullptr, scales),
                                colours)
                     : seen_view.rgba;
-            const Image& truth = asked.attenuation ? *targets[v].second : own_truths[v];
+            const Image& truth = asked.attenuation ? targets[v].truth : own_truths[v];
             candidate.psnr_db = std::min(candidate.psnr_db, psnr_rgb_db(truth, shown));
         }
         measured.push_back(candidate);
@@ -1274,7 +1382,7 @@ void Instrument::Impl::compute_field(const FieldPlan& plan, StepRecord& record,
     // needs them, and stored only on request ("keep_training_images").
     // Training functions are in the top-level function's units: only its fields train.
     const bool trains = config.trains(name) && !config.training_transfer_functions.empty();
-    const bool fits_model = trains && config.colour_model.enabled && config.proxies.attenuation;
+    const bool fits_model = fits_colour_model(name);
     if (trains && (config.keep_training_images || fits_model)) {
         single.training_transfer_functions = config.training_transfer_functions;
     }
@@ -1286,7 +1394,9 @@ void Instrument::Impl::compute_field(const FieldPlan& plan, StepRecord& record,
     training_attenuation.depth_layers = false;
     training_attenuation.mean_depth = false;
     ColourModelSettings model_settings;
-    model_settings.clusters = config.colour_model.clusters;
+    model_settings.clusters = plan.budget && plan.budget->colour_model
+                                  ? plan.budget->colour_model->clusters
+                                  : config.colour_model.clusters;
 
     ProxyRequest multi = base;
     multi.depth_layers = config.proxies.distortion;

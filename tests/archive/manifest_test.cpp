@@ -177,6 +177,20 @@ TEST(Manifest, BudgetChoicesRoundTripWithInfinitePsnr) {
     EXPECT_EQ(light_field_back.light_field->psnr_db, 27.5);
     EXPECT_EQ(light_field_back.light_field->bytes, 3e6);
     EXPECT_EQ(light_field_back.light_field->milliseconds, 41.0);
+    EXPECT_FALSE(light_field_back.colour_model.has_value());
+    // K likewise.
+    BudgetRecord with_model = choice;
+    with_model.colour_model = BudgetRecord::ColourModelChoice{16, false, 29.5, 7.5};
+    const BudgetRecord model_back =
+        budget_from_entry(nlohmann::json::parse(budget_entry(with_model).dump()));
+    ASSERT_TRUE(model_back.colour_model.has_value());
+    EXPECT_EQ(model_back.colour_model->clusters, 16);
+    EXPECT_FALSE(model_back.colour_model->met);
+    EXPECT_EQ(model_back.colour_model->psnr_db, 29.5);
+    EXPECT_EQ(model_back.colour_model->milliseconds, 7.5);
+    nlohmann::json no_clusters = budget_entry(with_model);
+    no_clusters["colour_model"]["clusters"] = 0;
+    expect_error_naming<ParseError>([&] { budget_from_entry(no_clusters); }, "clusters 0");
     nlohmann::json odd_rig = budget_entry(with_light_field);
     odd_rig["light_field"]["cameras"] = 40;
     expect_error_naming<InvalidArgument>([&] { budget_from_entry(odd_rig); }, "40");

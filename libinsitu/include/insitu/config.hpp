@@ -137,11 +137,15 @@ struct ColourModelConfig {
 /// measured cheapest first (cameras x size^2) and the first that meets the accuracy asked is
 /// taken; without one (or where none meets it) the cheapest affordable one within
 /// kBudgetPsnrTolerance of the most accurate affordable one.
-/// What it leaves as configured, and why: the depth layers and K (the held-out edit's
-/// recomposition reads neither: layers serve relighting and depth, K the colour model, which
-/// only a run with training functions fits); the multi-perspective pass, off by default because
-/// the Explorer reconstructs new views better without it (ProxySelection), so a budget could
-/// only drop one a configuration asks for, and explicit settings win.
+/// With a colour model fitted (training transfer functions), it chooses K too
+/// (kBudgetColourModelClusters, fewest first): the Explorer colours an opacity edit of the same
+/// colours, as the held-out edit is, by the model, so each K is fitted on the training pairs of
+/// the chosen intervals and size and measured on the held-out edit in the same views, the first
+/// that meets the accuracy taken (else the rule above, the fit's time the cost).
+/// What it leaves as configured, and why: the depth layers (the held-out edit reads none: they
+/// serve relighting and depth, a few 1-channel images); the multi-perspective pass, off by
+/// default because the Explorer reconstructs new views better without it (ProxySelection), so
+/// a budget could only drop one a configuration asks for, and explicit settings win.
 struct BudgetConfig {
     /// "psnr_db": the least PSNR, over the stored view and its "rotations", of a held-out edit
     /// (the run's function with every opacity halved, a' = 1 - (1 - a)^0.5) recomposed from
@@ -181,7 +185,14 @@ struct BudgetConfig {
     /// "light_field" in "choose": the light field's "cameras" and "size" (where the
     /// configuration has a "light_field"); a "light_field" object that gives either keeps both.
     bool chooses_light_field = true;
+    /// "colour_model" in "choose": K (where the run fits a colour model); a "colour_model"
+    /// object that gives "clusters" keeps it.
+    bool chooses_colour_model = true;
 };
+
+/// K a budget that chooses the colour model measures (seed 000 Fig. 12 on Gray-Scott,
+/// bench/RESULTS.md "Colour model and opacity edits": the error falls to K = 24 and flattens).
+inline constexpr int kBudgetColourModelClusters[] = {4, 8, 16, 24, 48};
 
 /// Camera counts a budget that chooses the light field measures: 12 cameras reconstruct
 /// Gray-Scott's random views at 20.9 dB, 42 at 23.8, 162 at 28.3 (256^2 maps, bench/RESULTS.md

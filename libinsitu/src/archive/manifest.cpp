@@ -198,6 +198,12 @@ nlohmann::json budget_entry(const BudgetRecord& choice) {
             {"met", light_field->met},         {"psnr_db", psnr_json(light_field->psnr_db)},
             {"bytes", light_field->bytes},     {"ms", light_field->milliseconds}};
     }
+    if (const auto& model = choice.colour_model) {
+        entry["colour_model"] = {{"clusters", model->clusters},
+                                 {"met", model->met},
+                                 {"psnr_db", psnr_json(model->psnr_db)},
+                                 {"ms", model->milliseconds}};
+    }
     return entry;
 }
 
@@ -248,6 +254,19 @@ BudgetRecord budget_from_entry(const nlohmann::json& entry) {
         light_field.bytes = chosen.at("bytes").get<double>();
         light_field.milliseconds = chosen.at("ms").get<double>();
         choice.light_field = light_field;
+    }
+    if (entry.contains("colour_model")) {  // only where the budget chose K
+        const nlohmann::json& chosen = entry.at("colour_model");
+        BudgetRecord::ColourModelChoice model;
+        model.clusters = chosen.at("clusters").get<int>();
+        if (model.clusters < 1 || model.clusters > kMaxColourModelClusters) {
+            fail<ParseError>("colour model clusters ", model.clusters, " is outside [1, ",
+                             kMaxColourModelClusters, "]");
+        }
+        model.met = chosen.at("met").get<bool>();
+        model.psnr_db = psnr_from_json(chosen.at("psnr_db"));
+        model.milliseconds = chosen.at("ms").get<double>();
+        choice.colour_model = model;
     }
     return choice;
 }

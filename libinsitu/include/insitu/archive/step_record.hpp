@@ -76,6 +76,14 @@ struct BudgetRecord {
         double milliseconds = 0.0;  ///< its capture's time per step, at the check
     };
     std::optional<LightFieldChoice> light_field;
+    /// The colour model's K, where the budget chose it (BudgetConfig::chooses_colour_model).
+    struct ColourModelChoice {
+        int clusters = 0;           ///< K asked of the fit
+        bool met = false;           ///< it met the accuracy and what the views left of the time
+        double psnr_db = 0.0;       ///< the held-out edit as the model colours it, least of views
+        double milliseconds = 0.0;  ///< the fit's time, at the check
+    };
+    std::optional<ColourModelChoice> colour_model;
 };
 
 /// One field's light field at one timestep (written as one multi-part EXR, a part per camera).
