@@ -17,7 +17,8 @@
 //  "light_field": {"cameras": 42, "size": 256, "segments": "layers", "attenuation": true,
 //                  "depth_bits": 8, "depth_threshold": 0.3},
 //  "budget": {"psnr_db": 40, "bytes_per_step": 8e6, "ms_per_step": 500, "check_every": 10,
-//             "rotations": [-20, 20], "choose": ["intervals", "precision", "size"]}}
+//             "rotations": [-20, 20],
+//             "choose": ["intervals", "precision", "size", "light_field", "colour_model"]}}
 //
 // Every key is optional; defaults are listed on the members below. Unknown keys (at any level)
 // are collected by name, not silently ignored: an Instrument refuses them unless "strict" is
@@ -175,10 +176,10 @@ struct BudgetConfig {
     /// the archive's bytes turn on; "precision" (the views' proxies stored as half or float,
     /// measured as read back; light fields keep the run's "precision"); "size" (the views
     /// stored at their width and height or at half of each, kBudgetSizeDivisors, measured as the
-    /// Explorer shows the smaller one at the asked size: bilinearly enlarged). All three by
-    /// default; explicit settings win: a configuration that sets "intervals", "precision" or
-    /// any view's "size" itself keeps it unless "choose" is given and names it. "light_field"
-    /// (the light field's camera count and map size) likewise.
+    /// Explorer shows the smaller one at the asked size: bilinearly enlarged); "light_field"
+    /// and "colour_model" (below). All by default; explicit settings win: a configuration that
+    /// sets "intervals", "precision", any view's "size", the light field's "cameras" or "size"
+    /// or the colour model's "clusters" itself keeps it unless "choose" is given and names it.
     bool chooses_intervals = true;
     bool chooses_precision = true;
     bool chooses_size = true;
