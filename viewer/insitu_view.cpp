@@ -26,6 +26,7 @@
 #include <cstdio>
 #include <exception>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -56,7 +57,8 @@ using insitu::cli::UsageError;
 const CommandHelp& info_help() {
     static const CommandHelp help{
         "insitu-view info ARCHIVE [--json]",
-        "Describes ARCHIVE: its steps, views, proxies and configuration. Every file is checked "
+        "Describes ARCHIVE: its steps, views, proxies, light fields, what an error budget chose "
+        "at each step, and its configuration. Every file is checked "
         "against the index (size, CRC-32); of a damaged archive it shows what can be read and "
         "lists each problem, one line each naming the file, under \"damage:\".",
         {{"--json", "",
@@ -233,6 +235,43 @@ int run_info(const std::vector<std::string>& args) {
                   << "^2 maps, " << light_field.at("segments") << " segment(s), attenuation "
                   << (light_field.at("attenuation").get<bool>() ? "yes" : "no") << ", depth "
                   << light_field.at("depth_bits") << " bits\n";
+    }
+    // What an error budget chose at each step: the views' intervals, precision and size, the
+    // light field's rig and the colour model's K, each with the PSNR it measured.
+    for (const auto& entry : description.value("budget", nlohmann::json::array())) {
+        const auto psnr = [](const nlohmann::json& value) {
+            std::ostringstream text;
+            text << std::fixed << std::setprecision(1);
+            if (value.is_null()) {
+                text << "exact";
+            } else {
+                text << value.get<double>() << " dB";
+            }
+            return text.str();
+        };
+        const auto met = [](const nlohmann::json& choice) {
+            return choice.at("met").get<bool>() ? " met" : " NOT met";
+        };
+        std::cout << "budget        step " << entry.at("step") << " "
+                  << entry.at("field").get<std::string>() << ": " << entry.at("intervals") << " "
+                  << entry.at("mode").get<std::string>() << " intervals";
+        if (entry.contains("precision")) {
+            std::cout << ", " << entry.at("precision").get<std::string>();
+        }
+        if (entry.value("size_divisor", 1) != 1) std::cout << ", 1/" << entry.at("size_divisor");
+        std::cout << ", " << psnr(entry.at("psnr_db")) << met(entry);
+        if (entry.contains("light_field")) {
+            const auto& light_field = entry.at("light_field");
+            std::cout << "; light field " << light_field.at("cameras") << " cameras at "
+                      << light_field.at("size") << "^2, " << psnr(light_field.at("psnr_db"))
+                      << met(light_field);
+        }
+        if (entry.contains("colour_model")) {
+            const auto& model = entry.at("colour_model");
+            std::cout << "; colour model K=" << model.at("clusters") << ", "
+                      << psnr(model.at("psnr_db")) << met(model);
+        }
+        std::cout << (entry.value("checked", false) ? "" : " (kept from the last check)") << "\n";
     }
     if (inspection.manifest_readable) {
         std::cout << "configuration " << description.at("configuration").dump() << "\n";

@@ -155,3 +155,27 @@ light_field_case(bad_segment 2 STDERR "segment-opacity segment 5" render ${lf_ar
                  --out ${lf_output}/never.png)
 view_case(no_light_field 2 STDERR "has no light field" render ${view_archive} --step 4
           --azimuth 200 --source lightfield --out ${lf_output}/never.png)
+
+# An error budget (issue 17): a Gray-Scott archive whose light field the budget sized, and info
+# listing what it chose at the step (the rig, with its measured PSNR), and the rig stored.
+set(budget_archive ${CMAKE_CURRENT_BINARY_DIR}/insitu_view_budget.cdb)
+set(budget_config ${CMAKE_CURRENT_BINARY_DIR}/insitu_view_budget_config.json)
+file(WRITE ${budget_config} [=[
+{"fields": ["v"], "views": [{"azimuth": 30, "elevation": 20, "size": [48, 48]}],
+ "steps": [8], "light_field": {"attenuation": false},
+ "budget": {"psnr_db": 1, "choose": ["light_field"]}}
+]=])
+add_test(NAME insitu_view.setup_budget_clean COMMAND ${CMAKE_COMMAND} -E rm -rf ${budget_archive})
+add_test(NAME insitu_view.setup_budget_archive
+         COMMAND gray-scott --size 24 --steps 8 --config ${budget_config} --out ${budget_archive})
+set_tests_properties(insitu_view.setup_budget_clean PROPERTIES
+                     FIXTURES_SETUP insitu_view_budget_clean)
+set_tests_properties(insitu_view.setup_budget_archive PROPERTIES
+                     FIXTURES_REQUIRED insitu_view_budget_clean
+                     FIXTURES_SETUP insitu_view_budget_archive TIMEOUT 120)
+archive_case(insitu_view_budget_archive info_budget 0 STDOUT
+             "budget        step 8 v: 16 uniform intervals, half" info ${budget_archive})
+archive_case(insitu_view_budget_archive info_budget_light_field 0 STDOUT
+             "light field 12 cameras at 64^2" info ${budget_archive})
+archive_case(insitu_view_budget_archive info_budget_rig 0 STDOUT
+             "light field   v: 12 cameras, 64^2 maps" info ${budget_archive})

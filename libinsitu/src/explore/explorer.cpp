@@ -279,6 +279,16 @@ nlohmann::json describe_archive(const ArchiveReader& archive) {
         }
     }
     description["light_fields"] = light_fields;
+
+    // Per step with an error budget, what it chose for each field (the manifest's entries).
+    nlohmann::json budget = nlohmann::json::array();
+    for (const nlohmann::json& step : manifest.at("steps")) {
+        for (nlohmann::json entry : step.value("budget", nlohmann::json::array())) {
+            entry["step"] = step.at("step");
+            budget.push_back(std::move(entry));
+        }
+    }
+    description["budget"] = budget;
     return description;
 }
 
