@@ -1007,6 +1007,7 @@ BudgetRecord::ColourModelChoice Instrument::Impl::check_colour_model_budget(
     // The held-out edit's attenuation in each measured view, as the Explorer estimates it (a
     // turned view synthesised from the stored one's proxies first).
     request.mean_depth = true;
+    request.depth_layers = config.proxies.depth;  // as the view is stored
     request.transfer_function = plan.transfer_function;
     const ProxyFrame stored = renderer->render(source, request);
     const std::vector<double> scales = opacity_scales(
