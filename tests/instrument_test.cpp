@@ -891,11 +891,11 @@ TEST_F(InstrumentTest, AnErrorBudgetChoosesTheColourModelsClusters) {
 // that gives the cameras keeps them.
 TEST_F(InstrumentTest, AnErrorBudgetChoosesTheLightFieldsCamerasAndMapSize) {
     const auto run = [&](const std::string& name, BudgetConfig budget, bool given_cameras,
-                         std::string* log) {
+                         std::string* log, bool attenuation = false) {
         InstrumentConfig config = small_config(directory_ / name, 48);
         config.interval_count = 8;
         LightFieldSettings light_field;
-        light_field.attenuation = false;
+        light_field.attenuation = attenuation;
         light_field.size = 2 * kBudgetMinLightFieldSide;  // measured at 128^2 and 64^2
         config.light_field = light_field;
         budget.chooses_intervals = false;
@@ -950,6 +950,17 @@ TEST_F(InstrumentTest, AnErrorBudgetChoosesTheLightFieldsCamerasAndMapSize) {
     EXPECT_FALSE(short_of_bytes.light_field->met);
     EXPECT_EQ(short_of_bytes.light_field->cameras, 12);
     EXPECT_EQ(short_of_bytes.light_field->size, kBudgetMinLightFieldSide);
+
+    // An attenuation light field is measured on the held-out edit (through its reconstructed
+    // a_j), not on the run's own function: another PSNR for the same rig.
+    const ArchiveReader edited_run = run("attenuation.cdb", easy, false, nullptr, true);
+    const BudgetRecord edited = edited_run.budget(0).at(0);
+    ASSERT_TRUE(edited.light_field.has_value());
+    EXPECT_EQ(edited.light_field->cameras, 12);
+    EXPECT_TRUE(std::isfinite(edited.light_field->psnr_db));
+    EXPECT_NE(edited.light_field->psnr_db, cheap.light_field->psnr_db);
+    EXPECT_GT(edited.light_field->bytes, cheap.light_field->bytes);  // + a_j and mean depths
+    EXPECT_TRUE(edited_run.load_light_field(0, "f").settings.attenuation);
 
     // Explicit settings win: the configured rig, nothing chosen.
     const ArchiveReader given = run("given.cdb", easy, true, nullptr);
