@@ -312,6 +312,13 @@ struct Instrument::Impl {
     /// Measures every candidate on the field's first view and picks the cheapest that meets
     /// the budget (see BudgetConfig).
     BudgetRecord check_budget(const FieldPlan& plan) const;
+    /// The budget's ground truth: the proxies' step, marched on to T = 0 as the proxies are.
+    RenderSettings budget_truth_settings() const {
+        RenderSettings settings;
+        settings.step_voxels = config.step_voxels;
+        settings.early_termination_opacity = 1.0;
+        return settings;
+    }
     /// Whether the field's views fit the colour model: the training functions apply to it
     /// (InstrumentConfig::trains), the model is enabled and the attenuation it maps is stored.
     bool fits_colour_model(const std::string& field) const {
@@ -698,9 +705,32 @@ TransferFunction halved_opacity(const TransferFunction& tf) {
     return TransferFunction(points, tf.unit_length());
 }
 
-}  // namespace
+/// The held-out edit's attenuation (`scales`) in a measured view, from the stored view's proxies
+/// as the Explorer makes it: estimated in place for the stored view, first synthesised into the
+/// view turned by `turn_deg` from `source` for a turned one (`turned_view`).
+Image held_out_attenuation(const ProxyFrame& stored, const Camera& source, bool turned_view,
+                           double turn_deg, const std::vector<double>& scales) {
+    if (!turned_view) {
+        return estimate_attenuation(stored.attenuation, stored.mean_depth, nullptr, scales);
+    }
+    const SynthesisedAttenuation turned = synthesise_attenuation(
+        stored, source.reorbit(source.azimuth_deg() + turn_deg, source.elevation_deg()));
+    return estimate_attenuation(turned.attenuation, turned.mean_depth, nullptr, scales);
+}
 
-namespace {
+/// PSNR of `shown` against `truth` as a display shows it: enlarged bilinearly to the truth's
+/// size where the budget stored the view smaller.
+double psnr_as_shown(const Image& truth, Image shown) {
+    if (shown.width != truth.width || shown.height != truth.height) {
+        shown = resize_bilinear(shown, truth.width, truth.height);
+    }
+    return psnr_rgb_db(truth, shown);
+}
+
+/// Whether a measured PSNR meets the accuracy the budget asks (any, where it asks none).
+bool accurate_enough(const BudgetConfig& budget, double psnr_db) {
+    return !budget.psnr_db || psnr_db >= *budget.psnr_db;
+}
 
 /// The budget's rule over the candidates it measured (BudgetConfig): with an accuracy asked, the
 /// cheapest that meets every limit; else (or where none does) the cheapest affordable one within
@@ -771,9 +801,7 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
     // The fields share the step's bytes and time evenly.
     const double share = 1.0 / static_cast<double>(config.fields.size());
     const TransferFunction held_out = halved_opacity(plan.transfer_function);
-    RenderSettings truth_settings;
-    truth_settings.step_voxels = config.step_voxels;
-    truth_settings.early_termination_opacity = 1.0;
+    const RenderSettings truth_settings = budget_truth_settings();
     // The measured views' ground truths, once per check: the stored view, then each rotation
     // (turned in azimuth as the Explorer turns a view, Camera::reorbit).
     std::vector<BudgetView> measured_views;
@@ -841,9 +869,7 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
         return (!budget.bytes_per_step || c.bytes <= share * *budget.bytes_per_step) &&
                (!budget.ms_per_step || c.milliseconds <= share * *budget.ms_per_step);
     };
-    const auto accurate = [&](const BudgetRecord& c) {
-        return !budget.psnr_db || c.psnr_db >= *budget.psnr_db;
-    };
+    const auto accurate = [&](const BudgetRecord& c) { return accurate_enough(budget, c.psnr_db); };
     // A candidate's proxies as compute_field makes them, and what its accuracy is measured with.
     struct CandidateProxies {
         int count = 0;
@@ -876,22 +902,12 @@ BudgetRecord Instrument::Impl::check_budget(const FieldPlan& plan) const {
             encoded.parts, false);
         candidate.psnr_db = std::numeric_limits<double>::infinity();
         for (const BudgetView& target : measured_views) {
-            Image edited;
-            if (&target == &measured_views.front()) {
-                edited = estimate_attenuation(stored.attenuation, stored.mean_depth, nullptr,
-                                              proxies.scales);
-            } else {
-                const Camera turned_camera = source.reorbit(
-                    source.azimuth_deg() + target.azimuth_offset_deg, source.elevation_deg());
-                const SynthesisedAttenuation turned = synthesise_attenuation(stored, turned_camera);
-                edited = estimate_attenuation(turned.attenuation, turned.mean_depth, nullptr,
-                                              proxies.scales);
-            }
-            Image shown = recolour(edited, proxies.colours);
-            if (shown.width != target.truth.width || shown.height != target.truth.height) {
-                shown = resize_bilinear(shown, target.truth.width, target.truth.height);
-            }
-            const double psnr_db = psnr_rgb_db(target.truth, shown);
+            const bool turned = &target != &measured_views.front();
+            const double psnr_db = psnr_as_shown(
+                target.truth,
+                recolour(held_out_attenuation(stored, source, turned, target.azimuth_offset_deg,
+                                              proxies.scales),
+                         proxies.colours));
             candidate.views.push_back({target.azimuth_offset_deg, psnr_db});
             candidate.psnr_db = std::min(candidate.psnr_db, psnr_db);
         }
@@ -982,9 +998,7 @@ BudgetRecord::ColourModelChoice Instrument::Impl::check_colour_model_budget(
         return !budget.ms_per_step ||
                views.milliseconds + c.milliseconds <= share * *budget.ms_per_step;
     };
-    const auto accurate = [&](const Choice& c) {
-        return !budget.psnr_db || c.psnr_db >= *budget.psnr_db;
-    };
+    const auto accurate = [&](const Choice& c) { return accurate_enough(budget, c.psnr_db); };
 
     // The training pairs compute_field fits on (attenuation under each training function from
     // the chosen intervals, and its ground truth), in the stored view at the size chosen.
@@ -994,9 +1008,7 @@ BudgetRecord::ColourModelChoice Instrument::Impl::check_colour_model_budget(
         renderer->choose_intervals(views.intervals, views.interval_mode, &plan.transfer_function);
     request.march.step_voxels = config.step_voxels;
     request.depth_layers = false;
-    RenderSettings truth_settings;
-    truth_settings.step_voxels = config.step_voxels;
-    truth_settings.early_termination_opacity = 1.0;
+    const RenderSettings truth_settings = budget_truth_settings();
     std::vector<Image> training_attenuation, training_colour;
     request.mean_depth = false;
     for (const TransferFunction& tf : config.training_transfer_functions) {
@@ -1013,17 +1025,9 @@ BudgetRecord::ColourModelChoice Instrument::Impl::check_colour_model_budget(
     const std::vector<double> scales = opacity_scales(
         plan.transfer_function, halved_opacity(plan.transfer_function), *request.intervals);
     std::vector<Image> edited;
-    for (const BudgetView& target : targets) {
-        if (target.azimuth_offset_deg == 0.0) {
-            edited.push_back(
-                estimate_attenuation(stored.attenuation, stored.mean_depth, nullptr, scales));
-        } else {
-            const SynthesisedAttenuation turned = synthesise_attenuation(
-                stored, source.reorbit(source.azimuth_deg() + target.azimuth_offset_deg,
-                                       source.elevation_deg()));
-            edited.push_back(
-                estimate_attenuation(turned.attenuation, turned.mean_depth, nullptr, scales));
-        }
+    for (std::size_t v = 0; v < targets.size(); ++v) {  // the stored view first, as measured
+        edited.push_back(
+            held_out_attenuation(stored, source, v > 0, targets[v].azimuth_offset_deg, scales));
     }
 
     std::vector<Choice> measured;
@@ -1037,12 +1041,8 @@ BudgetRecord::ColourModelChoice Instrument::Impl::check_colour_model_budget(
         candidate.milliseconds = 1e3 * seconds_since(start);
         candidate.psnr_db = std::numeric_limits<double>::infinity();
         for (std::size_t v = 0; v < targets.size(); ++v) {
-            Image shown = model.predict(edited[v]);
-            const Image& truth = targets[v].truth;
-            if (shown.width != truth.width || shown.height != truth.height) {
-                shown = resize_bilinear(shown, truth.width, truth.height);
-            }
-            candidate.psnr_db = std::min(candidate.psnr_db, psnr_rgb_db(truth, shown));
+            candidate.psnr_db = std::min(candidate.psnr_db,
+                                         psnr_as_shown(targets[v].truth, model.predict(edited[v])));
         }
         measured.push_back(candidate);
         // Fewest clusters first (the fit's time grows with K): the first that meets it is taken.
@@ -1072,9 +1072,7 @@ BudgetRecord::LightFieldChoice Instrument::Impl::check_light_field_budget(
                (!budget.ms_per_step ||
                 views.milliseconds + c.milliseconds <= share * *budget.ms_per_step);
     };
-    const auto accurate = [&](const Choice& c) {
-        return !budget.psnr_db || c.psnr_db >= *budget.psnr_db;
-    };
+    const auto accurate = [&](const Choice& c) { return accurate_enough(budget, c.psnr_db); };
 
     // What the light field shows is measured: an attenuation light field carries the held-out
     // edit (through its reconstructed a_j, as the Explorer edits), one without shows the run's
@@ -1094,13 +1092,11 @@ BudgetRecord::LightFieldChoice Instrument::Impl::check_light_field_budget(
         scales = opacity_scales(plan.transfer_function, held_out, *request.intervals);
         colours = interval_colours(held_out, *request.intervals);
     } else {
-        RenderSettings truth_settings;
-        truth_settings.step_voxels = config.step_voxels;
-        truth_settings.early_termination_opacity = 1.0;
         for (const BudgetView& target : targets) {
-            own_truths.push_back(
-                renderer->render_ground_truth(target.camera, plan.transfer_function, truth_settings)
-                    .rgba);
+            own_truths.push_back(renderer
+                                     ->render_ground_truth(target.camera, plan.transfer_function,
+                                                           budget_truth_settings())
+                                     .rgba);
         }
     }
     const archive_format::LightFieldEncoding encoding =
