@@ -1,0 +1,81 @@
+#include "parallel/composited_passes.hpp"
+
+#include <optional>
+
+#include "core/elapsed.hpp"
+#include "insitu/parallel/compositing.hpp"
+#include "insitu/render/distortion_camera.hpp"
+
+namespace insitu {
+
+namespace {
+
+/// Runs `composite` and adds its time to `seconds`.
+template <typename Composite>
+auto timed(double& seconds, Composite&& composite) {
+    const auto start = SteadyClock::now();
+    auto result = composite();
+    seconds += seconds_since(start);
+    return result;
+}
+
+}  // namespace
+
+Image CompositedPasses::truth(const Camera& camera, const TransferFunction& tf,
+                              const RenderSettings& settings) {
+    std::optional<Rendering> partial;
+    if (has_block_) {
+        failure_.guard([&] { partial = renderer_.render_ground_truth(camera, tf, settings); });
+    }
+    // Every rank takes part in every composite, failed or not (see LocalFailure).
+    Rendering composited;
+    failure_.always([&] {
+        composited = timed(composite_seconds_, [&] {
+            return composite_rendering(ranks_, camera.width(), camera.height(),
+                                       partial ? &*partial : nullptr, 0);
+        });
+    });
+    return composited.rgba;
+}
+
+ProxyFrame CompositedPasses::proxies(const OrbitView& orbit, const Bounds& bounds, double tilt_deg,
+                                     bool multi_perspective, const ProxyRequest& request) {
+    const Camera camera = Camera::orbit(orbit, bounds);
+    const DistortionCamera distortion = DistortionCamera::orbit(orbit, bounds, tilt_deg);
+    ProxyRequest march = request;
+    march.training_transfer_functions.clear();
+    // A block cannot count re-entries of intervals the ray met in front of it (see
+    // ProxyRequest::interleaving): distributed archives carry no interleaving, and the
+    // Explorer's edit trust then goes without that term.
+    march.interleaving = false;
+    // Likewise the entry depth: the first interval a block sees may not be the ray's.
+    march.entry_depth = false;
+    std::optional<ProxyFrame> partial;
+    if (has_block_) {
+        failure_.guard([&] {
+            partial = multi_perspective ? renderer_.render(distortion, march)
+                                        : renderer_.render(camera, march);
+        });
+    }
+    ProxyFrame frame;
+    failure_.always([&] {
+        frame = timed(composite_seconds_, [&] {
+            const ProxyFrame shell = multi_perspective
+                                         ? frame_shell(distortion.base(), tilt_deg, true, march)
+                                         : frame_shell(camera, 0.0, false, march);
+            return composite_proxies(ranks_, shell, partial ? &*partial : nullptr, 0);
+        });
+    });
+    for (const TransferFunction& tf : request.training_transfer_functions) {
+        frame.training.push_back(truth(camera, tf, request.march));
+    }
+    return frame;
+}
+
+void CompositedPasses::finish() {
+    const auto start = SteadyClock::now();
+    agree(ranks_, failure_);
+    composite_seconds_ += seconds_since(start);
+}
+
+}  // namespace insitu

@@ -1,0 +1,114 @@
+#include "parallel/reduced_field_statistics.hpp"
+
+#include <limits>
+
+#include "core/elapsed.hpp"
+
+namespace insitu {
+
+ReducedFieldStatistics::ReducedFieldStatistics(Communicator& ranks, ProxyRenderer& renderer,
+                                               const std::string& name,
+                                               const std::vector<const Field*>& blocks,
+                                               std::vector<float>& joined_storage,
+                                               double& collective_seconds)
+    : ranks_(ranks), renderer_(renderer), collective_seconds_(collective_seconds) {
+    failure_.guard([&] {
+        if (blocks.size() == 1) block_ = *blocks.front();
+        if (blocks.size() > 1) block_ = join_blocks(blocks, joined_storage);
+    });
+    // Every rank learns every block's extent, and decomposes the grid the same way.
+    const BlockExtent mine = block_ ? BlockExtent::of(*block_) : BlockExtent{};
+    const auto start = SteadyClock::now();
+    const std::vector<Bytes> extents = agree(ranks_, failure_, doubles_bytes(mine.to_values()));
+    collective_seconds_ += seconds_since(start);
+    std::vector<BlockExtent> all;
+    for (const Bytes& bytes : extents) {
+        const std::vector<double> values = bytes_doubles(bytes);
+        if (values.size() != BlockExtent::kValues) fail<Error>("block extent of a rank cut short");
+        all.push_back(BlockExtent::from_values(values.data()));
+    }
+    grid_ = decompose(name, all);
+    reduce_range();
+}
+
+void ReducedFieldStatistics::reduce_range() {
+    // This rank's part: the upload, and what it owns of the range.
+    const int me = ranks_.rank();
+    ValueRange local;
+    local.min = std::numeric_limits<double>::infinity();
+    local.max = -local.min;
+    failure_.guard([&] {
+        if (!block_) return;
+        renderer_.upload(grid_->marched_block(*block_, me));
+        renderer_.set_region(grid_->region(me));
+        const DeviceVolume& volume = renderer_.volume();
+        const ValueRange counts = grid_->owned_counts(volume.host_values, volume.dims, me);
+        local.finite_count = counts.finite_count;
+        local.nonfinite_count = counts.nonfinite_count;
+        // The marched ghost layer holds the neighbour's own values, so min and max over the
+        // marched blocks are those of the grid.
+        if (!volume.range.empty()) {
+            local.min = volume.range.min;
+            local.max = volume.range.max;
+        }
+    });
+    const auto start = SteadyClock::now();
+    agree(ranks_, failure_);
+    std::vector<double> low{local.min};
+    std::vector<double> high{local.max};
+    std::vector<double> counts{static_cast<double>(local.finite_count),
+                               static_cast<double>(local.nonfinite_count)};
+    ranks_.all_reduce(low, Reduction::min);
+    ranks_.all_reduce(high, Reduction::max);
+    ranks_.all_reduce(counts, Reduction::sum);
+    collective_seconds_ += seconds_since(start);
+    range_.finite_count = static_cast<std::int64_t>(counts[0]);
+    range_.nonfinite_count = static_cast<std::int64_t>(counts[1]);
+    if (!range_.empty()) {
+        range_.min = low[0];
+        range_.max = high[0];
+    }
+}
+
+void ReducedFieldStatistics::sum_over_ranks(std::vector<double>& counts) {
+    const auto start = SteadyClock::now();
+    ranks_.all_reduce(counts, Reduction::sum);
+    agree(ranks_, failure_);
+    collective_seconds_ += seconds_since(start);
+}
+
+ValueHistogram ReducedFieldStatistics::histogram() {
+    // The grid's histogram: the sum of the ranks' counts of the samples each owns, over the
+    // agreed range (a rank without a block adds zeros, as every rank reduces).
+    ValueHistogram histogram = ValueHistogram::of({}, min(), max());
+    failure_.guard([&] {
+        if (!block_) return;
+        const DeviceVolume& volume = renderer_.volume();
+        histogram = ValueHistogram::of(
+            grid_->owned_values(volume.host_values, volume.dims, ranks_.rank()), min(), max());
+    });
+    sum_over_ranks(histogram.counts);
+    return histogram;
+}
+
+IntervalSet ReducedFieldStatistics::intervals(int count, IntervalMode mode,
+                                              const TransferFunction& tf) {
+    if (mode == IntervalMode::uniform) return IntervalSet::uniform(min(), max(), count);
+    // The sum of the ranks' histograms of the samples each owns: the grid's histogram.
+    const std::size_t bins = static_cast<std::size_t>(64 * count);
+    std::vector<double> histogram(bins, 0.0);
+    failure_.guard([&] {
+        if (!block_) return;
+        const DeviceVolume& volume = renderer_.volume();
+        histogram = IntervalSet::equalization_histogram(
+            grid_->owned_values(volume.host_values, volume.dims, ranks_.rank()), min(), max(),
+            count);
+    });
+    if (histogram.size() != bins) histogram.assign(bins, 0.0);  // as every rank reduces
+    sum_over_ranks(histogram);
+    return mode == IntervalMode::opacity_adaptive
+               ? IntervalSet::opacity_adaptive(histogram, min(), max(), count, tf)
+               : IntervalSet::from_equalization_histogram(histogram, min(), max(), count);
+}
+
+}  // namespace insitu

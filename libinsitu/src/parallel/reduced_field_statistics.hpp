@@ -1,0 +1,50 @@
+#pragma once
+// FieldStatistics of a distributed field: each rank uploads its block (with the ghost layer the
+// march needs) and the range, histograms and counts are those of the samples each rank owns,
+// reduced over the ranks. Every member is a collective every rank calls in the same order; a
+// rank that fails locally still takes part and the next agreement raises it on every rank.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "insitu/parallel/communicator.hpp"
+#include "insitu/parallel/decomposition.hpp"
+#include "insitu/render/proxy_renderer.hpp"
+#include "parallel/agreement.hpp"
+#include "step/field_plan.hpp"
+
+namespace insitu {
+
+class ReducedFieldStatistics final : public FieldStatistics {
+public:
+    /// Agrees on every block's extent (decomposing the grid the same way on every rank), uploads
+    /// this rank's block of field `name` (`blocks`: none, one, or tiles joined into
+    /// `joined_storage`) and reduces the range. Time spent in collectives adds to
+    /// `collective_seconds`.
+    ReducedFieldStatistics(Communicator& ranks, ProxyRenderer& renderer, const std::string& name,
+                           const std::vector<const Field*>& blocks,
+                           std::vector<float>& joined_storage, double& collective_seconds);
+
+    const Bounds& bounds() const override { return grid_->bounds; }
+    bool has_block() const override { return block_.has_value(); }
+    const ValueRange& range() const override { return range_; }
+    ValueHistogram histogram() override;
+    IntervalSet intervals(int count, IntervalMode mode, const TransferFunction& tf) override;
+
+private:
+    /// Sums `counts` over the ranks and agrees (raising any rank's failure since the last).
+    void sum_over_ranks(std::vector<double>& counts);
+    void reduce_range();
+    double min() const { return range_.empty() ? 0.0 : range_.min; }
+    double max() const { return range_.empty() ? 0.0 : range_.max; }
+
+    Communicator& ranks_;
+    ProxyRenderer& renderer_;
+    double& collective_seconds_;
+    LocalFailure failure_;
+    std::optional<Field> block_;
+    std::optional<Decomposition> grid_;
+    ValueRange range_;
+};
+
+}  // namespace insitu

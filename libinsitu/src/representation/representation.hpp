@@ -1,0 +1,35 @@
+#pragma once
+// A representation: what a step stores of a field (DESIGN.md "Representations"), one room with
+// the same verbs. Here the in-situ ones: capture (its part of the step, through the step's
+// passes) and choose (its budget candidates measured, its choice recorded). The registry lists
+// them in the order a step captures and a budget check chooses them.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "budget/field_budget_check.hpp"
+#include "insitu/archive/step_record.hpp"
+#include "step/field_plan.hpp"
+#include "step/step_passes.hpp"
+#include "step/step_recipe.hpp"
+
+namespace insitu {
+
+class Representation {
+public:
+    virtual ~Representation() = default;
+    /// As the configuration and manifest name it ("views", "light_field").
+    virtual std::string name() const = 0;
+    /// Adds what it stores of the plan's field at this step, by `recipe`, to `record`.
+    virtual void capture(const InstrumentConfig& config, const FieldPlan& plan,
+                         const FieldRecipe& recipe, StepPasses& passes,
+                         StepRecord& record) const = 0;
+    /// Measures its candidates (where the configuration lets the budget choose them) and
+    /// records its choice in `choice`; the representations before it have chosen.
+    virtual void choose(const FieldBudgetCheck& check, BudgetRecord& choice) const = 0;
+};
+
+/// Every representation, in capture order: the views' proxies first.
+const std::vector<std::unique_ptr<Representation>>& representations();
+
+}  // namespace insitu
