@@ -2,9 +2,9 @@
 
 #include <optional>
 
+#include "insitu/archive/archive_description.hpp"
 #include "insitu/archive/archive_reader.hpp"
 #include "insitu/error.hpp"
-#include "insitu/explore/explorer.hpp"
 
 namespace insitu::viewer {
 

@@ -35,6 +35,7 @@
 #include "arguments.hpp"
 #include "cli.hpp"
 #include "explore_options.hpp"
+#include "insitu/archive/archive_description.hpp"
 #include "insitu/config.hpp"
 #include "insitu/core/image.hpp"
 #include "insitu/error.hpp"

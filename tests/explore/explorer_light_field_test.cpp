@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "insitu/archive/archive.hpp"
+#include "insitu/archive/archive_description.hpp"
 #include "insitu/explore/explorer.hpp"
 #include "insitu/instrument.hpp"
 #include "insitu/render/proxy_renderer.hpp"

@@ -19,6 +19,7 @@
 
 #include "explore_options.hpp"
 #include "insitu/archive/archive.hpp"
+#include "insitu/archive/archive_description.hpp"
 #include "insitu/explore/colour_model.hpp"
 #include "insitu/explore/transfer_function_edit.hpp"
 #include "insitu/instrument.hpp"

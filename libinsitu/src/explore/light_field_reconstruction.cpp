@@ -13,10 +13,17 @@
 #include <utility>
 #include <vector>
 
+#include "explore/light_field_rays.hpp"
 #include "insitu/error.hpp"
 
 namespace insitu {
 namespace {
+
+using detail::bilinear_taps;
+using detail::camera_spacing_rad;
+using detail::ray_neighbourhood;
+using detail::RayNeighbourhood;
+using detail::Taps;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr int kMinSearchSteps = 4;
@@ -37,55 +44,13 @@ constexpr double kAgreementFootprints = 2.0;
 // / 7-15 %. 0.2 keeps the overlay usable; bench/RESULTS.md has the figures.
 constexpr double kColourAgreement = 0.2;
 
-// Where the line origin + t direction (unit) meets a sphere: t of entry and exit, or nothing
-// when it misses (a tangent line counts as a miss: nothing to see along it).
-std::optional<std::pair<double, double>> sphere_chord(const Ray& ray, const glm::dvec3& centre,
-                                                      double radius) {
-    const glm::dvec3 oc = ray.origin - centre;
-    const double b = glm::dot(oc, ray.direction);
-    const double discriminant = b * b - (glm::dot(oc, oc) - radius * radius);
-    if (!(discriminant > 0.0)) return std::nullopt;
-    const double root = std::sqrt(discriminant);
-    return std::pair{-b - root, -b + root};
-}
-
-// Where a target ray crosses the bounding sphere ([t0, t1], in front of its origin) and the
-// cameras around it; nothing for a ray that misses the sphere (it sees nothing). The line meets
-// the camera sphere (Rc > R, so it does) where it enters it; for a perspective eye between R
-// and Rc that point lies behind the eye, as it should: the cameras there see the ray's
-// direction.
-struct RayNeighbourhood {
-    double t0 = 0.0, t1 = 0.0;
-    CameraNeighbourhood around;
+// A target ray's chord through the bounding sphere, [t0, t1], and its point nearest the
+// centre (t_centre): where a camera without a hit reads the ray.
+struct RaySpan {
+    Ray ray;
+    double t0 = 0.0, t1 = 0.0, t_centre = 0.0;
+    glm::dvec3 at(double t) const { return ray.origin + t * ray.direction; }
 };
-std::optional<RayNeighbourhood> ray_neighbourhood(const LightFieldRig& rig, const Ray& ray) {
-    const auto chord = sphere_chord(ray, rig.center(), rig.bounding_radius());
-    if (!chord) return std::nullopt;
-    const double t0 = std::max(chord->first, 0.0), t1 = chord->second;
-    if (!(t1 > t0)) return std::nullopt;
-    const double t_entry = sphere_chord(ray, rig.center(), rig.camera_radius())->first;
-    return RayNeighbourhood{
-        t0, t1, rig.cameras_around(ray.origin + t_entry * ray.direction - rig.center())};
-}
-
-// Bilinear taps over pixel centres (x + 1/2), clamped at the map's edges.
-struct Taps {
-    std::array<std::size_t, 4> pixel{};
-    std::array<double, 4> weight{};
-};
-
-Taps bilinear_taps(int size, const glm::dvec2& map_position) {
-    const double fx = std::clamp(map_position.x - 0.5, 0.0, size - 1.0);
-    const double fy = std::clamp(map_position.y - 0.5, 0.0, size - 1.0);
-    const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
-    const int x1 = std::min(x0 + 1, size - 1), y1 = std::min(y0 + 1, size - 1);
-    const double wx = fx - x0, wy = fy - y0;
-    const auto at = [size](int x, int y) { return static_cast<std::size_t>(y) * size + x; };
-    Taps taps;
-    taps.pixel = {at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1)};
-    taps.weight = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
-    return taps;
-}
 
 // One present camera around a pixel's ray.
 struct CameraSample {
@@ -178,20 +143,6 @@ std::vector<const LightFieldImages*> camera_table(const LightField& light_field,
         }
     }
     return table;
-}
-
-// Mean angle between neighbouring cameras, seen from the centre: the scale of the angular term.
-double camera_spacing_rad(const Icosphere& icosphere) {
-    double sum = 0.0;
-    for (const auto& triangle : icosphere.triangles) {
-        for (int e = 0; e < 3; ++e) {
-            const glm::dvec3& a = icosphere.vertices[static_cast<std::size_t>(triangle[e])];
-            const glm::dvec3& b =
-                icosphere.vertices[static_cast<std::size_t>(triangle[(e + 1) % 3])];
-            sum += std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));
-        }
-    }
-    return sum / (3.0 * static_cast<double>(icosphere.triangles.size()));
 }
 
 class Reconstructor {
@@ -334,13 +285,35 @@ private:
         const std::optional<RayNeighbourhood> crossing = ray_neighbourhood(rig_, ray);
         if (!crossing) return;  // the defaults: empty, depth +inf, confidence 1
         const double t0 = crossing->t0, t1 = crossing->t1;
-        const CameraNeighbourhood& around = crossing->around;
         const double t_centre =
             std::clamp(glm::dot(rig_.center() - ray.origin, ray.direction), t0, t1);
-        const auto at = [&](double t) { return ray.origin + t * ray.direction; };
+        const RaySpan span{ray, t0, t1, t_centre};
         std::array<CameraSample, 3> samples;
-        int present = 0;
         double present_weight = 0.0;
+        const int present = present_cameras(crossing->around, scratch, samples, present_weight);
+        const std::size_t p = static_cast<std::size_t>(y) * target_.width() + x;
+        if (present == 0) {  // nothing known about this ray
+            result_.confidence.pixels[p] = 0.0f;
+            return;
+        }
+        for (int i = 0; i < present; ++i) {
+            place(samples[static_cast<std::size_t>(i)], present_weight, span);
+        }
+        blend_segments(samples, present, span, scratch);
+        const double unscaled_transmittance = composite_segments(scratch, p);
+        double hit_t = 0.0;
+        const double hit_weight = blended_first_hit(samples, present, span, p, hit_t);
+        if (intervals_ > 0) attenuation(samples, present, p);
+        result_.confidence.pixels[p] =
+            static_cast<float>(confidence(samples, present, present_weight, hit_weight, hit_t,
+                                          1.0 - unscaled_transmittance, ray.direction));
+    }
+
+    // The cameras around the ray that the light field holds, into `samples` (the others are
+    // marked missing), with their summed weight; returns how many.
+    int present_cameras(const CameraNeighbourhood& around, Scratch& scratch,
+                        std::array<CameraSample, 3>& samples, double& present_weight) const {
+        int present = 0;
         for (int i = 0; i < 3; ++i) {
             const int k = around.cameras[static_cast<std::size_t>(i)];
             const double weight = around.weights[static_cast<std::size_t>(i)];
@@ -356,25 +329,24 @@ private:
             sample.weight = weight;
             present_weight += weight;
         }
-        const std::size_t p = static_cast<std::size_t>(y) * target_.width() + x;
-        if (present == 0) {  // nothing known about this ray
-            result_.confidence.pixels[p] = 0.0f;
-            return;
-        }
+        return present;
+    }
 
-        for (int i = 0; i < present; ++i) {
-            CameraSample& sample = samples[static_cast<std::size_t>(i)];
-            const Camera& camera = rig_.camera(sample.camera);
-            sample.weight /= present_weight;
-            sample.hit_t = first_hit(camera, sample.images->depth, ray, t0, t1);
-            sample.read_point = at(sample.hit_t.value_or(t_centre));
-            sample.read_map = camera.project(sample.read_point);
-            sample.passes_by = !sample.hit_t && std::isfinite(stored_distance(sample.images->depth,
-                                                                              sample.read_map));
-        }
+    // One camera's whole-ray first hit, depth-corrected, and where it reads the ray.
+    void place(CameraSample& sample, double present_weight, const RaySpan& span) const {
+        const Camera& camera = rig_.camera(sample.camera);
+        sample.weight /= present_weight;
+        sample.hit_t = first_hit(camera, sample.images->depth, span.ray, span.t0, span.t1);
+        sample.read_point = span.at(sample.hit_t.value_or(span.t_centre));
+        sample.read_map = camera.project(sample.read_point);
+        sample.passes_by =
+            !sample.hit_t && std::isfinite(stored_distance(sample.images->depth, sample.read_map));
+    }
 
-        // Segments: each camera depth-corrected against the segment's own depth, blended, then
-        // composited front to back with the segment's opacity scale.
+    // Segments: each camera depth-corrected against the segment's own depth, blended (into the
+    // scratch's segment colours, and each camera's own composited colour of the ray).
+    void blend_segments(std::array<CameraSample, 3>& samples, int present, const RaySpan& span,
+                        Scratch& scratch) const {
         for (auto& rgba : scratch.segment_rgba) rgba = {0.0, 0.0, 0.0, 0.0};
         for (double& weight : scratch.segment_weight) weight = 0.0;
         for (int i = 0; i < present; ++i) {
@@ -385,9 +357,10 @@ private:
                 const Image& depth = segments_ > 1
                                          ? sample.images->segment_depth[static_cast<std::size_t>(s)]
                                          : sample.images->depth;
-                const auto hit =
-                    segments_ > 1 ? first_hit(camera, depth, ray, t0, t1) : sample.hit_t;
-                const glm::dvec2 map = camera.project(at(hit.value_or(t_centre)));
+                const auto hit = segments_ > 1
+                                     ? first_hit(camera, depth, span.ray, span.t0, span.t1)
+                                     : sample.hit_t;
+                const glm::dvec2 map = camera.project(span.at(hit.value_or(span.t_centre)));
                 // No hit: what the camera saw there is either faint (no first hit recorded:
                 // read it, it lies somewhere along the ray) or a surface the ray passes by
                 // (recorded, yet the ray never reached it): nothing of it is on this ray.
@@ -413,6 +386,11 @@ private:
                 for (double& c : scratch.segment_rgba[static_cast<std::size_t>(s)]) c /= weight;
             }
         }
+    }
+
+    // The blended segments composited front to back with their opacity scales into pixel p's
+    // colour; returns the transmittance without the scales.
+    double composite_segments(const Scratch& scratch, std::size_t p) {
         std::array<double, 3> colour{0.0, 0.0, 0.0};
         double transmittance = 1.0, unscaled_transmittance = 1.0;
         for (int s = 0; s < segments_; ++s) {
@@ -431,9 +409,15 @@ private:
         }
         for (int c = 0; c < 3; ++c) result_.rgba.pixels[4 * p + c] = static_cast<float>(colour[c]);
         result_.rgba.pixels[4 * p + 3] = static_cast<float>(1.0 - transmittance);
+        return unscaled_transmittance;
+    }
 
-        // The blended first hit, over the cameras that recorded one.
-        double hit_weight = 0.0, hit_t = 0.0;
+    // The first hit blended over the cameras that recorded one, into pixel p's depth: returns
+    // their weight, and the hit in `hit_t`.
+    double blended_first_hit(const std::array<CameraSample, 3>& samples, int present,
+                             const RaySpan& span, std::size_t p, double& hit_t) {
+        double hit_weight = 0.0;
+        hit_t = 0.0;
         for (int i = 0; i < present; ++i) {
             const CameraSample& sample = samples[static_cast<std::size_t>(i)];
             if (!sample.hit_t) continue;
@@ -442,14 +426,9 @@ private:
         }
         if (hit_weight > 0.0) {
             hit_t /= hit_weight;
-            result_.depth.pixels[p] = static_cast<float>(target_.depth_of(at(hit_t)));
+            result_.depth.pixels[p] = static_cast<float>(target_.depth_of(span.at(hit_t)));
         }
-
-        if (intervals_ > 0) attenuation(samples, present, p);
-
-        result_.confidence.pixels[p] =
-            static_cast<float>(confidence(samples, present, present_weight, hit_weight, hit_t,
-                                          1.0 - unscaled_transmittance, ray.direction));
+        return hit_weight;
     }
 
     // a_j of each camera at its whole-ray hit (or where the colour was read without one), blended

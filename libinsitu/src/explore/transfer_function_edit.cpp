@@ -297,9 +297,9 @@ void recompose_in_order(const float* a, const float* tau, TransmittanceFrom from
     }
 }
 
-}  // namespace
-
-Image edit_error(const EditTrustInputs& inputs) {
+/// The scales edit_error weighs (all 1 where none are given), after checking every input's size
+/// against the stored attenuation.
+std::vector<double> checked_trust_scales(const EditTrustInputs& inputs) {
     if (!inputs.attenuation || !inputs.mean_depth) {
         fail<InvalidArgument>("edit_error: attenuation and mean depth are required");
     }
@@ -321,7 +321,7 @@ Image edit_error(const EditTrustInputs& inputs) {
                               " stored spreads for ", intervals, " intervals (expected ",
                               3 * intervals, " and ", intervals, ")");
     }
-    const std::vector<double> scales =
+    std::vector<double> scales =
         inputs.scales.empty() ? std::vector<double>(L, 1.0) : inputs.scales;
     if (scales.size() != L || inputs.colours.size() != 3 * L ||
         (!inputs.colour_spread.empty() && inputs.colour_spread.size() != L)) {
@@ -330,143 +330,196 @@ Image edit_error(const EditTrustInputs& inputs) {
                               intervals, " intervals (expected ", intervals, ", ", 3 * intervals,
                               " and ", intervals, ")");
     }
+    return scales;
+}
+
+/// One pixel as edit_error reads it: the stored and edited a_j, tau_j (null without optical
+/// depth), and the intervals with light front to back by mean depth, as estimate_attenuation
+/// walks them (ties by index).
+struct TrustPixel {
+    std::size_t index = 0;
+    const float* a = nullptr;
+    const float* a_edited = nullptr;
+    const float* tau = nullptr;
+    std::vector<std::pair<float, int>> order;
+};
+
+/// The precision term: how far the edit can move with each t_j known only to the resolution.
+double precision_term(const TrustPixel& pixel, const std::vector<double>& scales,
+                      double resolution) {
+    const float* a = pixel.a;
+    const float* tau = pixel.tau;
+    double total = 0.0;
+    double transmittance = 1.0, edited_transmittance = 1.0;
+    for (const auto& [depth, j] : pixel.order) {
+        (void)depth;
+        const double s = scales[j];
+        // t_j as the estimator takes it. Stored tau is known relatively, a_j absolutely (so
+        // its t_j to within res / T); a blend of the two, as uncertain as its parts.
+        const double inferred = inferred_transmittance(a[j], transmittance);
+        const double w = tau ? optical_depth_weight(s) : 0.0;
+        const double t = tau ? blended_transmittance(inferred, tau[j], w) : inferred;
+        double uncertainty = 0.0;
+        if (w > 0.0) {
+            const double tau_j = std::max(0.0, double(tau[j]));
+            uncertainty += w * std::exp(-tau_j) * tau_j * resolution;
+        }
+        if (w < 1.0 && transmittance > 0.0) uncertainty += (1.0 - w) * resolution / transmittance;
+        if (s > 0.0 && uncertainty > 0.0) {
+            const double high = std::min(1.0, t + uncertainty);
+            total += edited_transmittance * std::abs(std::pow(high, s) - std::pow(t, s));
+        }
+        transmittance *= inferred;
+        edited_transmittance *= s > 0.0 ? std::pow(t, s) : 1.0;
+    }
+    return total;
+}
+
+/// The recolouring term: the bound of what the colour inside each interval adds, calibrated
+/// where the stored rendering shows what recolouring missed at the stored function.
+double recolouring_term(const TrustPixel& pixel, const EditTrustInputs& inputs) {
+    const std::size_t L = inputs.colour_spread.size();
+    double bound = 0.0;
+    for (std::size_t j = 0; j < L; ++j) bound += pixel.a_edited[j] * inputs.colour_spread[j];
+    if (inputs.stored_rendering) {
+        double stored_bound = 0.0, missed = 0.0;
+        double rgb[3] = {0.0, 0.0, 0.0};
+        for (std::size_t j = 0; j < L; ++j) {
+            stored_bound += pixel.a[j] * inputs.stored_colour_spread[j];
+            for (int c = 0; c < 3; ++c) rgb[c] += pixel.a[j] * inputs.stored_colours[3 * j + c];
+        }
+        const float* rendering = &inputs.stored_rendering->pixels[4 * pixel.index];
+        for (int c = 0; c < 3; ++c) missed = std::max(missed, std::abs(rgb[c] - rendering[c]));
+        if (stored_bound > kCalibratedSpreadFloor) {
+            bound = std::min(bound, missed * bound / stored_bound);
+        }
+    }
+    return bound;
+}
+
+/// The order terms (interleaving, and with the entry depth thickening's and thinning's
+/// alternatives), each added to `total` in turn. `thickening` and `thinning` are the per-interval
+/// weights of edit_error's definition.
+class OrderTerms {
+public:
+    OrderTerms(const EditTrustInputs& inputs, const std::vector<double>& scales)
+        : inputs_(inputs), scales_(scales), thickening_(scales.size()), thinning_(scales.size()) {
+        for (std::size_t j = 0; j < scales.size(); ++j) {
+            const double octaves = scales[j] > 0.0 ? std::log2(scales[j]) : -INFINITY;
+            thickening_[j] = std::clamp(octaves / 2.0, 0.0, 1.0);
+            thinning_[j] = thinning_weight(scales[j]);
+        }
+        entry_order_.reserve(scales.size());
+    }
+
+    void add(const TrustPixel& pixel, double& total) {
+        double light = 0.0, thick = 0.0, thin = 0.0;
+        for (std::size_t j = 0; j < scales_.size(); ++j) {
+            light += pixel.a[j];
+            thick += pixel.a[j] * thickening_[j];
+            thin += pixel.a[j] * thinning_[j];
+        }
+        if (!inputs_.entry_depth) {
+            total += interleaving(pixel, light);
+        } else if (pixel.order.size() > 1 && light > 0.0) {
+            // Order: the shown estimate against the entry-depth order (thickening); thinning's
+            // two estimates against each other with tau, else the interleaving term for the
+            // thinned share of the light.
+            if (thick > 0.0) total += thick / light * entry_order_difference(pixel);
+            if (pixel.tau && thin > 0.0) {
+                // The two estimates of thinning disagree by this much; the estimator takes one
+                // or the other (or between) by s_j, and either may be the wrong one.
+                double from_attenuation[3], from_thinning[3];
+                recompose(pixel, TransmittanceFrom::attenuation, pixel.order, from_attenuation);
+                recompose(pixel, TransmittanceFrom::thinning, pixel.order, from_thinning);
+                total += largest_difference(from_thinning, from_attenuation);
+            } else if (thin > 0.0) {
+                total += thin / light * interleaving(pixel, light);
+            }
+        }
+    }
+
+private:
+    void recompose(const TrustPixel& pixel, TransmittanceFrom from,
+                   const std::vector<std::pair<float, int>>& order, double* rgb) const {
+        recompose_in_order(pixel.a, pixel.tau, from, scales_, inputs_.colours, order.begin(),
+                           order.end(), rgb);
+    }
+
+    // Interleaving: where the ray re-entered intervals, the one-run-per-interval order the
+    // estimator assumed holds only for the light of first runs. The estimate in the reverse
+    // order (nearest last) is the other extreme; the light of the re-entered runs, as a share of
+    // the pixel's, says how far towards it the truth may lie. 0 without an opacity edit: both
+    // orders then return a itself.
+    double interleaving(const TrustPixel& pixel, double light) const {
+        const float* counts =
+            inputs_.interleaving ? &inputs_.interleaving->pixels[2 * pixel.index] : nullptr;
+        if (!counts || !(counts[0] > 0.0f) || pixel.order.size() < 2) return 0.0;
+        const double share = light > 0.0 ? std::min(1.0, counts[1] / light) : 0.0;
+        double forward[3], backward[3];
+        recompose(pixel, TransmittanceFrom::estimator, pixel.order, forward);
+        recompose_in_order(pixel.a, pixel.tau, TransmittanceFrom::estimator, scales_,
+                           inputs_.colours, pixel.order.rbegin(), pixel.order.rend(), backward);
+        return share * largest_difference(forward, backward);
+    }
+
+    /// The shown estimate against the one recomposed from a_j in entry-depth order.
+    double entry_order_difference(const TrustPixel& pixel) {
+        double shown[3], other[3];
+        recompose(pixel, TransmittanceFrom::estimator, pixel.order, shown);
+        const float* entry = &inputs_.entry_depth->pixels[pixel.index * scales_.size()];
+        entry_order_.clear();
+        for (const auto& [depth, j] : pixel.order) {
+            (void)depth;
+            entry_order_.emplace_back(std::isnan(entry[j]) ? INFINITY : entry[j], j);
+        }
+        std::stable_sort(entry_order_.begin(), entry_order_.end(),
+                         [](const auto& x, const auto& y) { return x.first < y.first; });
+        recompose(pixel, TransmittanceFrom::attenuation, entry_order_, other);
+        return largest_difference(other, shown);
+    }
+
+    const EditTrustInputs& inputs_;
+    const std::vector<double>& scales_;
+    std::vector<double> thickening_, thinning_;
+    std::vector<std::pair<float, int>> entry_order_;
+};
+
+}  // namespace
+
+Image edit_error(const EditTrustInputs& inputs) {
+    const std::vector<double> scales = checked_trust_scales(inputs);
+    const Image& stored = *inputs.attenuation;
+    const auto L = static_cast<std::size_t>(stored.channels);
     const bool unrecoverable = std::any_of(
         scales.begin(), scales.end(), [](double s) { return s >= kUnrecoverableOpacityScale; });
     const Image& edited = inputs.edited_attenuation ? *inputs.edited_attenuation : stored;
-    const double resolution = inputs.attenuation_resolution;
 
     Image error(stored.width, stored.height, 1);
     if (unrecoverable) {
         std::fill(error.pixels.begin(), error.pixels.end(), 1.0f);
         return error;
     }
-    // The order terms' weights per interval (edit_error's definition, in the header).
-    std::vector<double> thickening(L), thinning(L);
-    for (std::size_t j = 0; j < L; ++j) {
-        const double octaves = scales[j] > 0.0 ? std::log2(scales[j]) : -INFINITY;
-        thickening[j] = std::clamp(octaves / 2.0, 0.0, 1.0);
-        thinning[j] = thinning_weight(scales[j]);
-    }
-    std::vector<std::pair<float, int>> order, entry_order;
-    order.reserve(L);
-    entry_order.reserve(L);
+    OrderTerms order_terms(inputs, scales);
+    TrustPixel pixel;
+    pixel.order.reserve(L);
     for (std::size_t p = 0; p < stored.pixel_count(); ++p) {
-        const float* a = &stored.pixels[p * L];
-        const float* a_edited = &edited.pixels[p * L];
+        pixel.index = p;
+        pixel.a = &stored.pixels[p * L];
+        pixel.a_edited = &edited.pixels[p * L];
+        pixel.tau = inputs.optical_depth ? &inputs.optical_depth->pixels[p * L] : nullptr;
         const float* z = &inputs.mean_depth->pixels[p * L];
-        const float* tau = inputs.optical_depth ? &inputs.optical_depth->pixels[p * L] : nullptr;
-        // Front to back by mean depth, as estimate_attenuation walks them (ties by index).
-        order.clear();
+        pixel.order.clear();
         for (std::size_t j = 0; j < L; ++j) {
-            if (a[j] > 0.0f) order.emplace_back(std::isnan(z[j]) ? INFINITY : z[j], int(j));
+            if (pixel.a[j] > 0.0f)
+                pixel.order.emplace_back(std::isnan(z[j]) ? INFINITY : z[j], int(j));
         }
-        std::stable_sort(order.begin(), order.end(),
+        std::stable_sort(pixel.order.begin(), pixel.order.end(),
                          [](const auto& x, const auto& y) { return x.first < y.first; });
 
-        double total = 0.0;
-        // Precision, and the recolouring spread.
-        double transmittance = 1.0, edited_transmittance = 1.0;
-        for (const auto& [depth, j] : order) {
-            (void)depth;
-            const double s = scales[j];
-            // t_j as the estimator takes it. Stored tau is known relatively, a_j absolutely (so
-            // its t_j to within res / T); a blend of the two, as uncertain as its parts.
-            const double inferred = inferred_transmittance(a[j], transmittance);
-            const double w = tau ? optical_depth_weight(s) : 0.0;
-            const double t = tau ? blended_transmittance(inferred, tau[j], w) : inferred;
-            double uncertainty = 0.0;
-            if (w > 0.0) {
-                const double tau_j = std::max(0.0, double(tau[j]));
-                uncertainty += w * std::exp(-tau_j) * tau_j * resolution;
-            }
-            if (w < 1.0 && transmittance > 0.0)
-                uncertainty += (1.0 - w) * resolution / transmittance;
-            if (s > 0.0 && uncertainty > 0.0) {
-                const double high = std::min(1.0, t + uncertainty);
-                total += edited_transmittance * std::abs(std::pow(high, s) - std::pow(t, s));
-            }
-            transmittance *= inferred;
-            edited_transmittance *= s > 0.0 ? std::pow(t, s) : 1.0;
-        }
-        if (!inputs.colour_spread.empty()) {
-            double bound = 0.0;
-            for (std::size_t j = 0; j < L; ++j) bound += a_edited[j] * inputs.colour_spread[j];
-            if (calibrated) {
-                // What recolouring missed at the stored function, where the truth is known.
-                double stored_bound = 0.0, missed = 0.0;
-                double rgb[3] = {0.0, 0.0, 0.0};
-                for (std::size_t j = 0; j < L; ++j) {
-                    stored_bound += a[j] * inputs.stored_colour_spread[j];
-                    for (int c = 0; c < 3; ++c) rgb[c] += a[j] * inputs.stored_colours[3 * j + c];
-                }
-                const float* rendering = &inputs.stored_rendering->pixels[4 * p];
-                for (int c = 0; c < 3; ++c)
-                    missed = std::max(missed, std::abs(rgb[c] - rendering[c]));
-                if (stored_bound > kCalibratedSpreadFloor) {
-                    bound = std::min(bound, missed * bound / stored_bound);
-                }
-            }
-            total += bound;
-        }
-        double light = 0.0, thick = 0.0, thin = 0.0;
-        for (std::size_t j = 0; j < L; ++j) {
-            light += a[j];
-            thick += a[j] * thickening[j];
-            thin += a[j] * thinning[j];
-        }
-        // Interleaving: where the ray re-entered intervals, the one-run-per-interval order the
-        // estimator assumed holds only for the light of first runs. The estimate in the reverse
-        // order (nearest last) is the other extreme; the light of the re-entered runs, as a
-        // share of the pixel's, says how far towards it the truth may lie. 0 without an opacity
-        // edit: both orders then return a itself.
-        const float* interleaving =
-            inputs.interleaving ? &inputs.interleaving->pixels[2 * p] : nullptr;
-        auto interleaving_term = [&] {
-            if (!interleaving || !(interleaving[0] > 0.0f) || order.size() < 2) return 0.0;
-            const double share = light > 0.0 ? std::min(1.0, interleaving[1] / light) : 0.0;
-            double forward[3], backward[3];
-            recompose_in_order(a, tau, TransmittanceFrom::estimator, scales, inputs.colours,
-                               order.begin(), order.end(), forward);
-            recompose_in_order(a, tau, TransmittanceFrom::estimator, scales, inputs.colours,
-                               order.rbegin(), order.rend(), backward);
-            return share * largest_difference(forward, backward);
-        };
-        if (!inputs.entry_depth) {
-            total += interleaving_term();
-        } else if (order.size() > 1 && light > 0.0) {
-            // Order: the shown estimate against the entry-depth order (thickening); thinning's
-            // two estimates against each other with tau, else the interleaving term for the
-            // thinned share of the light.
-            double other[3];
-            if (thick > 0.0) {
-                double shown[3];
-                recompose_in_order(a, tau, TransmittanceFrom::estimator, scales, inputs.colours,
-                                   order.begin(), order.end(), shown);
-                const float* entry = &inputs.entry_depth->pixels[p * L];
-                entry_order.clear();
-                for (const auto& [depth, j] : order) {
-                    (void)depth;
-                    entry_order.emplace_back(std::isnan(entry[j]) ? INFINITY : entry[j], j);
-                }
-                std::stable_sort(entry_order.begin(), entry_order.end(),
-                                 [](const auto& x, const auto& y) { return x.first < y.first; });
-                recompose_in_order(a, tau, TransmittanceFrom::attenuation, scales, inputs.colours,
-                                   entry_order.begin(), entry_order.end(), other);
-                total += thick / light * largest_difference(other, shown);
-            }
-            if (tau && thin > 0.0) {
-                // The two estimates of thinning disagree by this much; the estimator takes one
-                // or the other (or between) by s_j, and either may be the wrong one.
-                double from_attenuation[3];
-                recompose_in_order(a, tau, TransmittanceFrom::attenuation, scales, inputs.colours,
-                                   order.begin(), order.end(), from_attenuation);
-                recompose_in_order(a, tau, TransmittanceFrom::thinning, scales, inputs.colours,
-                                   order.begin(), order.end(), other);
-                total += largest_difference(other, from_attenuation);
-            } else if (thin > 0.0) {
-                total += thin / light * interleaving_term();
-            }
-        }
+        double total = precision_term(pixel, scales, inputs.attenuation_resolution);
+        if (!inputs.colour_spread.empty()) total += recolouring_term(pixel, inputs);
+        order_terms.add(pixel, total);
         error.pixels[p] = static_cast<float>(total);
     }
     return error;

@@ -5,7 +5,8 @@
 // serve) and the benchmarks all go through Explorer::render, so they show the same pixels.
 //
 // One frame, in order:
-//  1. proxies of (step, view) from the archive (cached: the last few frames stay in memory);
+//  1. proxies of (step, view) from the archive (cached: the last few frames stay in memory,
+//     step_cache.hpp);
 //  2. the target camera: the stored one, or Camera::reorbit(azimuth, elevation) of it;
 //  3. attenuation a (+ mean depth) in the target camera: as stored when the camera is the
 //     stored one, else synthesised (from the single-perspective proxies unless the request or
@@ -22,7 +23,6 @@
 // function's colour at its isovalue.
 #include <cstdint>
 #include <iosfwd>
-#include <list>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -39,6 +39,7 @@
 #include "insitu/explore/enhancement.hpp"
 #include "insitu/explore/light_field_reconstruction.hpp"
 #include "insitu/explore/relighting.hpp"
+#include "insitu/explore/step_cache.hpp"
 #include "insitu/explore/view_synthesis.hpp"
 
 namespace insitu {
@@ -154,9 +155,6 @@ struct FrameRecipe {
     std::optional<EnhancementSettings> enhancement;
 };
 
-/// A summary of an archive for `insitu-view info` and the viewer's API.
-nlohmann::json describe_archive(const ArchiveReader& archive);
-
 class Explorer {
 public:
     /// Opens the archive (IoError/ParseError name the file).
@@ -165,7 +163,7 @@ public:
 
     /// Re-reads the manifest so steps a running simulation wrote since appear.
     void refresh();
-    const ArchiveReader& archive() const { return *archive_; }
+    const ArchiveReader& archive() const { return steps_.archive(); }
 
     /// Renders one frame. InvalidArgument names a step or view the archive lacks, an interval
     /// index out of range, a negative or non-finite scale, or a model requested that the
@@ -177,33 +175,9 @@ public:
     FrameRecipe recipe(const ExploreRequest& request);
 
 private:
-    struct CachedStep {
-        std::int64_t step = 0;
-        int view = 0;
-        std::optional<ProxyFrame> single;  ///< at least one of the two is present
-        std::optional<ProxyFrame> multi;
-    };
-    const CachedStep& load(std::int64_t step, int view);
-    /// The light field of (step, field) holding at least `cameras` (loaded on demand: a frame
-    /// needs the cameras facing it, not all of them); null when the step has none for `field`.
-    const LightField* load_light_field(std::int64_t step, const std::string& field,
-                                       const std::vector<int>& cameras);
-    /// One light field kept (they are large: cameras x map pixels x channels).
-    struct CachedLightField {
-        std::int64_t step = 0;
-        std::string field;
-        LightField light_field;
-    };
-    std::optional<CachedLightField> light_field_cache_;
-    /// How exactly the archive stores a_j, by its "precision" (EditTrustInputs); read once per
-    /// refresh, on the first edit.
-    double stored_attenuation_resolution();
-    std::optional<double> attenuation_resolution_;
-
     std::string path_;
     std::shared_ptr<ComputeDevice> device_;
-    std::unique_ptr<ArchiveReader> archive_;
-    std::list<CachedStep> cache_;  ///< most recently used first
+    StepCache steps_;
     std::mutex mutex_;
 };
 

@@ -1,0 +1,17 @@
+#pragma once
+// What an archive holds, from its manifest and the headers of its first step: the summary
+// `insitu-view info` prints and the viewer's /api/archive serves.
+#include <cstdint>
+#include <nlohmann/json.hpp>
+
+#include "insitu/archive/archive_reader.hpp"
+
+namespace insitu {
+
+/// A summary of an archive for `insitu-view info` and the viewer's API.
+nlohmann::json describe_archive(const ArchiveReader& archive);
+
+/// Whether the manifest lists single- or multi-perspective parts for (step, view).
+bool has_perspective(const nlohmann::json& manifest, std::int64_t step, int view, bool multi);
+
+}  // namespace insitu

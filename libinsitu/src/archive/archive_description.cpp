@@ -1,0 +1,119 @@
+#include "insitu/archive/archive_description.hpp"
+
+#include <set>
+#include <string>
+#include <vector>
+
+#include "archive/archive_format.hpp"
+
+namespace insitu {
+
+namespace af = archive_format;
+
+bool has_perspective(const nlohmann::json& manifest, std::int64_t step, int view, bool multi) {
+    for (const nlohmann::json& step_entry : manifest.at("steps")) {
+        if (step_entry.at("step").get<std::int64_t>() != step) continue;
+        for (const nlohmann::json& view_entry : step_entry.at("views")) {
+            if (view_entry.at("view").get<int>() != view) continue;
+            for (const nlohmann::json& part : view_entry.at("parts")) {
+                if (af::is_multi_part(part.get<std::string>()) == multi) return true;
+            }
+        }
+    }
+    return false;
+}
+
+nlohmann::json describe_archive(const ArchiveReader& archive) {
+    const nlohmann::json& manifest = archive.manifest();
+    nlohmann::json description;
+    description["schema_version"] = manifest.value("schema_version", 0);
+    description["producer"] = manifest.value("producer", nlohmann::json::object());
+    description["configuration"] = manifest.at("configuration");
+    description["steps"] = archive.steps();
+    description["view_count"] = archive.view_count();
+    std::uint64_t total_bytes = 0;
+    nlohmann::json parts = nlohmann::json::object();
+    for (const nlohmann::json& step : manifest.at("steps")) {
+        for (const nlohmann::json& view : step.at("views")) {
+            for (const nlohmann::json& file : view.at("files")) {
+                total_bytes += file.at("bytes").get<std::uint64_t>();
+            }
+            for (const nlohmann::json& part : view.at("parts")) {
+                parts[part.get<std::string>()] = true;
+            }
+        }
+        for (const nlohmann::json& light_field :
+             step.value("light_fields", nlohmann::json::array())) {
+            total_bytes += light_field.at("bytes").get<std::uint64_t>();
+        }
+    }
+    description["bytes"] = total_bytes;
+    nlohmann::json part_names = nlohmann::json::array();
+    for (const auto& item : parts.items()) part_names.push_back(item.key());
+    description["parts"] = part_names;
+
+    // Per view, what the first step holds: image size, layers, intervals, colour model.
+    nlohmann::json views = nlohmann::json::array();
+    const std::vector<std::int64_t> steps = archive.steps();
+    if (!steps.empty()) {
+        for (int v = 0; v < archive.view_count(); ++v) {
+            nlohmann::json view{{"view", v}};
+            for (const bool multi : {false, true}) {
+                if (!has_perspective(manifest, steps.front(), v, multi)) continue;
+                const ProxyFrame frame = archive.load(steps.front(), v, multi);
+                nlohmann::json entry{{"size", {frame.camera.width(), frame.camera.height()}},
+                                     {"projection", to_string(frame.camera.projection())},
+                                     {"azimuth", frame.camera.azimuth_deg()},
+                                     {"elevation", frame.camera.elevation_deg()},
+                                     {"isovalues", frame.isovalues},
+                                     {"depth_layers", frame.depth_layers.size()},
+                                     {"attenuation", frame.attenuation.channels > 0},
+                                     {"optical_depth", frame.optical_depth.channels > 0},
+                                     {"training_images", frame.training.size()}};
+                if (frame.intervals) entry["intervals"] = frame.intervals->to_json();
+                if (multi) entry["distortion_tilt"] = frame.distortion_tilt_deg;
+                if (frame.colour_model) {
+                    entry["colour_model"] = {{"intervals", frame.colour_model->intervals()},
+                                             {"clusters", frame.colour_model->clusters()}};
+                }
+                view[multi ? "multi" : "single"] = entry;
+            }
+            views.push_back(view);
+        }
+    }
+    description["views"] = views;
+
+    // Per field, the light field of the first step that has one: its rig and what it holds.
+    nlohmann::json light_fields = nlohmann::json::array();
+    std::set<std::string> described;
+    for (const std::int64_t step : steps) {
+        for (const ArchivedLightField& stored : archive.light_fields(step)) {
+            if (!described.insert(stored.field).second) continue;
+            // Camera 0 only: the headers say what every part holds.
+            const LightField light_field = archive.load_light_field(step, stored.field, {0});
+            light_fields.push_back({{"field", stored.field},
+                                    {"first_step", step},
+                                    {"cameras", stored.cameras},
+                                    {"map_size", stored.map_size},
+                                    {"segments", light_field.segment_count()},
+                                    {"segment_rule", to_string(light_field.settings.segments)},
+                                    {"attenuation", light_field.settings.attenuation},
+                                    {"depth_bits", light_field.settings.depth_bits},
+                                    {"isovalues", light_field.isovalues}});
+        }
+    }
+    description["light_fields"] = light_fields;
+
+    // Per step with an error budget, what it chose for each field (the manifest's entries).
+    nlohmann::json budget = nlohmann::json::array();
+    for (const nlohmann::json& step : manifest.at("steps")) {
+        for (nlohmann::json entry : step.value("budget", nlohmann::json::array())) {
+            entry["step"] = step.at("step");
+            budget.push_back(std::move(entry));
+        }
+    }
+    description["budget"] = budget;
+    return description;
+}
+
+}  // namespace insitu

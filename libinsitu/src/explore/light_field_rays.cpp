@@ -1,0 +1,55 @@
+#include "explore/light_field_rays.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <glm/geometric.hpp>
+
+namespace insitu::detail {
+
+std::optional<std::pair<double, double>> sphere_chord(const Ray& ray, const glm::dvec3& centre,
+                                                      double radius) {
+    const glm::dvec3 oc = ray.origin - centre;
+    const double b = glm::dot(oc, ray.direction);
+    const double discriminant = b * b - (glm::dot(oc, oc) - radius * radius);
+    if (!(discriminant > 0.0)) return std::nullopt;
+    const double root = std::sqrt(discriminant);
+    return std::pair{-b - root, -b + root};
+}
+
+std::optional<RayNeighbourhood> ray_neighbourhood(const LightFieldRig& rig, const Ray& ray) {
+    const auto chord = sphere_chord(ray, rig.center(), rig.bounding_radius());
+    if (!chord) return std::nullopt;
+    const double t0 = std::max(chord->first, 0.0), t1 = chord->second;
+    if (!(t1 > t0)) return std::nullopt;
+    const double t_entry = sphere_chord(ray, rig.center(), rig.camera_radius())->first;
+    return RayNeighbourhood{
+        t0, t1, rig.cameras_around(ray.origin + t_entry * ray.direction - rig.center())};
+}
+
+Taps bilinear_taps(int size, const glm::dvec2& map_position) {
+    const double fx = std::clamp(map_position.x - 0.5, 0.0, size - 1.0);
+    const double fy = std::clamp(map_position.y - 0.5, 0.0, size - 1.0);
+    const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+    const int x1 = std::min(x0 + 1, size - 1), y1 = std::min(y0 + 1, size - 1);
+    const double wx = fx - x0, wy = fy - y0;
+    const auto at = [size](int x, int y) { return static_cast<std::size_t>(y) * size + x; };
+    Taps taps;
+    taps.pixel = {at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1)};
+    taps.weight = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+    return taps;
+}
+
+double camera_spacing_rad(const Icosphere& icosphere) {
+    double sum = 0.0;
+    for (const auto& triangle : icosphere.triangles) {
+        for (int e = 0; e < 3; ++e) {
+            const glm::dvec3& a = icosphere.vertices[static_cast<std::size_t>(triangle[e])];
+            const glm::dvec3& b =
+                icosphere.vertices[static_cast<std::size_t>(triangle[(e + 1) % 3])];
+            sum += std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));
+        }
+    }
+    return sum / (3.0 * static_cast<double>(icosphere.triangles.size()));
+}
+
+}  // namespace insitu::detail

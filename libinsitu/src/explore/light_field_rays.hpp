@@ -1,0 +1,43 @@
+#pragma once
+// Where a target ray meets a light field's rig (light_field_reconstruction.hpp, step 1): its
+// chord through the bounding sphere and the cameras around it, and the bilinear taps with which
+// a camera's map is read; the rig's camera spacing.
+#include <array>
+#include <cstddef>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <optional>
+#include <utility>
+
+#include "insitu/core/camera.hpp"
+#include "insitu/core/light_field.hpp"
+
+namespace insitu::detail {
+
+// Where the line origin + t direction (unit) meets a sphere: t of entry and exit, or nothing
+// when it misses (a tangent line counts as a miss: nothing to see along it).
+std::optional<std::pair<double, double>> sphere_chord(const Ray& ray, const glm::dvec3& centre,
+                                                      double radius);
+
+// Where a target ray crosses the bounding sphere ([t0, t1], in front of its origin) and the
+// cameras around it; nothing for a ray that misses the sphere (it sees nothing). The line meets
+// the camera sphere (Rc > R, so it does) where it enters it; for a perspective eye between R
+// and Rc that point lies behind the eye, as it should: the cameras there see the ray's
+// direction.
+struct RayNeighbourhood {
+    double t0 = 0.0, t1 = 0.0;
+    CameraNeighbourhood around;
+};
+std::optional<RayNeighbourhood> ray_neighbourhood(const LightFieldRig& rig, const Ray& ray);
+
+// Bilinear taps over pixel centres (x + 1/2), clamped at the map's edges.
+struct Taps {
+    std::array<std::size_t, 4> pixel{};
+    std::array<double, 4> weight{};
+};
+Taps bilinear_taps(int size, const glm::dvec2& map_position);
+
+// Mean angle between neighbouring cameras, seen from the centre: the scale of the angular term.
+double camera_spacing_rad(const Icosphere& icosphere);
+
+}  // namespace insitu::detail
