@@ -169,42 +169,23 @@ std::string entries_text(const std::set<std::pair<std::int64_t, int>>& entries) 
     return text;
 }
 
-int run_info(const std::vector<std::string>& args) {
-    std::string archive;
-    bool json = false;
-    for (const std::string& arg : args) {
-        if (arg == "--json") {
-            json = true;
-        } else if (arg.rfind("--", 0) == 0) {
-            throw UsageError("info: unknown flag " + arg);
-        } else if (archive.empty()) {
-            archive = arg;
-        } else {
-            throw UsageError("info: unexpected argument \"" + arg + "\"");
-        }
-    }
-    if (archive.empty()) throw UsageError("info: missing ARCHIVE");
-    const insitu::viewer::ArchiveInspection inspection = insitu::viewer::inspect_archive(archive);
-    const nlohmann::json& description = inspection.description;
+/// info --json: the archive's description with its damage and unreadable entries.
+int print_info_json(const std::string& archive,
+                    const insitu::viewer::ArchiveInspection& inspection) {
     const std::vector<std::string>& damage = inspection.damage;
-    if (json) {
-        nlohmann::json output = description;
-        output["damage"] = damage;
-        output["unreadable"] = nlohmann::json::array();
-        for (const auto& [step, view] : inspection.unreadable) {
-            output["unreadable"].push_back({{"step", step}, {"view", view}});
-        }
-        output["manifest_readable"] = inspection.manifest_readable;
-        std::cout << output.dump(2) << "\n";
-        return damage.empty() ? 0 : report_damage(archive, damage.size(), "(\"damage\")");
+    nlohmann::json output = inspection.description;
+    output["damage"] = damage;
+    output["unreadable"] = nlohmann::json::array();
+    for (const auto& [step, view] : inspection.unreadable) {
+        output["unreadable"].push_back({{"step", step}, {"view", view}});
     }
-    const auto& steps = description.at("steps");
-    std::cout << "archive       " << archive << "\n"
-              << "steps         " << steps.size();
-    if (!steps.empty()) std::cout << " (" << steps.front() << " .. " << steps.back() << ")";
-    std::cout << "\nviews         " << description.at("view_count") << "\n"
-              << "bytes         " << description.at("bytes") << "\n"
-              << "parts         " << description.at("parts").dump() << "\n";
+    output["manifest_readable"] = inspection.manifest_readable;
+    std::cout << output.dump(2) << "\n";
+    return damage.empty() ? 0 : report_damage(archive, damage.size(), "(\"damage\")");
+}
+
+/// info's line per view and perspective: size, projection, camera, layers, attenuation.
+void print_views(const nlohmann::json& description) {
     for (const auto& view : description.at("views")) {
         for (const char* perspective : {"single", "multi"}) {
             if (!view.contains(perspective)) continue;
@@ -229,6 +210,10 @@ int run_info(const std::vector<std::string>& args) {
             std::cout << "\n";
         }
     }
+}
+
+/// info's line per light field: its rig, segments, attenuation and depth precision.
+void print_light_fields(const nlohmann::json& description) {
     for (const auto& light_field : description.at("light_fields")) {
         std::cout << "light field   " << light_field.at("field").get<std::string>() << ": "
                   << light_field.at("cameras") << " cameras, " << light_field.at("map_size")
@@ -236,22 +221,29 @@ int run_info(const std::vector<std::string>& args) {
                   << (light_field.at("attenuation").get<bool>() ? "yes" : "no") << ", depth "
                   << light_field.at("depth_bits") << " bits\n";
     }
-    // What an error budget chose at each step: the views' intervals, precision and size, the
-    // light field's rig and the colour model's K, each with the PSNR it measured.
+}
+
+/// A budget's measured PSNR as info prints it ("exact" where nothing was lost).
+std::string budget_psnr_text(const nlohmann::json& value) {
+    std::ostringstream text;
+    text << std::fixed << std::setprecision(1);
+    if (value.is_null()) {
+        text << "exact";
+    } else {
+        text << value.get<double>() << " dB";
+    }
+    return text.str();
+}
+
+/// Whether a budget's choice met its target, as info prints it.
+const char* budget_met_text(const nlohmann::json& choice) {
+    return choice.at("met").get<bool>() ? " met" : " NOT met";
+}
+
+/// What an error budget chose at each step: the views' intervals, precision and size, the light
+/// field's rig and the colour model's K, each with the PSNR it measured.
+void print_budget(const nlohmann::json& description) {
     for (const auto& entry : description.value("budget", nlohmann::json::array())) {
-        const auto psnr = [](const nlohmann::json& value) {
-            std::ostringstream text;
-            text << std::fixed << std::setprecision(1);
-            if (value.is_null()) {
-                text << "exact";
-            } else {
-                text << value.get<double>() << " dB";
-            }
-            return text.str();
-        };
-        const auto met = [](const nlohmann::json& choice) {
-            return choice.at("met").get<bool>() ? " met" : " NOT met";
-        };
         std::cout << "budget        step " << entry.at("step") << " "
                   << entry.at("field").get<std::string>() << ": " << entry.at("intervals") << " "
                   << entry.at("mode").get<std::string>() << " intervals";
@@ -259,20 +251,38 @@ int run_info(const std::vector<std::string>& args) {
             std::cout << ", " << entry.at("precision").get<std::string>();
         }
         if (entry.value("size_divisor", 1) != 1) std::cout << ", 1/" << entry.at("size_divisor");
-        std::cout << ", " << psnr(entry.at("psnr_db")) << met(entry);
+        std::cout << ", " << budget_psnr_text(entry.at("psnr_db")) << budget_met_text(entry);
         if (entry.contains("light_field")) {
             const auto& light_field = entry.at("light_field");
             std::cout << "; light field " << light_field.at("cameras") << " cameras at "
-                      << light_field.at("size") << "^2, " << psnr(light_field.at("psnr_db"))
-                      << met(light_field);
+                      << light_field.at("size") << "^2, "
+                      << budget_psnr_text(light_field.at("psnr_db"))
+                      << budget_met_text(light_field);
         }
         if (entry.contains("colour_model")) {
             const auto& model = entry.at("colour_model");
             std::cout << "; colour model K=" << model.at("clusters") << ", "
-                      << psnr(model.at("psnr_db")) << met(model);
+                      << budget_psnr_text(model.at("psnr_db")) << budget_met_text(model);
         }
         std::cout << (entry.value("checked", false) ? "" : " (kept from the last check)") << "\n";
     }
+}
+
+/// info as text: a line per property, view, light field and budget check, then the damage.
+int print_info_text(const std::string& archive,
+                    const insitu::viewer::ArchiveInspection& inspection) {
+    const nlohmann::json& description = inspection.description;
+    const std::vector<std::string>& damage = inspection.damage;
+    const auto& steps = description.at("steps");
+    std::cout << "archive       " << archive << "\n"
+              << "steps         " << steps.size();
+    if (!steps.empty()) std::cout << " (" << steps.front() << " .. " << steps.back() << ")";
+    std::cout << "\nviews         " << description.at("view_count") << "\n"
+              << "bytes         " << description.at("bytes") << "\n"
+              << "parts         " << description.at("parts").dump() << "\n";
+    print_views(description);
+    print_light_fields(description);
+    print_budget(description);
     if (inspection.manifest_readable) {
         std::cout << "configuration " << description.at("configuration").dump() << "\n";
     } else {
@@ -290,6 +300,25 @@ int run_info(const std::vector<std::string>& args) {
     for (const std::string& problem : damage)
         std::cout << "  " << insitu::one_line(problem) << "\n";
     return report_damage(archive, damage.size(), "(listed under \"damage:\")");
+}
+
+int run_info(const std::vector<std::string>& args) {
+    std::string archive;
+    bool json = false;
+    for (const std::string& arg : args) {
+        if (arg == "--json") {
+            json = true;
+        } else if (arg.rfind("--", 0) == 0) {
+            throw UsageError("info: unknown flag " + arg);
+        } else if (archive.empty()) {
+            archive = arg;
+        } else {
+            throw UsageError("info: unexpected argument \"" + arg + "\"");
+        }
+    }
+    if (archive.empty()) throw UsageError("info: missing ARCHIVE");
+    const insitu::viewer::ArchiveInspection inspection = insitu::viewer::inspect_archive(archive);
+    return json ? print_info_json(archive, inspection) : print_info_text(archive, inspection);
 }
 
 /// Refuses (UsageError) a flag that render does not list.

@@ -81,18 +81,11 @@ void append_codes(std::string& out, const Image& depth, int camera) {
     }
 }
 
-}  // namespace
-
-std::string light_field_payload(const LightField& light_field, std::int64_t step,
-                                const std::string& field) {
+/// Refuses (InvalidArgument) images that do not fit the rig; the cameras present, in slot order.
+std::vector<int> present_cameras(const LightField& light_field, int intervals) {
     const LightFieldRig& rig = light_field.rig;
     const int n = rig.map_size();
     const int segments = light_field.segment_count();
-    const int depth_bits = light_field.settings.depth_bits;
-    const int intervals = light_field.settings.attenuation && light_field.intervals
-                              ? light_field.intervals->count()
-                              : 0;
-    const int groups = (intervals + 3) / 4;
     std::vector<int> present;
     for (const LightFieldImages& images : light_field.cameras) {
         if (images.camera < 0 || images.camera >= rig.camera_count()) {
@@ -118,28 +111,53 @@ std::string light_field_payload(const LightField& light_field, std::int64_t step
         }
         present.push_back(images.camera);
     }
+    return present;
+}
 
-    const std::size_t pixels = static_cast<std::size_t>(n) * n;
-    const std::size_t depth_bytes = depth_bits == 8 ? 1 : 2;
-    const std::size_t slots = present.size();
-    const std::size_t rgba_bytes = slots * segments * pixels * 4 * 2;
-    const std::size_t first_hit_bytes = slots * pixels * depth_bytes;
-    const std::size_t depth_end = rgba_bytes + first_hit_bytes * (segments > 1 ? segments + 1 : 1);
-    // The attenuation planes, as the page uploads them.
+/// Where each kind of plane starts in the data after the header, in bytes, and the attenuation
+/// planes as the page uploads them.
+struct PlaneLayout {
+    std::size_t rgba_bytes = 0;
+    std::size_t first_hit_bytes = 0;
+    /// End of the depth planes (first hit, then each segment's).
+    std::size_t depth_end = 0;
     std::vector<float> attenuation;
     std::vector<float> mean_depth;
+    bool attenuation_half = false;
+    bool mean_depth_half = false;
+    std::size_t attenuation_at = 0;
+    std::size_t mean_depth_at = 0;
+    std::size_t end = 0;
+};
+
+PlaneLayout plane_layout(const LightField& light_field, std::size_t slots, int intervals) {
+    const int n = light_field.rig.map_size();
+    const int segments = light_field.segment_count();
+    const int groups = (intervals + 3) / 4;
+    PlaneLayout layout;
+    const std::size_t pixels = static_cast<std::size_t>(n) * n;
+    const std::size_t depth_bytes = light_field.settings.depth_bits == 8 ? 1 : 2;
+    layout.rgba_bytes = slots * segments * pixels * 4 * 2;
+    layout.first_hit_bytes = slots * pixels * depth_bytes;
+    layout.depth_end =
+        layout.rgba_bytes + layout.first_hit_bytes * (segments > 1 ? segments + 1 : 1);
     for (const LightFieldImages& images : light_field.cameras) {
         if (intervals == 0) break;
-        append_groups(attenuation, images.attenuation, groups, 0.0f);
-        append_groups(mean_depth, images.mean_depth, groups, INFINITY);
+        append_groups(layout.attenuation, images.attenuation, groups, 0.0f);
+        append_groups(layout.mean_depth, images.mean_depth, groups, INFINITY);
     }
-    const bool attenuation_half = all_half(attenuation);
-    const bool mean_depth_half = all_half(mean_depth);
-    const std::size_t attenuation_at = (depth_end + 3) / 4 * 4;
-    const std::size_t mean_depth_at =
-        attenuation_at + attenuation.size() * (attenuation_half ? 2 : 4);
-    const std::size_t end = mean_depth_at + mean_depth.size() * (mean_depth_half ? 2 : 4);
+    layout.attenuation_half = all_half(layout.attenuation);
+    layout.mean_depth_half = all_half(layout.mean_depth);
+    layout.attenuation_at = (layout.depth_end + 3) / 4 * 4;
+    layout.mean_depth_at =
+        layout.attenuation_at + layout.attenuation.size() * (layout.attenuation_half ? 2 : 4);
+    layout.end = layout.mean_depth_at + layout.mean_depth.size() * (layout.mean_depth_half ? 2 : 4);
+    return layout;
+}
 
+/// The rig's geometry as the page's look-ups read it: every camera's frame, the icosphere and
+/// the cube-map cells' triangles (LightFieldRig::cameras_around).
+void add_rig(json& header, const LightFieldRig& rig) {
     json cameras = json::array();
     for (int k = 0; k < rig.camera_count(); ++k) {
         const Camera& camera = rig.camera(k);
@@ -156,45 +174,39 @@ std::string light_field_payload(const LightField& light_field, std::int64_t step
         for (const int t : cell) cell_triangles.push_back(t);
         cell_offsets.push_back(cell_triangles.size());
     }
+    header["map_size"] = rig.map_size();
+    header["map_half_extent"] = rig.camera(0).half_height();
+    header["cameras"] = rig.camera_count();
+    header["center"] = vec3(rig.center());
+    header["bounding_radius"] = rig.bounding_radius();
+    header["camera_radius"] = rig.camera_radius();
+    header["vertices"] = vertices;
+    header["triangles"] = rig.icosphere().triangles;
+    header["camera_frames"] = cameras;
+    header["cells_per_face"] = rig.cells_per_face();
+    header["cell_offsets"] = cell_offsets;
+    header["cell_triangles"] = cell_triangles;
+}
+
+/// The byte offset of each kind of plane, as the header's "planes" gives them.
+json planes_header(const PlaneLayout& layout, int segments, int depth_bits, int intervals) {
     json planes{{"rgba", 0},
-                {"depth", rgba_bytes},
-                {"segment_depth", segments > 1 ? rgba_bytes + first_hit_bytes : 0},
+                {"depth", layout.rgba_bytes},
+                {"segment_depth", segments > 1 ? layout.rgba_bytes + layout.first_hit_bytes : 0},
                 {"depth_type", depth_bits == 8 ? "uint8 code" : "half"}};
     if (intervals > 0) {
-        planes["attenuation"] = {{"offset", attenuation_at},
-                                 {"type", attenuation_half ? "half" : "float"}};
-        planes["mean_depth"] = {{"offset", mean_depth_at},
-                                {"type", mean_depth_half ? "half" : "float"}};
+        planes["attenuation"] = {{"offset", layout.attenuation_at},
+                                 {"type", layout.attenuation_half ? "half" : "float"}};
+        planes["mean_depth"] = {{"offset", layout.mean_depth_at},
+                                {"type", layout.mean_depth_half ? "half" : "float"}};
     }
-    const json header{{"step", step},
-                      {"field", field},
-                      {"map_size", n},
-                      {"map_half_extent", rig.camera(0).half_height()},
-                      {"cameras", rig.camera_count()},
-                      {"center", vec3(rig.center())},
-                      {"bounding_radius", rig.bounding_radius()},
-                      {"camera_radius", rig.camera_radius()},
-                      {"vertices", vertices},
-                      {"triangles", rig.icosphere().triangles},
-                      {"camera_frames", cameras},
-                      {"cells_per_face", rig.cells_per_face()},
-                      {"cell_offsets", cell_offsets},
-                      {"cell_triangles", cell_triangles},
-                      {"segments", segments},
-                      {"segment_rule", to_string(light_field.settings.segments)},
-                      {"depth_bits", depth_bits},
-                      {"depth_threshold", light_field.settings.depth_threshold},
-                      {"intervals", intervals},
-                      {"present", present},
-                      {"planes", planes}};
-    std::string out = payload_opening("insituLF", kLightFieldPayloadVersion, header);
-    const std::size_t data_start = out.size();
-    out.reserve(data_start + end);
-    for (const LightFieldImages& images : light_field.cameras) {
-        for (const Image& rgba : images.segment_rgba) append_half(out, rgba);
-    }
+    return planes;
+}
+
+/// The first-hit depth of each slot, then with several segments each segment's depth.
+void append_depth_planes(std::string& out, const LightField& light_field) {
     const auto append_depth = [&](const Image& depth, int camera) {
-        if (depth_bits == 8) {
+        if (light_field.settings.depth_bits == 8) {
             append_codes(out, depth, camera);
         } else {
             append_half(out, depth);
@@ -203,25 +215,56 @@ std::string light_field_payload(const LightField& light_field, std::int64_t step
     for (const LightFieldImages& images : light_field.cameras) {
         append_depth(images.depth, images.camera);
     }
-    if (segments > 1) {
+    if (light_field.segment_count() > 1) {
         for (const LightFieldImages& images : light_field.cameras) {
             for (const Image& depth : images.segment_depth) append_depth(depth, images.camera);
         }
     }
-    INSITU_CHECK_EQ(out.size() - data_start, depth_end);
-    if (intervals > 0) {
-        out.resize(data_start + attenuation_at, '\0');
-        const auto append = [&out](const std::vector<float>& values, bool half) {
-            if (half) {
-                append_half(out, values);
-            } else {
-                append_float(out, values);
-            }
-        };
-        append(attenuation, attenuation_half);
-        append(mean_depth, mean_depth_half);
+}
+
+void append_half_or_float(std::string& out, const std::vector<float>& values, bool half) {
+    if (half) {
+        append_half(out, values);
+    } else {
+        append_float(out, values);
     }
-    INSITU_CHECK_EQ(out.size() - data_start, end);
+}
+
+}  // namespace
+
+std::string light_field_payload(const LightField& light_field, std::int64_t step,
+                                const std::string& field) {
+    const int segments = light_field.segment_count();
+    const int depth_bits = light_field.settings.depth_bits;
+    const int intervals = light_field.settings.attenuation && light_field.intervals
+                              ? light_field.intervals->count()
+                              : 0;
+    const std::vector<int> present = present_cameras(light_field, intervals);
+    const PlaneLayout layout = plane_layout(light_field, present.size(), intervals);
+    json header{{"step", step},
+                {"field", field},
+                {"segments", segments},
+                {"segment_rule", to_string(light_field.settings.segments)},
+                {"depth_bits", depth_bits},
+                {"depth_threshold", light_field.settings.depth_threshold},
+                {"intervals", intervals},
+                {"present", present},
+                {"planes", planes_header(layout, segments, depth_bits, intervals)}};
+    add_rig(header, light_field.rig);
+    std::string out = payload_opening("insituLF", kLightFieldPayloadVersion, header);
+    const std::size_t data_start = out.size();
+    out.reserve(data_start + layout.end);
+    for (const LightFieldImages& images : light_field.cameras) {
+        for (const Image& rgba : images.segment_rgba) append_half(out, rgba);
+    }
+    append_depth_planes(out, light_field);
+    INSITU_CHECK_EQ(out.size() - data_start, layout.depth_end);
+    if (intervals > 0) {
+        out.resize(data_start + layout.attenuation_at, '\0');
+        append_half_or_float(out, layout.attenuation, layout.attenuation_half);
+        append_half_or_float(out, layout.mean_depth, layout.mean_depth_half);
+    }
+    INSITU_CHECK_EQ(out.size() - data_start, layout.end);
     return out;
 }
 

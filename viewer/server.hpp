@@ -31,6 +31,9 @@
 // Safety: only files the manifest names and that resolve inside the archive directory are read
 // (a symlink out is refused with 403); bad parameters get 4xx with a JSON {"error": ...}; every
 // refusal is logged on stderr. Binds 127.0.0.1 unless --bind says otherwise.
+//
+// Where: guarded_server.hpp (the socket's guards against clients), viewer_service.hpp (the
+// routes, over served_archive.hpp), http_boundary.hpp (failures to statuses, the refusal log).
 #include <string>
 #include <vector>
 

@@ -189,6 +189,50 @@ int create(const char* function, insitu_instrument** out,
 
 enum class Blocks { replace, append };
 
+// Checked at the hand-over rather than left to execute, so the message points at the call that
+// passed the wrong name and the run need not reach a selected step to find out.
+void require_configured_field(const insitu::Instrument& instrument, const char* name) {
+    bool known = false;
+    std::string names;
+    for (const auto& field_name : instrument.config().fields) {
+        known = known || field_name == name;
+        names += (names.empty() ? "\"" : ", \"") + field_name + "\"";
+    }
+    if (!known) {
+        insitu::fail<insitu::InvalidArgument>(
+            "field \"", name, "\" is not in the configuration's fields (", names, ")");
+    }
+}
+
+// The block a C caller describes, as a Field; a NULL origin, spacing, strides or ghost layers
+// keeps Field's default.
+insitu::Field block_field(const char* name, const void* data, int scalar_type,
+                          const int64_t dims[3], const double origin[3], const double spacing[3],
+                          const int64_t ghosts_low[3], const int64_t ghosts_high[3],
+                          const int64_t strides[3], int centering) {
+    if (centering != INSITU_NODE && centering != INSITU_CELL) {
+        insitu::fail<insitu::InvalidArgument>("centering = ", centering,
+                                              " is not INSITU_NODE (0) or INSITU_CELL (1)");
+    }
+    const insitu::ScalarType type = scalar_type_from_c(scalar_type);
+    insitu::Field field(name, data, type, {dims[0], dims[1], dims[2]});
+    field.set_centering(centering == INSITU_CELL ? insitu::Centering::cell
+                                                 : insitu::Centering::node);
+    if (origin != nullptr) field.set_origin({origin[0], origin[1], origin[2]});
+    if (spacing != nullptr) field.set_spacing({spacing[0], spacing[1], spacing[2]});
+    if (strides != nullptr) field.set_strides({strides[0], strides[1], strides[2]});
+    if (ghosts_low != nullptr) {
+        const insitu::Index3 low{ghosts_low[0], ghosts_low[1], ghosts_low[2]};
+        const insitu::Index3 high =
+            ghosts_high == nullptr ? low
+                                   : insitu::Index3{ghosts_high[0], ghosts_high[1], ghosts_high[2]};
+        field.set_ghost_layers(low, high);
+    } else if (ghosts_high != nullptr) {
+        field.set_ghost_layers({0, 0, 0}, {ghosts_high[0], ghosts_high[1], ghosts_high[2]});
+    }
+    return field;
+}
+
 int add_block(const char* function, insitu_instrument* instrument, const char* name,
               const void* data, int scalar_type, const int64_t dims[3], const double origin[3],
               const double spacing[3], const int64_t ghosts_low[3], const int64_t ghosts_high[3],
@@ -202,41 +246,9 @@ int add_block(const char* function, insitu_instrument* instrument, const char* n
         if (instrument->finalized) {
             throw StateError(std::string("field \"") + name + "\" set after insitu_finalize");
         }
-        // Checked here rather than left to execute, so the message points at the call that
-        // passed the wrong name and the run need not reach a selected step to find out.
-        const auto& configured = instrument->instrument->config().fields;
-        bool known = false;
-        std::string names;
-        for (const auto& field_name : configured) {
-            known = known || field_name == name;
-            names += (names.empty() ? "\"" : ", \"") + field_name + "\"";
-        }
-        if (!known) {
-            insitu::fail<insitu::InvalidArgument>(
-                "field \"", name, "\" is not in the configuration's fields (", names, ")");
-        }
-        if (centering != INSITU_NODE && centering != INSITU_CELL) {
-            insitu::fail<insitu::InvalidArgument>("centering = ", centering,
-                                                  " is not INSITU_NODE (0) or INSITU_CELL (1)");
-        }
-
-        const insitu::ScalarType type = scalar_type_from_c(scalar_type);
-        insitu::Field field(name, data, type, {dims[0], dims[1], dims[2]});
-        field.set_centering(centering == INSITU_CELL ? insitu::Centering::cell
-                                                     : insitu::Centering::node);
-        if (origin != nullptr) field.set_origin({origin[0], origin[1], origin[2]});
-        if (spacing != nullptr) field.set_spacing({spacing[0], spacing[1], spacing[2]});
-        if (strides != nullptr) field.set_strides({strides[0], strides[1], strides[2]});
-        if (ghosts_low != nullptr) {
-            const insitu::Index3 low{ghosts_low[0], ghosts_low[1], ghosts_low[2]};
-            const insitu::Index3 high =
-                ghosts_high == nullptr
-                    ? low
-                    : insitu::Index3{ghosts_high[0], ghosts_high[1], ghosts_high[2]};
-            field.set_ghost_layers(low, high);
-        } else if (ghosts_high != nullptr) {
-            field.set_ghost_layers({0, 0, 0}, {ghosts_high[0], ghosts_high[1], ghosts_high[2]});
-        }
+        require_configured_field(*instrument->instrument, name);
+        insitu::Field field = block_field(name, data, scalar_type, dims, origin, spacing,
+                                          ghosts_low, ghosts_high, strides, centering);
         std::vector<insitu::Field>& pending = instrument->pending_fields[name];
         if (blocks == Blocks::replace) pending.clear();
         pending.push_back(std::move(field));

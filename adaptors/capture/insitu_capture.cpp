@@ -28,6 +28,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "arguments.hpp"
@@ -227,9 +228,10 @@ bool configuration_sets(const std::string& path, std::initializer_list<const cha
                        [&](const char* key) { return json.contains(key); });
 }
 
-int run(const Arguments& arguments) {
-    namespace capture = insitu::capture;
-    // Everything cheap is checked before any input is read and OpenCL is started.
+/// The configuration as --config and --out give it, its unknown keys refused or warned about
+/// as an Instrument does. Everything cheap is checked before any input is read and OpenCL is
+/// started.
+insitu::InstrumentConfig capture_configuration(const Arguments& arguments) {
     std::vector<std::string> unknown_keys;
     insitu::InstrumentConfig config =
         insitu::InstrumentConfig::from_json_file(arguments.config_path, &unknown_keys);
@@ -245,27 +247,35 @@ int run(const Arguments& arguments) {
     // Each input is a step the user chose to capture: the simulation's default cadence (every
     // 10th step) applies only when the configuration asks for a cadence itself.
     if (!configuration_sets(arguments.config_path, {"every", "steps"})) config.every = 1;
+    return config;
+}
 
-    capture::InputOptions input_options;
+/// How the readers read each input: the array or grid, the field's name, raw samples' layout.
+insitu::capture::InputOptions input_options_of(const Arguments& arguments,
+                                               const insitu::InstrumentConfig& config,
+                                               bool field_from_file) {
+    insitu::capture::InputOptions input_options;
     input_options.field_name = config.fields.front();
     input_options.array_name = arguments.field.empty() ? config.fields.front() : arguments.field;
-    // Neither --field nor "fields": the first file's only array or grid (its active scalars or
-    // first scalar grid where there are several), under its own name, which every later file
-    // must then hold too.
-    const bool field_from_file =
-        arguments.field.empty() && !configuration_sets(arguments.config_path, {"fields"});
     if (field_from_file) input_options.field_name = input_options.array_name = "";
     if (arguments.raw_dims) {
-        capture::RawOptions raw;
+        insitu::capture::RawOptions raw;
         raw.dims = *arguments.raw_dims;
         raw.type = *arguments.raw_type;
         raw.spacing_world = arguments.raw_spacing;
         raw.big_endian = arguments.raw_big_endian;
         input_options.raw = raw;
     }
+    return input_options;
+}
 
+/// The steps the inputs hold, in order (a .pvd contributes each of its data sets); an input this
+/// build cannot read, or raw input without its layout, is refused before anything is read.
+std::vector<insitu::capture::InputStep> input_steps(
+    const std::vector<std::string>& inputs, const insitu::capture::InputOptions& input_options) {
+    namespace capture = insitu::capture;
     std::vector<capture::InputStep> steps;
-    for (const std::string& path : arguments.inputs) {
+    for (const std::string& path : inputs) {
         const capture::InputKind kind = capture::input_kind(path);
         if (!capture::supported(kind)) {
             throw UsageError("\"" + path + "\": " + capture::to_string(kind) +
@@ -284,112 +294,169 @@ int run(const Arguments& arguments) {
             steps.push_back({path, kind, std::nullopt});
         }
     }
+    return steps;
+}
 
-    const auto start = std::chrono::steady_clock::now();
-    ProgressBar progress(steps.size());
-    std::unique_ptr<insitu::Instrument> instrument;
-    std::size_t captured = 0;
-    std::size_t not_selected = 0;
-    std::size_t dropped = 0;
-    std::size_t skipped = 0;
-    std::string layers_note;
-    std::string field_note;
-    // An input that cannot be used: skipped, or the end of the run (the archive keeps what the
-    // Instrument already wrote: finalize drains its queue).
-    const auto input_failed = [&](const std::string& why) {
-        if (arguments.on_error == OnError::skip) {
-            ++skipped;
-            // Every reader's message names the file already.
-            progress.message(std::string(kProgram) + ": skipped: " + one_line(why));
-            return;
-        }
-        progress.finish();
-        if (instrument) instrument->finalize();
-        throw UsageError(one_line(why) + " (stopped; the archive keeps the " +
-                         std::to_string(captured) +
-                         " step(s) captured before; --on-error skip goes on)");
-    };
+/// One capture of the input steps into the archive: the Instrument, started at the first input
+/// read, and the count of what became of each step, for the summary line.
+class Capture {
+public:
+    Capture(const Arguments& arguments, insitu::InstrumentConfig config,
+            insitu::capture::InputOptions input_options, bool field_from_file,
+            std::size_t step_count)
+        : arguments_(arguments),
+          config_(std::move(config)),
+          input_options_(std::move(input_options)),
+          field_from_file_(field_from_file),
+          step_count_(step_count),
+          progress_(step_count) {}
 
-    progress.update(0);
-    for (std::size_t i = 0; i < steps.size(); ++i) {
-        const capture::InputStep& input = steps[i];
-        const std::int64_t step = arguments.first_step + static_cast<std::int64_t>(i);
-        std::unique_ptr<capture::LoadedStep> loaded;
-        try {
-            loaded = capture::load_step(input, input_options);
-        } catch (const insitu::Error& error) {
-            input_failed(error.what());
-            progress.update(i + 1);
-            continue;
+    /// Loads and executes each step in turn; an input that cannot be used is skipped or ends the
+    /// capture, as --on-error says.
+    void capture(const std::vector<insitu::capture::InputStep>& steps) {
+        progress_.update(0);
+        for (std::size_t i = 0; i < steps.size(); ++i) {
+            const insitu::capture::InputStep& input = steps[i];
+            const std::int64_t step = arguments_.first_step + static_cast<std::int64_t>(i);
+            std::unique_ptr<insitu::capture::LoadedStep> loaded;
+            try {
+                loaded = insitu::capture::load_step(input, input_options_);
+            } catch (const insitu::Error& error) {
+                input_failed(error.what());
+                progress_.update(i + 1);
+                continue;
+            }
+            if (!instrument_) start_instrument(*loaded, input.path);
+            const double time = input.time.value_or(static_cast<double>(step));
+            count(instrument_->execute(step, time, {loaded->field()}), input.path, step);
+            progress_.update(i + 1);
         }
-        if (!instrument && field_from_file) {
-            const std::string name = loaded->field().name();
+        progress_.finish();
+    }
+
+    /// Finalizes the archive and prints the summary line.
+    void finish() {
+        if (!instrument_) {
+            throw UsageError("none of the " + std::to_string(step_count_) +
+                             " inputs could be read; nothing was captured");
+        }
+        if (instrument_->finalize() == insitu::Status::error) {
+            throw RuntimeFailure("writing the archive \"" + config_.archive +
+                                 "\" failed: " + instrument_->last_error());
+        }
+        const double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+        const insitu::InstrumentStatistics statistics = instrument_->statistics();
+        std::ostringstream summary;
+        summary << std::fixed << std::setprecision(2) << kProgram << ": "
+                << statistics.steps_written << " of " << step_count_ << " steps archived ("
+                << skipped_ << " skipped, " << not_selected_ << " not selected by the cadence, "
+                << dropped_ << " dropped) in " << seconds << " s, "
+                << (seconds > 0.0 ? captured_ / seconds : 0.0) << " steps/s" << field_note_
+                << layers_note_ << " -> " << config_.archive;
+        std::cout << summary.str() << "\n";
+    }
+
+private:
+    /// The Instrument, from the configuration completed by the first input read: the field's
+    /// name where the file names it, a level set's zero crossing as its layer.
+    void start_instrument(const insitu::capture::LoadedStep& loaded, const std::string& path) {
+        if (field_from_file_) {
+            const std::string name = loaded.field().name();
             if (name.empty()) {
-                throw UsageError("\"" + input.path +
+                throw UsageError("\"" + path +
                                  "\": its array has no name, which an archive's field needs");
             }
-            config.fields = {name};
-            input_options.array_name = input_options.field_name = name;
-            field_note = ", field \"" + name + "\" (named by the first file)";
+            config_.fields = {name};
+            input_options_.array_name = input_options_.field_name = name;
+            field_note_ = ", field \"" + name + "\" (named by the first file)";
         }
-        if (!instrument) {
-            // Level sets: the zero crossing is a layer unless the configuration names layers.
-            if (!config.layers && !loaded->default_isovalues().empty()) {
-                config.layers = loaded->default_isovalues();
-                layers_note = ", layers at the level set's zero crossing";
-            }
-            insitu::InstrumentOptions instrument_options;
-            instrument_options.log = false;  // this tool reports, one line per problem
-            try {
-                instrument = std::make_unique<insitu::Instrument>(config, instrument_options);
-            } catch (const insitu::Error& error) {
-                progress.finish();
-                throw RuntimeFailure(std::string("cannot start capturing into \"") +
-                                     config.archive + "\": " + error.what());
-            }
+        // Level sets: the zero crossing is a layer unless the configuration names layers.
+        if (!config_.layers && !loaded.default_isovalues().empty()) {
+            config_.layers = loaded.default_isovalues();
+            layers_note_ = ", layers at the level set's zero crossing";
         }
-        const double time = input.time.value_or(static_cast<double>(step));
-        const insitu::Status status = instrument->execute(step, time, {loaded->field()});
+        insitu::InstrumentOptions instrument_options;
+        instrument_options.log = false;  // this tool reports, one line per problem
+        try {
+            instrument_ = std::make_unique<insitu::Instrument>(config_, instrument_options);
+        } catch (const insitu::Error& error) {
+            progress_.finish();
+            throw RuntimeFailure(std::string("cannot start capturing into \"") + config_.archive +
+                                 "\": " + error.what());
+        }
+    }
+
+    /// Counts what became of a step; a step the Instrument refuses is an input that cannot be
+    /// used, any other error ends the capture.
+    void count(insitu::Status status, const std::string& path, std::int64_t step) {
         if (status == insitu::Status::error) {
-            const std::string why = "\"" + input.path + "\" (step " + std::to_string(step) +
-                                    "): " + instrument->last_error();
-            if (instrument->last_error_kind() == insitu::ErrorKind::invalid_argument) {
+            const std::string why = "\"" + path + "\" (step " + std::to_string(step) +
+                                    "): " + instrument_->last_error();
+            if (instrument_->last_error_kind() == insitu::ErrorKind::invalid_argument) {
                 input_failed(why);
             } else {
-                progress.finish();
-                instrument->finalize();
+                progress_.finish();
+                instrument_->finalize();
                 throw RuntimeFailure(one_line(why) + " (the archive keeps the " +
-                                     std::to_string(captured) + " steps before it)");
+                                     std::to_string(captured_) + " steps before it)");
             }
         } else if (status == insitu::Status::ok) {
-            ++captured;
+            ++captured_;
         } else if (status == insitu::Status::not_selected) {
-            ++not_selected;
+            ++not_selected_;
         } else {
-            ++dropped;
+            ++dropped_;
         }
-        progress.update(i + 1);
     }
-    progress.finish();
 
-    if (!instrument) {
-        throw UsageError("none of the " + std::to_string(steps.size()) +
-                         " inputs could be read; nothing was captured");
+    /// An input that cannot be used: skipped, or the end of the run (the archive keeps what the
+    /// Instrument already wrote: finalize drains its queue).
+    void input_failed(const std::string& why) {
+        if (arguments_.on_error == OnError::skip) {
+            ++skipped_;
+            // Every reader's message names the file already.
+            progress_.message(std::string(kProgram) + ": skipped: " + one_line(why));
+            return;
+        }
+        progress_.finish();
+        if (instrument_) instrument_->finalize();
+        throw UsageError(one_line(why) + " (stopped; the archive keeps the " +
+                         std::to_string(captured_) +
+                         " step(s) captured before; --on-error skip goes on)");
     }
-    if (instrument->finalize() == insitu::Status::error) {
-        throw RuntimeFailure("writing the archive \"" + config.archive +
-                             "\" failed: " + instrument->last_error());
-    }
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const insitu::InstrumentStatistics statistics = instrument->statistics();
-    std::ostringstream summary;
-    summary << std::fixed << std::setprecision(2) << kProgram << ": " << statistics.steps_written
-            << " of " << steps.size() << " steps archived (" << skipped << " skipped, "
-            << not_selected << " not selected by the cadence, " << dropped << " dropped) in "
-            << seconds << " s, " << (seconds > 0.0 ? captured / seconds : 0.0) << " steps/s"
-            << field_note << layers_note << " -> " << config.archive;
-    std::cout << summary.str() << "\n";
+
+    const Arguments& arguments_;
+    insitu::InstrumentConfig config_;
+    insitu::capture::InputOptions input_options_;
+    bool field_from_file_;
+    std::size_t step_count_;
+    std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+    ProgressBar progress_;
+    std::unique_ptr<insitu::Instrument> instrument_;
+    std::size_t captured_ = 0;
+    std::size_t not_selected_ = 0;
+    std::size_t dropped_ = 0;
+    std::size_t skipped_ = 0;
+    std::string layers_note_;
+    std::string field_note_;
+};
+
+int run(const Arguments& arguments) {
+    insitu::InstrumentConfig config = capture_configuration(arguments);
+    // Neither --field nor "fields": the first file's only array or grid (its active scalars or
+    // first scalar grid where there are several), under its own name, which every later file
+    // must then hold too.
+    const bool field_from_file =
+        arguments.field.empty() && !configuration_sets(arguments.config_path, {"fields"});
+    insitu::capture::InputOptions input_options =
+        input_options_of(arguments, config, field_from_file);
+    const std::vector<insitu::capture::InputStep> steps =
+        input_steps(arguments.inputs, input_options);
+    Capture capture(arguments, std::move(config), std::move(input_options), field_from_file,
+                    steps.size());
+    capture.capture(steps);
+    capture.finish();
     return 0;
 }
 

@@ -1,0 +1,120 @@
+#include "payload_routes.hpp"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <iterator>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+
+#include "http_boundary.hpp"
+#include "light_field_payload.hpp"
+#include "proxy_payload.hpp"
+#include "request_parameters.hpp"
+
+namespace insitu::viewer {
+namespace {
+
+/// Payloads (light fields, proxies) kept in memory: the steps shown and those a page prefetches.
+constexpr std::size_t kMaxPayloads = 8;
+
+/// `bytes` as a gzip stream (zlib's deflate with the gzip wrapper) at the fastest level: half
+/// floats compress a little whatever the level, and the server should not sit on a step.
+std::string gzip(const std::string& bytes) {
+    z_stream stream{};
+    if (deflateInit2(&stream, Z_BEST_SPEED, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK) {
+        throw std::runtime_error("zlib: deflateInit2 failed");
+    }
+    std::string out(deflateBound(&stream, bytes.size()), '\0');
+    stream.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes.data()));
+    stream.avail_in = static_cast<uInt>(bytes.size());
+    stream.next_out = reinterpret_cast<Bytef*>(out.data());
+    stream.avail_out = static_cast<uInt>(out.size());
+    const int result = deflate(&stream, Z_FINISH);
+    deflateEnd(&stream);
+    if (result != Z_STREAM_END) throw std::runtime_error("zlib: deflate did not finish");
+    out.resize(stream.total_out);
+    return out;
+}
+
+/// A payload's ETag: its kind and format version, the step, and the file's modification time
+/// and size (a step's files never change once listed).
+std::string payload_etag(const char* kind, std::uint32_t version, const StepKey& key,
+                         const std::filesystem::path& file) {
+    const auto [modified, size] = file_stamp(file);
+    return "\"" + std::string(kind) + std::to_string(version) + "-" + std::to_string(key.step) +
+           "-" + std::to_string(key.view) + "-" + std::to_string(modified) + "-" +
+           std::to_string(size) + "\"";
+}
+
+}  // namespace
+
+void PayloadRoutes::light_field(const httplib::Request& request, httplib::Response& response) {
+    const StepKey key = step_key(request, archive_);
+    std::lock_guard<std::mutex> lock(archive_.mutex());
+    const ArchiveReader& reader = archive_.reader_locked();
+    const std::string field = reader.entry(key.step, key.view).field;
+    std::optional<ArchivedLightField> stored;
+    for (const ArchivedLightField& candidate : reader.light_fields(key.step)) {
+        if (candidate.field == field) stored = candidate;
+    }
+    if (!stored) {
+        throw HttpError(404, "step " + std::to_string(key.step) +
+                                 " has no light field of field \"" + field + "\"");
+    }
+    archive_.require_inside(stored->exr_path);
+    send_payload(request, response,
+                 payload_etag("lf", kLightFieldPayloadVersion, key, stored->exr_path), [&] {
+                     return light_field_payload(reader.load_light_field(key.step, field), key.step,
+                                                field);
+                 });
+}
+
+void PayloadRoutes::proxies(const httplib::Request& request, httplib::Response& response) {
+    const StepKey key = step_key(request, archive_);
+    std::lock_guard<std::mutex> lock(archive_.mutex());
+    const ArchiveReader& reader = archive_.reader_locked();
+    const ArchivedView entry = reader.entry(key.step, key.view);
+    const std::string where =
+        "step " + std::to_string(key.step) + " view " + std::to_string(key.view);
+    if (entry.exr_path.empty()) throw HttpError(404, where + " has no proxies");
+    archive_.require_inside(entry.exr_path);
+    send_payload(request, response, payload_etag("px", kProxyPayloadVersion, key, entry.exr_path),
+                 [&] {
+                     const ProxyFrame frame = reader.load(key.step, key.view);
+                     if (frame.attenuation.channels < 1) {
+                         throw HttpError(404, where + " has no attenuation proxies");
+                     }
+                     return proxy_payload(frame, key.step, key.view, entry.field);
+                 });
+}
+
+void PayloadRoutes::send_payload(const httplib::Request& request, httplib::Response& response,
+                                 const std::string& etag,
+                                 const std::function<std::string()>& make) {
+    response.set_header("ETag", etag);
+    response.set_header("Cache-Control", "no-cache");
+    if (request.get_header_value("If-None-Match") == etag) {
+        response.status = 304;
+        return;
+    }
+    auto cached = std::find_if(payloads_.begin(), payloads_.end(),
+                               [&](const auto& entry) { return entry.first == etag; });
+    if (cached == payloads_.end()) {
+        const std::string payload = make();
+        if (payloads_.size() >= kMaxPayloads) payloads_.erase(payloads_.begin());
+        payloads_.emplace_back(etag, std::pair{payload, gzip(payload)});
+        cached = std::prev(payloads_.end());
+    }
+    const auto& [raw, compressed] = cached->second;
+    response.set_header("X-Insitu-Payload-Bytes", std::to_string(raw.size()));
+    if (request.get_header_value("Accept-Encoding").find("gzip") != std::string::npos) {
+        response.set_header("Content-Encoding", "gzip");
+        response.set_content(compressed, "application/octet-stream");
+    } else {
+        response.set_content(raw, "application/octet-stream");
+    }
+}
+
+}  // namespace insitu::viewer

@@ -1,0 +1,41 @@
+#pragma once
+// /api/lightfield and /api/proxies: a step's light field and its stored view's proxies in the
+// binary forms the page uploads to WebGL2 textures (light_field_payload.hpp, proxy_payload.hpp),
+// gzip-compressed when the client accepts it, with an ETag, the last few kept in memory.
+#include <httplib.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "served_archive.hpp"
+
+namespace insitu::viewer {
+
+class PayloadRoutes {
+public:
+    explicit PayloadRoutes(ServedArchive& archive) : archive_(archive) {}
+
+    /// The light field of the field that (step, view) shows; 404 when the step has none.
+    void light_field(const httplib::Request& request, httplib::Response& response);
+    /// The stored view's single-perspective proxies of (step, view); 404 where the view has no
+    /// single-perspective attenuation proxies (the page then asks for frames).
+    void proxies(const httplib::Request& request, httplib::Response& response);
+
+private:
+    /// Sends a binary payload: gzip-compressed when the client accepts it, a 304 when the client
+    /// holds `etag` already; the last few payloads stay in memory for a scrubbing page. Caller
+    /// holds the archive's lock (`make` reads the archive).
+    void send_payload(const httplib::Request& request, httplib::Response& response,
+                      const std::string& etag, const std::function<std::string()>& make);
+
+    ServedArchive& archive_;
+    /// (ETag, (payload, its gzip)), oldest first: light fields and proxies. Guarded by
+    /// archive_.mutex().
+    std::vector<std::pair<std::string, std::pair<std::string, std::string>>> payloads_;
+};
+
+}  // namespace insitu::viewer
