@@ -730,6 +730,26 @@ TEST_F(InstrumentTest, AnErrorBudgetChoosesTheSizeOfTheViewsItArchives) {
     EXPECT_EQ(small.size_divisor, 1);
 }
 
+// The bytes a budget measures a candidate at are the bytes the step then archives: the budget
+// measures the step's own single-perspective pass (step/step_recipe), optical depth included.
+TEST_F(InstrumentTest, AnErrorBudgetMeasuresTheBytesTheStepArchives) {
+    InstrumentConfig config = small_config(directory_ / "bytes.cdb", 48);
+    config.proxies.optical_depth = true;
+    // The stored rendering is the held-out edit's truth in the budget's pass (the same size,
+    // other pixels): without it the two files hold the same images.
+    config.proxies.rendering = false;
+    BudgetConfig budget;
+    budget.psnr_db = 1.0;
+    budget.chooses_precision = false;
+    budget.chooses_size = false;
+    config.budget = budget;
+    const ArchiveReader archive = run_with_budget(config, volume_, 1);
+    const BudgetRecord choice = archive.budget(0).at(0);
+    ASSERT_TRUE(choice.checked);
+    EXPECT_FALSE(archive.load(0, 0).optical_depth.pixels.empty());
+    EXPECT_EQ(choice.bytes, static_cast<double>(fs::file_size(archive.entry(0, 0).exr_path)));
+}
+
 // "rotations": the PSNR a budget asks is the least over the stored view and views turned in
 // azimuth, synthesised from the stored view's proxies. On Gaussian blobs the turned views lose
 // what the stored one hides (their PSNR is below the stored view's), so a PSNR the stored view

@@ -62,6 +62,7 @@ TEST(StepRecipe, TheBudgetMeasuresTheStepsPassThroughAttenuationWithoutTraining)
     InstrumentConfig config = config_of_one_field();
     config.training_transfer_functions = {TransferFunction({{0.0, {1, 1, 1, 0.2f}}})};
     config.keep_training_images = true;
+    config.proxies.optical_depth = true;
     const FieldPlan plan = plan_of(config);
     const IntervalSet candidate = IntervalSet::uniform(0.0, 1.0, 16);
     const ProxyRequest step = field_recipe(config, plan).view_passes.single;
@@ -70,6 +71,7 @@ TEST(StepRecipe, TheBudgetMeasuresTheStepsPassThroughAttenuationWithoutTraining)
     EXPECT_EQ(measured.depth_layers, step.depth_layers);
     EXPECT_EQ(measured.interleaving, step.interleaving);
     EXPECT_EQ(measured.entry_depth, step.entry_depth);
+    EXPECT_EQ(measured.optical_depth, step.optical_depth);
     EXPECT_EQ(measured.isovalues, step.isovalues);
     EXPECT_EQ(measured.march.step_voxels, step.march.step_voxels);
     // The named differences: no training renderings (the colour model's chooser measures them).

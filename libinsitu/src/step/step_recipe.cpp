@@ -111,7 +111,6 @@ ProxyRequest measured_single_pass(const InstrumentConfig& config, const FieldPla
                                   const IntervalSet& intervals) {
     ProxySelection measured = config.proxies;
     measured.attenuation = true;
-    measured.optical_depth = false;
     ProxyRequest request = single_request(measured, base_request(config, plan));
     request.intervals = intervals;
     return request;
