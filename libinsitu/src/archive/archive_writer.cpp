@@ -137,6 +137,102 @@ int light_field_number(const InstrumentConfig& config, const std::string& field,
     return static_cast<int>(found - config.fields.begin());
 }
 
+/// Places the files of one view (its proxies' EXR, unless a light field of the step stands in
+/// for them (manifest.hpp), and its preview), appended to `written`; returns the view's entry.
+nlohmann::json write_view(const fs::path& archive, const InstrumentConfig& config,
+                          const StepRecord& record, const ViewRecord& view,
+                          std::vector<WrittenFile>& written) {
+    nlohmann::json files = nlohmann::json::array();
+    std::vector<std::string> parts;
+    if (record.light_fields.empty() || af::holds_proxy_images(view)) {
+        const std::string exr_path = af::proxy_relative_path(record.step, view.view_index);
+        af::EncodedView exr = af::encode_view(
+            record, view, view.precision.value_or(config.precision), config.compression, exr_path);
+        written.push_back(place_file(archive, exr_path, exr.bytes));
+        files.push_back(af::file_entry(written.back(), af::kProxyKind));
+        parts = std::move(exr.parts);
+    }
+    written.push_back(
+        place_png(archive, af::preview_relative_path(record.step, view.view_index), view.preview));
+    files.push_back(af::file_entry(written.back(), af::kPreviewKind));
+    return {{"view", view.view_index},
+            {"field", view.field.empty() ? record.field : view.field},
+            {"phi", view.view.orbit.azimuth_deg},
+            {"theta", view.view.orbit.elevation_deg},
+            {"parts", parts},
+            {af::kViewTransferFunctionKey, view.transfer_function.to_json()},
+            {"files", std::move(files)}};
+}
+
+/// Places the step's light fields, appended to `written`; returns their "light_fields" list.
+nlohmann::json write_light_fields(const fs::path& archive, const InstrumentConfig& config,
+                                  const StepRecord& record, std::vector<WrittenFile>& written) {
+    const af::LightFieldEncoding encoding =
+        af::light_field_encoding(config.precision, config.compression);
+    nlohmann::json entries = nlohmann::json::array();
+    for (const LightFieldRecord& light_field : record.light_fields) {
+        const std::string path = af::light_field_relative_path(
+            record.step, light_field_number(config, light_field.field, record.step));
+        const af::EncodedLightField exr =
+            af::encode_light_field(record, light_field, encoding, path);
+        written.push_back(place_file(archive, path, exr.bytes));
+        const LightFieldRig& rig = light_field.light_field.rig;
+        entries.push_back(af::light_field_entry(light_field.field, written.back(),
+                                                rig.camera_count(), rig.map_size()));
+    }
+    return entries;
+}
+
+/// Places every file of the step, appended to `written` in the order they are placed (views,
+/// then light fields); returns the step's entry, which names them.
+nlohmann::json write_step_files(const fs::path& archive, const InstrumentConfig& config,
+                                const StepRecord& record, std::vector<WrittenFile>& written) {
+    nlohmann::json step_entry{{"step", record.step},
+                              {"time", record.time},
+                              {"field", record.field},
+                              {"views", nlohmann::json::array()}};
+    for (const ViewRecord& view : record.views) {
+        step_entry["views"].push_back(write_view(archive, config, record, view, written));
+    }
+    if (!record.light_fields.empty()) {
+        step_entry[af::kLightFieldsKey] = write_light_fields(archive, config, record, written);
+    }
+    if (!record.fields.empty()) {
+        nlohmann::json& summaries = step_entry[af::kFieldsKey];
+        summaries = nlohmann::json::array();
+        for (const FieldSummaryRecord& summary : record.fields) {
+            summaries.push_back({{"field", summary.field},
+                                 {"histogram", summary.histogram.to_json()},
+                                 {"nonfinite", summary.nonfinite_samples}});
+        }
+    }
+    if (!record.budget.empty()) {
+        nlohmann::json& budget = step_entry[af::kBudgetKey];
+        budget = nlohmann::json::array();
+        for (const BudgetRecord& choice : record.budget) budget.push_back(af::budget_entry(choice));
+    }
+    return step_entry;
+}
+
+/// After a write failed before the step was indexed: nothing names its files, so they are
+/// removed and the archive is as it was (best effort, a leftover would only be clutter that the
+/// next write of this step replaces). Rows already in data.csv are cut back first; should that
+/// fail they still name the files, which then stay.
+void remove_unindexed_files(const fs::path& archive, std::optional<std::uint64_t> csv_size_before,
+                            const std::vector<WrittenFile>& written) {
+    if (csv_size_before) {
+        try {
+            af::truncate_file(archive / af::kCsvFile, *csv_size_before);
+        } catch (const IoError&) {
+            return;
+        }
+    }
+    for (const WrittenFile& file : written) {
+        std::error_code ignored;
+        fs::remove(archive / file.relative_path, ignored);
+    }
+}
+
 }  // namespace
 
 namespace {
@@ -260,70 +356,10 @@ StepWriteResult ArchiveWriter::write(const StepRecord& record) {
     const fs::path archive(path_);
 
     StepWriteResult result;
-    nlohmann::json step_entry{{"step", record.step},
-                              {"time", record.time},
-                              {"field", record.field},
-                              {"views", nlohmann::json::array()}};
     bool indexed = false;
     std::optional<std::uint64_t> csv_size_before;
     try {
-        for (const ViewRecord& view : record.views) {
-            nlohmann::json files = nlohmann::json::array();
-            std::vector<std::string> parts;
-            // A view of a step with light fields may hold only its preview (no "proxies"): the
-            // light field stands in for its proxies (manifest.hpp).
-            if (record.light_fields.empty() || af::holds_proxy_images(view)) {
-                const std::string exr_path = af::proxy_relative_path(record.step, view.view_index);
-                af::EncodedView exr =
-                    af::encode_view(record, view, view.precision.value_or(config_.precision),
-                                    config_.compression, exr_path);
-                result.files.push_back(place_file(archive, exr_path, exr.bytes));
-                files.push_back(af::file_entry(result.files.back(), af::kProxyKind));
-                parts = std::move(exr.parts);
-            }
-            result.files.push_back(place_png(
-                archive, af::preview_relative_path(record.step, view.view_index), view.preview));
-            files.push_back(af::file_entry(result.files.back(), af::kPreviewKind));
-            step_entry["views"].push_back(
-                {{"view", view.view_index},
-                 {"field", view.field.empty() ? record.field : view.field},
-                 {"phi", view.view.orbit.azimuth_deg},
-                 {"theta", view.view.orbit.elevation_deg},
-                 {"parts", parts},
-                 {af::kViewTransferFunctionKey, view.transfer_function.to_json()},
-                 {"files", std::move(files)}});
-        }
-        if (!record.light_fields.empty()) {
-            const af::LightFieldEncoding encoding =
-                af::light_field_encoding(config_.precision, config_.compression);
-            nlohmann::json& entries = step_entry[af::kLightFieldsKey];
-            entries = nlohmann::json::array();
-            for (const LightFieldRecord& light_field : record.light_fields) {
-                const std::string path = af::light_field_relative_path(
-                    record.step, light_field_number(config_, light_field.field, record.step));
-                const af::EncodedLightField exr =
-                    af::encode_light_field(record, light_field, encoding, path);
-                result.files.push_back(place_file(archive, path, exr.bytes));
-                const LightFieldRig& rig = light_field.light_field.rig;
-                entries.push_back(af::light_field_entry(light_field.field, result.files.back(),
-                                                        rig.camera_count(), rig.map_size()));
-            }
-        }
-        if (!record.fields.empty()) {
-            nlohmann::json& summaries = step_entry[af::kFieldsKey];
-            summaries = nlohmann::json::array();
-            for (const FieldSummaryRecord& summary : record.fields) {
-                summaries.push_back({{"field", summary.field},
-                                     {"histogram", summary.histogram.to_json()},
-                                     {"nonfinite", summary.nonfinite_samples}});
-            }
-        }
-        if (!record.budget.empty()) {
-            nlohmann::json& budget = step_entry[af::kBudgetKey];
-            budget = nlohmann::json::array();
-            for (const BudgetRecord& choice : record.budget)
-                budget.push_back(af::budget_entry(choice));
-        }
+        const nlohmann::json step_entry = write_step_files(archive, config_, record, result.files);
         // The entry must read back before anything names it (issue 19).
         try {
             af::check_step_entry(step_entry, (archive / af::kJournalFile).string(), "new entry");
@@ -347,24 +383,7 @@ StepWriteResult ArchiveWriter::write(const StepRecord& record) {
             compact();
         }
     } catch (...) {
-        if (!indexed) {
-            // Nothing names these files; remove them so the archive is as it was (best effort,
-            // a leftover would only be clutter that the next write of this step replaces). Rows
-            // already in data.csv are cut back first; should that fail they still name files.
-            bool rows_named = false;
-            if (csv_size_before) {
-                try {
-                    af::truncate_file(archive / af::kCsvFile, *csv_size_before);
-                } catch (const IoError&) {
-                    rows_named = true;
-                }
-            }
-            for (const WrittenFile& file : result.files) {
-                if (rows_named) break;
-                std::error_code ignored;
-                fs::remove(archive / file.relative_path, ignored);
-            }
-        }
+        if (!indexed) remove_unindexed_files(archive, csv_size_before, result.files);
         throw;
     }
     return result;

@@ -47,7 +47,8 @@ inline constexpr const char* kMalformedKey = "malformed_steps";
 nlohmann::json empty_manifest();
 
 /// One field's budget choice as the step entry's "budget" list holds it, and back (ParseError
-/// or nlohmann's exceptions for an entry of the wrong form: check_step_entry names it).
+/// or nlohmann's exceptions for an entry of the wrong form: check_step_entry names it). These
+/// and the PSNR's form below are in manifest_budget.cpp.
 nlohmann::json budget_entry(const BudgetRecord& choice);
 BudgetRecord budget_from_entry(const nlohmann::json& entry);
 

@@ -10,18 +10,14 @@
 #include <ostream>
 #include <utility>
 
+#include "core/light_field_cameras.hpp"
 #include "insitu/core/check.hpp"
 #include "insitu/error.hpp"
 
 namespace insitu {
 
-namespace {
+namespace detail {
 
-using nlohmann::json;
-
-constexpr const char* kCameraCountsText = "12, 42, 162 or 642";
-
-// Index of `count` in kLightFieldCameraCounts (the subdivision level), or -1.
 int subdivision_level(int count) {
     const auto found =
         std::find(kLightFieldCameraCounts.begin(), kLightFieldCameraCounts.end(), count);
@@ -29,6 +25,15 @@ int subdivision_level(int count) {
                ? -1
                : static_cast<int>(found - kLightFieldCameraCounts.begin());
 }
+
+}  // namespace detail
+
+using detail::kCameraCountsText;
+using detail::subdivision_level;
+
+namespace {
+
+using nlohmann::json;
 
 // Round trips through degrees (Camera::orbit) and through JSON text lose a few ulps of the
 // scene's scale; anything beyond this fraction of it is a different rig.
@@ -470,194 +475,4 @@ std::ostream& operator<<(std::ostream& out, const LightFieldRig& rig) {
                << "), R=" << rig.bounding_radius() << ", Rc=" << rig.camera_radius() << "}";
 }
 
-// ---------------------------------------------------------------------------------------------
-// LightFieldSettings ("light_field" in the configuration; messages as config.cpp writes them)
-
-namespace {
-
-constexpr const char* kSettingsKey = "light_field";
-
-std::string settings_key(const std::string& member) {
-    return std::string(kSettingsKey) + "." + member;
-}
-
-[[noreturn]] void settings_wrong_type(const std::string& key, const json& value,
-                                      const char* expected) {
-    fail<ParseError>("configuration \"", key, "\" = ", value.dump(), " (expected ", expected, ")");
-}
-
-template <typename... Why>
-[[noreturn]] void settings_out_of_range(const std::string& key, const json& value,
-                                        const Why&... why) {
-    fail<InvalidArgument>("configuration \"", key, "\" = ", value.dump(), " (", why..., ")");
-}
-
-int settings_integer(const json& value, const std::string& key) {
-    if (!value.is_number_integer()) settings_wrong_type(key, value, "an integer");
-    if ((value.is_number_unsigned() &&
-         value.get<std::uint64_t>() >
-             static_cast<std::uint64_t>(std::numeric_limits<int>::max())) ||
-        value.get<std::int64_t>() < std::numeric_limits<int>::min() ||
-        value.get<std::int64_t>() > std::numeric_limits<int>::max()) {
-        settings_out_of_range(key, value, "does not fit in an int");
-    }
-    return value.get<int>();
-}
-
-double settings_number(const json& value, const std::string& key) {
-    if (!value.is_number()) settings_wrong_type(key, value, "a number");
-    return value.get<double>();
-}
-
-bool settings_boolean(const json& value, const std::string& key) {
-    if (!value.is_boolean()) settings_wrong_type(key, value, "true or false");
-    return value.get<bool>();
-}
-
-json segments_json(const LightFieldSettings& settings) {
-    switch (settings.segments) {
-        case SegmentRule::whole_ray:
-            return "none";
-        case SegmentRule::layers:
-            return "layers";
-        case SegmentRule::opacity:
-            return settings.opacity_thresholds;
-    }
-    fail<Error>("light field settings: a segment rule without a name");  // a bug
-}
-
-constexpr const char* kSettingsKeys[] = {"cameras",     "size",       "segments",
-                                         "attenuation", "depth_bits", "depth_threshold"};
-
-}  // namespace
-
-std::string to_string(SegmentRule rule) {
-    switch (rule) {
-        case SegmentRule::whole_ray:
-            return "whole_ray";
-        case SegmentRule::layers:
-            return "layers";
-        case SegmentRule::opacity:
-            return "opacity";
-    }
-    fail<Error>("to_string(SegmentRule): a rule without a name");  // a bug
-}
-
-void LightFieldSettings::validate() const {
-    if (subdivision_level(cameras) < 0) {
-        settings_out_of_range(settings_key("cameras"), cameras, "must be ", kCameraCountsText,
-                              ": the vertices of a subdivided icosahedron");
-    }
-    if (size < kMinLightFieldMapSize || size > kMaxLightFieldMapSize) {
-        settings_out_of_range(settings_key("size"), size, "map pixels per side, must be in [",
-                              kMinLightFieldMapSize, ", ", kMaxLightFieldMapSize, "]");
-    }
-    if (segments == SegmentRule::opacity) {
-        if (opacity_thresholds.empty()) {
-            settings_out_of_range(settings_key("segments"), segments_json(*this),
-                                  "expected \"none\", \"layers\" or at least one opacity "
-                                  "threshold");
-        }
-        for (size_t i = 0; i < opacity_thresholds.size(); ++i) {
-            const double threshold = opacity_thresholds[i];
-            if (!(threshold > 0.0 && threshold < 1.0)) {
-                settings_out_of_range(settings_key("segments[" + std::to_string(i) + "]"),
-                                      threshold, "an opacity threshold, must be in (0, 1)");
-            }
-            if (i > 0 && !(threshold > opacity_thresholds[i - 1])) {
-                settings_out_of_range(settings_key("segments"), segments_json(*this),
-                                      "opacity thresholds must increase");
-            }
-        }
-    } else if (!opacity_thresholds.empty()) {
-        settings_out_of_range(settings_key("segments"), segments_json(*this),
-                              "opacity thresholds are given but the segments are ",
-                              to_string(segments));
-    }
-    if (depth_bits != 8 && depth_bits != 16) {
-        settings_out_of_range(settings_key("depth_bits"), depth_bits, "expected 8 or 16");
-    }
-    if (!(depth_threshold > 0.0 && depth_threshold < 1.0)) {
-        settings_out_of_range(settings_key("depth_threshold"), depth_threshold,
-                              "opacity of the first hit, must be in (0, 1)");
-    }
-}
-
-json LightFieldSettings::to_json() const {
-    return {{"cameras", cameras},
-            {"size", size},
-            {"segments", segments_json(*this)},
-            {"attenuation", attenuation},
-            {"depth_bits", depth_bits},
-            {"depth_threshold", depth_threshold}};
-}
-
-std::vector<std::string> LightFieldSettings::keys() {
-    return {std::begin(kSettingsKeys), std::end(kSettingsKeys)};
-}
-
-LightFieldSettings LightFieldSettings::from_json(const json& object,
-                                                 std::vector<std::string>* unknown_keys) {
-    if (!object.is_object()) settings_wrong_type(kSettingsKey, object, "an object");
-    std::vector<std::string> unknown;
-    for (const auto& item : object.items()) {
-        if (std::none_of(std::begin(kSettingsKeys), std::end(kSettingsKeys),
-                         [&](const char* known) { return item.key() == known; })) {
-            unknown.push_back(settings_key(item.key()));
-        }
-    }
-    if (unknown_keys != nullptr) {
-        unknown_keys->insert(unknown_keys->end(), unknown.begin(), unknown.end());
-    } else if (!unknown.empty()) {
-        std::string joined;
-        for (const std::string& key : unknown) joined += (joined.empty() ? "" : ", ") + key;
-        fail<ParseError>("configuration: unknown keys ", joined);
-    }
-
-    LightFieldSettings settings;
-    const auto read = [&](const char* key, auto parse) {
-        const auto found = object.find(key);
-        if (found != object.end()) parse(*found, settings_key(key));
-    };
-    read("cameras",
-         [&](const json& v, const std::string& k) { settings.cameras = settings_integer(v, k); });
-    read("size",
-         [&](const json& v, const std::string& k) { settings.size = settings_integer(v, k); });
-    read("segments", [&](const json& v, const std::string& k) {
-        if (v.is_string()) {
-            const std::string name = v.get<std::string>();
-            if (name == "none") {
-                settings.segments = SegmentRule::whole_ray;
-            } else if (name == "layers") {
-                settings.segments = SegmentRule::layers;
-            } else {
-                settings_out_of_range(k, v,
-                                      "expected \"none\", \"layers\" or a list of increasing "
-                                      "opacity thresholds in (0, 1)");
-            }
-        } else if (v.is_array()) {
-            settings.segments = SegmentRule::opacity;
-            for (size_t i = 0; i < v.size(); ++i) {
-                settings.opacity_thresholds.push_back(
-                    settings_number(v[i], k + "[" + std::to_string(i) + "]"));
-            }
-        } else {
-            settings_wrong_type(k, v, "\"none\", \"layers\" or an array of opacity thresholds");
-        }
-    });
-    read("attenuation", [&](const json& v, const std::string& k) {
-        settings.attenuation = settings_boolean(v, k);
-    });
-    read("depth_bits", [&](const json& v, const std::string& k) {
-        settings.depth_bits = settings_integer(v, k);
-    });
-    read("depth_threshold", [&](const json& v, const std::string& k) {
-        settings.depth_threshold = settings_number(v, k);
-    });
-    settings.validate();
-    return settings;
-}
-
 }  // namespace insitu
-
-// light_field.cpp: complete

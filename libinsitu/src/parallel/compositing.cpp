@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <exception>
 #include <glm/trigonometric.hpp>
 #include <limits>
 
 #include "insitu/core/check.hpp"
 #include "insitu/error.hpp"
+#include "parallel/direct_send.hpp"
 
 namespace insitu {
 
@@ -362,10 +362,6 @@ void check_partial(const ProxyLayout& layout, const ProxyFrame& shell, const Pro
     }
 }
 
-std::int64_t tile_begin(std::int64_t pixels, int tiles, int tile) {
-    return pixels * tile / tiles;
-}
-
 // Ground truth: the fragment's first index, premultiplied RGBA, depth.
 constexpr int kRenderingRecord = 6;
 constexpr int kRenderingOutputs = 5;
@@ -426,77 +422,6 @@ void unpack_rendering(const float* values, std::int64_t begin, std::int64_t end,
     }
 }
 
-// Direct send: tile k of every rank's records to rank k, fold, gather the tiles at the root,
-// which hands each folded tile to unpack(begin, end, values). A rank's share of its own tile
-// and the root's own folded tile never go through the communicator (no copy of them).
-template <typename Pack, typename Fold, typename Unpack>
-void direct_send(Communicator& communicator, std::int64_t pixels, int outputs, int root, Pack pack,
-                 Fold fold, Unpack unpack) {
-    const int ranks = communicator.size();
-    if (pixels >= std::int64_t{1} << 32) {
-        fail<InvalidArgument>("compositing: ", pixels, " pixels exceed 2^32");
-    }
-    // A rank whose own work fails (packing, folding, unpacking) still takes part in both
-    // exchanges, with nothing to send, and throws once they are done: the others must not wait
-    // for it. (Its caller then agrees on the failure with them.)
-    std::exception_ptr failure;
-    const auto local = [&](auto&& work) {
-        try {
-            work();
-        } catch (...) {
-            if (!failure) failure = std::current_exception();
-        }
-    };
-    const int me = communicator.rank();
-    std::vector<Bytes> to_each(static_cast<std::size_t>(ranks));
-    Bytes own;
-    const std::int64_t begin = tile_begin(pixels, ranks, me);
-    const std::int64_t end = tile_begin(pixels, ranks, me + 1);
-    local([&] {
-        for (int k = 0; k < ranks; ++k) {
-            if (k != me) {
-                to_each[k] = pack(tile_begin(pixels, ranks, k), tile_begin(pixels, ranks, k + 1));
-            }
-        }
-        own = pack(begin, end);
-    });
-    if (failure) to_each.assign(static_cast<std::size_t>(ranks), Bytes{});
-    std::vector<Bytes> received = communicator.all_to_all(to_each);
-    received[me] = std::move(own);
-    std::vector<float> tile;
-    local([&] { tile = fold(received, begin, end); });
-    tile.resize(static_cast<std::size_t>((end - begin) * outputs));  // what the root expects
-    received.clear();
-    Bytes mine;
-    if (me != root) {
-        const auto* tile_bytes = reinterpret_cast<const std::uint8_t*>(tile.data());
-        mine.assign(tile_bytes, tile_bytes + tile.size() * sizeof(float));
-    }
-    const std::vector<Bytes> tiles = communicator.gather(mine, root);
-    if (me == root) {
-        local([&] {
-            std::vector<float> values;
-            for (int k = 0; k < ranks; ++k) {
-                const std::int64_t first = tile_begin(pixels, ranks, k);
-                const std::int64_t last = tile_begin(pixels, ranks, k + 1);
-                if (k == root) {
-                    unpack(first, last, tile.data());
-                    continue;
-                }
-                const std::size_t expected = static_cast<std::size_t>((last - first) * outputs);
-                if (tiles[k].size() != expected * sizeof(float)) {
-                    fail<Error>("compositing: rank ", k, " sent a tile of ", tiles[k].size(),
-                                " bytes, expected ", expected * sizeof(float));
-                }
-                values.resize(expected);
-                if (expected > 0) std::memcpy(values.data(), tiles[k].data(), tiles[k].size());
-                unpack(first, last, values.data());
-            }
-        });
-    }
-    if (failure) std::rethrow_exception(failure);
-}
-
 }  // namespace
 
 ProxyFrame frame_shell(const Camera& camera, double tilt_deg, bool multi_perspective,
@@ -535,7 +460,7 @@ ProxyFrame composite_proxies(Communicator& communicator, const ProxyFrame& shell
         static_cast<std::int64_t>(shell.camera.width()) * shell.camera.height();
     ProxyFrame frame = shell;
     if (communicator.rank() == root) allocate_images(frame);
-    direct_send(
+    detail::direct_send(
         communicator, pixels, layout.outputs(), root,
         [&](std::int64_t begin, std::int64_t end) {
             return partial != nullptr ? pack_proxy_records(layout, *partial, begin, end) : Bytes{};
@@ -561,7 +486,7 @@ Rendering composite_rendering(Communicator& communicator, int width, int height,
         result.rgba = Image(width, height, 4);
         result.depth = Image(width, height, 1);
     }
-    direct_send(
+    detail::direct_send(
         communicator, pixels, kRenderingOutputs, root,
         [&](std::int64_t begin, std::int64_t end) {
             return partial != nullptr ? pack_rendering_records(*partial, begin, end) : Bytes{};

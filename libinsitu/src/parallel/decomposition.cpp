@@ -85,10 +85,12 @@ BlockExtent BlockExtent::from_values(const double* values) {
     return extent;
 }
 
-Decomposition decompose(const std::string& field, const std::vector<BlockExtent>& blocks) {
-    Decomposition grid;
-    grid.field = field;
-    const std::string what = "field \"" + field + "\": ";
+namespace {
+
+/// The grid the blocks share: its spacing and centring, which every block must have, and its
+/// first sample, the lowest of theirs.
+void check_shared_grid(Decomposition& grid, const std::vector<BlockExtent>& blocks,
+                       const std::string& what) {
     int first = -1;
     for (std::size_t r = 0; r < blocks.size(); ++r) {
         if (blocks[r].present) {
@@ -121,7 +123,11 @@ Decomposition decompose(const std::string& field, const std::vector<BlockExtent>
             grid.first_sample[axis] = std::min(grid.first_sample[axis], block.first_sample[axis]);
         }
     }
+}
 
+/// Each block's interior in grid samples, which must fall on the grid, and the grid's size.
+void place_blocks(Decomposition& grid, const std::vector<BlockExtent>& blocks,
+                  const std::string& what) {
     grid.parts.resize(blocks.size());
     for (int axis = 0; axis < 3; ++axis) grid.dims[axis] = 0;
     for (std::size_t r = 0; r < blocks.size(); ++r) {
@@ -145,21 +151,27 @@ Decomposition decompose(const std::string& field, const std::vector<BlockExtent>
                 std::max(grid.dims[axis], part.interior_lower[axis] + block.dims[axis]);
         }
     }
+}
 
-    // Where a neighbour's interior starts right after a rank's last interior sample, the rank
-    // marches the cell between (with its ghost layer); where a neighbour shares that sample
-    // (face-sharing tiles), ownership ends there.
-    const auto overlaps_across = [&](std::size_t r, std::size_t s, int axis) {
-        for (int other = 0; other < 3; ++other) {
-            if (other == axis) continue;
-            const std::int64_t r_low = grid.parts[r].interior_lower[other];
-            const std::int64_t s_low = grid.parts[s].interior_lower[other];
-            const std::int64_t r_high = r_low + blocks[r].dims[other] - 1;
-            const std::int64_t s_high = s_low + blocks[s].dims[other] - 1;
-            if (std::max(r_low, s_low) > std::min(r_high, s_high)) return false;
-        }
-        return true;
-    };
+/// Whether the interiors of ranks r and s overlap on the two axes other than `axis`.
+bool overlaps_across(const Decomposition& grid, const std::vector<BlockExtent>& blocks,
+                     std::size_t r, std::size_t s, int axis) {
+    for (int other = 0; other < 3; ++other) {
+        if (other == axis) continue;
+        const std::int64_t r_low = grid.parts[r].interior_lower[other];
+        const std::int64_t s_low = grid.parts[s].interior_lower[other];
+        const std::int64_t r_high = r_low + blocks[r].dims[other] - 1;
+        const std::int64_t s_high = s_low + blocks[s].dims[other] - 1;
+        if (std::max(r_low, s_low) > std::min(r_high, s_high)) return false;
+    }
+    return true;
+}
+
+/// The box each rank owns. Where a neighbour's interior starts right after a rank's last
+/// interior sample, the rank marches the cell between (with its ghost layer); where a neighbour
+/// shares that sample (face-sharing tiles), ownership ends there.
+void assign_ownership(Decomposition& grid, const std::vector<BlockExtent>& blocks,
+                      const std::string& what) {
     for (std::size_t r = 0; r < blocks.size(); ++r) {
         Decomposition::Part& part = grid.parts[r];
         if (!part.present) continue;
@@ -174,7 +186,8 @@ Decomposition decompose(const std::string& field, const std::vector<BlockExtent>
             int ghost_neighbour = -1;
             for (std::size_t s = 0; s < blocks.size(); ++s) {
                 if (s == r || !grid.parts[s].present) continue;
-                if (grid.parts[s].interior_lower[axis] == high + 1 && overlaps_across(r, s, axis)) {
+                if (grid.parts[s].interior_lower[axis] == high + 1 &&
+                    overlaps_across(grid, blocks, r, s, axis)) {
                     ghost_neighbour = static_cast<int>(s);
                     break;
                 }
@@ -194,10 +207,13 @@ Decomposition decompose(const std::string& field, const std::vector<BlockExtent>
             part.marched_ghosts[axis] = 1;
         }
     }
+}
 
-    // The owned boxes must partition the grid: no two overlap and together they fill it.
+/// The owned boxes must partition the grid: no two overlap and together they fill it.
+void check_partition(const Decomposition& grid, const std::string& what) {
+    const std::size_t ranks = grid.parts.size();
     double owned_volume = 0.0;
-    for (std::size_t r = 0; r < blocks.size(); ++r) {
+    for (std::size_t r = 0; r < ranks; ++r) {
         const Decomposition::Part& a = grid.parts[r];
         if (!a.present) continue;
         double volume = 1.0;
@@ -205,7 +221,7 @@ Decomposition decompose(const std::string& field, const std::vector<BlockExtent>
             volume *= std::max(0.0, finite_upper(a, axis, grid.dims) - finite_lower(a, axis));
         }
         owned_volume += volume;
-        for (std::size_t s = r + 1; s < blocks.size(); ++s) {
+        for (std::size_t s = r + 1; s < ranks; ++s) {
             const Decomposition::Part& b = grid.parts[s];
             if (!b.present) continue;
             double shared = 1.0;
@@ -230,6 +246,18 @@ Decomposition decompose(const std::string& field, const std::vector<BlockExtent>
                               grid.dims[2], "-sample grid from ", vector_text(grid.first_sample),
                               " (interiors must together hold every sample)");
     }
+}
+
+}  // namespace
+
+Decomposition decompose(const std::string& field, const std::vector<BlockExtent>& blocks) {
+    Decomposition grid;
+    grid.field = field;
+    const std::string what = "field \"" + field + "\": ";
+    check_shared_grid(grid, blocks, what);
+    place_blocks(grid, blocks, what);
+    assign_ownership(grid, blocks, what);
+    check_partition(grid, what);
     grid.bounds.lower = grid.first_sample;
     for (int axis = 0; axis < 3; ++axis) {
         grid.bounds.upper[axis] =

@@ -52,6 +52,110 @@ std::string list_text(const std::vector<double>& values) {
     return text.str() + "]";
 }
 
+/// What one proxy pass computes: which outputs, how many layers, intervals and segments, and
+/// the kernel's flags for them.
+struct PassPlan {
+    bool want_layers = false;
+    bool want_accumulation = false;
+    bool want_segments = false;
+    /// Both read the transfer function's opacity, so both decide which blocks may be skipped.
+    bool want_opacity = false;
+    bool partial = false;  ///< a block of a distributed run: fragments for compositing
+    std::vector<double> crossing_isovalues;
+    int segments = 0;
+    int layer_count = 0;
+    int interval_count = 0;
+    int wanted = 0;  ///< detail::kWant* flags
+};
+
+/// Refuses the outputs that partial frames cannot composite: a block sees its own part of each
+/// ray only.
+void check_partial_request(const ProxyRequest& request, bool want_segments) {
+    // A run that the block's neighbour interrupts is not a re-entry it can count.
+    if (request.interleaving) {
+        fail<InvalidArgument>(
+            "interleaving counts are not composited across blocks: a block of a distributed "
+            "run cannot know which intervals the ray met in front of it");
+    }
+    if (request.entry_depth) {
+        fail<InvalidArgument>(
+            "entry depths are not composited across blocks: a block of a distributed run "
+            "cannot know which intervals the ray met in front of it");
+    }
+    // A segment's and the first hit's opacity thresholds depend on the opacity in front of
+    // the block, which a block does not know.
+    if (want_segments) {
+        fail<InvalidArgument>(
+            "segment and first-hit outputs (light fields) are not composited across blocks: "
+            "a block of a distributed run cannot know the opacity in front of it");
+    }
+    if (request.march.early_termination_opacity < 1.0) {
+        fail<InvalidArgument>(
+            "early_termination_opacity = ", request.march.early_termination_opacity,
+            " for a block (a block cannot know the opacity in front of it: "
+            "partial frames composite exactly only with 1)");
+    }
+}
+
+PassPlan plan_pass(const ProxyRequest& request, bool multi_perspective, bool partial) {
+    PassPlan plan;
+    plan.want_layers = request.depth_layers && !request.isovalues.empty();
+    plan.want_accumulation = accumulates(request);
+    plan.want_segments = wants_segments(request);
+    // Segments split at the layers need their crossings found, depth layers stored or not.
+    const bool find_crossings =
+        plan.want_layers || (plan.want_segments && request.segments == SegmentRule::layers &&
+                             !request.isovalues.empty());
+    plan.want_opacity = plan.want_accumulation || plan.want_segments;
+    plan.crossing_isovalues = find_crossings ? request.isovalues : std::vector<double>{};
+    plan.segments = plan.want_segments ? segment_count(request) : 0;
+    plan.layer_count = static_cast<int>(plan.crossing_isovalues.size());
+    plan.interval_count = plan.want_accumulation ? request.intervals->count() : 0;
+    // validate() bounded both; the kernel's private arrays are sized by these limits.
+    INSITU_CHECK_LE(plan.layer_count, kMaxLayers);
+    INSITU_CHECK_LE(plan.interval_count, kMaxIntervals);
+
+    int& wanted = plan.wanted;
+    if (plan.want_layers) wanted |= detail::kWantDepth;
+    if (plan.want_layers && multi_perspective) wanted |= detail::kWantDistortion;
+    if (request.attenuation) wanted |= detail::kWantAttenuation;
+    if (request.mean_depth) wanted |= detail::kWantMeanDepth;
+    if (request.optical_depth) wanted |= detail::kWantOpticalDepth;
+    if (request.segment_rgba) wanted |= detail::kWantSegmentRgba;
+    if (request.segment_depth) wanted |= detail::kWantSegmentDepth;
+    if (request.first_hit_depth) wanted |= detail::kWantFirstHitDepth;
+    if (request.interleaving) wanted |= detail::kWantInterleaving;
+    if (request.entry_depth) wanted |= detail::kWantEntryDepth;
+    plan.partial = partial;
+    if (partial) {
+        check_partial_request(request, plan.want_segments);
+        wanted |= detail::kWantFragment;
+    }
+    return plan;
+}
+
+/// The pass's output buffers; null for outputs the pass does not make.
+struct PassOutputs {
+    cl::Buffer depth, distortion, attenuation, mean_depth, optical_depth, interleaving, entry_depth,
+        segment_rgba, segment_depth, first_hit, fragment;
+};
+
+/// The pass's inputs on the device (null buffers for those it does not read).
+struct PassInputs {
+    TransferTable table;
+    cl::Buffer table_buffer, isovalues, thresholds, edges;
+    /// Equal-width intervals let the kernel compute the index instead of searching for it.
+    double uniform_scale = 0.0;
+};
+
+/// The blocks the pass may skip (empty space); defaults make the kernel look up no blocks.
+struct SkippedBlocks {
+    cl::Buffer skippable;
+    cl_int4 block_counts = {{1, 1, 1, 0}};
+    cl_int block_voxels = 0;
+    double skippable_fraction = 0.0;
+};
+
 }  // namespace
 
 void validate(const ProxyRequest& request) {
@@ -118,6 +222,13 @@ struct ProxyRenderer::DeviceState {
     /// Block ranges of the uploaded volume, rescanned when its generation changes.
     detail::BlockRanges blocks;
     std::uint64_t blocks_generation = 0;
+
+    PassOutputs outputs(detail::OpenClDevice& opencl, const ProxyRequest& request,
+                        const PassPlan& plan, bool multi_perspective, std::size_t pixels);
+    PassInputs upload_inputs(detail::OpenClDevice& opencl, const ProxyRequest& request,
+                             const PassPlan& plan, double step_world);
+    SkippedBlocks skip_blocks(detail::OpenClDevice& opencl, const DeviceVolume& volume,
+                              const TransferTable& table, const PassPlan& plan);
 };
 
 ProxyRenderer::ProxyRenderer(std::shared_ptr<ComputeDevice> device)
@@ -171,6 +282,183 @@ ProxyFrame ProxyRenderer::render(const DistortionCamera& camera, const ProxyRequ
     return march(camera.base(), camera.tilt_deg(), true, request);
 }
 
+namespace {
+
+/// A reused device buffer of `planes` float planes of `pixels`, or a null buffer when the pass
+/// does not make that output.
+cl::Buffer output_buffer(detail::OpenClDevice& opencl, detail::DeviceMemory& reused, bool needed,
+                         std::size_t pixels, int planes) {
+    if (!needed) return cl::Buffer();
+    opencl.ensure_buffer(reused.buffer, reused.capacity, pixels * planes * sizeof(float),
+                         CL_MEM_WRITE_ONLY);
+    return reused.buffer;
+}
+
+/// `values` in a reused read-only device buffer; a null buffer when there are none.
+cl::Buffer upload_floats(detail::OpenClDevice& opencl, detail::DeviceMemory& reused,
+                         const std::vector<float>& values, const char* what) {
+    if (values.empty()) return cl::Buffer();
+    const std::size_t bytes = values.size() * sizeof(float);
+    opencl.ensure_buffer(reused.buffer, reused.capacity, bytes, CL_MEM_READ_ONLY);
+    opencl.upload(reused.buffer, values.data(), bytes, what);
+    return reused.buffer;
+}
+
+}  // namespace
+
+PassOutputs ProxyRenderer::DeviceState::outputs(detail::OpenClDevice& opencl,
+                                                const ProxyRequest& request, const PassPlan& plan,
+                                                bool multi_perspective, std::size_t pixels) {
+    // Only requested outputs get device memory; the others are passed as null buffers.
+    const int layers = plan.layer_count;
+    const int intervals = plan.interval_count;
+    PassOutputs out;
+    out.depth = output_buffer(opencl, depth_out, plan.want_layers, pixels, layers);
+    out.distortion = output_buffer(opencl, distortion_out, plan.want_layers && multi_perspective,
+                                   pixels, layers);
+    // The kernel accumulates a_j in place whenever it accumulates anything (mean depth divides
+    // by it), so this buffer exists then even if a_j itself is not returned.
+    out.attenuation =
+        output_buffer(opencl, attenuation_out, plan.want_accumulation, pixels, intervals);
+    out.mean_depth = output_buffer(opencl, mean_depth_out, request.mean_depth, pixels, intervals);
+    out.optical_depth =
+        output_buffer(opencl, optical_depth_out, request.optical_depth, pixels, intervals);
+    out.interleaving = output_buffer(opencl, interleaving_out, request.interleaving, pixels, 2);
+    out.entry_depth =
+        output_buffer(opencl, entry_depth_out, request.entry_depth, pixels, intervals);
+    out.segment_rgba =
+        output_buffer(opencl, segment_rgba_out, request.segment_rgba, pixels, 4 * plan.segments);
+    out.segment_depth =
+        output_buffer(opencl, segment_depth_out, request.segment_depth, pixels, plan.segments);
+    out.first_hit = output_buffer(opencl, first_hit_out, request.first_hit_depth, pixels, 1);
+    out.fragment =
+        output_buffer(opencl, fragment_out, plan.partial, pixels, detail::kFragmentChannels);
+    return out;
+}
+
+PassInputs ProxyRenderer::DeviceState::upload_inputs(detail::OpenClDevice& opencl,
+                                                     const ProxyRequest& request,
+                                                     const PassPlan& plan, double step_world) {
+    PassInputs in;
+    // The attenuation's opacity and the segments' colour are classified exactly as the ground
+    // truth classifies them. Without either a one-entry transparent table keeps the kernel's
+    // arguments valid.
+    in.table = plan.want_opacity
+                   ? step_corrected_table(*request.transfer_function, step_world, request.march)
+                   : TransferFunction({{0.0, glm::vec4(0.0f)}, {1.0, glm::vec4(0.0f)}}).sample(2);
+    in.table_buffer = upload_floats(opencl, table, in.table.rgba, "transfer-function table");
+    const std::vector<double>& crossings = plan.crossing_isovalues;
+    in.isovalues = upload_floats(
+        opencl, isovalues, std::vector<float>(crossings.begin(), crossings.end()), "isovalues");
+    const std::vector<double>& opacities = request.segment_thresholds;
+    in.thresholds =
+        upload_floats(opencl, thresholds,
+                      plan.want_segments ? std::vector<float>(opacities.begin(), opacities.end())
+                                         : std::vector<float>{},
+                      "segment opacity thresholds");
+    std::vector<float> interval_edges;
+    if (plan.want_accumulation) {
+        interval_edges.assign(request.intervals->edges().begin(), request.intervals->edges().end());
+    }
+    in.edges = upload_floats(opencl, edges, interval_edges, "interval edges");
+    if (plan.want_accumulation && request.intervals->is_uniform()) {
+        in.uniform_scale = plan.interval_count / (interval_edges.back() - interval_edges.front());
+    }
+    return in;
+}
+
+SkippedBlocks ProxyRenderer::DeviceState::skip_blocks(detail::OpenClDevice& opencl,
+                                                      const DeviceVolume& volume,
+                                                      const TransferTable& table,
+                                                      const PassPlan& plan) {
+    SkippedBlocks skipped;
+    if (blocks_generation != volume.generation) {
+        blocks = detail::scan_blocks_on_device(opencl, block_ranges, block_ranges_out, volume);
+        blocks_generation = volume.generation;
+    }
+    const std::vector<std::uint8_t> per_block =
+        detail::skippable_blocks(blocks, table, plan.crossing_isovalues, plan.want_opacity);
+    skipped.skippable_fraction =
+        static_cast<double>(std::count(per_block.begin(), per_block.end(), 1)) /
+        static_cast<double>(per_block.size());
+    // With nothing to skip, the per-block lookups would be pure overhead.
+    if (skipped.skippable_fraction > 0.0) {
+        opencl.ensure_buffer(skippable.buffer, skippable.capacity, per_block.size(),
+                             CL_MEM_READ_ONLY);
+        opencl.upload(skippable.buffer, per_block.data(), per_block.size(), "skippable blocks");
+        skipped.skippable = skippable.buffer;
+        skipped.block_counts = {{static_cast<cl_int>(blocks.counts[0]),
+                                 static_cast<cl_int>(blocks.counts[1]),
+                                 static_cast<cl_int>(blocks.counts[2]), 0}};
+        skipped.block_voxels = blocks.block_voxels;
+    }
+    return skipped;
+}
+
+namespace {
+
+/// Reads the pass's outputs back into `frame`.
+void download_outputs(detail::OpenClDevice& opencl, const ProxyRequest& request,
+                      const PassPlan& plan, const PassOutputs& outputs, ProxyFrame& frame) {
+    const int width = frame.camera.width();
+    const int height = frame.camera.height();
+    const std::size_t pixels = static_cast<std::size_t>(width) * height;
+    const int layer_count = plan.layer_count;
+    const int segments = plan.segments;
+    std::vector<float> planar;
+    auto fetch = [&](const cl::Buffer& buffer, int planes, const char* what) {
+        planar.resize(pixels * planes);
+        opencl.download(buffer, planar.data(), planar.size() * sizeof(float), what);
+    };
+    if (plan.want_layers) {
+        fetch(outputs.depth, layer_count, "depth layers");
+        frame.depth_layers = planes_to_images(planar, width, height, layer_count);
+        if (frame.multi_perspective) {
+            fetch(outputs.distortion, layer_count, "distortion layers");
+            frame.distortion_layers = planes_to_images(planar, width, height, layer_count);
+        }
+    }
+    // Per-interval outputs are pixel-interleaved on the device, as Image stores channels.
+    auto fetch_channels = [&](const cl::Buffer& buffer, const char* what) {
+        Image image(width, height, plan.interval_count);
+        opencl.download(buffer, image.pixels.data(), image.pixels.size() * sizeof(float), what);
+        return image;
+    };
+    if (request.attenuation) frame.attenuation = fetch_channels(outputs.attenuation, "attenuation");
+    if (request.mean_depth) frame.mean_depth = fetch_channels(outputs.mean_depth, "mean depth");
+    if (request.optical_depth) {
+        frame.optical_depth = fetch_channels(outputs.optical_depth, "optical depth");
+    }
+    if (request.entry_depth) {
+        frame.entry_depth = fetch_channels(outputs.entry_depth, "entry depth");
+    }
+    if (request.segment_rgba) {
+        fetch(outputs.segment_rgba, 4 * segments, "segment RGBA");
+        frame.segment_rgba = planes_to_images(planar, width, height, segments, 4);
+    }
+    if (request.segment_depth) {
+        fetch(outputs.segment_depth, segments, "segment depth");
+        frame.segment_depth = planes_to_images(planar, width, height, segments);
+    }
+    if (request.interleaving) {
+        frame.interleaving = Image(width, height, 2);
+        opencl.download(outputs.interleaving, frame.interleaving.pixels.data(),
+                        frame.interleaving.pixels.size() * sizeof(float), "interleaving");
+    }
+    if (request.first_hit_depth) {
+        frame.first_hit_depth = Image(width, height, 1);
+        opencl.download(outputs.first_hit, frame.first_hit_depth.pixels.data(),
+                        pixels * sizeof(float), "first-hit depth");
+    }
+    if (plan.partial) {
+        frame.fragment = Image(width, height, detail::kFragmentChannels);
+        opencl.download(outputs.fragment, frame.fragment.pixels.data(),
+                        frame.fragment.pixels.size() * sizeof(float), "fragments");
+    }
+}
+
+}  // namespace
+
 ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool multi_perspective,
                                 const ProxyRequest& request) {
     validate(request);
@@ -181,165 +469,23 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     frame.multi_perspective = multi_perspective;
     frame.camera = camera;
     frame.distortion_tilt_deg = tilt_deg;
-    const bool want_layers = request.depth_layers && !request.isovalues.empty();
-    const bool want_accumulation = accumulates(request);
-    const bool want_segments = wants_segments(request);
-    // Segments split at the layers need their crossings found, depth layers stored or not.
-    const bool find_crossings =
-        want_layers ||
-        (want_segments && request.segments == SegmentRule::layers && !request.isovalues.empty());
-    // Both read the transfer function's opacity, so both decide which blocks may be skipped.
-    const bool want_opacity = want_accumulation || want_segments;
-    if (want_layers) frame.isovalues = request.isovalues;
-    if (want_accumulation) frame.intervals = request.intervals;
-    const std::vector<double> crossing_isovalues =
-        find_crossings ? request.isovalues : std::vector<double>{};
-    const int segments = want_segments ? segment_count(request) : 0;
+    const bool partial = volume.region.has_value();
+    const PassPlan plan = plan_pass(request, multi_perspective, partial);
+    if (plan.want_layers) frame.isovalues = request.isovalues;
+    if (plan.want_accumulation) frame.intervals = request.intervals;
 
     const int width = camera.width();
     const int height = camera.height();
     const std::size_t pixels = static_cast<std::size_t>(width) * height;
-    const int layer_count = static_cast<int>(crossing_isovalues.size());
-    const int interval_count = want_accumulation ? request.intervals->count() : 0;
-    // validate() bounded both; the kernel's private arrays are sized by these limits.
-    INSITU_CHECK_LE(layer_count, kMaxLayers);
-    INSITU_CHECK_LE(interval_count, kMaxIntervals);
-
-    int wanted = 0;
-    if (want_layers) wanted |= detail::kWantDepth;
-    if (want_layers && multi_perspective) wanted |= detail::kWantDistortion;
-    if (request.attenuation) wanted |= detail::kWantAttenuation;
-    if (request.mean_depth) wanted |= detail::kWantMeanDepth;
-    if (request.optical_depth) wanted |= detail::kWantOpticalDepth;
-    if (request.segment_rgba) wanted |= detail::kWantSegmentRgba;
-    if (request.segment_depth) wanted |= detail::kWantSegmentDepth;
-    if (request.first_hit_depth) wanted |= detail::kWantFirstHitDepth;
-    if (request.interleaving) wanted |= detail::kWantInterleaving;
-    if (request.entry_depth) wanted |= detail::kWantEntryDepth;
-    const bool partial = volume.region.has_value();
-    if (partial) {
-        // A block sees its own part of each ray: a run that the block's neighbour interrupts
-        // is not a re-entry it can count.
-        if (request.interleaving) {
-            fail<InvalidArgument>(
-                "interleaving counts are not composited across blocks: a block of a distributed "
-                "run cannot know which intervals the ray met in front of it");
-        }
-        if (request.entry_depth) {
-            fail<InvalidArgument>(
-                "entry depths are not composited across blocks: a block of a distributed run "
-                "cannot know which intervals the ray met in front of it");
-        }
-        // A segment's and the first hit's opacity thresholds depend on the opacity in front of
-        // the block, which a block does not know.
-        if (want_segments) {
-            fail<InvalidArgument>(
-                "segment and first-hit outputs (light fields) are not composited across blocks: "
-                "a block of a distributed run cannot know the opacity in front of it");
-        }
-        if (request.march.early_termination_opacity < 1.0) {
-            fail<InvalidArgument>(
-                "early_termination_opacity = ", request.march.early_termination_opacity,
-                " for a block (a block cannot know the opacity in front of it: "
-                "partial frames composite exactly only with 1)");
-        }
-        wanted |= detail::kWantFragment;
-    }
-
-    // Only requested outputs get device memory; the others are passed as null buffers.
-    auto output = [&](detail::DeviceMemory& reused, bool needed, int planes) -> cl::Buffer {
-        if (!needed) return cl::Buffer();
-        device_->opencl().ensure_buffer(reused.buffer, reused.capacity,
-                                        pixels * planes * sizeof(float), CL_MEM_WRITE_ONLY);
-        return reused.buffer;
-    };
-    const cl::Buffer depth_out = output(state_->depth_out, want_layers, layer_count);
-    const cl::Buffer distortion_out =
-        output(state_->distortion_out, want_layers && multi_perspective, layer_count);
-    // The kernel accumulates a_j in place whenever it accumulates anything (mean depth divides
-    // by it), so this buffer exists then even if a_j itself is not returned.
-    const cl::Buffer attenuation_out =
-        output(state_->attenuation_out, want_accumulation, interval_count);
-    const cl::Buffer mean_depth_out =
-        output(state_->mean_depth_out, request.mean_depth, interval_count);
-    const cl::Buffer optical_depth_out =
-        output(state_->optical_depth_out, request.optical_depth, interval_count);
-    const cl::Buffer interleaving_out = output(state_->interleaving_out, request.interleaving, 2);
-    const cl::Buffer entry_depth_out =
-        output(state_->entry_depth_out, request.entry_depth, interval_count);
-    const cl::Buffer segment_rgba_out =
-        output(state_->segment_rgba_out, request.segment_rgba, 4 * segments);
-    const cl::Buffer segment_depth_out =
-        output(state_->segment_depth_out, request.segment_depth, segments);
-    const cl::Buffer first_hit_out = output(state_->first_hit_out, request.first_hit_depth, 1);
-    const cl::Buffer fragment_out =
-        output(state_->fragment_out, partial, detail::kFragmentChannels);
-
-    auto upload_floats = [&](detail::DeviceMemory& reused, const std::vector<float>& values,
-                             const char* what) -> cl::Buffer {
-        if (values.empty()) return cl::Buffer();
-        const std::size_t bytes = values.size() * sizeof(float);
-        device_->opencl().ensure_buffer(reused.buffer, reused.capacity, bytes, CL_MEM_READ_ONLY);
-        device_->opencl().upload(reused.buffer, values.data(), bytes, what);
-        return reused.buffer;
-    };
+    detail::OpenClDevice& opencl = device_->opencl();
+    const PassOutputs outputs = state_->outputs(opencl, request, plan, multi_perspective, pixels);
     const double step_world = volume.step_world(request.march.step_voxels);
-    // The attenuation's opacity and the segments' colour are classified exactly as the ground
-    // truth classifies them. Without either a one-entry transparent table keeps the kernel's
-    // arguments valid.
-    const TransferTable table =
-        want_opacity ? step_corrected_table(*request.transfer_function, step_world, request.march)
-                     : TransferFunction({{0.0, glm::vec4(0.0f)}, {1.0, glm::vec4(0.0f)}}).sample(2);
-    const cl::Buffer table_buffer =
-        upload_floats(state_->table, table.rgba, "transfer-function table");
-    const cl::Buffer isovalue_buffer = upload_floats(
-        state_->isovalues, std::vector<float>(crossing_isovalues.begin(), crossing_isovalues.end()),
-        "isovalues");
-    const std::vector<double>& thresholds = request.segment_thresholds;
-    const cl::Buffer threshold_buffer =
-        upload_floats(state_->thresholds,
-                      want_segments ? std::vector<float>(thresholds.begin(), thresholds.end())
-                                    : std::vector<float>{},
-                      "segment opacity thresholds");
-    std::vector<float> edges;
-    if (want_accumulation) {
-        edges.assign(frame.intervals->edges().begin(), frame.intervals->edges().end());
-    }
-    const cl::Buffer edge_buffer = upload_floats(state_->edges, edges, "interval edges");
-    // Equal-width intervals let the kernel compute the index instead of searching for it.
-    double uniform_scale = 0.0;
-    if (want_accumulation && frame.intervals->is_uniform()) {
-        uniform_scale = interval_count / (edges.back() - edges.front());
-    }
-
-    cl::Buffer skippable_buffer;
-    cl_int4 block_counts = {{1, 1, 1, 0}};
-    cl_int block_voxels = 0;  // 0: the kernel looks up no blocks
+    const PassInputs inputs = state_->upload_inputs(opencl, request, plan, step_world);
+    SkippedBlocks skipped;
     last_skippable_fraction_ = 0.0;
     if (request.skip_empty_space) {
-        if (state_->blocks_generation != volume.generation) {
-            state_->blocks = detail::scan_blocks_on_device(device_->opencl(), state_->block_ranges,
-                                                           state_->block_ranges_out, volume);
-            state_->blocks_generation = volume.generation;
-        }
-        const detail::BlockRanges& blocks = state_->blocks;
-        const std::vector<std::uint8_t> skippable =
-            detail::skippable_blocks(blocks, table, crossing_isovalues, want_opacity);
-        last_skippable_fraction_ =
-            static_cast<double>(std::count(skippable.begin(), skippable.end(), 1)) /
-            static_cast<double>(skippable.size());
-        // With nothing to skip, the per-block lookups would be pure overhead.
-        if (last_skippable_fraction_ > 0.0) {
-            device_->opencl().ensure_buffer(state_->skippable.buffer, state_->skippable.capacity,
-                                            skippable.size(), CL_MEM_READ_ONLY);
-            device_->opencl().upload(state_->skippable.buffer, skippable.data(), skippable.size(),
-                                     "skippable blocks");
-            skippable_buffer = state_->skippable.buffer;
-            block_counts = {{static_cast<cl_int>(blocks.counts[0]),
-                             static_cast<cl_int>(blocks.counts[1]),
-                             static_cast<cl_int>(blocks.counts[2]), 0}};
-            block_voxels = blocks.block_voxels;
-        }
+        skipped = state_->skip_blocks(opencl, volume, inputs.table, plan);
+        last_skippable_fraction_ = skipped.skippable_fraction;
     }
 
     const double tilt = glm::radians(tilt_deg);
@@ -348,73 +494,26 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     // Whole volumes march in ray packets (ray_march.cl) unless a light field splits its rays
     // at the layers' crossings; blocks of a distributed run march one ray per work-item.
     const bool packets = request.march.ray_packets && !partial && volume.packets_addressable() &&
-                         device_->opencl().is_cpu() &&
-                         (!want_segments || request.segments != SegmentRule::layers);
+                         opencl.is_cpu() &&
+                         (!plan.want_segments || request.segments != SegmentRule::layers);
     last_pass_in_packets_ = packets;
-    device_->opencl().launch(
+    opencl.launch(
         packets ? state_->packet_kernel : state_->kernel,
         packets ? detail::packet_global_range(width, height)
                 : detail::image_global_range(width, height),
         packets ? detail::packet_local_range() : detail::image_local_range(),
-        detail::volume_args(volume), detail::transfer_args(table_buffer, table),
-        detail::camera_args(camera), detail::image_size(camera), march, static_cast<cl_int>(wanted),
-        static_cast<cl_int>(layer_count), isovalue_buffer, static_cast<cl_int>(interval_count),
-        static_cast<cl_float>(uniform_scale), edge_buffer, depth_out, distortion_out,
-        attenuation_out, mean_depth_out, optical_depth_out, interleaving_out, entry_depth_out,
-        static_cast<cl_int>(request.segments), static_cast<cl_int>(segments), threshold_buffer,
-        static_cast<cl_float>(request.first_hit_threshold), segment_rgba_out, segment_depth_out,
-        first_hit_out, skippable_buffer, block_counts, block_voxels, fragment_out);
+        detail::volume_args(volume), detail::transfer_args(inputs.table_buffer, inputs.table),
+        detail::camera_args(camera), detail::image_size(camera), march,
+        static_cast<cl_int>(plan.wanted), static_cast<cl_int>(plan.layer_count), inputs.isovalues,
+        static_cast<cl_int>(plan.interval_count), static_cast<cl_float>(inputs.uniform_scale),
+        inputs.edges, outputs.depth, outputs.distortion, outputs.attenuation, outputs.mean_depth,
+        outputs.optical_depth, outputs.interleaving, outputs.entry_depth,
+        static_cast<cl_int>(request.segments), static_cast<cl_int>(plan.segments),
+        inputs.thresholds, static_cast<cl_float>(request.first_hit_threshold), outputs.segment_rgba,
+        outputs.segment_depth, outputs.first_hit, skipped.skippable, skipped.block_counts,
+        skipped.block_voxels, outputs.fragment);
 
-    std::vector<float> planar;
-    auto fetch = [&](const cl::Buffer& buffer, int planes, const char* what) {
-        planar.resize(pixels * planes);
-        device_->opencl().download(buffer, planar.data(), planar.size() * sizeof(float), what);
-    };
-    if (want_layers) {
-        fetch(depth_out, layer_count, "depth layers");
-        frame.depth_layers = planes_to_images(planar, width, height, layer_count);
-        if (multi_perspective) {
-            fetch(distortion_out, layer_count, "distortion layers");
-            frame.distortion_layers = planes_to_images(planar, width, height, layer_count);
-        }
-    }
-    // Per-interval outputs are pixel-interleaved on the device, as Image stores channels.
-    auto fetch_channels = [&](const cl::Buffer& buffer, const char* what) {
-        Image image(width, height, interval_count);
-        device_->opencl().download(buffer, image.pixels.data(), image.pixels.size() * sizeof(float),
-                                   what);
-        return image;
-    };
-    if (request.attenuation) frame.attenuation = fetch_channels(attenuation_out, "attenuation");
-    if (request.mean_depth) frame.mean_depth = fetch_channels(mean_depth_out, "mean depth");
-    if (request.optical_depth) {
-        frame.optical_depth = fetch_channels(optical_depth_out, "optical depth");
-    }
-    if (request.entry_depth) frame.entry_depth = fetch_channels(entry_depth_out, "entry depth");
-    if (request.segment_rgba) {
-        fetch(segment_rgba_out, 4 * segments, "segment RGBA");
-        frame.segment_rgba = planes_to_images(planar, width, height, segments, 4);
-    }
-    if (request.segment_depth) {
-        fetch(segment_depth_out, segments, "segment depth");
-        frame.segment_depth = planes_to_images(planar, width, height, segments);
-    }
-    if (request.interleaving) {
-        frame.interleaving = Image(width, height, 2);
-        device_->opencl().download(interleaving_out, frame.interleaving.pixels.data(),
-                                   frame.interleaving.pixels.size() * sizeof(float),
-                                   "interleaving");
-    }
-    if (request.first_hit_depth) {
-        frame.first_hit_depth = Image(width, height, 1);
-        device_->opencl().download(first_hit_out, frame.first_hit_depth.pixels.data(),
-                                   pixels * sizeof(float), "first-hit depth");
-    }
-    if (partial) {
-        frame.fragment = Image(width, height, detail::kFragmentChannels);
-        device_->opencl().download(fragment_out, frame.fragment.pixels.data(),
-                                   frame.fragment.pixels.size() * sizeof(float), "fragments");
-    }
+    download_outputs(opencl, request, plan, outputs, frame);
     return frame;
 }
 
