@@ -1,136 +1,26 @@
+// InstrumentConfig's JSON from its key tables (config_json.hpp): the top level and its small
+// objects here, the views in config_views.cpp, the budget in budget/budget_config.cpp; the
+// checks of validate() in config_checks.cpp.
 #include "insitu/config.hpp"
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 
+#include "config_json.hpp"
+#include "config_views.hpp"
 #include "insitu/core/histogram.hpp"
-#include "insitu/core/layers.hpp"
 #include "insitu/error.hpp"
 
 namespace insitu {
 
 namespace {
 
-using nlohmann::json;
-using Unknown = std::vector<std::string>;
-
-// OpenEXR's lossless and lossy codecs that every OpenEXR 3 build has.
-constexpr std::array<const char*, 7> kCompressions = {"none", "rle",   "zips", "zip",
-                                                      "piz",  "pxr24", "b44"};
-// Largest image side a view may ask for; beyond it a single frame would need gigabytes.
-constexpr int kMaxImageSide = 16384;
-
-std::string child_key(const std::string& parent, const std::string& key) {
-    return parent.empty() ? key : parent + "." + key;
-}
-
-std::string element_key(const std::string& parent, std::size_t index) {
-    return parent + "[" + std::to_string(index) + "]";
-}
-
-// Every error names the dotted key and the offending JSON value.
-[[noreturn]] void wrong_type(const std::string& key, const json& value, const char* expected) {
-    fail<ParseError>("configuration \"", key, "\" = ", value.dump(), " (expected ", expected, ")");
-}
-
-template <typename... Why>
-[[noreturn]] void out_of_range(const std::string& key, const std::string& value,
-                               const Why&... why) {
-    fail<InvalidArgument>("configuration \"", key, "\" = ", value, " (", why..., ")");
-}
-
-template <typename Value>
-std::string text_of(const Value& value) {
-    std::ostringstream out;
-    out << value;
-    return out.str();
-}
-
-std::string list_text(const std::vector<double>& values) {
-    std::string text = "[";
-    for (std::size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + text_of(values[i]);
-    return text + "]";
-}
-
-// Runs one of the library's own parsers or checks, so that a configuration accepts exactly what
-// the library does; its InvalidArgument gains the key and the value.
-template <typename Check>
-auto checked(const std::string& key, const std::string& value, Check check) -> decltype(check()) {
-    try {
-        return check();
-    } catch (const InvalidArgument& error) {
-        fail<InvalidArgument>("configuration \"", key, "\" = ", value, ": ", error.what());
-    }
-}
-
-const json& require_object(const json& value, const std::string& key) {
-    if (!value.is_object()) wrong_type(key, value, "an object");
-    return value;
-}
-
-const json& require_array(const json& value, const std::string& key) {
-    if (!value.is_array()) wrong_type(key, value, "an array");
-    return value;
-}
-
-double number(const json& value, const std::string& key) {
-    if (!value.is_number()) wrong_type(key, value, "a number");
-    return value.get<double>();
-}
-
-std::int64_t integer(const json& value, const std::string& key) {
-    // JSON 2.0 is a float to nlohmann; counts and sizes must be written as integers.
-    if (!value.is_number_integer()) wrong_type(key, value, "an integer");
-    if (value.is_number_unsigned() &&
-        value.get<std::uint64_t>() >
-            static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) {
-        out_of_range(key, value.dump(), "too large");
-    }
-    return value.get<std::int64_t>();
-}
-
-int small_integer(const json& value, const std::string& key) {
-    const std::int64_t wide = integer(value, key);
-    if (wide < std::numeric_limits<int>::min() || wide > std::numeric_limits<int>::max()) {
-        out_of_range(key, value.dump(), "does not fit in an int");
-    }
-    return static_cast<int>(wide);
-}
-
-std::string text(const json& value, const std::string& key) {
-    if (!value.is_string()) wrong_type(key, value, "a string");
-    return value.get<std::string>();
-}
-
-bool boolean(const json& value, const std::string& key) {
-    if (!value.is_boolean()) wrong_type(key, value, "true or false");
-    return value.get<bool>();
-}
-
-template <typename Element>
-std::vector<Element> list_of(const json& value, const std::string& key,
-                             Element (*element)(const json&, const std::string&)) {
-    require_array(value, key);
-    std::vector<Element> list;
-    for (std::size_t i = 0; i < value.size(); ++i) {
-        list.push_back(element(value[i], element_key(key, i)));
-    }
-    return list;
-}
-
-// The words of a configuration value that names one of a few choices.
-template <typename Value>
-struct Choice {
-    const char* name;
-    Value value;
-};
+using namespace config_json;
 
 constexpr Choice<StoragePrecision> kPrecisions[] = {{"half", StoragePrecision::half},
                                                     {"float", StoragePrecision::single}};
@@ -145,70 +35,6 @@ constexpr Choice<bool ProxySelection::*> kProxies[] = {
     {"rendering", &ProxySelection::rendering},
     {"interleaving", &ProxySelection::interleaving},
     {"entry_depth", &ProxySelection::entry_depth}};
-
-/// "a, b or c".
-template <typename Value, std::size_t N>
-std::string alternatives(const Choice<Value> (&choices)[N]) {
-    std::string words;
-    for (std::size_t i = 0; i < N; ++i) {
-        words += (i == 0 ? "" : i + 1 == N ? " or " : ", ") + std::string(choices[i].name);
-    }
-    return words;
-}
-
-template <typename Value, std::size_t N>
-Value choose(const json& value, const std::string& key, const Choice<Value> (&choices)[N]) {
-    const std::string name = text(value, key);
-    for (const Choice<Value>& choice : choices) {
-        if (name == choice.name) return choice.value;
-    }
-    out_of_range(key, value.dump(), "expected ", alternatives(choices));
-}
-
-template <typename Value, std::size_t N>
-const char* name_of(Value value, const Choice<Value> (&choices)[N]) {
-    for (const Choice<Value>& choice : choices) {
-        if (value == choice.value) return choice.name;
-    }
-    fail<Error>("configuration: a value without a name");  // a bug: every enumerator is listed
-}
-
-// One table per JSON object of the configuration: each entry spells its key once and says how
-// to parse its value into the target and how to write it back. Parsing, the detection of
-// unknown keys and to_json all run from the table.
-template <typename Target>
-struct Key {
-    const char* name;
-    /// `key` is the dotted path of the value, for errors; nested objects add their unknown keys.
-    void (*parse)(const json& value, const std::string& key, Target& target, Unknown& unknown);
-    /// Null leaves the key out (the cadence: one of "every" and "steps").
-    json (*write)(const Target& target);
-};
-
-template <typename Target, std::size_t N>
-void parse_object(const json& value, const std::string& key, const Key<Target> (&keys)[N],
-                  Target& target, Unknown& unknown) {
-    require_object(value, key);
-    for (const auto& item : value.items()) {
-        const bool known = std::any_of(std::begin(keys), std::end(keys),
-                                       [&](const Key<Target>& k) { return item.key() == k.name; });
-        if (!known) unknown.push_back(child_key(key, item.key()));
-    }
-    for (const Key<Target>& entry : keys) {
-        const auto found = value.find(entry.name);
-        if (found != value.end()) entry.parse(*found, child_key(key, entry.name), target, unknown);
-    }
-}
-
-template <typename Target, std::size_t N>
-json write_object(const Target& target, const Key<Target> (&keys)[N]) {
-    json result = json::object();
-    for (const Key<Target>& entry : keys) {
-        json value = entry.write(target);
-        if (!value.is_null()) result[entry.name] = std::move(value);
-    }
-    return result;
-}
 
 // A transfer function object: its own unknown keys are collected here (TransferFunction's parser
 // would reject them), its errors are prefixed with the key and keep their type.
@@ -235,44 +61,6 @@ TransferFunction parse_transfer_function(const json& value, const std::string& k
         fail<InvalidArgument>("configuration \"", key, "\": ", error.what());
     }
 }
-
-const Key<ViewConfig> kViewKeys[] = {
-    {"azimuth",
-     [](const json& value, const std::string& key, ViewConfig& view, Unknown&) {
-         view.orbit.azimuth_deg = number(value, key);
-     },
-     [](const ViewConfig& view) { return json(view.orbit.azimuth_deg); }},
-    {"elevation",
-     [](const json& value, const std::string& key, ViewConfig& view, Unknown&) {
-         view.orbit.elevation_deg = number(value, key);
-     },
-     [](const ViewConfig& view) { return json(view.orbit.elevation_deg); }},
-    {"camera",
-     [](const json& value, const std::string& key, ViewConfig& view, Unknown&) {
-         const std::string name = text(value, key);
-         view.orbit.projection = checked(key, value.dump(), [&] { return parse_projection(name); });
-     },
-     [](const ViewConfig& view) { return json(to_string(view.orbit.projection)); }},
-    {"fov",
-     [](const json& value, const std::string& key, ViewConfig& view, Unknown&) {
-         view.orbit.fov_y_deg = number(value, key);
-     },
-     [](const ViewConfig& view) { return json(view.orbit.fov_y_deg); }},
-    {"size",
-     [](const json& value, const std::string& key, ViewConfig& view, Unknown&) {
-         if (!value.is_array() || value.size() != 2) wrong_type(key, value, "[width, height]");
-         view.orbit.width = small_integer(value[0], element_key(key, 0));
-         view.orbit.height = small_integer(value[1], element_key(key, 1));
-     },
-     [](const ViewConfig& view) {
-         return json{view.orbit.width, view.orbit.height};
-     }},
-    {"distortion_tilt",
-     [](const json& value, const std::string& key, ViewConfig& view, Unknown&) {
-         view.distortion_tilt_deg = number(value, key);
-     },
-     [](const ViewConfig& view) { return json(view.distortion_tilt_deg); }},
-};
 
 const Key<InstrumentConfig> kIntervalKeys[] = {
     {"count",
@@ -314,108 +102,6 @@ const Key<ColourModelConfig> kColourModelKeys[] = {
      },
      [](const ColourModelConfig& model) { return json(model.enabled); }},
 };
-
-// "budget": {"psnr_db", "bytes_per_step", "ms_per_step", "check_every", "rotations",
-// "choose"}.
-enum class BudgetChoice { intervals, precision, size, light_field, colour_model };
-constexpr Choice<BudgetChoice> kBudgetChoices[] = {{"intervals", BudgetChoice::intervals},
-                                                   {"precision", BudgetChoice::precision},
-                                                   {"size", BudgetChoice::size},
-                                                   {"light_field", BudgetChoice::light_field},
-                                                   {"colour_model", BudgetChoice::colour_model}};
-// The BudgetConfig member each "choose" entry sets.
-bool BudgetConfig::*chooses(BudgetChoice choice) {
-    switch (choice) {
-        case BudgetChoice::intervals:
-            return &BudgetConfig::chooses_intervals;
-        case BudgetChoice::precision:
-            return &BudgetConfig::chooses_precision;
-        case BudgetChoice::size:
-            return &BudgetConfig::chooses_size;
-        case BudgetChoice::light_field:
-            return &BudgetConfig::chooses_light_field;
-        case BudgetChoice::colour_model:
-            return &BudgetConfig::chooses_colour_model;
-    }
-    return &BudgetConfig::chooses_intervals;
-}
-// Whether the configuration gives a view's "size" itself, at the top level or in a field's
-// own views: the budget then keeps every view's size (explicit settings win).
-bool gives_view_size(const json& document) {
-    const auto any_sized = [](const json& views) {
-        return views.is_array() && std::any_of(views.begin(), views.end(), [](const json& view) {
-                   return view.is_object() && view.contains("size");
-               });
-    };
-    if (document.contains("views") && any_sized(document["views"])) return true;
-    if (!document.contains("fields") || !document["fields"].is_array()) return false;
-    return std::any_of(document["fields"].begin(), document["fields"].end(), [&](const json& f) {
-        return f.is_object() && f.contains("views") && any_sized(f["views"]);
-    });
-}
-const Key<BudgetConfig> kBudgetKeys[] = {
-    {"psnr_db",
-     [](const json& value, const std::string& key, BudgetConfig& budget, Unknown&) {
-         budget.psnr_db = number(value, key);
-     },
-     [](const BudgetConfig& budget) { return budget.psnr_db ? json(*budget.psnr_db) : json(); }},
-    {"bytes_per_step",
-     [](const json& value, const std::string& key, BudgetConfig& budget, Unknown&) {
-         budget.bytes_per_step = number(value, key);
-     },
-     [](const BudgetConfig& budget) {
-         return budget.bytes_per_step ? json(*budget.bytes_per_step) : json();
-     }},
-    {"ms_per_step",
-     [](const json& value, const std::string& key, BudgetConfig& budget, Unknown&) {
-         budget.ms_per_step = number(value, key);
-     },
-     [](const BudgetConfig& budget) {
-         return budget.ms_per_step ? json(*budget.ms_per_step) : json();
-     }},
-    {"check_every",
-     [](const json& value, const std::string& key, BudgetConfig& budget, Unknown&) {
-         budget.check_every = small_integer(value, key);
-     },
-     [](const BudgetConfig& budget) { return json(budget.check_every); }},
-    {"rotations",
-     [](const json& value, const std::string& key, BudgetConfig& budget, Unknown&) {
-         budget.rotations_deg = list_of<double>(value, key, number);
-     },
-     [](const BudgetConfig& budget) { return json(budget.rotations_deg); }},
-    {"choose",
-     [](const json& value, const std::string& key, BudgetConfig& budget, Unknown&) {
-         require_array(value, key);
-         for (const auto& [name, choice] : kBudgetChoices) budget.*chooses(choice) = false;
-         for (std::size_t i = 0; i < value.size(); ++i) {
-             budget.*chooses(choose(value[i], element_key(key, i), kBudgetChoices)) = true;
-         }
-     },
-     [](const BudgetConfig& budget) {
-         json chosen = json::array();
-         for (const auto& [name, choice] : kBudgetChoices) {
-             if (budget.*chooses(choice)) chosen.push_back(name);
-         }
-         return chosen;
-     }},
-};
-
-std::vector<ViewConfig> parse_views(const json& value, const std::string& key, Unknown& unknown) {
-    require_array(value, key);
-    std::vector<ViewConfig> views;
-    for (std::size_t i = 0; i < value.size(); ++i) {
-        ViewConfig view;
-        parse_object(value[i], element_key(key, i), kViewKeys, view, unknown);
-        views.push_back(view);
-    }
-    return views;
-}
-
-json write_views(const std::vector<ViewConfig>& views) {
-    json list = json::array();
-    for (const ViewConfig& view : views) list.push_back(write_object(view, kViewKeys));
-    return list;
-}
 
 /// "layers": "auto" (nullopt) or a list of isovalues.
 std::optional<std::vector<double>> parse_layers(const json& value, const std::string& key) {
@@ -644,62 +330,29 @@ const Key<InstrumentConfig> kTopLevelKeys[] = {
          return config.light_field ? config.light_field->to_json() : json();
      }},
     {"budget",
-     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
-         BudgetConfig budget;
-         parse_object(value, key, kBudgetKeys, budget, unknown);
-         config.budget = budget;
+     [](const json& value, const std::string&, InstrumentConfig& config, Unknown& unknown) {
+         config.budget = BudgetConfig::from_json(value, unknown);
      },
      [](const InstrumentConfig& config) {
-         return config.budget ? write_object(*config.budget, kBudgetKeys) : json();
+         return config.budget ? config.budget->to_json() : json();
      }},
 };
 
 // The key names of each object of the configuration, by the name of the key that holds the
 // object ("" for the top level), for suggest_key.
-template <typename Target, std::size_t N>
-std::vector<std::string> names_of(const Key<Target> (&keys)[N]) {
-    std::vector<std::string> names;
-    for (const Key<Target>& key : keys) names.push_back(key.name);
-    return names;
-}
-
 std::vector<std::string> known_keys_under(const std::string& parent) {
     if (parent.empty()) return names_of(kTopLevelKeys);
-    if (parent == "views") return names_of(kViewKeys);
+    if (parent == "views") return view_keys();
     if (parent == "fields") return names_of(kFieldKeys);
     if (parent == "intervals") return names_of(kIntervalKeys);
     if (parent == "writer") return names_of(kWriterKeys);
     if (parent == "colour_model") return names_of(kColourModelKeys);
     if (parent == "light_field") return LightFieldSettings::keys();
-    if (parent == "budget") return names_of(kBudgetKeys);
+    if (parent == "budget") return BudgetConfig::keys();
     if (parent == "transfer_function" || parent == "training_transfer_functions") {
         return {kTransferFunctionKeys.begin(), kTransferFunctionKeys.end()};
     }
     return {};
-}
-
-// Optimal string alignment distance (Levenshtein plus adjacent transpositions): "evry" is one
-// edit from "every", "stpe" one from "step".
-std::size_t edit_distance(const std::string& a, const std::string& b) {
-    std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
-    for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
-    for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
-    for (std::size_t i = 1; i <= a.size(); ++i) {
-        for (std::size_t j = 1; j <= b.size(); ++j) {
-            const std::size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
-            d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
-            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) {
-                d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
-            }
-        }
-    }
-    return d[a.size()][b.size()];
-}
-
-std::string join(const std::vector<std::string>& names) {
-    std::string joined;
-    for (const std::string& name : names) joined += (joined.empty() ? "" : ", ") + name;
-    return joined;
 }
 
 }  // namespace
@@ -720,20 +373,7 @@ std::string suggest_key(const std::string& unknown_path) {
     const std::size_t parent_dot = parent.rfind('.');
     if (parent_dot != std::string::npos) parent = parent.substr(parent_dot + 1);
     parent = parent.substr(0, parent.find('['));
-
-    std::string best;
-    std::size_t best_distance = std::numeric_limits<std::size_t>::max();
-    for (const std::string& known : known_keys_under(parent)) {
-        const std::size_t distance = edit_distance(key, known);
-        if (distance < best_distance) {
-            best_distance = distance;
-            best = known;
-        }
-    }
-    // Close means at most a third of the letters differ (at least one edit): "evry" -> "every",
-    // but "colour" is not offered for "zoom".
-    const std::size_t allowed = std::max<std::size_t>(1, key.size() / 3);
-    return best_distance <= allowed ? best : std::string();
+    return nearest_key(key, known_keys_under(parent));
 }
 
 std::string describe_unknown_keys(const std::vector<std::string>& unknown_paths) {
@@ -760,10 +400,6 @@ std::string refuse_unknown_keys(const InstrumentConfig& config,
     return source + describe_unknown_keys(unknown_paths) + ": ignored (\"strict\": false)";
 }
 
-nlohmann::json ViewConfig::to_json() const {
-    return write_object(*this, kViewKeys);
-}
-
 InstrumentConfig InstrumentConfig::from_json(const nlohmann::json& document,
                                              std::vector<std::string>* unknown_keys) {
     if (!document.is_object()) {
@@ -777,24 +413,7 @@ InstrumentConfig InstrumentConfig::from_json(const nlohmann::json& document,
     Unknown unknown;
     InstrumentConfig config;
     parse_object(document, "", kTopLevelKeys, config, unknown);
-    // Explicit settings win over the budget: given "intervals" or "precision" are kept unless
-    // "choose" says otherwise.
-    if (config.budget && !document["budget"].contains("choose")) {
-        if (document.contains("intervals")) config.budget->chooses_intervals = false;
-        if (document.contains("precision")) config.budget->chooses_precision = false;
-        if (gives_view_size(document)) config.budget->chooses_size = false;
-        const json* light_field =
-            document.contains("light_field") ? &document["light_field"] : nullptr;
-        if (light_field && light_field->is_object() &&
-            (light_field->contains("cameras") || light_field->contains("size"))) {
-            config.budget->chooses_light_field = false;
-        }
-        const json* colour_model =
-            document.contains("colour_model") ? &document["colour_model"] : nullptr;
-        if (colour_model && colour_model->is_object() && colour_model->contains("clusters")) {
-            config.budget->chooses_colour_model = false;
-        }
-    }
+    if (config.budget) config.budget->keep_given_settings(document);
     config.validate();
     if (unknown_keys != nullptr) {
         unknown_keys->insert(unknown_keys->end(), unknown.begin(), unknown.end());
@@ -832,159 +451,6 @@ InstrumentConfig InstrumentConfig::from_json_file(const std::string& path,
         fail<ParseError>(path, ": ", error.what());
     } catch (const InvalidArgument& error) {
         fail<InvalidArgument>(path, ": ", error.what());
-    }
-}
-
-namespace {
-// The checks of one "views" list (the top level's, or a field's own), naming `views_key`.
-void validate_views(const std::vector<ViewConfig>& views, const std::string& views_key) {
-    if (views.empty()) out_of_range(views_key, "[]", "give at least one view");
-    for (std::size_t i = 0; i < views.size(); ++i) {
-        const std::string key = element_key(views_key, i);
-        const OrbitView& orbit = views[i].orbit;
-        checked(child_key(key, "azimuth"), text_of(orbit.azimuth_deg),
-                [&] { check_orbit_azimuth(orbit.azimuth_deg); });
-        checked(child_key(key, "elevation"), text_of(orbit.elevation_deg),
-                [&] { check_orbit_elevation(orbit.elevation_deg); });
-        // Whatever the projection: to_json records every view's fov, and it must read back.
-        checked(child_key(key, "fov"), text_of(orbit.fov_y_deg),
-                [&] { check_orbit_fov(orbit.fov_y_deg); });
-        const std::string size = "[" + text_of(orbit.width) + ", " + text_of(orbit.height) + "]";
-        checked(child_key(key, "size"), size, [&] { check_orbit_size(orbit.width, orbit.height); });
-        if (orbit.width > kMaxImageSide || orbit.height > kMaxImageSide) {
-            out_of_range(child_key(key, "size"), size, "pixels, each side in [1, ", kMaxImageSide,
-                         "]");
-        }
-        const double tilt = views[i].distortion_tilt_deg;
-        if (!(tilt >= 0.0 && tilt < 90.0)) {
-            out_of_range(child_key(key, "distortion_tilt"), text_of(tilt),
-                         "degrees, must be in [0, 90)");
-        }
-    }
-}
-}  // namespace
-
-void InstrumentConfig::validate() const {
-    if (fields.empty()) out_of_range("fields", "[]", "name at least one field");
-    for (std::size_t i = 0; i < fields.size(); ++i) {
-        if (fields[i].empty()) out_of_range(element_key("fields", i), "\"\"", "empty name");
-    }
-    validate_views(views, "views");
-    for (std::size_t i = 0; i < fields.size(); ++i) {
-        const auto first = std::find(fields.begin(), fields.begin() + i, fields[i]);
-        if (first != fields.begin() + i) {
-            out_of_range(element_key("fields", i), "\"" + fields[i] + "\"", "repeats ",
-                         element_key("fields", static_cast<std::size_t>(first - fields.begin())),
-                         "; give each field once");
-        }
-    }
-    for (const auto& entry : field_styles) {
-        // Not a structured binding: C++17 lambdas (below) cannot capture those.
-        const std::string& name = entry.first;
-        const FieldStyle& style = entry.second;
-        const auto at = std::find(fields.begin(), fields.end(), name);
-        if (at == fields.end()) {
-            out_of_range("fields", "\"" + name + "\"", "has settings but is not listed");
-        }
-        const std::string key =
-            element_key("fields", static_cast<std::size_t>(at - fields.begin()));
-        if (style.views) validate_views(*style.views, child_key(key, "views"));
-        if (style.layers) {
-            checked(child_key(key, "layers"), list_text(*style.layers),
-                    [&] { validate_isovalues(*style.layers); });
-        }
-    }
-    if (layers) checked("layers", list_text(*layers), [&] { validate_isovalues(*layers); });
-    if (max_auto_layers < 1 || max_auto_layers > kMaxLayers) {
-        out_of_range("max_layers", text_of(max_auto_layers), "must be in [1, ", kMaxLayers, "]");
-    }
-    if (interval_count < 1 || interval_count > kMaxIntervals) {
-        out_of_range("intervals.count", text_of(interval_count), "must be in [1, ", kMaxIntervals,
-                     "]");
-    }
-    if (!(step_voxels > 0.0) || !std::isfinite(step_voxels)) {
-        out_of_range("step", text_of(step_voxels), "voxels, must be finite and > 0");
-    }
-    if (step_voxels < kMinStepVoxels) {
-        out_of_range("step", text_of(step_voxels), "voxels, must be >= ", kMinStepVoxels,
-                     ": finer steps resample the same cells and float positions stop advancing");
-    }
-    if (every < 1) out_of_range("every", text_of(every), "must be an integer >= 1");
-    for (std::size_t i = 0; i < steps.size(); ++i) {
-        // Archive files are named by step number, and a listed step can be executed only once.
-        if (steps[i] < 0) {
-            out_of_range(element_key("steps", i), text_of(steps[i]), "step numbers must be >= 0");
-        }
-        const auto first = std::find(steps.begin(), steps.begin() + i, steps[i]);
-        if (first != steps.begin() + i) {
-            out_of_range(element_key("steps", i), text_of(steps[i]), "repeats ",
-                         element_key("steps", static_cast<std::size_t>(first - steps.begin())));
-        }
-    }
-    if (archive.empty()) out_of_range("archive", "\"\"", "name the archive directory");
-    if (light_field) light_field->validate();
-    if (std::find(kCompressions.begin(), kCompressions.end(), compression) == kCompressions.end()) {
-        out_of_range("compression", "\"" + compression + "\"",
-                     "expected none, rle, zips, zip, piz, pxr24 or b44");
-    }
-    if (writer_queue < 1) out_of_range("writer.queue", text_of(writer_queue), "must be >= 1");
-    if (budget) {
-        if (budget->psnr_db && !(*budget->psnr_db > 0.0 && *budget->psnr_db <= 200.0)) {
-            out_of_range("budget.psnr_db", text_of(*budget->psnr_db), "dB, must be in (0, 200]");
-        }
-        if (budget->bytes_per_step &&
-            !(*budget->bytes_per_step > 0.0 && std::isfinite(*budget->bytes_per_step))) {
-            out_of_range("budget.bytes_per_step", text_of(*budget->bytes_per_step),
-                         "bytes, must be finite and > 0");
-        }
-        if (budget->ms_per_step &&
-            !(*budget->ms_per_step > 0.0 && std::isfinite(*budget->ms_per_step))) {
-            out_of_range("budget.ms_per_step", text_of(*budget->ms_per_step),
-                         "milliseconds, must be finite and > 0");
-        }
-        if (budget->check_every < 1) {
-            out_of_range("budget.check_every", text_of(budget->check_every), "must be >= 1");
-        }
-        for (std::size_t i = 0; i < budget->rotations_deg.size(); ++i) {
-            const double rotation = budget->rotations_deg[i];
-            if (!(std::isfinite(rotation) && rotation > -180.0 && rotation <= 180.0)) {
-                out_of_range(element_key("budget.rotations", i), text_of(rotation),
-                             "degrees of azimuth, must be finite and in (-180, 180]");
-            }
-        }
-        // Its held-out edit scales opacity per interval, which a 2D function does not have.
-        bool two_d = transfer_function && transfer_function->is_2d();
-        for (const auto& entry : field_styles) {
-            two_d = two_d ||
-                    (entry.second.transfer_function && entry.second.transfer_function->is_2d());
-        }
-        if (two_d) {
-            out_of_range("budget", "{...}",
-                         "measures opacity edits per interval, which needs 1D transfer functions");
-        }
-    }
-    if (colour_model.clusters < 1 || colour_model.clusters > kMaxColourModelClusters) {
-        out_of_range("colour_model.clusters", text_of(colour_model.clusters), "must be in [1, ",
-                     kMaxColourModelClusters, "]");
-    }
-    // Last: the estimate needs every value above in range. A step's cost would otherwise be
-    // bounded by nothing the simulation can see before its run stalls.
-    const double samples = estimated_samples_per_step();
-    if (samples > kMaxSamplesPerStep) {
-        double pixels = 0.0;
-        const std::vector<PlannedView> planned = planned_views();
-        for (const PlannedView& planned_view : planned) {
-            pixels +=
-                static_cast<double>(planned_view.view.orbit.width) * planned_view.view.orbit.height;
-        }
-        fail<InvalidArgument>(
-            "configuration: about ", samples, " samples per step, above the ceiling of ",
-            kMaxSamplesPerStep, " (", kWorstDiagonalVoxels,
-            "-voxel rays at \"step\" = ", step_voxels, " over \"views\": ", planned.size(),
-            " views of ", fields.size(), " field(s), ", pixels, " pixels in all, ",
-            passes_per_view(),
-            " passes each from \"proxies\" and \"training_transfer_functions\"); raise \"step\" "
-            "or reduce the others");
     }
 }
 
