@@ -9,7 +9,7 @@
 #include <string>
 
 #include "insitu/archive/step_record.hpp"
-#include "insitu/config.hpp"
+#include "insitu/budget/budget_config.hpp"
 #include "insitu/core/histogram.hpp"
 
 namespace insitu {

@@ -5,7 +5,7 @@
 #include <limits>
 #include <vector>
 
-#include "insitu/config.hpp"
+#include "insitu/budget/budget_config.hpp"
 
 namespace insitu {
 
