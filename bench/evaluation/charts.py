@@ -2,9 +2,9 @@
 """Charts and RESULTS.md of the evaluation harness (bench/evaluate).
 
 Reads the CSV files insitu_evaluate and insitu_evaluate_vtk wrote into RESULTS_DIR, draws one
-PNG per chart there (matplotlib, Agg) and writes the markdown report. With --check it also
-verifies that every chart exists and every number in every CSV is finite, and exits 1 naming
-what is not (the CI smoke test).
+PNG per chart there (matplotlib, Agg) and writes the markdown report, bench/design_figures.md
+appended to it. With --check it also verifies that every chart exists and every number in every
+CSV is finite, and exits 1 naming what is not (the CI smoke test).
 
     charts.py RESULTS_DIR --markdown FILE [--image-prefix PREFIX] [--elapsed SECONDS] [--check]
 """
@@ -24,6 +24,10 @@ CHARTS = ["pareto", "rotation", "radiality", "clusters", "opacity_edits", "stora
 DPI = 80
 SOURCES = {"multi45": "multi-perspective, tilt 45°", "multi20": "multi-perspective, tilt 20°",
            "single": "single perspective"}
+# Figures behind design choices, measured once and edited by hand: every RESULTS.md carries them,
+# so a full run does not drop what the code's comments point to.
+DESIGN_FIGURES = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir,
+                              "design_figures.md")
 
 
 def read(directory, name):
@@ -782,8 +786,18 @@ def write_markdown(d, path, prefix, elapsed):
 
     lines += ["## What they mean", ""]
     lines += [meaning(configs, primary, c15, c30, edit_min, rotation, rot_scene, occlusion, scale), ""]
+    lines += ["## Figures behind design choices", "", design_figures(), ""]
     with open(path, "w") as f:
         f.write("\n".join(lines))
+
+
+def design_figures():
+    """bench/design_figures.md without its title, which the report's own heading replaces."""
+    with open(DESIGN_FIGURES, encoding="utf-8") as f:
+        text = f.read()
+    if text.startswith("# "):
+        text = text.split("\n", 1)[1]
+    return text.strip("\n")
 
 
 def meaning(configs, primary, c15, c30, edit_min, rotation, rot_scene, occlusion, scale):

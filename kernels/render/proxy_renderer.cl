@@ -4,7 +4,8 @@
 // Layer outputs are planar (layer l of pixel p at l * pixel_count + p: one image per layer);
 // per-interval outputs are interleaved (interval j of pixel p at p * interval_count + j), and
 // the kernel accumulates into them in place: a pixel's intervals share one or two cache lines,
-// whereas private arrays indexed by a data-dependent interval cost PoCL about 3x the whole pass.
+// whereas private arrays indexed by a data-dependent interval cost PoCL a multiple of the whole
+// pass (bench/RESULTS.md, "Per-interval outputs interleaved in the proxy kernel").
 
 // Segment outputs (light-field capture, seed 001 §7) are planar too: segment s of pixel p at
 // s * pixel_count + p. Samples reach the segments in order, so only the segment being composited

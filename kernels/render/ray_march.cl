@@ -213,7 +213,8 @@ inline float absorb(float* transmittance, float alpha) {
 // the trilinear corners and the transfer table. Every lane computes what march_ray(),
 // sample_trilinear() and lookup_transfer() compute for its ray, with the same formulas, so a
 // packet pass takes the same samples as the one-ray-per-work-item pass (tests compare the two).
-// 16 lanes measured 2.8x, 8 lanes 2.2x faster than one ray per work-item at 128^3 / 256^2.
+// 16 lanes ran faster than 8, both well ahead of one ray per work-item (bench/RESULTS.md, "Ray
+// packets on CPU devices, 16 lanes").
 #define PACKET_LANES 16
 #define PACKET_W 4
 #define PACKET_H 4

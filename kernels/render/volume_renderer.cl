@@ -82,10 +82,10 @@ __kernel void render_volume(__global const float* volume, int4 dims, float4 orig
 }
 
 // pow(x, w) for x in [0, 1] and w >= 0 (n.l and the Phong shininess), as exp2(w log2 x): on
-// PoCL the 16-wide pow took more than half of a shaded packet's time (Marschner-Lobb 128^3,
-// 256^2: 72 ms a frame, 23-33 ms with the specular term replaced by a product), exp2 and log2
-// far less. It differs from pow by a few ulp times w |log2 x|, checked against render_volume's
-// pow by the packet tests. pow(x, 0) is 1, also at x = 0.
+// PoCL the 16-wide pow took most of a shaded packet's time, exp2 and log2 far less
+// (bench/RESULTS.md, "pow as exp2 and log2 in shaded packets"). It differs from pow by a few ulp
+// times w |log2 x|, checked against render_volume's pow by the packet tests. pow(x, 0) is 1, also
+// at x = 0.
 inline floatp packet_pow_unit(floatp x, float w) {
     if (w == 0.0f) return (floatp)(1.0f);
     return exp2(w * log2(x));  // log2(0) = -inf gives 0

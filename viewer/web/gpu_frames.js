@@ -20,9 +20,10 @@ const KEPT_STEPS = 3;  // light fields kept parsed: the shown step and the ones 
 // While the user drags, each frame is drawn at the largest size that keeps the GPU's time for it
 // within a budget (frame_cost.js): the full frame where the GPU draws it that fast, else a
 // preview (the image scaled down by a whole factor; light fields with PREVIEW_SEARCH_STEPS
-// search steps instead of the reference's 64), and the full frame once the pointer rests. On
-// SwiftShader (2 cores) a 512^2 light-field frame takes about 3.3 s in full, 87 ms as a 128^2
-// preview; on a GPU both take a few milliseconds.
+// search steps instead of the reference's 64), and the full frame once the pointer rests. A
+// software renderer such as SwiftShader takes seconds for a full light-field frame and a small
+// fraction of that for a preview; a GPU draws both quickly (bench/RESULTS.md, "Preview frames
+// while dragging in the web viewer").
 const PREVIEW_SEARCH_STEPS = 16;
 const FULL_SEARCH_STEPS = 64;  // LightFieldReconstructionSettings::search_steps' default
 

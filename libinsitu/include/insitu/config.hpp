@@ -70,11 +70,10 @@ enum class WhenFull { block, drop };  ///< writer policy when its queue is full
 /// multi-perspective frame, holding only the attenuation proxies.
 /// Defaults pay for themselves (issue 17): a kind is on by default only where the Explorer's
 /// default ("auto") reconstructs better with it. The multi-perspective pass is off: "auto"
-/// synthesises new views from the single-perspective proxies, which bench/RESULTS.md ("Depth
-/// correlation by proxy source") measures ahead of the distortion camera's at 15 and 30 degrees
-/// (0.976 / 0.970 against 0.907 / 0.938 at the default tilt), so it cost one of a default
-/// step's three passes and 15 % more bytes (Gray-Scott 64^3 at 256^2) for frames only "source":
-/// "multi" shows. "rendering" is 18 % of such a step's bytes and costs no pass.
+/// synthesises new views from the single-perspective proxies, whose synthesised depth correlates
+/// better than the distortion camera's at 15 and 30 degrees, so it cost a pass and bytes for
+/// frames only "source": "multi" shows. "rendering" costs a small share of the bytes and no
+/// pass (bench/RESULTS.md, "Default proxies: multi-perspective off, rendering on").
 struct ProxySelection {
     bool depth = true;               ///< "depth": single-perspective depth layers
     bool distortion = false;         ///< "distortion": multi-perspective depth + distortion layers
@@ -82,9 +81,9 @@ struct ProxySelection {
     bool multi_attenuation = false;  ///< "multi_attenuation": the same from the distortion camera
     /// "optical_depth": tau_j as well. Edits that thin an interval by 4 or more take its
     /// transmittance from it, and the edit trust needs it to measure thinning. Off by default:
-    /// bench/RESULTS.md ("Where the methods fail") finds it scene-dependent, 38.8 -> 58.8 dB for
-    /// opacity / 16 on Gray-Scott but 47.5 -> 36.4 dB for the nested shells' outer one faded to
-    /// 0.3, for 35 % more bytes (Gray-Scott 64^3, 300 steps at 256^2: 31.7 -> 42.7 MB).
+    /// what it gains is scene-dependent (it helps a strong thinning on Gray-Scott and hurts a
+    /// faded shell), and every step stores more bytes for it (bench/RESULTS.md, "Optical depth
+    /// off by default").
     bool optical_depth = false;
     /// "rendering": the stored view's ground truth with the run's function in half RGBA (the
     /// preview costs that pass anyway), so the Explorer returns that view exactly (issue 17).
@@ -92,21 +91,18 @@ struct ProxySelection {
     /// "interleaving" (with "attenuation"): per pixel, how many times the ray re-entered an
     /// interval it had left, one channel counted in the attenuation pass (no pass of its own).
     /// Opacity edits are exact where it is 0 and approximate elsewhere, so the Explorer's trust
-    /// for edits reads it (issue 17; bench/RESULTS.md, "Where the methods fail"). Measured on
-    /// Gray-Scott 128^3, 100 steps at 256^2: 4.8 % of the archive's bytes, and proxies per
-    /// archived step 77-83 ms with it against 79-88 ms without (no measurable time).
+    /// for edits reads it (issue 17; bench/RESULTS.md, "Where the methods fail"). On by default:
+    /// it costs a small share of the archive's bytes and no measurable time (bench/RESULTS.md,
+    /// "Interleaving counts on by default").
     /// Not written by distributed runs: a block cannot count what the ray met in front of it.
     bool interleaving = true;
     /// "entry_depth" (with "attenuation"): per pixel and interval, the depth where the
     /// interval first took light, counted in the attenuation pass. Opacity edits that thicken
     /// the volume turn on the front of each interval, which the mean depth (the estimator's
     /// order) puts too far back where the ray re-entered it; the edit trust compares the two
-    /// orders (issue 17). bench/RESULTS.md ("Where the methods fail"): with it, the trust flags
-    /// 97-99 % of the wrong pixels of opacity scaled by 2-64 and 4-10 % of the right ones,
-    /// against 68-89 % and 26-58 % from the interleaving counts alone. Cost on Gray-Scott 64^3,
-    /// 300 steps at 256^2 (the mini-app's defaults): the archive grows from 26.9 to 31.7 MB
-    /// (18 %); on 128^3, 100 steps every 10, from 3.79 to 4.42 MB (17 %) and proxies per archived
-    /// step from 68-72 to 75 ms (two runs each, interleaved).
+    /// orders (issue 17). On by default: with it the trust flags more of the wrong pixels of
+    /// thickening edits and far fewer of the right ones than the interleaving counts alone, for
+    /// a modest share of bytes and little time (bench/RESULTS.md, "Entry depth on by default").
     /// Not written by distributed runs, like "interleaving".
     bool entry_depth = true;
 };
@@ -130,8 +126,9 @@ constexpr double kMinStepVoxels = 1e-3;
 constexpr double kWorstDiagonalVoxels = 2815.0;
 /// Ceiling on InstrumentConfig::estimated_samples_per_step(), 2^42: the largest view (16384^2
 /// pixels) with the default proxies at a 1-voxel step fits under it. At the performance model's
-/// rate on 2 CPU cores (about 4.7e8 samples/s) that is some hours, on a GPU minutes; beyond it a
-/// configuration is orders of magnitude off rather than tuned, so it is refused at start-up.
+/// rate on 2 CPU cores that is some hours, on a GPU minutes (bench/RESULTS.md, "Ceiling on
+/// samples per step"); beyond it a configuration is orders of magnitude off rather than tuned,
+/// so it is refused at start-up.
 constexpr double kMaxSamplesPerStep = 4398046511104.0;
 
 /// "on_existing": what a run does when its archive directory already holds an archive.
@@ -209,11 +206,10 @@ struct InstrumentConfig {
     double step_voxels = 1.0;  ///< "step": ray step in voxels
     /// "every": emit on steps divisible by N; or "steps": an explicit list. Default 10 with the
     /// default 256^2 view, so that a configuration naming only its fields costs a modest share of
-    /// a run (issue 18: every step at 512^2 took a 30-step run from 0.56 s to 10.8 s). Measured
-    /// on the Gray-Scott mini-app at 128^3, 100 steps (bench/README.md "bench_overhead", 2
-    /// cores): 1.54 s inside execute() against 0.52 s of simulation, 0.15 s per archived step.
-    /// The mini-app's 5 ms steps make that three times the simulation; against a production
-    /// code's seconds per step, 10 steps between outputs make it a few percent.
+    /// a run (issue 18: emitting every step multiplied a short run's time). At every 10 the
+    /// outputs still take several times the simulation's own time on the Gray-Scott mini-app,
+    /// whose steps are short; against a production code's seconds per step, 10 steps between
+    /// outputs make it a few percent (bench/RESULTS.md, "Default cadence: every 10 steps").
     std::int64_t every = 10;
     std::vector<std::int64_t> steps;
     std::string archive = "run.cdb";  ///< "archive": directory of the proxy archive

@@ -66,10 +66,10 @@ Imf::Compression parse_compression(const std::string& name);
 
 /// zlib level of "zip" and "zips" parts. The encoding runs on the simulation's core (an MPI rank
 /// is bound to one), so it is chosen for time: zlib's levels 1 to 3 share its fast deflate, and
-/// on Gray-Scott proxies (256^2, depth and distortion layers, 16 intervals) level 2 encoded as
-/// fast as 1 with 1% fewer bytes, and took 31-38% less time than OpenEXR's default 4 for 7-13%
-/// more bytes (issue 18; bench_overhead measures it in situ). The level is not stored in the
-/// file: readers need nothing.
+/// level 2 encoded as fast as 1 for slightly fewer bytes, and took markedly less time than
+/// OpenEXR's default 4 for a few more bytes (issue 18; bench/RESULTS.md, "zlib level 2 for zip
+/// parts"; bench_overhead measures it in situ). The level is not stored in the file: readers
+/// need nothing.
 inline constexpr int kZipCompressionLevel = 2;
 
 /// Collects the encoded EXR in memory, so that the bytes are checksummed and written by the same

@@ -455,13 +455,11 @@ LightFieldEncoding light_field_encoding(StoragePrecision precision,
     LightFieldEncoding encoding;
     encoding.compact = precision == StoragePrecision::half ? Imf::HALF : Imf::FLOAT;
     encoding.compression = parse_compression(compression);
-    // Measured on volume renderings of nested shells through a 12-camera rig, 256^2 maps, S = 1,
-    // half precision, depth bytes a camera (8-bit UINT / 8-bit HALF / 16-bit HALF): zip 13.3 /
-    // 11.4 / 14.0 KB, zips 33.6 / 15.2 / 20.1 KB, piz 14.4 / 20.0 / 26.6 KB, pxr24 6.5 / 9.3 /
-    // 11.3 KB; uncompressed HALF is half of UINT, and rle gave 210 vs 104 KB a camera in all.
-    // The zip family splits pixels into two byte streams, not four, so UINT's zero bytes stay
-    // interleaved with the codes; piz and pxr24 separate them. b44 leaves UINT raw but is lossy
-    // for HALF, which would move codes: UINT. light_field_archive_test.cpp
+    // 8-bit depth codes took fewer bytes as HALF under the zip family, rle and no compression,
+    // and as UINT under piz and pxr24 (bench/RESULTS.md, "Light-field depth codes: UINT or HALF
+    // by compression"). The zip family splits pixels into two byte streams, not four, so UINT's
+    // zero bytes stay interleaved with the codes; piz and pxr24 separate them. b44 leaves UINT
+    // raw but is lossy for HALF, which would move codes: UINT. light_field_archive_test.cpp
     // (DepthCodeTypeIsTheSmallerUnderEachCompression) checks the choice on rendered maps.
     switch (encoding.compression) {
         case Imf::PIZ_COMPRESSION:

@@ -14,9 +14,10 @@ bool lower_writer_thread_priority() noexcept {
 #if defined(__linux__)
     // SCHED_IDLE: the fair scheduler's smallest weight, below nice 19, so a runnable simulation
     // thread on the same core always goes first; lowering a thread's own policy needs no
-    // privilege. Measured on one pinned core (bench_overhead, 128^3, every 10 steps, one 256^2
-    // view): the simulation's own time rose 41% with the writer at its priority, 0-3% at
-    // SCHED_IDLE, and the overhead it sees is then the time inside execute() and finalize().
+    // privilege. On one pinned core the writer at the simulation's priority slowed the
+    // simulation's own steps markedly, at SCHED_IDLE hardly (bench/RESULTS.md, "The archive
+    // writer's thread at SCHED_IDLE"), and the overhead it sees is then the time inside
+    // execute() and finalize().
     sched_param parameters{};
     parameters.sched_priority = 0;  // the only value SCHED_IDLE takes
     if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &parameters) == 0) return true;

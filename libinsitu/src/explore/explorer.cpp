@@ -151,15 +151,13 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
             // Fused per pixel: the view's proxies fill in only where the light field knows
             // nothing of the ray (none of its cameras there: empty, confidence 0). Everywhere
             // else the light field's pixel is the better one, whatever the two confidences say:
-            // on bench/evaluate's random views (42 cameras, 512^2) even its least trusted pixels
-            // (confidence < 0.001) are off by 0.11 (Gray-Scott) and 0.06 (Marschner-Lobb) at
-            // their worst component on average, where a view synthesised from one camera's
-            // proxies is off by 2-3 times as much (5.6-5.7 % mean error against 2.2 / 1.1 %).
-            // Fusing wherever the light field's confidence was below 0.1 lost 1.0 percentage
-            // point of mean error on both scenes once the light field's blend stopped mixing in
-            // cameras that do not see the ray; at large rotations the synthesised view's samples
-            // land on the wrong side of the object with full confidence (fusing by the larger
-            // confidence lost 11 dB at 90 degrees).
+            // even its least trusted pixels are off by little, a view synthesised from one
+            // camera's proxies is off by a few times the light field's mean error, and fusing
+            // below a confidence threshold lost accuracy once the light field's blend stopped
+            // mixing in cameras that do not see the ray; at large rotations the synthesised
+            // view's samples land on the wrong side of the object with full confidence, so fusing
+            // by the larger confidence loses badly there (bench/RESULTS.md, "Fused frames: the
+            // light field's pixel over the proxies'").
             ExploreFrame from_proxies =
                 proxies_frame(plan, request, attenuation_resolution, device);
             ExploreFrame from_light_field =

@@ -200,7 +200,8 @@ FramePlan plan_frame(const ExploreRequest& request, StepCache& steps,
     if (plan.source != FrameSource::light_field) pick_proxies(plan, request, archive_path);
     // The stored view with the run's own function, unedited: the rendering the Instrument kept
     // is that view exactly (to half precision), where recomposing it from intervals treats each
-    // interval's colour as constant (38.8 dB on a CT head, issue 17).
+    // interval's colour as constant (issue 17; bench/RESULTS.md, "The stored rendering for the
+    // stored view").
     plan.stored_rendering =
         plan.same_view && plan.single &&
         shows_stored_rendering(*plan.single, asks_stored_tf(request, plan.stored_tf),

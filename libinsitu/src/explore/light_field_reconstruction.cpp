@@ -38,10 +38,10 @@ constexpr double kSurfaceFootprints = 4.0;
 // and the cameras' hits along the ray are told to agree within:
 constexpr double kAgreementFootprints = 2.0;
 // The cameras' colours of the ray (each camera's segments composited) are told to agree within
-// this (premultiplied, of full scale 1). Chosen on bench/evaluate's random views (42 cameras,
-// Gray-Scott and Marschner-Lobb): 0.05 flags 95 % of the pixels off by more than 0.1 but 76 % of
-// the good ones, 0.12 flags 91 % / 32-43 %, 0.2 flags 84-88 % / 23-27 %; without the term 38-55 %
-// / 7-15 %. 0.2 keeps the overlay usable; bench/RESULTS.md has the figures.
+// this (premultiplied, of full scale 1). Chosen on bench/evaluate's random views: a tighter
+// tolerance flags a few more of the wrong pixels but far more of the good ones, and without the
+// term many wrong pixels go unflagged; 0.2 keeps the overlay usable (bench/RESULTS.md,
+// "Light-field colour agreement").
 constexpr double kColourAgreement = 0.2;
 
 // A target ray's chord through the bounding sphere, [t0, t1], and its point nearest the
@@ -377,9 +377,9 @@ private:
             sample.rgba[3] = 1.0 - camera_transmittance;
         }
         // A camera that sees a surface the ray passes by holds nothing of this ray: the segment is
-        // what the others saw, not a blend that mixes in black (bench/evaluate, 42 cameras:
-        // mean error 3.52 -> 2.24 % on Gray-Scott, 1.90 -> 1.10 % on Marschner-Lobb, where the
-        // cameras disagree about which side of a semi-transparent feature the ray is on).
+        // what the others saw, not a blend that mixes in black, which added error where the
+        // cameras disagree about which side of a semi-transparent feature the ray is on
+        // (bench/RESULTS.md, "Light-field segments: a camera that misses the ray left out").
         for (int s = 0; s < segments_; ++s) {
             const double weight = scratch.segment_weight[static_cast<std::size_t>(s)];
             if (weight > 0.0) {

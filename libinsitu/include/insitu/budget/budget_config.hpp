@@ -109,13 +109,13 @@ struct BudgetConfig {
 /// bench/RESULTS.md "Colour model and opacity edits": the error falls to K = 24 and flattens).
 inline constexpr int kBudgetColourModelClusters[] = {4, 8, 16, 24, 48};
 
-/// Camera counts a budget that chooses the light field measures: 12 cameras reconstruct
-/// Gray-Scott's random views at 20.9 dB, 42 at 23.8, 162 at 28.3 (256^2 maps, bench/RESULTS.md
-/// "Light fields"); 642 would store 4x 162's bytes and is left to a configuration that asks.
+/// Camera counts a budget that chooses the light field measures: each larger rig reconstructs
+/// Gray-Scott's random views a few dB better (bench/RESULTS.md, "Light-field rigs a budget
+/// measures"); 642 would store 4x 162's bytes and is left to a configuration that asks.
 inline constexpr int kBudgetLightFieldCameraCounts[] = {12, 42, 162};
-/// What it divides the configured map size by: doubling the map gains 0.1-0.6 dB there at 4x
-/// the bytes, so smaller maps are often the better buy. Only sizes of at least
-/// kBudgetMinLightFieldSide are measured.
+/// What it divides the configured map size by: doubling the map gains little there at 4x
+/// the bytes (bench/RESULTS.md, "Light-field rigs a budget measures"), so smaller maps are often
+/// the better buy. Only sizes of at least kBudgetMinLightFieldSide are measured.
 inline constexpr int kBudgetLightFieldSizeDivisors[] = {1, 2, 4};
 inline constexpr int kBudgetMinLightFieldSide = 64;
 
@@ -131,9 +131,9 @@ inline constexpr int kBudgetSizeDivisors[] = {1, 2};
 inline constexpr int kBudgetMinViewSide = 64;
 /// PSNR a budget gives up for bytes where it cannot meet its accuracy (or asks none): it takes
 /// the cheapest affordable candidate within this of the most accurate one. About what one
-/// choice's achieved PSNR moves between neighbouring archived steps (0.05-0.35 dB on Gray-Scott,
-/// bench/RESULTS.md "Error budget over a Gray-Scott run"): a difference the next step may
-/// reverse is not worth more bytes.
+/// choice's achieved PSNR moves between neighbouring archived steps on Gray-Scott
+/// (bench/RESULTS.md, "Budget PSNR tolerance"): a difference the next step may reverse is not
+/// worth more bytes.
 inline constexpr double kBudgetPsnrTolerance = 0.5;
 /// Share of a field's samples whose values may move (histogram_distance) before the budget is
 /// checked again ahead of "check_every".

@@ -63,9 +63,9 @@ struct LightFieldSettings {
     int depth_bits = 8;       ///< "depth_bits": 8 (as seed 001) or 16 (half)
     /// "depth_threshold": the opacity at which the ray's "first hit" is recorded, in (0, 1).
     /// Seed 001 takes "a small threshold"; on semi-transparent fields the depth that colour is
-    /// read at should sit inside the material, not at its front: bench/evaluate's sweep (42
-    /// cameras, random views) measured mean error 3.74 / 3.57 / 3.71 / 4.43 % on Gray-Scott and
-    /// 2.26 / 1.99 / 2.03 / 2.29 % on Marschner-Lobb at 0.1 / 0.3 / 0.5 / 0.7.
+    /// read at should sit inside the material, not at its front. 0.3 gave the least mean error
+    /// on Gray-Scott and Marschner-Lobb in bench/evaluate's sweep (bench/RESULTS.md, "Light-field
+    /// depth threshold").
     double depth_threshold = 0.3;
 
     /// InvalidArgument naming the "light_field" key and value of the first bad member.

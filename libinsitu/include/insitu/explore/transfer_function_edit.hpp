@@ -76,10 +76,9 @@ Image estimate_attenuation(const Image& attenuation, const Image& mean_depth,
                            ComputeDevice& device = *ComputeDevice::shared());
 
 /// How much of t_j a thinning edit by s takes from the optical depth: 0 for s >= 1/2, 1 for
-/// s <= 1/4, linear in log2(s) between. bench/RESULTS.md ("Where the methods fail") measures the
-/// two sources on Gray-Scott, where runs interleave at most pixels: at s = 1/2, exp(-tau_j) gets
-/// 835 pixels wrong by > 0.1 against 8 for the inferred t_j; at s = 1/4, 41 against 371; at
-/// 1/16, 0 against 135.
+/// s <= 1/4, linear in log2(s) between. On Gray-Scott, where runs interleave at most pixels, the
+/// inferred t_j gets far fewer pixels wrong at s = 1/2 and exp(-tau_j) far fewer from s = 1/4 on
+/// (bench/RESULTS.md, "Thinning edits: how much of t_j comes from the optical depth").
 double optical_depth_weight(double scale);
 
 /// Trust for transfer-function edits (issue 17): a per-pixel estimate of how far an edited frame

@@ -59,10 +59,11 @@ struct RenderSettings {
     /// Resolution of the transfer-function table on the device.
     int tf_value_bins = 1024;
     int tf_gradient_bins = 64;
-    /// March a whole volume's rays in SIMD packets of 4x4 neighbouring pixels on a CPU device (the
-    /// same samples and arithmetic per ray, 2-3x faster on PoCL's pthread device; a GPU keeps one
-    /// ray per work-item, its own SIMD lanes). false marches one ray per work-item, the form
-    /// blocks of a distributed run always take: the reference packets are tested against.
+    /// March a whole volume's rays in SIMD packets of 4x4 neighbouring pixels on a CPU device: the
+    /// same samples and arithmetic per ray, a few times faster on PoCL's pthread device
+    /// (bench/RESULTS.md, "Ray packets on CPU devices, 16 lanes"); a GPU keeps one ray per
+    /// work-item, its own SIMD lanes. false marches one ray per work-item, the form blocks of a
+    /// distributed run always take: the reference packets are tested against.
     bool ray_packets = true;
 };
 std::ostream& operator<<(std::ostream& out, const RenderSettings& settings);
