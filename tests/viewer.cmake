@@ -1,4 +1,4 @@
-# Tests of the web viewer, `insitu-view serve` (viewer/server.cpp, viewer/web/), included from
+# Tests of the web viewer, `insitu-view serve` (viewer/, viewer/web/), included from
 # tests/CMakeLists.txt. A small Gray-Scott archive is the fixture; node runs the tests in
 # tests/viewer/: browser.test.mjs drives headless Debian chromium through playwright-core
 # (installed by scripts/setup into tests/viewer/node_modules) and compares every displayed frame

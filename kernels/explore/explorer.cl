@@ -1,7 +1,7 @@
 // Per-pixel steps of Explorer::render that belong to no single method
-// (libinsitu/src/explore/explorer.cpp): combining the colour with lighting and occlusion factors,
-// and drawing depth layers as surfaces when an archive holds no attenuation proxies. One work-item
-// per pixel.
+// (libinsitu/src/explore/frame_basis.cpp): combining the colour with lighting and occlusion
+// factors, and drawing depth layers as surfaces when an archive holds no attenuation proxies. One
+// work-item per pixel.
 
 // colour.rgb *= lit.rgb / lit.a: `lit` is light_volume() of the same attenuation with white
 // interval colours, so lit.rgb / lit.a is the lighting factor of the pixel, whichever way its

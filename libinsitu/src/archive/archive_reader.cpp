@@ -2,8 +2,8 @@
 //
 // Everything read is validated: the manifest's shape (manifest.cpp), each file's size and CRC-32
 // against the manifest before it is parsed, and every EXR part, channel and attribute the frame
-// needs (exr_frame.cpp). open_damaged() is the one tolerant way in: it keeps what a damaged index
-// still holds, for the tools that report damage.
+// needs (exr_frame_decoder.cpp). open_damaged() is the one tolerant way in: it keeps what a
+// damaged index still holds, for the tools that report damage.
 #include "insitu/archive/archive_reader.hpp"
 
 #include <algorithm>

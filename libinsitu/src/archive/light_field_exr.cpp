@@ -1,5 +1,5 @@
 // The light-field codec (light_field_exr.hpp). It works on bytes in memory as the view codec
-// does (exr_frame.cpp, whose streams, header checks and channel reader it shares): the writer
+// does (exr_frame.hpp, whose streams, header checks and channel reader it shares): the writer
 // checksums what it encodes and stores it through the crash-safe path, and the reader parses
 // only bytes it already checked against the manifest, and of those only the parts of the
 // cameras it was asked for.
@@ -497,8 +497,8 @@ EncodedLightField encode_light_field(const StepRecord& record, const LightFieldR
     MemoryOutputStream stream(relative_path);
     std::string current_part;
     try {
-        // No OpenEXR worker threads, as for the views (exr_frame.cpp): the encoding stays on the
-        // writer thread and its lowered priority.
+        // No OpenEXR worker threads, as for the views (exr_frame_encoder.cpp): the encoding stays
+        // on the writer thread and its lowered priority.
         Imf::MultiPartOutputFile file(stream, headers.data(), static_cast<int>(headers.size()),
                                       /*overrideSharedAttributes=*/false, /*numThreads=*/0);
         for (std::size_t p = 0; p < cameras.size(); ++p) {

@@ -18,8 +18,6 @@ namespace insitu {
 class Representation {
 public:
     virtual ~Representation() = default;
-    /// As the configuration and manifest name it ("views", "light_field").
-    virtual std::string name() const = 0;
     /// Adds what it stores of the plan's field at this step, by `recipe`, to `record`.
     virtual void capture(const InstrumentConfig& config, const FieldPlan& plan,
                          const FieldRecipe& recipe, StepPasses& passes,

@@ -8,7 +8,6 @@ namespace insitu {
 
 class LightFieldRepresentation final : public Representation {
 public:
-    std::string name() const override { return "light_field"; }
     void capture(const InstrumentConfig& config, const FieldPlan& plan, const FieldRecipe& recipe,
                  StepPasses& passes, StepRecord& record) const override;
     void choose(const FieldBudgetCheck& check, BudgetRecord& choice) const override;

@@ -9,7 +9,6 @@ namespace insitu {
 
 class ViewProxies final : public Representation {
 public:
-    std::string name() const override { return "views"; }
     void capture(const InstrumentConfig& config, const FieldPlan& plan, const FieldRecipe& recipe,
                  StepPasses& passes, StepRecord& record) const override;
     void choose(const FieldBudgetCheck& check, BudgetRecord& choice) const override;
