@@ -67,6 +67,7 @@ std::ostream& operator<<(std::ostream& out, const InstrumentStatistics& s) {
 namespace {
 
 namespace fs = std::filesystem;
+
 // Largest step number the manifest holds exactly (see Impl::check_step).
 constexpr std::int64_t kMaxStep = (std::int64_t{1} << 53) - 1;
 
