@@ -4,7 +4,6 @@
 // passes) and choose (its budget candidates measured, its choice recorded). The registry lists
 // them in the order a step captures and a budget check chooses them.
 #include <memory>
-#include <string>
 #include <vector>
 
 #include "budget/field_budget_check.hpp"
