@@ -29,12 +29,6 @@ TEST(BudgetHeldOutEdit, HalvesEveryOpacityInExtinctionAndKeepsTheColours) {
     EXPECT_EQ(edit.unit_length(), run.unit_length());
 }
 
-TEST(BudgetHeldOutEdit, TruthSettingsMarchAtTheProxiesStepToZeroTransmittance) {
-    const RenderSettings settings = budget_truth_settings(0.5);
-    EXPECT_EQ(settings.step_voxels, 0.5);
-    EXPECT_EQ(settings.early_termination_opacity, 1.0);
-}
-
 TEST(BudgetHeldOutEdit, ASmallerViewIsShownEnlargedToTheTruthsSize) {
     Image truth(8, 8, 4, 0.5f);
     // A uniform image enlarged bilinearly stays uniform: the same picture, at psnr_rgb_db's

@@ -40,6 +40,8 @@ TEST(StepRecipe, TheViewsPassesFollowTheConfiguredProxies) {
     EXPECT_EQ(passes.single.march.step_voxels, 0.5);
     EXPECT_FALSE(passes.wants_multi);
     EXPECT_FALSE(passes.fits_colour_model);  // no training functions
+    // The preview (also the budget's ground truth) marches at the proxies' step to T = 0.
+    EXPECT_EQ(passes.preview.step_voxels, 0.5);
     EXPECT_EQ(passes.preview.early_termination_opacity, 1.0);
     ASSERT_EQ(recipe.views.size(), 1u);
     EXPECT_EQ(recipe.views[0].orbit.width, 64);

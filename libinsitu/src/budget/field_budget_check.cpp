@@ -2,6 +2,7 @@
 
 #include "core/elapsed.hpp"
 #include "representation/representation.hpp"
+#include "step/step_recipe.hpp"
 
 namespace insitu {
 
@@ -22,7 +23,7 @@ BudgetRecord check_field_budget(const InstrumentConfig& config, ProxyRenderer& r
                            plan,
                            1.0 / static_cast<double>(config.fields.size()),
                            halved_opacity(plan.transfer_function),
-                           budget_truth_settings(config.step_voxels),
+                           field_recipe(config, plan).view_passes.preview,
                            {},
                            0.0};
     // The measured views' ground truths, once per check: the field's first view, then each

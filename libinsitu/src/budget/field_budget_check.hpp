@@ -22,7 +22,7 @@ struct FieldBudgetCheck {
     const FieldPlan& plan;          ///< the plan, before the budget's choice
     double share = 1.0;             ///< the field's share of the step's limits
     TransferFunction held_out;      ///< halved_opacity of the plan's function
-    RenderSettings truth_settings;  ///< budget_truth_settings
+    RenderSettings truth_settings;  ///< the ground truth as the step's preview marches it
     std::vector<BudgetView> views;  ///< the stored view (first view of the field) and its turns
     double stored_truth_ms = 0.0;   ///< one ground-truth pass of the stored view, as a preview
 

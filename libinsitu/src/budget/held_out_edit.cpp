@@ -17,13 +17,6 @@ TransferFunction halved_opacity(const TransferFunction& tf) {
     return TransferFunction(points, tf.unit_length());
 }
 
-RenderSettings budget_truth_settings(double step_voxels) {
-    RenderSettings settings;
-    settings.step_voxels = step_voxels;
-    settings.early_termination_opacity = 1.0;
-    return settings;
-}
-
 std::vector<BudgetView> budget_views(ProxyRenderer& renderer, const Camera& camera,
                                      const TransferFunction& held_out,
                                      const std::vector<double>& rotations_deg,

@@ -16,9 +16,6 @@ namespace insitu {
 /// extinction, a' = 1 - (1 - a)^0.5 (the law opacity edits follow), colours kept.
 TransferFunction halved_opacity(const TransferFunction& tf);
 
-/// The budget's ground truth: the proxies' step, marched on to T = 0 as the proxies are.
-RenderSettings budget_truth_settings(double step_voxels);
-
 /// A view the budget measures: the stored one (offset 0) or a turn of it in azimuth
 /// (Camera::reorbit), with the held-out edit's ground truth in it.
 struct BudgetView {
@@ -28,8 +25,9 @@ struct BudgetView {
 };
 
 /// The budget's views of `camera` (the stored one first, then a turn per rotation, in degrees of
-/// azimuth), each with `held_out`'s ground truth. `stored_truth_ms` gets the stored view's pass
-/// time: the step's preview is one such pass per view.
+/// azimuth), each with `held_out`'s ground truth, marched with `truth_settings` (the step's
+/// preview settings: the proxies' step, on to T = 0 as the proxies are). `stored_truth_ms` gets the
+/// stored view's pass time: the step's preview is one such pass per view.
 std::vector<BudgetView> budget_views(ProxyRenderer& renderer, const Camera& camera,
                                      const TransferFunction& held_out,
                                      const std::vector<double>& rotations_deg,
