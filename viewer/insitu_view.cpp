@@ -3,7 +3,7 @@
 //   insitu-view info ARCHIVE [--json]
 //   insitu-view render ARCHIVE --step N [--view V] [--azimuth DEG --elevation DEG]
 //               [--tf TF.json | --opacity-scale J=S,...] [--colour auto|model|recompose]
-//               [--segment-opacity S=F,...] [--source auto|single|multi|lightfield]
+//               [--segment-opacity S=F,...] [--source auto|single|multi|lightfield|volume]
 //               [--light AZ,EL[,DIFFUSE[,SPECULAR]] | --light camera]... [--ambient A]
 //               [--ao] [--ao-radius PIXELS] [--ao-strength S] [--enhance LAMBDA,GAMMA]
 //               [--fill PIXELS] [--mask OUT.png] --out OUT.png|exr
@@ -28,6 +28,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -102,7 +103,7 @@ const std::vector<OptionHelp>& render_options() {
          "auto"},
         {"--segment-opacity", "S=F,...",
          "scale light-field segment S's opacity by F >= 0 (seed 001's per-layer fades)", "none"},
-        {"--source", "auto|single|multi|lightfield",
+        {"--source", "auto|single|multi|lightfield|volume",
          "the stored proxies a new view is made from; auto: the stored view's proxies at the "
          "stored view, elsewhere the light field and the view's proxies fused per pixel by "
          "confidence where the step has a light field, else the single-perspective proxies",
@@ -223,6 +224,39 @@ void print_light_fields(const nlohmann::json& description) {
     }
 }
 
+/// info's line per field with a compressed field: its codec and tolerance or rate, and its
+/// bytes and ratio to the raw floats, over the steps that have it.
+void print_volumes(const nlohmann::json& description) {
+    std::map<std::string, std::vector<const nlohmann::json*>> by_field;
+    for (const auto& volume : description.at("volumes")) {
+        by_field[volume.at("field").get<std::string>()].push_back(&volume);
+    }
+    for (const auto& [field, volumes] : by_field) {
+        const nlohmann::json& first = *volumes.front();
+        double bytes = 0.0;
+        double ratio = 0.0;
+        for (const nlohmann::json* volume : volumes) {
+            bytes += volume->at("bytes").get<double>();
+            ratio += volume->at("ratio").get<double>();
+        }
+        const double steps = static_cast<double>(volumes.size());
+        std::cout << "volume        " << field << ": " << first.at("codec").get<std::string>()
+                  << " " << first.at("mode").get<std::string>() << " ";
+        if (first.at("mode") == "rate") {
+            std::cout << first.at("rate").get<double>() << " bits/value";
+        } else {
+            std::cout << "tolerance " << first.at("tolerance").get<double>() << " (range "
+                      << first.at("min").get<double>() << ".." << first.at("max").get<double>()
+                      << ")";
+        }
+        std::cout << ", " << first.at("dims")[0] << "x" << first.at("dims")[1] << "x"
+                  << first.at("dims")[2] << ", " << volumes.size() << " step(s), "
+                  << std::setprecision(3) << bytes / steps / 1e6 << " MB/step, ratio "
+                  << std::setprecision(3) << ratio / steps << ":1\n"
+                  << std::setprecision(6);
+    }
+}
+
 /// A budget's measured PSNR as info prints it ("exact" where nothing was lost).
 std::string budget_psnr_text(const nlohmann::json& value) {
     std::ostringstream text;
@@ -282,6 +316,7 @@ int print_info_text(const std::string& archive,
               << "parts         " << description.at("parts").dump() << "\n";
     print_views(description);
     print_light_fields(description);
+    print_volumes(description);
     print_budget(description);
     if (inspection.manifest_readable) {
         std::cout << "configuration " << description.at("configuration").dump() << "\n";

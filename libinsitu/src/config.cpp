@@ -329,6 +329,13 @@ const Key<InstrumentConfig> kTopLevelKeys[] = {
      [](const InstrumentConfig& config) {
          return config.light_field ? config.light_field->to_json() : json();
      }},
+    {"volume",
+     [](const json& value, const std::string&, InstrumentConfig& config, Unknown& unknown) {
+         config.volume = VolumeSettings::from_json(value, unknown);
+     },
+     [](const InstrumentConfig& config) {
+         return config.volume ? config.volume->to_json() : json();
+     }},
     {"budget",
      [](const json& value, const std::string&, InstrumentConfig& config, Unknown& unknown) {
          config.budget = BudgetConfig::from_json(value, unknown);
@@ -348,6 +355,7 @@ std::vector<std::string> known_keys_under(const std::string& parent) {
     if (parent == "writer") return names_of(kWriterKeys);
     if (parent == "colour_model") return names_of(kColourModelKeys);
     if (parent == "light_field") return LightFieldSettings::keys();
+    if (parent == "volume") return VolumeSettings::keys();
     if (parent == "budget") return BudgetConfig::keys();
     if (parent == "transfer_function" || parent == "training_transfer_functions") {
         return {kTransferFunctionKeys.begin(), kTransferFunctionKeys.end()};

@@ -211,6 +211,12 @@ void Instrument::Impl::open_distributed(InstrumentConfig distributed_config) {
                 "and first hits depend on the opacity in front of a block, which the block "
                 "cannot know); capture them in a run without a communicator");
         }
+        if (distributed_config.volume) {
+            fail<InvalidArgument>(
+                "\"volume\": a distributed run does not store the compressed field yet (each "
+                "rank would write its own blocks, and only rank 0 writes); keep it in a run "
+                "without a communicator");
+        }
     });
     config = std::move(distributed_config);
     failure.guard([&] { renderer = std::make_unique<ProxyRenderer>(); });

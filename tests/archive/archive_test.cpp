@@ -310,7 +310,7 @@ TEST_F(Archive, RenderedProxiesRoundTrip) {
     view.transfer_function = *request.transfer_function;
     view.training_transfer_functions = {ramp(0.3f)};
     FieldSummaryRecord summary{"v", ValueHistogram::of(volume.values), 3};
-    StepRecord step{42, 4.2, "v", {view}, {}, {summary}, {}};
+    StepRecord step{42, 4.2, "v", {view}, {}, {summary}, {}, {}};
 
     ArchiveWriter(config_).write(step);
     const ArchiveReader reader(archive().string());

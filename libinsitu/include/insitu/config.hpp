@@ -16,6 +16,7 @@
 //  "colour_model": {"clusters": 24, "enabled": true},
 //  "light_field": {"cameras": 42, "size": 256, "segments": "layers", "attenuation": true,
 //                  "depth_bits": 8, "depth_threshold": 0.3},
+//  "volume": {"codec": "zfp", "tolerance": 0.001},
 //  "budget": {"psnr_db": 40, "bytes_per_step": 8e6, "ms_per_step": 500, "check_every": 10,
 //             "rotations": [-20, 20],
 //             "choose": ["intervals", "precision", "size", "light_field", "colour_model"]}}
@@ -46,6 +47,7 @@
 #include "insitu/core/intervals.hpp"
 #include "insitu/core/light_field.hpp"
 #include "insitu/core/transfer_function.hpp"
+#include "insitu/core/volume_settings.hpp"
 
 namespace insitu {
 
@@ -228,6 +230,10 @@ struct InstrumentConfig {
     /// "light_field": per step and field, a light field (seed 001) from an icosphere of cameras
     /// (insitu/core/light_field.hpp), captured in the proxy pass; none by default.
     std::optional<LightFieldSettings> light_field;
+    /// "volume" (insitu/core/volume_settings.hpp): per step and field, the field's values
+    /// compressed with ZFP (the compressed field: any view, any transfer function, from the
+    /// archive alone); none by default.
+    std::optional<VolumeSettings> volume;
     /// "budget" (insitu/budget/budget_config.hpp): none by default (the settings above, as
     /// given, are what runs).
     std::optional<BudgetConfig> budget;

@@ -46,6 +46,9 @@ nlohmann::json describe_archive(const ArchiveReader& archive) {
              step.value("light_fields", nlohmann::json::array())) {
             total_bytes += light_field.at("bytes").get<std::uint64_t>();
         }
+        for (const ArchivedVolume& volume : archive.volumes(step.at("step").get<std::int64_t>())) {
+            total_bytes += volume.bytes;
+        }
     }
     description["bytes"] = total_bytes;
     nlohmann::json part_names = nlohmann::json::array();
@@ -103,6 +106,29 @@ nlohmann::json describe_archive(const ArchiveReader& archive) {
         }
     }
     description["light_fields"] = light_fields;
+
+    // Per step and field, the compressed field: how it was compressed and what it costs.
+    nlohmann::json volumes = nlohmann::json::array();
+    for (const std::int64_t step : steps) {
+        for (const ArchivedVolume& volume : archive.volumes(step)) {
+            const double raw_bytes = 4.0 * static_cast<double>(volume.dims[0]) *
+                                     static_cast<double>(volume.dims[1]) *
+                                     static_cast<double>(volume.dims[2]);
+            volumes.push_back({{"step", step},
+                               {"field", volume.field},
+                               {"codec", volume.codec},
+                               {"mode", to_string(volume.mode)},
+                               {"tolerance", volume.tolerance},
+                               {"rate", volume.rate},
+                               {"dims", volume.dims},
+                               {"min", volume.min},
+                               {"max", volume.max},
+                               {"nonfinite", volume.nonfinite},
+                               {"bytes", volume.bytes},
+                               {"ratio", raw_bytes / static_cast<double>(volume.bytes)}});
+        }
+    }
+    description["volumes"] = volumes;
 
     // Per step with an error budget, what it chose for each field (the manifest's entries).
     nlohmann::json budget = nlohmann::json::array();

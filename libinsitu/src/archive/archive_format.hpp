@@ -133,6 +133,11 @@ inline constexpr int kMaxLightFieldSegments = kMaxLayers + 1;
 inline constexpr int kDepthCodeSteps = kLightFieldDepthCodeSteps;
 inline constexpr int kNoHitDepthCode = kLightFieldNoHitCode;
 
+// The compressed field (zfp_volume.hpp).
+/// The step entry's list of compressed fields, and the folder of their files.
+inline constexpr const char* kVolumesKey = "volumes";
+inline constexpr const char* kVolumeFolder = "volumes";
+
 /// "camera7": the part of camera 7.
 inline std::string camera_part(int camera) {
     return kCameraPartPrefix + std::to_string(camera);
@@ -173,6 +178,20 @@ inline std::string light_field_relative_path(std::int64_t step, int field) {
     std::snprintf(name, sizeof name, "step%06lld_lightfield%d.exr", static_cast<long long>(step),
                   field);
     return std::string(kProxyFolder) + "/" + name;
+}
+/// "volumes/step000010_field0.zfp" (or "..._field0_block3.zfp" for block 3 of a distributed
+/// run's field), with `extension` ".zfp" for the ZFP stream and ".mask" for its non-finite mask.
+inline std::string volume_relative_path(std::int64_t step, int field, int block, int blocks,
+                                        const char* extension) {
+    char name[96];
+    if (blocks == 1) {
+        std::snprintf(name, sizeof name, "step%06lld_field%d%s", static_cast<long long>(step),
+                      field, extension);
+    } else {
+        std::snprintf(name, sizeof name, "step%06lld_field%d_block%d%s",
+                      static_cast<long long>(step), field, block, extension);
+    }
+    return std::string(kVolumeFolder) + "/" + name;
 }
 /// "proxies/step000010_view0.exr" and "previews/step000010_view0.png", relative to the archive.
 inline std::string proxy_relative_path(std::int64_t step, int view) {

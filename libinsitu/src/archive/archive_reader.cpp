@@ -21,6 +21,7 @@
 #include "archive/light_field_exr.hpp"
 #include "archive/manifest.hpp"
 #include "archive/preview_png.hpp"
+#include "archive/volume_entries.hpp"
 #include "insitu/error.hpp"
 
 namespace insitu {
@@ -327,6 +328,25 @@ bool inside(const fs::path& root, const fs::path& path) {
 }
 
 }  // namespace
+std::vector<ArchivedVolume> ArchiveReader::volumes(std::int64_t step) const {
+    const nlohmann::json& step_entry = af::find_step(*manifest_, path_, step);
+    std::vector<ArchivedVolume> result;
+    for (const nlohmann::json& entry : af::volume_entries(step_entry)) {
+        result.push_back(af::archived_volume(step_entry, entry));
+    }
+    return result;
+}
+
+VolumeGrid ArchiveReader::load_volume(std::int64_t step, const std::string& field) const {
+    const nlohmann::json& step_entry = af::find_step(*manifest_, path_, step);
+    return af::read_volume(path_, af::find_volume(step_entry, path_, field));
+}
+
+Field VolumeGrid::as_field() const {
+    Field view(field, values.data(), ScalarType::float32, dims);
+    view.set_origin(origin).set_spacing(spacing);
+    return view;
+}
 
 std::vector<std::string> ArchiveReader::verify() const {
     return check().problems;
@@ -353,6 +373,16 @@ ArchiveCheck ArchiveReader::check() const {
                                                  entry.at("field").get<std::string>()});
         }
     }
+    std::multimap<std::string, std::pair<std::int64_t, std::string>> volume_owners;
+    for (const nlohmann::json& step : manifest_->at("steps")) {
+        for (const nlohmann::json& entry : af::volume_entries(step)) {
+            for (const af::ListedFile& file : af::listed_volume_files(path_, entry)) {
+                volume_owners.emplace(file.absolute_path,
+                                      std::pair{step.at("step").get<std::int64_t>(),
+                                                entry.at("field").get<std::string>()});
+            }
+        }
+    }
     // Files found unusable here are not reported again for data.csv's rows that name them.
     std::set<fs::path> reported;
     const auto unusable = [&](const af::ListedFile& file, std::string problem) {
@@ -365,6 +395,10 @@ ArchiveCheck ArchiveReader::check() const {
         const auto [first_field, last_field] = light_field_owners.equal_range(file.absolute_path);
         for (auto owner = first_field; owner != last_field; ++owner) {
             result.unreadable_light_fields.insert(owner->second);
+        }
+        const auto [first_volume, last_volume] = volume_owners.equal_range(file.absolute_path);
+        for (auto owner = first_volume; owner != last_volume; ++owner) {
+            result.unreadable_volumes.insert(owner->second);
         }
     };
     const fs::path root = resolved(fs::absolute(path_));

@@ -28,6 +28,7 @@
 #include "archive/exr_frame.hpp"
 #include "archive/light_field_exr.hpp"
 #include "archive/manifest.hpp"
+#include "archive/volume_entries.hpp"
 #include "insitu/error.hpp"
 
 // libinsitu/CMakeLists.txt passes project(VERSION) as INSITU_VERSION.
@@ -122,16 +123,23 @@ void validate_record(const StepRecord& record, const ArchiveWriter& writer) {
             fail<InvalidArgument>(where, ": two light fields of field \"", light_field.field, "\"");
         }
     }
+    std::set<std::string> volumes;
+    for (const VolumeRecord& volume : record.volumes) {
+        if (!volumes.insert(volume.field).second) {
+            fail<InvalidArgument>(where, ": two compressed fields of field \"", volume.field, "\"");
+        }
+    }
 }
 
-/// The light field's file number: the field's position in the configuration's "fields", so
-/// that a field's light fields share one name pattern across steps and restarts whatever the
-/// other fields capture, as the views are numbered field by field (planned_views).
-int light_field_number(const InstrumentConfig& config, const std::string& field,
-                       std::int64_t step) {
+/// The light field's (and the compressed field's) file number: the field's position in the
+/// configuration's "fields", so that a field's light fields share one name pattern across steps and
+/// restarts whatever the other fields capture, as the views are numbered field by field
+/// (planned_views).
+int field_number(const InstrumentConfig& config, const std::string& field, std::int64_t step,
+                 const char* what) {
     const auto found = std::find(config.fields.begin(), config.fields.end(), field);
     if (found == config.fields.end()) {
-        fail<InvalidArgument>("step ", step, ": light field of \"", field,
+        fail<InvalidArgument>("step ", step, ": ", what, " of \"", field,
                               "\", a field the configuration's \"fields\" does not list");
     }
     return static_cast<int>(found - config.fields.begin());
@@ -172,7 +180,7 @@ nlohmann::json write_light_fields(const fs::path& archive, const InstrumentConfi
     nlohmann::json entries = nlohmann::json::array();
     for (const LightFieldRecord& light_field : record.light_fields) {
         const std::string path = af::light_field_relative_path(
-            record.step, light_field_number(config, light_field.field, record.step));
+            record.step, field_number(config, light_field.field, record.step, "light field"));
         const af::EncodedLightField exr =
             af::encode_light_field(record, light_field, encoding, path);
         written.push_back(place_file(archive, path, exr.bytes));
@@ -196,6 +204,16 @@ nlohmann::json write_step_files(const fs::path& archive, const InstrumentConfig&
     }
     if (!record.light_fields.empty()) {
         step_entry[af::kLightFieldsKey] = write_light_fields(archive, config, record, written);
+    }
+    if (!record.volumes.empty()) {
+        nlohmann::json& volumes = step_entry[af::kVolumesKey];
+        volumes = nlohmann::json::array();
+        for (const VolumeRecord& volume : record.volumes) {
+            volumes.push_back(af::write_volume(
+                archive, record.step,
+                field_number(config, volume.field, record.step, "compressed field"), volume,
+                written));
+        }
     }
     if (!record.fields.empty()) {
         nlohmann::json& summaries = step_entry[af::kFieldsKey];
@@ -249,7 +267,7 @@ void remove_archive_files(const fs::path& archive) {
                           ": ", error.message());
         }
     }
-    for (const char* folder : {af::kProxyFolder, af::kPreviewFolder}) {
+    for (const char* folder : {af::kProxyFolder, af::kPreviewFolder, af::kVolumeFolder}) {
         std::error_code error;
         for (const fs::directory_entry& entry : fs::directory_iterator(archive / folder, error)) {
             if (entry.is_regular_file()) fs::remove(entry.path(), error);
@@ -267,7 +285,8 @@ ArchiveWriter::ArchiveWriter(const InstrumentConfig& config)
     af::check_compression(config_.compression);  // fail early, before touching the disk
     if (path_.empty()) fail<InvalidArgument>("archive: empty path");
     const fs::path archive(path_);
-    const fs::path folders[] = {archive, archive / af::kProxyFolder, archive / af::kPreviewFolder};
+    const fs::path folders[] = {archive, archive / af::kProxyFolder, archive / af::kPreviewFolder,
+                                archive / af::kVolumeFolder};
     for (const fs::path& folder : folders) {
         std::error_code error;
         fs::create_directories(folder, error);

@@ -9,6 +9,8 @@
 
 #include "archive/archive_format.hpp"
 #include "archive/atomic_file.hpp"
+#include "archive/manifest_keys.hpp"
+#include "archive/volume_entries.hpp"
 #include "insitu/archive/step_record.hpp"
 #include "insitu/core/histogram.hpp"
 #include "insitu/core/light_field.hpp"
@@ -20,71 +22,6 @@ namespace insitu::archive_format {
 namespace fs = std::filesystem;
 
 namespace {
-
-/// What a manifest key must hold.
-enum class Expect { number, integer, count, crc32, string, object, array };
-
-bool holds(const nlohmann::json& value, Expect expect) {
-    switch (expect) {
-        case Expect::number:
-            // nlohmann keeps NaN and Inf as numbers but writes them as null, which no reader
-            // takes back: a non-finite number is never a valid value.
-            return value.is_number() &&
-                   (!value.is_number_float() || std::isfinite(value.get<double>()));
-        case Expect::integer:
-            return value.is_number_integer();
-        // An entry built in memory holds signed integers, one parsed back unsigned ones: a
-        // count is any integer >= 0 (the writer checks entries before they reach the disk).
-        case Expect::count:
-            return value.is_number_unsigned() ||
-                   (value.is_number_integer() && value.get<std::int64_t>() >= 0);
-        case Expect::crc32:
-            return holds(value, Expect::count) && value.get<std::uint64_t>() <= 0xFFFFFFFFu;
-        case Expect::string:
-            return value.is_string();
-        case Expect::object:
-            return value.is_object();
-        case Expect::array:
-            return value.is_array();
-    }
-    return false;
-}
-
-/// A value as a message shows it: non-finite numbers by name (dump() would say null).
-std::string value_text(const nlohmann::json& value) {
-    if (value.is_number_float() && !std::isfinite(value.get<double>())) {
-        const double number = value.get<double>();
-        return std::isnan(number) ? "nan" : number > 0 ? "inf" : "-inf";
-    }
-    return value.dump();
-}
-
-/// Checks one key of a JSON object; ParseError names the file and the dotted key.
-const nlohmann::json& require(const nlohmann::json& object, const char* key, Expect expect,
-                              const std::string& file, const std::string& where) {
-    const std::string name = where.empty() ? key : where + "." + key;
-    if (!object.is_object() || !object.contains(key)) {
-        fail<ParseError>("\"", file, "\": missing key \"", name, "\"");
-    }
-    const nlohmann::json& value = object.at(key);
-    if (!holds(value, expect)) {
-        fail<ParseError>("\"", file, "\": key \"", name,
-                         "\" has the wrong type: ", value_text(value));
-    }
-    return value;
-}
-
-/// Paths in the manifest must stay inside the archive.
-void check_relative_path(const std::string& path, const std::string& file, const std::string& where,
-                         const char* key = "path") {
-    const fs::path relative(path);
-    bool escapes = path.empty() || relative.is_absolute();
-    for (const fs::path& component : relative) escapes = escapes || component == "..";
-    if (escapes) {
-        fail<ParseError>("\"", file, "\": ", where, ".", key, " \"", path,
-                         "\" is not a relative path inside the archive");
-    }
-}
 
 /// The optional "light_fields" list of a step entry: one file per field, as views list theirs.
 void check_light_field_entries(const nlohmann::json& step, const std::string& file,
@@ -224,6 +161,7 @@ void check_step_entry(const nlohmann::json& step, const std::string& file,
         }
     }
     check_light_field_entries(step, file, where);
+    check_volume_entries(step, file, where);
     check_field_summaries(step, file, where);
     check_budget_entries(step, file, where);
 }
@@ -429,6 +367,11 @@ std::vector<ListedFile> listed_files(const std::string& archive, const nlohmann:
         }
         for (const nlohmann::json& entry : light_field_entries(step)) {
             files.push_back(listed_light_field(archive, entry));
+        }
+        for (const nlohmann::json& entry : volume_entries(step)) {
+            for (ListedFile& file : listed_volume_files(archive, entry)) {
+                files.push_back(std::move(file));
+            }
         }
     }
     return files;

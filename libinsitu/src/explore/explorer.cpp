@@ -1,5 +1,6 @@
 #include "insitu/explore/explorer.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <glm/geometric.hpp>
 #include <ostream>
@@ -7,8 +8,10 @@
 
 #include "explore/frame_plan.hpp"
 #include "explore/frame_sources.hpp"
+#include "explore/volume_frames.hpp"
 #include "insitu/error.hpp"
 #include "insitu/explore/transfer_function_edit.hpp"
+#include "step/step_recipe.hpp"
 
 namespace insitu {
 
@@ -22,6 +25,7 @@ using detail::light_field_frame;
 using detail::plan_edit;
 using detail::plan_frame;
 using detail::proxies_frame;
+using detail::volume_frame;
 
 std::string to_string(ColourSource source) {
     switch (source) {
@@ -49,6 +53,8 @@ std::string to_string(ProxySource source) {
             return "multi";
         case ProxySource::lightfield:
             return "lightfield";
+        case ProxySource::volume:
+            return "volume";
     }
     return "unknown";
 }
@@ -58,7 +64,9 @@ ProxySource parse_proxy_source(const std::string& text) {
     if (text == "single") return ProxySource::single;
     if (text == "multi") return ProxySource::multi;
     if (text == "lightfield") return ProxySource::lightfield;
-    fail<InvalidArgument>("source = \"", text, "\" (expected auto, single, multi or lightfield)");
+    if (text == "volume") return ProxySource::volume;
+    fail<InvalidArgument>("source = \"", text,
+                          "\" (expected auto, single, multi, lightfield or volume)");
 }
 
 ColourSource parse_colour_source(const std::string& text) {
@@ -70,6 +78,8 @@ ColourSource parse_colour_source(const std::string& text) {
 
 Explorer::Explorer(const std::string& archive_path, std::shared_ptr<ComputeDevice> device)
     : path_(archive_path), device_(std::move(device)), steps_(archive_path) {}
+
+Explorer::~Explorer() = default;
 
 void Explorer::refresh() {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -99,6 +109,14 @@ void add_lighting_and_occlusion(FrameRecipe& recipe, const ExploreRequest& reque
     if (request.ambient_occlusion) {
         recipe.ambient_occlusion = occlusion_terms(*request.ambient_occlusion, stored);
     }
+}
+
+/// Whether the request's step holds a compressed field of its view's field.
+bool has_volume(const ArchiveReader& archive, const ExploreRequest& request) {
+    const std::string field = archive.entry(request.step, request.view).field;
+    const std::vector<ArchivedVolume> volumes = archive.volumes(request.step);
+    return std::any_of(volumes.begin(), volumes.end(),
+                       [&](const ArchivedVolume& volume) { return volume.field == field; });
 }
 
 /// The recipe's last terms (lights, occlusion, enhancement): it is drawable.
@@ -168,6 +186,10 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
         case FrameSource::proxies:
             frame = proxies_frame(plan, request, attenuation_resolution, device);
             break;
+        case FrameSource::volume:
+            if (!volume_frames_) volume_frames_ = std::make_unique<detail::VolumeFrames>(device_);
+            frame = volume_frame(plan, request, steps_.archive().configuration(), *volume_frames_);
+            break;
     }
     frame.milliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -177,6 +199,21 @@ ExploreFrame Explorer::render(const ExploreRequest& request) {
 FrameRecipe Explorer::recipe(const ExploreRequest& request) {
     std::lock_guard<std::mutex> lock(mutex_);
     FrameRecipe recipe;
+    if (request.source == ProxySource::volume ||
+        (request.source == ProxySource::automatic && has_volume(steps_.archive(), request))) {
+        const FramePlan plan = plan_frame(request, steps_, path_);
+        if (plan.source == FrameSource::volume) {
+            // The client ray-marches the compressed field with render()'s settings.
+            const RenderSettings settings = preview_settings(steps_.archive().configuration());
+            recipe.volume = true;
+            recipe.synthesised = !plan.same_view;
+            recipe.step_voxels = settings.step_voxels;
+            recipe.early_termination_opacity = settings.early_termination_opacity;
+            recipe.shading = request.lighting.has_value();
+            recipe.drawable = true;
+            return recipe;
+        }
+    }
     const CachedStep& cached = steps_.load(request.step, request.view);
     const ProxyFrame* single = cached.single ? &*cached.single : nullptr;
     if (!single || !has_attenuation(*single)) {

@@ -68,10 +68,19 @@ Camera stored_camera(const FrameInputs& plan, const ExploreRequest& request,
                      const ArchiveReader& archive) {
     if (plan.single || plan.multi) return plan.single ? plan.single->camera : plan.multi->camera;
     const std::vector<PlannedView> planned = archive.configuration().planned_views();
+    const OrbitView& orbit = planned.at(static_cast<std::size_t>(request.view)).view.orbit;
+    if (plan.light_field == nullptr) {
+        // The compressed field's grid is the field's: its bounds are those the run framed.
+        const VolumeGrid& grid = *plan.volume;
+        const glm::dvec3 last(static_cast<double>(grid.dims[0] - 1),
+                              static_cast<double>(grid.dims[1] - 1),
+                              static_cast<double>(grid.dims[2] - 1));
+        return Camera::orbit(orbit, Bounds{grid.origin, grid.origin + last * grid.spacing});
+    }
     const double half_side = plan.light_field->rig.bounding_radius() / std::sqrt(3.0);
     const Bounds sphere_box{plan.light_field->rig.center() - glm::dvec3(half_side),
                             plan.light_field->rig.center() + glm::dvec3(half_side)};
-    return Camera::orbit(planned.at(static_cast<std::size_t>(request.view)).view.orbit, sphere_box);
+    return Camera::orbit(orbit, sphere_box);
 }
 
 void aim(FrameInputs& plan, const ExploreRequest& request) {
@@ -94,6 +103,7 @@ const ProxyFrame* pick(const FramePlan& plan, const ExploreRequest& request,
             return multi_ok ? plan.multi : nullptr;
         case ProxySource::automatic:
         case ProxySource::lightfield:
+        case ProxySource::volume:
             break;
     }
     // The single-perspective proxies are the stored view exactly, and bench/evaluate measured
@@ -159,17 +169,28 @@ FrameInputs frame_inputs(const ExploreRequest& request, StepCache& steps,
     plan.has_view_proxies =
         (plan.single && (has_attenuation(*plan.single) || has_layers(*plan.single))) ||
         (plan.multi && (has_attenuation(*plan.multi) || has_layers(*plan.multi)));
+    // The compressed field of the view's field, when the step has one: asked for by name, or in
+    // auto, where it makes every frame but the stored view's as stored (plan_frame).
+    if (request.source == ProxySource::volume || request.source == ProxySource::automatic) {
+        plan.volume = steps.load_volume(request.step, plan.field);
+    }
+    if (request.source == ProxySource::volume && plan.volume == nullptr) {
+        fail<InvalidArgument>("source = volume, but ", plan.where,
+                              " has no compressed field of field \"", plan.field, "\"");
+    }
     // A light field of the view's field, when the step has one and the frame can use it: asked
-    // for by name, or in auto for another view or a view without proxies of its own.
+    // for by name, or in auto for another view or a view without proxies of its own (where no
+    // compressed field makes the frame).
     const bool wants_light_field =
         request.source == ProxySource::lightfield ||
-        (request.source == ProxySource::automatic && (!plan.has_view_proxies || !plan.same_view));
+        (request.source == ProxySource::automatic && plan.volume == nullptr &&
+         (!plan.has_view_proxies || !plan.same_view));
     if (wants_light_field) plan.light_field = steps.load_light_field(request.step, plan.field, {0});
     if (request.source == ProxySource::lightfield && plan.light_field == nullptr) {
         fail<InvalidArgument>("source = lightfield, but ", plan.where,
                               " has no light field of field \"", plan.field, "\"");
     }
-    if (!plan.single && !plan.multi && plan.light_field == nullptr) {
+    if (!plan.single && !plan.multi && plan.light_field == nullptr && plan.volume == nullptr) {
         fail<InvalidArgument>(plan.where,
                               " has no proxies (neither single- nor multi-perspective)");
     }
@@ -196,16 +217,31 @@ FramePlan plan_frame(const ExploreRequest& request, StepCache& steps,
     FramePlan plan(std::move(inputs), std::move(stored_tf), std::move(shown_tf));
     plan.edits = request.transfer_function.has_value() || !request.opacity_scales.empty();
     plan.model = plan.single && plan.single->colour_model ? &*plan.single->colour_model : nullptr;
+    const bool as_stored =
+        plan.same_view && plan.single &&
+        shows_stored_rendering(*plan.single, asks_stored_tf(request, plan.stored_tf),
+                               scales_any_opacity(request), request);
+    // Interval and segment scales are edits of proxies and light fields; the compressed field
+    // takes the edited function itself.
+    const bool scales_proxies =
+        !request.opacity_scales.empty() || !request.segment_opacity_scales.empty();
+    if (request.source == ProxySource::volume && scales_proxies) {
+        fail<InvalidArgument>(
+            "source = volume takes an edited transfer function, not opacity "
+            "scales of intervals or segments (",
+            plan.where, ")");
+    }
+    if (plan.volume && (request.source == ProxySource::volume || (!as_stored && !scales_proxies))) {
+        plan.source = FrameSource::volume;
+        return plan;
+    }
     plan.source = choose_source(plan, request);
     if (plan.source != FrameSource::light_field) pick_proxies(plan, request, archive_path);
     // The stored view with the run's own function, unedited: the rendering the Instrument kept
     // is that view exactly (to half precision), where recomposing it from intervals treats each
     // interval's colour as constant (issue 17; bench/RESULTS.md, "The stored rendering for the
     // stored view").
-    plan.stored_rendering =
-        plan.same_view && plan.single &&
-        shows_stored_rendering(*plan.single, asks_stored_tf(request, plan.stored_tf),
-                               scales_any_opacity(request), request);
+    plan.stored_rendering = as_stored;
     return plan;
 }
 

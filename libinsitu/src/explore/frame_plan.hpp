@@ -22,6 +22,7 @@ enum class FrameSource {
     light_field,  ///< the step's light field only
     fused,        ///< the light field, the view's proxies where it knows nothing of a ray
     proxies,      ///< the view's own proxies (single or multi perspective)
+    volume,       ///< the step's compressed field, rendered
 };
 
 /// What the step holds for the view, and the cameras (explorer.hpp, steps 1-2).
@@ -33,6 +34,8 @@ struct FrameInputs {
     bool has_view_proxies = false;  ///< attenuation or depth layers in either
     /// The step's light field of the view's field, where the frame uses it.
     const LightField* light_field = nullptr;
+    /// The step's compressed field of the view's field, where the frame may use it.
+    const VolumeGrid* volume = nullptr;
     /// The stored view's camera and the one the frame is made for.
     Camera stored;
     Camera target;

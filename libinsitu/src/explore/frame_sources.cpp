@@ -9,6 +9,7 @@
 #include "explore/frame_basis.hpp"
 #include "insitu/explore/light_field_reconstruction.hpp"
 #include "insitu/explore/view_synthesis.hpp"
+#include "step/step_recipe.hpp"
 
 namespace insitu::detail {
 
@@ -162,6 +163,22 @@ ExploreFrame proxies_frame(const FramePlan& plan, const ExploreRequest& request,
     }
     finish_frame(std::move(basis), request, plan.stored_tf, plan.shown_tf, plan.where, device, out);
     return out;
+}
+
+ExploreFrame volume_frame(const FramePlan& plan, const ExploreRequest& request,
+                          const InstrumentConfig& configuration, VolumeFrames& frames) {
+    // The step's preview settings: the run's own ground truth.
+    RenderSettings settings = preview_settings(configuration);
+    settings.shading = request.lighting.has_value();
+    Rendering rendering =
+        frames.render(request.step, *plan.volume, plan.target, plan.shown_tf, settings);
+    ExploreFrame frame;
+    frame.confidence = Image(rendering.rgba.width, rendering.rgba.height, 1, 1.0f);
+    frame.colour = std::move(rendering.rgba);
+    frame.camera = plan.target;
+    frame.synthesised_view = !plan.same_view;
+    frame.proxy_source = ProxySource::volume;
+    return frame;
 }
 
 ExploreFrame fuse_frames(ExploreFrame from_proxies, ExploreFrame from_light_field) {

@@ -84,4 +84,20 @@ const LightField* StepCache::load_light_field(std::int64_t step, const std::stri
     return &cached;
 }
 
+const VolumeGrid* StepCache::load_volume(std::int64_t step, const std::string& field) {
+    if (volume_ && volume_->first == step && volume_->second.field == field) {
+        return &volume_->second;
+    }
+    const std::vector<ArchivedVolume> available = archive_->volumes(step);
+    const bool listed =
+        std::any_of(available.begin(), available.end(),
+                    [&](const ArchivedVolume& volume) { return volume.field == field; });
+    if (!listed) return nullptr;
+    // One grid kept: the one being explored (a grid is the field's size; the next step's
+    // replaces it).
+    volume_.reset();
+    volume_.emplace(step, archive_->load_volume(step, field));
+    return &volume_->second;
+}
+
 }  // namespace insitu

@@ -2,6 +2,7 @@
 #include "representation/light_field/light_field_representation.hpp"
 #include "representation/representation.hpp"
 #include "representation/view_proxies/view_proxies.hpp"
+#include "representation/volume/volume_representation.hpp"
 
 namespace insitu {
 
@@ -10,6 +11,7 @@ const std::vector<std::unique_ptr<Representation>>& representations() {
         std::vector<std::unique_ptr<Representation>> all;
         all.push_back(std::make_unique<ViewProxies>());
         all.push_back(std::make_unique<LightFieldRepresentation>());
+        all.push_back(std::make_unique<VolumeRepresentation>());
         return all;
     }();
     return registered;

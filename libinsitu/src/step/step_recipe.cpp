@@ -59,13 +59,7 @@ ViewPasses view_passes(const InstrumentConfig& config, const FieldPlan& plan) {
     passes.multi.optical_depth = config.proxies.multi_attenuation && config.proxies.optical_depth;
     passes.wants_multi = config.proxies.distortion || config.proxies.multi_attenuation;
 
-    // The preview is what Cinema viewers show: the ground truth, unshaded like the proxies'
-    // emission-absorption model, at the proxies' step. It marches on to T = 0 like the proxies:
-    // it is also the stored view's "rendering", which the Explorer returns as that view exactly
-    // (stopping at 0.99 left up to 1 % of the colour behind), and distributed, a block cannot
-    // stop at an opacity it does not know is reached in front of it.
-    passes.preview.step_voxels = config.step_voxels;
-    passes.preview.early_termination_opacity = 1.0;
+    passes.preview = preview_settings(config);
     passes.stores_rendering = config.proxies.rendering;
     return passes;
 }
@@ -89,6 +83,18 @@ std::optional<LightFieldRequest> light_field_request(const InstrumentConfig& con
 }
 
 }  // namespace
+
+RenderSettings preview_settings(const InstrumentConfig& config) {
+    // The preview is what Cinema viewers show: the ground truth, unshaded like the proxies'
+    // emission-absorption model, at the proxies' step. It marches on to T = 0 like the proxies:
+    // it is also the stored view's "rendering", which the Explorer returns as that view exactly
+    // (stopping at 0.99 left up to 1 % of the colour behind), and distributed, a block cannot
+    // stop at an opacity it does not know is reached in front of it.
+    RenderSettings settings;
+    settings.step_voxels = config.step_voxels;
+    settings.early_termination_opacity = 1.0;
+    return settings;
+}
 
 FieldRecipe field_recipe(const InstrumentConfig& config, const FieldPlan& plan) {
     FieldRecipe recipe;

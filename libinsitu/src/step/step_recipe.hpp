@@ -47,6 +47,10 @@ struct FieldRecipe {
     std::optional<LightFieldRequest> light_field;
 };
 
+/// The settings of a step's preview (and stored rendering): the ground truth every view of the
+/// step is measured against; the Explorer renders the compressed field with them too.
+RenderSettings preview_settings(const InstrumentConfig& config);
+
 /// The recipe of `plan`'s field at this step (plan.budget, where set, is applied).
 FieldRecipe field_recipe(const InstrumentConfig& config, const FieldPlan& plan);
 

@@ -39,6 +39,33 @@ struct ArchivedLightField {
     int map_size = 0;
 };
 
+/// What the reader can load of one field's compressed field at one step (VolumeRecord).
+struct ArchivedVolume {
+    std::int64_t step = 0;
+    double time = 0.0;
+    std::string field;
+    std::string codec;  ///< "zfp"
+    VolumeMode mode = VolumeMode::accuracy;
+    double tolerance = 0.0;  ///< accuracy mode: the largest error of a sample, field units
+    double rate = 0.0;       ///< rate mode: bits per value
+    Index3 dims{0, 0, 0};
+    double min = 0.0, max = 0.0;  ///< the finite values' range
+    std::int64_t nonfinite = 0;   ///< NaN/Inf samples (kept: decoded as NaN)
+    int blocks = 1;
+    std::uint64_t bytes = 0;  ///< every file of it
+};
+
+/// A compressed field decoded: the grid, its values x fastest, NaN where the field was NaN/Inf.
+struct VolumeGrid {
+    std::string field;
+    Index3 dims{0, 0, 0};
+    glm::dvec3 origin{0.0};  ///< world position of sample (0, 0, 0)
+    glm::dvec3 spacing{1.0};
+    std::vector<float> values;
+    /// A float Field viewing `values` (valid while this grid lives and is not changed).
+    Field as_field() const;
+};
+
 /// What ArchiveReader::check() found.
 struct ArchiveCheck {
     /// One line per problem, each naming its file (verify()'s list).
@@ -48,6 +75,8 @@ struct ArchiveCheck {
     std::set<std::pair<std::int64_t, int>> unreadable_proxies;
     /// (step, field) of the light fields whose EXR cannot be used, for the same reasons.
     std::set<std::pair<std::int64_t, std::string>> unreadable_light_fields;
+    /// (step, field) of the compressed fields with a file that cannot be used.
+    std::set<std::pair<std::int64_t, std::string>> unreadable_volumes;
     bool clean() const { return problems.empty(); }
 };
 
@@ -116,6 +145,14 @@ public:
     /// The file's size and CRC-32 are checked against the manifest as for load().
     LightField load_light_field(std::int64_t step, const std::string& field,
                                 const std::vector<int>& cameras = {}) const;
+    /// The compressed fields of a step (one per field that has one; empty when none). A step the
+    /// manifest does not list raises InvalidArgument.
+    std::vector<ArchivedVolume> volumes(std::int64_t step) const;
+    /// Decodes the compressed field of (step, field): every block's files checked against the
+    /// manifest (size and CRC-32) before ZFP reads them, memory bounded by the dimensions the
+    /// manifest declares; IoError naming the file for one that is damaged or not what the
+    /// manifest says, InvalidArgument for a step or field without one.
+    VolumeGrid load_volume(std::int64_t step, const std::string& field) const;
     /// The preview as linear, premultiplied floats (the inverse of write_png, to 8-bit sRGB
     /// precision), with the PNG's channel count (1, 3 or 4).
     Image load_preview(std::int64_t step, int view) const;

@@ -9,6 +9,8 @@
 #include "insitu/config.hpp"
 #include "insitu/core/histogram.hpp"
 #include "insitu/core/image.hpp"
+#include "insitu/core/volume_settings.hpp"
+#include "insitu/field.hpp"
 #include "insitu/render/light_field_capture.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 
@@ -92,6 +94,29 @@ struct LightFieldRecord {
     LightField light_field;
 };
 
+/// One field's values at one timestep, kept as the compressed field ("volume",
+/// insitu/core/volume_settings.hpp): blocks of the whole grid, each compressed by the writer
+/// (on its thread) into a file of its own. One process holds one block, the whole grid; a rank
+/// of a distributed run would hold its own (no gather of the field).
+struct VolumeRecord {
+    struct Block {
+        Index3 offset{0, 0, 0};  ///< of its first sample in the whole grid
+        Index3 dims{0, 0, 0};
+        /// Copied off the simulation's memory: x fastest, non-finite where the field was.
+        std::vector<float> values;
+    };
+    std::string field;
+    Index3 dims{0, 0, 0};     ///< the whole grid's samples
+    glm::dvec3 origin{0.0};   ///< world position of sample (0, 0, 0)
+    glm::dvec3 spacing{1.0};  ///< world units between samples
+    VolumeMode mode = VolumeMode::accuracy;
+    double tolerance = 0.0;       ///< accuracy mode: field units (a relative one resolved)
+    double rate = 0.0;            ///< rate mode: bits per value
+    int threads = 1;              ///< the writer's compression threads
+    double min = 0.0, max = 0.0;  ///< the whole grid's finite range
+    std::vector<Block> blocks;
+};
+
 struct StepRecord {
     std::int64_t step = 0;
     double time = 0.0;
@@ -100,6 +125,7 @@ struct StepRecord {
     std::vector<LightFieldRecord> light_fields;  ///< one per field, when "light_field" is set
     std::vector<FieldSummaryRecord> fields;      ///< one per visualised field, in "fields" order
     std::vector<BudgetRecord> budget;            ///< one per field, with a "budget" only
+    std::vector<VolumeRecord> volumes;           ///< one per field, when "volume" is set
 };
 
 }  // namespace insitu

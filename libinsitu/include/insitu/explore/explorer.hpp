@@ -60,10 +60,14 @@ ColourSource parse_colour_source(const std::string& text);
 /// proxies
 /// when the archive has them (measured ahead of the multi-perspective ones for every rotation;
 /// bench/RESULTS.md), else the multi-perspective ones. "lightfield": the light field only
-/// (insitu/explore/light_field_reconstruction.hpp).
-enum class ProxySource { automatic, single, multi, lightfield };
+/// (insitu/explore/light_field_reconstruction.hpp). "volume": the step's compressed field of
+/// the view's field, rendered by the ground-truth VolumeRenderer with the step's preview
+/// settings (shaded by its headlight Phong where lighting is asked), confidence 1 everywhere;
+/// "auto" takes it wherever the step has one, except for the stored view as stored (the
+/// stored rendering is that view exactly).
+enum class ProxySource { automatic, single, multi, lightfield, volume };
 std::string to_string(ProxySource source);
-/// "auto" | "single" | "multi" | "lightfield"; InvalidArgument names other text.
+/// "auto" | "single" | "multi" | "lightfield" | "volume"; InvalidArgument names other text.
 ProxySource parse_proxy_source(const std::string& text);
 
 /// What to show. Everything optional: an empty request shows the stored view as stored.
@@ -98,7 +102,8 @@ struct ExploreFrame {
     bool synthesised_view = false;                         ///< the view differs from the stored one
     ColourSource colour_source = ColourSource::recompose;  ///< model or recompose, as used
     std::vector<double> opacity_scales;  ///< per interval, as applied (empty: none)
-    /// What the pixels came from: single, multi, lightfield, or auto when fused per pixel.
+    /// What the pixels came from: single, multi, lightfield, volume, or auto when fused per
+    /// pixel.
     ProxySource proxy_source = ProxySource::single;
     /// Share of pixels taken from the light field (fused frames; 1 for lightfield, 0 without).
     double light_field_share = 0.0;
@@ -129,6 +134,13 @@ struct FrameRecipe {
     /// It reconstructs the light field's a_j and mean depths too (an attenuation light field,
     /// for edits, lighting through them, or enhancement), in the light field's intervals.
     bool light_field_attenuation = false;
+    /// The step's compressed field makes the frame: the client ray-marches it as VolumeRenderer
+    /// does (volume_renderer.hpp) with the shown function and these settings (the step's
+    /// preview settings, shaded where lighting is asked); the other terms do not apply.
+    bool volume = false;
+    double step_voxels = 1.0;
+    double early_termination_opacity = 1.0;
+    bool shading = false;
     /// The stored rendering is the colour (the run's own function, unedited; steps 4-5 skipped).
     bool stored_rendering = false;
     std::vector<double> opacity_scales;  ///< s_j as estimate_attenuation applies them; all 1: none
@@ -155,11 +167,16 @@ struct FrameRecipe {
     std::optional<EnhancementSettings> enhancement;
 };
 
+namespace detail {
+class VolumeFrames;
+}
+
 class Explorer {
 public:
     /// Opens the archive (IoError/ParseError name the file).
     explicit Explorer(const std::string& archive_path,
                       std::shared_ptr<ComputeDevice> device = ComputeDevice::shared());
+    ~Explorer();
 
     /// Re-reads the manifest so steps a running simulation wrote since appear.
     void refresh();
@@ -178,6 +195,8 @@ private:
     std::string path_;
     std::shared_ptr<ComputeDevice> device_;
     StepCache steps_;
+    /// The compressed field's renderer, made on its first frame and kept with its upload.
+    std::unique_ptr<detail::VolumeFrames> volume_frames_;
     std::mutex mutex_;
 };
 

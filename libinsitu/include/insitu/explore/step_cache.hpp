@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "insitu/archive/archive_reader.hpp"
@@ -38,6 +39,9 @@ public:
     /// needs the cameras facing it, not all of them); null when the step has none for `field`.
     const LightField* load_light_field(std::int64_t step, const std::string& field,
                                        const std::vector<int>& cameras);
+    /// The compressed field of (step, field), decoded (the last one asked is kept); null when the
+    /// step has none of `field`.
+    const VolumeGrid* load_volume(std::int64_t step, const std::string& field);
     /// How exactly the archive stores a_j, by its "precision" (EditTrustInputs); read once per
     /// refresh, on the first edit.
     double stored_attenuation_resolution();
@@ -54,6 +58,7 @@ private:
     std::unique_ptr<ArchiveReader> archive_;
     std::list<CachedStep> steps_;  ///< most recently used first
     std::optional<CachedLightField> light_field_;
+    std::optional<std::pair<std::int64_t, VolumeGrid>> volume_;
     std::optional<double> attenuation_resolution_;
 };
 

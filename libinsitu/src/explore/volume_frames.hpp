@@ -1,0 +1,28 @@
+#pragma once
+// Frames of a step's compressed field (ProxySource::volume): the decoded grid on the
+// ground-truth VolumeRenderer, uploaded once per (step, field) and kept while frames of it are
+// asked, so that turning the view or editing the function re-renders without re-uploading.
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "insitu/archive/archive_reader.hpp"
+#include "insitu/render/volume_renderer.hpp"
+
+namespace insitu::detail {
+
+class VolumeFrames {
+public:
+    explicit VolumeFrames(std::shared_ptr<ComputeDevice> device) : renderer_(std::move(device)) {}
+
+    /// `grid` (the compressed field of `step`) in `camera` with `tf` and `settings`.
+    Rendering render(std::int64_t step, const VolumeGrid& grid, const Camera& camera,
+                     const TransferFunction& tf, const RenderSettings& settings);
+
+private:
+    VolumeRenderer renderer_;
+    std::int64_t uploaded_step_ = -1;
+    std::string uploaded_field_;
+};
+
+}  // namespace insitu::detail
