@@ -7,7 +7,7 @@
 // confidence, an edit's trust on top); of any other, the engine's mask of the frame shown.
 import { $, FPS_WINDOW_MS, errorText, session, showError, state, viewer } from './page.js';
 import { currentOptions, sameOptions } from './explore_options.js';
-import { baseTf, editedTf } from './transfer_function.js';
+import { baseTf } from './transfer_function.js';
 import { schedulePlay } from './timeline.js';
 
 let inFlight = false;
@@ -151,11 +151,10 @@ async function drawProxies(options, dragging) {
     });
 }
 
-// The transfer function a volume frame classifies with, as the engine takes the request's: the
-// edited one the options send, with the opacity scales baked in by the extinction law where
-// there are some (editedTf), else the step's own.
+// The transfer function a volume frame classifies with, as the engine's shown function: the
+// edited one the options send, else the step's own. (Opacity scales are edits of proxies: with
+// them the recipe is not a volume's.)
 function volumeTf(options) {
-  if (options['opacity-scale']) return editedTf(true);
   return options.tf ? JSON.parse(options.tf) : baseTf();
 }
 
