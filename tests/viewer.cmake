@@ -146,6 +146,30 @@ viewer_browser_test(segments lf_segments
                                 ARCHIVE_NO_LIGHT_FIELD=${viewer_archive}
                     FIXTURES viewer_archive viewer_lf_archive)
 
+# The compressed field (issue 40): the same 40^3 run archived at steps 300 and 600 with the
+# view's proxies and its field compressed by ZFP at accuracy 1e-3 (the "volume" configuration);
+# volume.test.mjs orbits, edits the function, shades, changes the step and drags in the page,
+# which ray-marches the field, comparing the canvas with `insitu-view render --source volume`.
+set(viewer_volume_config ${CMAKE_CURRENT_BINARY_DIR}/viewer_volume_config.json)
+file(WRITE ${viewer_volume_config} [=[
+{"fields": ["v"],
+ "views": [{"azimuth": 30, "elevation": 20, "size": [160, 160]}],
+ "transfer_function": {"points": [[0.0, 0.1, 0.25, 0.75, 0.0], [0.12, 0.1, 0.25, 0.75, 0.0],
+                                  [0.2, 0.15, 0.55, 0.9, 0.04], [0.28, 0.35, 0.85, 0.7, 0.1],
+                                  [0.36, 0.95, 0.8, 0.3, 0.22], [0.45, 1.0, 0.4, 0.15, 0.4]],
+                       "unit_length": 1.0},
+ "intervals": {"count": 8},
+ "every": 300,
+ "volume": {"codec": "zfp", "tolerance": 0.001}}
+]=])
+add_test(NAME viewer.setup_volume_archive
+         COMMAND gray-scott --size 40 --steps 600 --config ${viewer_volume_config}
+                 --out ${viewer_work}/viewer_volume.cdb)
+set_tests_properties(viewer.setup_volume_archive PROPERTIES
+                     FIXTURES_REQUIRED viewer_work FIXTURES_SETUP viewer_volume_archive
+                     TIMEOUT 120)
+viewer_browser_test(volume volume)
+
 # serve's command line: exit 2 and one line on stderr for bad arguments or archives.
 function(viewer_serve_case name exit_status stream text)
   string(JOIN "|" command $<TARGET_FILE:insitu-view> serve ${ARGN})

@@ -70,6 +70,14 @@ json step_description(const ArchiveReader& reader, const StepKey& key) {
         info["histogram"] = summary->histogram.to_json();
         info["nonfinite_samples"] = summary->nonfinite_samples;
     }
+    // The step's compressed field of the view's field, which the page may ray-march
+    // (/api/volume; the frame's recipe says when).
+    for (const ArchivedVolume& volume : reader.volumes(key.step)) {
+        if (volume.field != reader.entry(key.step, key.view).field) continue;
+        info["volume"] = {{"codec", volume.codec},         {"mode", to_string(volume.mode)},
+                          {"tolerance", volume.tolerance}, {"rate", volume.rate},
+                          {"dims", volume.dims},           {"bytes", volume.bytes}};
+    }
     if (frame.intervals) {
         const IntervalSet& intervals = *frame.intervals;
         info["intervals"] = intervals.edges();

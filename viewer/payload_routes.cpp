@@ -12,12 +12,15 @@
 #include "light_field_payload.hpp"
 #include "proxy_payload.hpp"
 #include "request_parameters.hpp"
+#include "volume_payload.hpp"
 
 namespace insitu::viewer {
 namespace {
 
-/// Payloads (light fields, proxies) kept in memory: the steps shown and those a page prefetches.
+/// Payloads (light fields, proxies, volumes) kept in memory: the steps shown and those a page
+/// prefetches, as long as they hold no more than kMaxPayloadBytes together (raw and gzip).
 constexpr std::size_t kMaxPayloads = 8;
+constexpr std::size_t kMaxPayloadBytes = std::size_t{256} << 20;
 
 /// `bytes` as a gzip stream (zlib's deflate with the gzip wrapper) at the fastest level: half
 /// floats compress a little whatever the level, and the server should not sit on a step.
@@ -90,6 +93,30 @@ void PayloadRoutes::proxies(const httplib::Request& request, httplib::Response& 
                  });
 }
 
+void PayloadRoutes::volume(const httplib::Request& request, httplib::Response& response) {
+    const StepKey key = step_key(request, archive_);
+    std::lock_guard<std::mutex> lock(archive_.mutex());
+    const ArchiveReader& reader = archive_.reader_locked();
+    const std::string field = reader.entry(key.step, key.view).field;
+    std::optional<ArchivedVolume> stored;
+    for (const ArchivedVolume& candidate : reader.volumes(key.step)) {
+        if (candidate.field == field) stored = candidate;
+    }
+    if (!stored) {
+        throw HttpError(
+            404, "step " + std::to_string(key.step) + " has no volume of field \"" + field + "\"");
+    }
+    archive_.require_files_inside_locked(key.step, key.view);
+    // The step's files are written together and never change once listed: the view's preview
+    // stamps them, the field's bytes tell the volume from the view's other payloads.
+    const std::string etag =
+        payload_etag(("vf" + std::to_string(stored->bytes) + "-").c_str(), kVolumePayloadVersion,
+                     key, reader.entry(key.step, key.view).preview_path);
+    send_payload(request, response, etag, [&] {
+        return volume_payload(reader.load_volume(key.step, field), *stored, key.view);
+    });
+}
+
 void PayloadRoutes::send_payload(const httplib::Request& request, httplib::Response& response,
                                  const std::string& etag,
                                  const std::function<std::string()>& make) {
@@ -103,8 +130,18 @@ void PayloadRoutes::send_payload(const httplib::Request& request, httplib::Respo
                                [&](const auto& entry) { return entry.first == etag; });
     if (cached == payloads_.end()) {
         const std::string payload = make();
-        if (payloads_.size() >= kMaxPayloads) payloads_.erase(payloads_.begin());
-        payloads_.emplace_back(etag, std::pair{payload, gzip(payload)});
+        std::string compressed = gzip(payload);
+        const auto bytes = [](const auto& entry) {
+            return entry.second.first.size() + entry.second.second.size();
+        };
+        std::size_t held = payload.size() + compressed.size();
+        for (const auto& entry : payloads_) held += bytes(entry);
+        while (!payloads_.empty() &&
+               (payloads_.size() >= kMaxPayloads || held > kMaxPayloadBytes)) {
+            held -= bytes(payloads_.front());
+            payloads_.erase(payloads_.begin());
+        }
+        payloads_.emplace_back(etag, std::pair{payload, std::move(compressed)});
         cached = std::prev(payloads_.end());
     }
     const auto& [raw, compressed] = cached->second;

@@ -1,7 +1,8 @@
 #pragma once
-// /api/lightfield and /api/proxies: a step's light field and its stored view's proxies in the
-// binary forms the page uploads to WebGL2 textures (light_field_payload.hpp, proxy_payload.hpp),
-// gzip-compressed when the client accepts it, with an ETag, the last few kept in memory.
+// /api/lightfield, /api/proxies and /api/volume: a step's light field, its stored view's proxies
+// and its compressed field in the binary forms the page uploads to WebGL2 textures
+// (light_field_payload.hpp, proxy_payload.hpp, volume_payload.hpp), gzip-compressed when the
+// client accepts it, with an ETag, the last few kept in memory (at most kMaxPayloadBytes).
 #include <httplib.h>
 
 #include <cstdint>
@@ -24,6 +25,9 @@ public:
     /// The stored view's single-perspective proxies of (step, view); 404 where the view has no
     /// single-perspective attenuation proxies (the page then asks for frames).
     void proxies(const httplib::Request& request, httplib::Response& response);
+    /// The compressed field of the field that (step, view) shows (ArchiveReader::load_volume);
+    /// 404 when the step has none.
+    void volume(const httplib::Request& request, httplib::Response& response);
 
 private:
     /// Sends a binary payload: gzip-compressed when the client accepts it, a 304 when the client

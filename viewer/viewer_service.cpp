@@ -58,6 +58,8 @@ void ViewerService::install(httplib::Server& server) {
                guarded([this](const auto& r, auto& s) { payload_routes_.light_field(r, s); }));
     server.Get("/api/proxies",
                guarded([this](const auto& r, auto& s) { payload_routes_.proxies(r, s); }));
+    server.Get("/api/volume",
+               guarded([this](const auto& r, auto& s) { payload_routes_.volume(r, s); }));
     server.Get("/api/step",
                guarded([this](const auto& r, auto& s) { archive_routes_.step_info(r, s); }));
     server.Get("/api/trust",

@@ -7,7 +7,8 @@
 //     by pointer events at 120 Hz dispatched in the page, as a real mouse sends them;
 //  3. the same drag with WebGL2 through SwiftShader (software, the worst case): the page draws
 //     every orbit frame itself, from the step's light field where it has one, else from the
-//     view's single-perspective proxies (view synthesis in the browser); then again with a
+//     view's single-perspective proxies (view synthesis in the browser), or from its compressed
+//     field where the recipe says so (ray-marched in the browser); then again with a
 //     headlight and ambient occlusion on (drawn from the proxies where the recipe allows).
 //     Reported with what drew the frames, the time to the first frame after opening a step
 //     (download + upload) and the bytes transferred per step.
@@ -166,6 +167,14 @@ try {
     console.log(`light field of step ${step}: ${(Number(transfer.headers.get('x-insitu-payload-bytes')) / 1e6).toFixed(1)} MB ` +
       `payload, ${transfer.headers.get('content-encoding') || 'identity'} on the wire`);
     void compressed;
+  }
+  const volume = await fetch(`${server.url}api/volume?step=${step}`,
+    { headers: { 'Accept-Encoding': 'gzip' } });
+  if (volume.ok) {
+    const wire = (await volume.arrayBuffer()).byteLength;
+    console.log(`volume of step ${step}: ${volume.headers.get('x-insitu-payload-bytes')} bytes ` +
+      `payload, ${volume.headers.get('content-length') || wire} bytes ` +
+      `${volume.headers.get('content-encoding') || 'identity'} on the wire`);
   }
   const status = await (await fetch(server.url + 'api/status')).json();
   console.log(`server: ${status.frames_rendered} frames rendered, ${status.superseded} superseded`);

@@ -1,11 +1,13 @@
 // Frames: at most one in flight; a control moved meanwhile is drawn once that one is done (the
 // server also coalesces, per session). Orbit views of a step with a light field (edited, lit
-// and occluded too), and the view's proxies' frames where their recipe allows (/api/recipe),
-// are drawn here by WebGL2 (gpu_frames.js); every other frame is the server's exploration
+// and occluded too), the view's proxies' frames where their recipe allows (/api/recipe), and
+// the frames the recipe makes from a step's compressed field (volume) are drawn here by WebGL2
+// (gpu_frames.js); every other frame is the server's exploration
 // engine's PNG. The confidence overlay of a frame drawn here is the page's own (its source's
 // confidence, an edit's trust on top); of any other, the engine's mask of the frame shown.
 import { $, FPS_WINDOW_MS, errorText, session, showError, state, viewer } from './page.js';
 import { currentOptions, sameOptions } from './explore_options.js';
+import { baseTf } from './transfer_function.js';
 import { schedulePlay } from './timeline.js';
 
 let inFlight = false;
@@ -14,10 +16,12 @@ let readoutShownAt = 0;
 
 // Whether the browser draws this frame from the light field without asking for its recipe: an
 // orbit view (the stored view is the archive's own proxies, exact) of a step with a light field,
-// without edits, lights, occlusion or enhancement. With lights or occlusion the recipe says
-// whether the light field makes the frame (drawProxies).
+// without edits, lights, occlusion or enhancement, where the step has no compressed field of the
+// view's field (that makes such views: the recipe says so). With lights or occlusion the recipe
+// says whether the light field makes the frame (drawProxies).
 export function drawnInBrowser(options) {
-  return Boolean(viewer.gpu && $('gpu-toggle').checked && state.lightField && state.info &&
+  return Boolean(viewer.gpu && $('gpu-toggle').checked && state.lightField && !state.volume &&
+    state.info &&
     state.info.camera && options.azimuth !== undefined && !atStoredView(options) && !options.tf &&
     !options['opacity-scale'] && !options.light && !options.ao && !options.enhance);
 }
@@ -34,11 +38,11 @@ function atStoredView(options) {
     sameAngle(Number(options.elevation), state.info.camera.elevation));
 }
 
-// Whether the browser may draw this frame from the view's single-perspective proxies; the
-// frame's recipe then says whether it does.
+// Whether the browser may draw this frame from the view's single-perspective proxies or the
+// step's compressed field; the frame's recipe then says whether it does.
 function proxiesInBrowser() {
-  return Boolean(viewer.gpu && viewer.gpu.proxyRenderer && $('gpu-toggle').checked &&
-    state.info && state.info.camera);
+  return Boolean(viewer.gpu && (viewer.gpu.proxyRenderer || (state.volume &&
+    viewer.gpu.volumeRenderer)) && $('gpu-toggle').checked && state.info && state.info.camera);
 }
 
 const recipes = new Map();  // options JSON (angles left out for other views) -> Promise
@@ -123,6 +127,14 @@ async function drawProxies(options, dragging) {
     drawInBrowser(options, dragging, recipe);
     return;
   }
+  if (recipe.volume) {
+    drawVolume(options, dragging, recipe);
+    return;
+  }
+  if (!viewer.gpu.proxyRenderer) {
+    serverFrame(options);
+    return;
+  }
   viewer.gpu.drawProxies(entry.step, state.view, recipe, Number(options.azimuth),
     Number(options.elevation), dragging, true, !unedited(options))
     .then((timing) => {
@@ -132,6 +144,33 @@ async function drawProxies(options, dragging) {
       }
       const what = recipe.synthesised ? 'synthesised view' : 'stored view';
       return showGpuFrame(options, timing, what, recipe.colour_source).then(frameDone);
+    })
+    .catch((error) => {
+      showError(String(error));
+      frameDone();
+    });
+}
+
+// The transfer function a volume frame classifies with, as the engine's shown function: the
+// edited one the options send, else the step's own. (Opacity scales are edits of proxies: with
+// them the recipe is not a volume's.)
+function volumeTf(options) {
+  return options.tf ? JSON.parse(options.tf) : baseTf();
+}
+
+// A frame ray-marched from the step's compressed field (the recipe says volume); the server's
+// where the page cannot after all.
+function drawVolume(options, dragging, recipe) {
+  const entry = state.timeline[state.stepIndex];
+  viewer.gpu.drawVolume(entry.step, state.view, recipe, state.info.camera, volumeTf(options),
+    !atStoredView(options), Number(options.azimuth), Number(options.elevation), dragging)
+    .then((timing) => {
+      if (!timing) {
+        serverFrame(options);
+        return null;
+      }
+      return showGpuFrame(options, timing, 'compressed field', recipe.colour_source)
+        .then(frameDone);
     })
     .catch((error) => {
       showError(String(error));
@@ -257,7 +296,10 @@ export async function updateMask() {
   if (displayed.gpu) {
     // The page reconstructs the frame's confidence too: the light field's or the view
     // synthesis's (1 everywhere at the stored view), with an edit's trust on top.
-    if (displayed.drawnFrom === 'light field' && !unedited(options)) {
+    if (displayed.drawnFrom === 'compressed field') {
+      // The field itself: confidence 1 everywhere, as the engine's.
+      confidence = new Uint8Array(width * height).fill(255);
+    } else if (displayed.drawnFrom === 'light field' && !unedited(options)) {
       confidence = viewer.gpu.lightFieldTrust();
     } else if (displayed.drawnFrom === 'light field') {
       const entry = state.timeline[state.stepIndex];

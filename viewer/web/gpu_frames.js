@@ -6,15 +6,20 @@
 //    the frame's recipe says;
 //  * the stored view and other views from its single-perspective proxies (proxy_renderer.js),
 //    with recolouring, opacity edits, relighting, ambient occlusion and enhancement, as the
-//    frame's recipe (/api/recipe) says.
+//    frame's recipe (/api/recipe) says;
+//  * any view of a step with a compressed field, where the recipe says so (volume): the field
+//    ray-marched as the ground truth renders it (volume_renderer.js), with the page's transfer
+//    function (edits exact) and the recipe's step, early termination and shading.
 // Frames of the colour model are drawn here too: the recipe carries its table.
 
-import { reorbit } from './camera.js';
+import { reorbit, storedCamera } from './camera.js';
 import { DRAG_FRAME_MS, FrameCost } from './frame_cost.js';
 import { fetchLightField } from './light_field_data.js';
 import { LightFieldRenderer, webgl2Available } from './light_field_renderer.js';
 import { coarserProxies, fetchProxies } from './proxy_data.js';
 import { ProxyRenderer } from './proxy_renderer.js';
+import { fetchVolume } from './volume_data.js';
+import { VolumeRenderer } from './volume_renderer.js';
 
 const KEPT_STEPS = 3;  // light fields kept parsed: the shown step and the ones around it
 // While the user drags, each frame is drawn at the largest size that keeps the GPU's time for it
@@ -26,6 +31,9 @@ const KEPT_STEPS = 3;  // light fields kept parsed: the shown step and the ones 
 // while dragging in the web viewer").
 const PREVIEW_SEARCH_STEPS = 16;
 const FULL_SEARCH_STEPS = 64;  // LightFieldReconstructionSettings::search_steps' default
+// A volume's preview marches this many times the recipe's step (its table corrected for that
+// step, so the picture keeps its opacity), on the preview's fewer pixels.
+const PREVIEW_STEP_FACTOR = 2;
 
 export class GpuFrames {
   /// null when this browser has no WebGL2 (the page then uses the server's frames only).
@@ -47,10 +55,16 @@ export class GpuFrames {
       console.warn(`frames from the view's proxies are drawn by the server: ${error.message}`);
       proxies = null;
     }
-    return new GpuFrames(lightFields, proxies, previews);
+    let volumes = null;
+    try {
+      volumes = await VolumeRenderer.create(canvas);
+    } catch (error) {
+      console.warn(`frames from the compressed field are drawn by the server: ${error.message}`);
+    }
+    return new GpuFrames(lightFields, proxies, previews, volumes);
   }
 
-  constructor(renderer, proxyRenderer, previewRenderer) {
+  constructor(renderer, proxyRenderer, previewRenderer, volumeRenderer = null) {
     this.renderer = renderer;
     this.proxyRenderer = proxyRenderer;  // null: frames from the view's proxies are the server's
     this.previewRenderer = previewRenderer;  // the same for previews (coarser proxies)
@@ -59,6 +73,9 @@ export class GpuFrames {
     this.uploaded = null;    // key of the light field on the GPU
     this.uploadedProxies = null;  // key of the proxies on the GPU
     this.uploadedPreviews = null;  // key of the coarser proxies on the GPU
+    this.volumeRenderer = volumeRenderer;  // null: volume frames are the server's
+    this.volumeCache = new Map();  // "step/view" -> Promise of {volume, downloadMs} (or null)
+    this.uploadedVolume = null;  // key of the volume on the GPU
     this.lastOpen = null;    // {key, downloadMs, uploadMs, bytes}
     this.costs = new Map();  // kind of frame -> FrameCost
     this.dragFrameMs = DRAG_FRAME_MS;  // tests change it to force previews or full frames
@@ -118,6 +135,57 @@ export class GpuFrames {
     return { milliseconds, uploadMs, preview: coarse, size: camera.size };
   }
 
+  /// The parsed compressed field of (step, view) with its download (and decoding) time; null
+  /// where the step has none.
+  volume(step, view) {
+    return cached(this.volumeCache, `${step}/${view}`, () => fetchVolume(step, view))
+      .then(({ value, downloadMs }) => ({ volume: value, downloadMs }));
+  }
+
+  /// Draws (step, view) from its compressed field with `recipe` (/api/recipe, volume) and the
+  /// transfer function `tf` (its JSON): the stored camera (`stored`, Camera::to_json) or, for an
+  /// `orbit` view, reorbited to the angles; while `dragging`, at the size the frame budget
+  /// allows with a longer step. Resolves to the frame's timing, or null without a volume (or a
+  /// GPU that cannot hold it).
+  async drawVolume(step, view, recipe, stored, tf, orbit, azimuthDeg, elevationDeg,
+    dragging = false) {
+    if (!this.volumeRenderer) return null;
+    const key = `${step}/${view}`;
+    const { volume, downloadMs } = await this.volume(step, view);
+    if (!volume) return null;
+    const renderer = this.volumeRenderer;
+    let uploadMs = 0;
+    if (this.uploadedVolume !== key) {
+      const started = performance.now();
+      try {
+        renderer.load(volume);
+      } catch (error) {
+        console.warn(`volume frames are drawn by the server: ${error.message}`);
+        return null;
+      }
+      await renderer.finish();
+      uploadMs = performance.now() - started;
+      this.uploadedVolume = key;
+      this.lastOpen = { key, downloadMs, uploadMs, bytes: volume.bytes };
+    }
+    const [width, height] = stored.size;
+    const cost = this.cost(`volume/${Boolean(recipe.shading)}`, PREVIEW_STEP_FACTOR);
+    const divisor = dragging ? cost.dragDivisor(width, height, this.dragFrameMs) : 1;
+    const preview = divisor > 1;
+    const size = [Math.max(1, Math.round(width / divisor)),
+      Math.max(1, Math.round(height / divisor))];
+    const camera = orbit ? reorbit({ ...stored, size }, azimuthDeg, elevationDeg)
+      : { ...storedCamera(stored), width: size[0], height: size[1] };
+    const settings = volumeSettings(recipe);
+    if (preview) settings.stepVoxels *= PREVIEW_STEP_FACTOR;
+    const started = performance.now();
+    renderer.render(camera, tf, settings);
+    await renderer.finish();
+    const milliseconds = performance.now() - started;
+    cost.record(preview, milliseconds, size[0] * size[1]);
+    return { milliseconds, uploadMs, preview, size };
+  }
+
   /// The confidence of an edited light-field frame drawn withTrust (LightFieldRenderer
   /// trustBytes), or null.
   lightFieldTrust() {
@@ -152,7 +220,8 @@ export class GpuFrames {
 
   /// Starts downloading a step's light field (and its stored view's proxies, where they are
   /// drawn here) ahead of need.
-  prefetch(step, view) {
+  prefetch(step, view, volume = false) {
+    if (volume && this.volumeRenderer) this.volume(step, view).catch(() => {});
     this.lightField(step, view).catch(() => {});
     if (this.proxyRenderer) this.proxies(step, view).catch(() => {});
   }
@@ -221,6 +290,14 @@ function cached(cache, key, load) {
     while (cache.size > KEPT_STEPS) cache.delete(cache.keys().next().value);
   }
   return cache.get(key);
+}
+
+/// What VolumeRenderer.render takes of a volume recipe (/api/recipe: the archive's preview
+/// settings, shading where the request asks for lighting).
+function volumeSettings(recipe) {
+  return { stepVoxels: recipe.step_voxels, stopOpacity: recipe.early_termination_opacity,
+    shading: Boolean(recipe.shading), phong: recipe.phong, valueBins: recipe.tf_value_bins,
+    gradientBins: recipe.tf_gradient_bins };
 }
 
 /// A recipe for proxies `divisor` times coarser: occlusion's radius in their pixels (at least 1)

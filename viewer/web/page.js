@@ -28,6 +28,7 @@ export const state = {
   mask: false,
   playing: false,
   lightField: false,      // whether the shown step has a light field the browser can draw
+  volume: false,          // whether the shown step has a compressed field of the view's field
   dragging: false,        // an orbit drag moved within the last REST_MS: previews will do
 };
 export const viewer = {

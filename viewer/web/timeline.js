@@ -46,13 +46,16 @@ export async function stepChanged() {
   if (!entry) return;
   const info = await getJson(`api/step?step=${entry.step}&view=${state.view}`);
   let lightField = false;
+  // A compressed field of the view's field (/api/step lists it): the recipe may draw from it.
+  const volume = Boolean(info.volume);
   if (viewer.gpu) {
     lightField = await viewer.gpu.has(entry.step, state.view).catch(() => false);
     const next = state.timeline[state.stepIndex + 1];
-    if (lightField && next) viewer.gpu.prefetch(next.step, state.view);
+    if ((lightField || volume) && next) viewer.gpu.prefetch(next.step, state.view, volume);
   }
   if (state.timeline[state.stepIndex] !== entry) return;  // the slider moved on meanwhile
   state.lightField = lightField;
+  state.volume = volume;
   const count = info.intervals ? info.intervals.length - 1 : 0;
   if (count !== state.scales.length) {
     state.scales = new Array(count).fill(1);
