@@ -300,7 +300,7 @@ void crossover_scene(const Scene& scene, bool smoke, CrossoverRows& rows, const 
     ProxyRenderer renderer;
     renderer.upload(scene.volume.field());
     const int image = smoke ? 64 : 256;
-    const int views = smoke ? 2 : n >= 512 ? 4 : 8;
+    const int views = smoke ? 2 : n >= 512 ? 3 : 4;
     const ViewSet set = make_view_set(renderer, scene, image, views, {"edit", "sharp"});
     std::printf("crossover: %s %d^3, %d views, truths %.1f s\n", rows.field.c_str(), n, views,
                 ms_since(start) / 1e3);
@@ -309,13 +309,12 @@ void crossover_scene(const Scene& scene, bool smoke, CrossoverRows& rows, const 
         rows.add(set, "field", setting.label(), static_cast<double>(r.compressed.bytes),
                  r.compressed.compress_ms, r.compressed.decompress_ms, r.scores);
     }
-    measure_proxies(set, smoke ? std::vector<int>{64} : std::vector<int>{128, 256, 512}, rows,
-                    scratch);
+    measure_proxies(set, smoke ? std::vector<int>{64} : std::vector<int>{128, 256}, rows, scratch);
     const std::vector<int> cameras = smoke      ? std::vector<int>{12}
                                      : n >= 512 ? std::vector<int>{12, 42}
                                                 : std::vector<int>{12, 42, 162};
     for (const int c : cameras) {
-        for (const int map : smoke ? std::vector<int>{32} : std::vector<int>{128, 256}) {
+        for (const int map : smoke ? std::vector<int>{32} : std::vector<int>{128}) {
             measure_light_field(set, renderer, c, map, rows, scratch);
         }
     }

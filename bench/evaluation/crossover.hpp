@@ -18,11 +18,12 @@ void section_volume(const std::vector<const Scene*>& scenes, bool smoke,
                     const std::filesystem::path& out, int image, int views);
 
 /// For Gray-Scott and Marschner-Lobb at each size of `sizes`: the bytes and capture (or
-/// compression) ms of the single-view proxies (images 128^2..512^2), the multi-perspective
-/// proxies, attenuation light fields of 12/42/162 cameras (maps 128^2 and 256^2) and the
+/// compression) ms of the single-view proxies (images 128^2 and 256^2), the multi-perspective
+/// proxies, attenuation light fields of 12/42/162 cameras (maps 128^2) and the
 /// compressed field (every ZFP setting), each with its mean PSNR over random views at 256^2
 /// under a held-out edit and under a sharp function (make_sharp_tf): crossover.csv.
-/// At sizes >= 512 fewer views (4) and no 162-camera rig, to fit the machine's time.
+/// 4 views (3 at sizes >= 512, and no 162-camera rig there), to fit 2 cores' time; light-field
+/// accuracy is set by the cameras' spacing, not the map size (light_fields.csv).
 void section_crossover(const std::vector<int>& sizes, bool smoke, const std::filesystem::path& out,
                        const std::filesystem::path& scratch);
 

@@ -168,8 +168,9 @@ def markdown(rows, machine, prefix):
              "field: raw ZFP 1.0, serial, full header, fixed accuracy 0.3–1e-4 of the range and "
              "fixed rate 0.25–8 bits, decoded and rendered by the ground-truth renderer; bytes = "
              "the stream. Images: the Instrument's archive of the stored view (single-view "
-             "proxies at 128²/256²/512², multi-perspective proxies the same), attenuation light "
-             "fields of 12/42/162 cameras at 128²/256² maps (the EXR as archived), Explorer "
+             "proxies at 128² and 256², multi-perspective proxies the same), attenuation light "
+             "fields of 12/42/162 cameras at 128² maps (the EXR as archived; 162 not run at 512³), "
+             "Explorer "
              "frames enlarged to 256² where smaller. Least bytes whose mean PSNR reaches the "
              "threshold; '—' = no setting reaches it (best mean PSNR in brackets)." % (
                  machine.get("cpu", "?"), machine.get("hardware_threads", "?"),
