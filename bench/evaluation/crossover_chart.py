@@ -79,6 +79,12 @@ def analyse(rows):
                         f_pts.append((n, _num(f, "bytes"), f["setting"]))
                     if i:
                         i_pts.append((n, _num(i, "bytes"), "%s %s" % (i["representation"], i["setting"])))
+                # The images' fit follows one representation, the cheapest at the largest size
+                # reaching the PSNR, over the sizes it reaches it (mixing kinds across sizes would
+                # fit a slope no representation has).
+                if i_pts:
+                    kind = i_pts[-1][2].split(" ")[0]
+                    i_pts = [p for p in i_pts if p[2].split(" ")[0] == kind]
                 f_fit = power_fit([(n, b) for n, b, _ in f_pts])
                 i_fit = power_fit([(n, b) for n, b, _ in i_pts])
                 out.append({"field": field, "tf": tf, "threshold": threshold, "field_points": f_pts,
@@ -210,8 +216,9 @@ def markdown(rows, machine, prefix):
                      "%s (%s)" % (_fit_text(a["image_fit"]), images) if images else "—",
                      cross_text, field_proj, image_proj])
     lines += ["Fits: least squares of log bytes on log n over the measured sizes, per representation "
-              "kind (the field's cheapest setting reaching the PSNR; the cheapest image "
-              "representation reaching it, constant in n where it reaches it at one size only); "
+              "kind (the field's cheapest setting reaching the PSNR; for images, the representation "
+              "cheapest at the largest size reaching it, over the sizes where it does, constant in "
+              "n where that is one size); "
               "the crossover is where the fits meet, images cheaper above it. Projections are the "
               "fits evaluated beyond the measured sizes, not measurements.", "",
               _table(header, body), ""]
