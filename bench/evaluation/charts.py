@@ -19,8 +19,10 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from crossover_chart import chart_crossover, markdown as crossover_markdown  # noqa: E402
+
 CHARTS = ["pareto", "rotation", "radiality", "clusters", "opacity_edits", "storage", "failures",
-          "light_fields", "budget", "budget_light_field"]
+          "light_fields", "budget", "budget_light_field", "crossover"]
 DPI = 80
 SOURCES = {"multi45": "multi-perspective, tilt 45°", "multi20": "multi-perspective, tilt 20°",
            "single": "single perspective"}
@@ -51,8 +53,14 @@ def pareto_front(points):
     return front
 
 
-def chart_pareto(d, rows, primary):
+def field_label(r):
+    """'a 0.01' / 'r 1' for a compressed-field row of volume_field.csv."""
+    return "%s %s" % ("a" if r["mode"] == "accuracy" else "r", r["value"])
+
+
+def chart_pareto(d, rows, primary, volume=()):
     rows = [r for r in rows if r["scene"] == primary]
+    volume = [r for r in volume if r["scene"] == primary]
     fig, axes = plt.subplots(2, 2, figsize=(11, 8))
     for i, (metric, title) in enumerate(
             [("edit_psnr", "held-out opacity edit (colour model)"),
@@ -78,6 +86,14 @@ def chart_pareto(d, rows, primary):
                 ax.scatter([x], [y], s=18, color="C0" if r["varied"] != "default" else "C3")
                 ax.annotate(value, (x, y), fontsize=7, xytext=(3, 2), textcoords="offset points")
             front = pareto_front([p for p in pts if p[1] >= floor])
+            # The compressed field: the same measure on the decoded field (section volume).
+            field_metric = "stored_edit_psnr" if metric == "edit_psnr" else "rotate15_psnr"
+            field_cost = "bytes" if cost == "archive_bytes" else "compress_ms"
+            for k, r in enumerate(volume):
+                ax.scatter([num(r, field_cost) * scale], [num(r, field_metric)], s=18, marker="^",
+                           color="C1", label="compressed field (ZFP)" if k == 0 else None)
+                ax.annotate(field_label(r), (num(r, field_cost) * scale, num(r, field_metric)),
+                            fontsize=6, color="C1", xytext=(3, -7), textcoords="offset points")
             ax.set_ylim(bottom=floor - 1.0)
             ax.step([p[0] for p in front], [p[1] for p in front], where="post", color="C2",
                     label="Pareto front")
@@ -248,7 +264,7 @@ def chart_budget_light_field(d, rows):
                       log_bytes=True)
 
 
-def chart_light_fields(d, rows):
+def chart_light_fields(d, rows, volume=()):
     """Light fields (seed 001 Table 1 on our scenes) beside the single-view proxies and their
     per-pixel fusion, all from the same random views: accuracy against bytes, error against
     cameras, capture cost per camera against one single-perspective proxy pass."""
@@ -268,6 +284,13 @@ def chart_light_fields(d, rows):
                 label += " seg " + r["segments"]
             axes[0].annotate(label, (x, y), fontsize=6, xytext=(3, 2), textcoords="offset points")
         front = pareto_front([(num(r, "stored_bytes") * 1e-6, num(r, "psnr")) for r in mine])
+        # The compressed field in the same views (section volume), the run's function.
+        field = sorted(((num(r, "bytes") * 1e-6, num(r, "psnr"), field_label(r))
+                        for r in volume if r["scene"] == scene), key=lambda p: p[0])
+        axes[0].scatter([p[0] for p in field], [p[1] for p in field], s=22, marker="^",
+                        color=colour, label="%s compressed field (ZFP)" % scene if field else None)
+        for x, y, label in field:
+            axes[0].annotate(label, (x, y), fontsize=6, xytext=(3, -7), textcoords="offset points")
         axes[0].step([p[0] for p in front], [p[1] for p in front], where="post", color=colour,
                      label="%s Pareto front" % scene)
         for size in sorted({r["map"] for r in mine if r["source"] == "lightfield"}, key=int):
@@ -291,7 +314,8 @@ def chart_light_fields(d, rows):
     axes[0].set_xscale("log")
     axes[0].set_xlabel("MB per step as stored")
     axes[0].set_ylabel("PSNR dB, mean of random views")
-    axes[0].set_title("accuracy per byte (o light field, s single view, D fused)", fontsize=10)
+    axes[0].set_title("accuracy per byte (o light field, s single view, D fused, ^ ZFP field)",
+                      fontsize=10)
     axes[0].legend(fontsize=7, loc="lower right")
     axes[1].axhline(2.0, color="grey", linestyle=":", label="goal 2 %")
     axes[1].set_xscale("log")
@@ -622,6 +646,11 @@ def write_markdown(d, path, prefix, elapsed):
                 for r in light]
         lines += [table(header, body), ""]
 
+    lines += volume_markdown(read(d, "volume_field"))
+    # The crossover may come from its own run (insitu_evaluate --sections crossover): say where.
+    own = {r["key"]: r["value"] for r in read(d, "crossover_machine")}
+    lines += crossover_markdown(read(d, "crossover"), own or machine, prefix)
+
     lines += ["## View synthesis against rotation (Fig. 6)", "", "![rotation](%srotation.png)" % prefix, "",
               "![radiality](%sradiality.png)" % prefix, ""]
     body = [[r["scene"], "%.1f" % num(r, "mean_radiality_deg"), "%.4f" % num(r, "corr_15"),
@@ -791,6 +820,29 @@ def write_markdown(d, path, prefix, elapsed):
         f.write("\n".join(lines))
 
 
+def volume_markdown(rows):
+    """The compressed field beside the light fields: what section volume measured."""
+    if not rows:
+        return []
+    header = ["scene", "ZFP", "tolerance (field units)", "MB", "ratio", "compress ms",
+              "decompress ms", "PSNR, run's function (least)", "PSNR, held-out edits (least)",
+              "stored view edit PSNR", "turned 15° PSNR"]
+    body = [[r["scene"], r["setting"], "%.3g" % num(r, "tolerance") if num(r, "tolerance") else "",
+             "%.3f" % (num(r, "bytes") / 1e6), "%.1f×" % (num(r, "raw_bytes") / num(r, "bytes")),
+             "%.0f" % num(r, "compress_ms"), "%.0f" % num(r, "decompress_ms"),
+             "%.1f (%.1f)" % (num(r, "psnr"), num(r, "psnr_min")),
+             "%.1f (%.1f)" % (num(r, "edit_psnr"), num(r, "edit_psnr_min")),
+             "%.1f" % num(r, "stored_edit_psnr"), "%.1f" % num(r, "rotate15_psnr")] for r in rows]
+    return ["## The compressed field in the light fields' views", "",
+            "The field itself through ZFP 1.0 (raw libzfp, serial, full header; fixed accuracy as a "
+            "share of the value range, or fixed rate in bits per value), decoded and rendered by "
+            "the ground-truth renderer with the same settings, in the light-field section's %s "
+            "random views with the run's function and its held-out edits, and in the "
+            "configuration grid's stored-view edit and 15° turn (its ^ points in the light-field "
+            "and Pareto charts). Times: median of 3 after a warm-up, one thread. PSNR is capped "
+            "at 100 dB (identical images)." % rows[0]["views"], "", table(header, body), ""]
+
+
 def design_figures():
     """bench/design_figures.md without its title, which the report's own heading replaces."""
     with open(DESIGN_FIGURES, encoding="utf-8") as f:
@@ -889,14 +941,16 @@ def main():
     d = args.results
     configs = read(d, "configurations")
     primary = read(d, "opacity_edits")[0]["scene"]
-    chart_pareto(d, configs, primary)
+    volume = read(d, "volume_field")
+    chart_pareto(d, configs, primary, volume)
     chart_rotation(d, read(d, "rotation"))
     chart_radiality(d, read(d, "radiality"), read(d, "curvature"))
     chart_clusters(d, read(d, "clusters"))
     chart_opacity_edits(d, read(d, "opacity_edits"))
     chart_storage(d, read(d, "storage"))
     chart_failures(d, read(d, "opacity_scale"), read(d, "intervals"), read(d, "occlusion"), read(d, "clusters"))
-    chart_light_fields(d, read(d, "light_fields"))
+    chart_light_fields(d, read(d, "light_fields"), volume)
+    chart_crossover(d, read(d, "crossover"))
     chart_budget(d, read(d, "budget"))
     chart_budget_light_field(d, read(d, "budget_light_field"))
     chart_peer(d)

@@ -6,7 +6,9 @@
 // CSV files; bench/evaluation/charts.py draws them. Measures and prints; asserts nothing.
 //
 //   insitu_evaluate --out DIR [--smoke] [--sections a,b,...] [--raw PATH:NXxNYxNZ:TYPE ...]
-// Sections: rotation, curvature, colour, configurations, storage, light_fields (default: all).
+//   [--sizes N,N,...]
+// Sections: rotation, curvature, colour, configurations, storage, light_fields, budget, volume,
+// crossover (default: all); --sizes: the crossover's volume sizes (default 64,128,256,512).
 #include <unistd.h>
 
 #include <algorithm>
@@ -29,8 +31,10 @@
 #include <vector>
 
 #include "arguments.hpp"
+#include "crossover.hpp"
 #include "gray_scott_simulation.hpp"
 #include "gray_scott_volume.hpp"
+#include "harness.hpp"
 #include "insitu/archive/archive.hpp"
 #include "insitu/explore/colour_model.hpp"
 #include "insitu/explore/explorer.hpp"
@@ -62,16 +66,19 @@ struct RawInput {
 struct Options {
     std::string out;
     bool smoke = false;
-    std::set<std::string> sections{"rotation", "curvature",    "colour", "configurations",
-                                   "storage",  "light_fields", "budget"};
+    std::set<std::string> sections{"rotation",       "curvature", "colour",
+                                   "configurations", "storage",   "light_fields",
+                                   "budget",         "volume",    "crossover"};
     std::vector<RawInput> raw;
+    /// The crossover's volume sizes (--sizes); empty: 64, 128, 256, 512 (smoke: 24, 32).
+    std::vector<int> sizes;
 };
 
 [[noreturn]] void usage_error(const std::string& message) {
     std::fprintf(stderr,
                  "insitu_evaluate: %s\nusage: insitu_evaluate --out DIR [--smoke] "
                  "[--sections rotation,curvature,colour,configurations,storage,light_fields,"
-                 "budget] "
+                 "budget,volume,crossover] [--sizes N,N,...] "
                  "[--raw PATH:NXxNYxNZ:TYPE ...]\n",
                  message.c_str());
     std::exit(2);
@@ -125,6 +132,16 @@ Options parse(int argc, char** argv) {
             options.out = value;
         } else if (flag == "--raw") {
             options.raw.push_back(parse_raw(value));
+        } else if (flag == "--sizes") {
+            std::stringstream list(value);
+            std::string item;
+            while (std::getline(list, item, ',')) {
+                int n = 0;
+                if (cli::convert_integer(item, n) != std::errc() || n < 8 || n > 4096) {
+                    usage_error("--sizes " + value + ": \"" + item + "\" (each 8..4096)");
+                }
+                options.sizes.push_back(n);
+            }
         } else if (flag == "--sections") {
             std::set<std::string> known = options.sections;
             options.sections.clear();
@@ -140,57 +157,6 @@ Options parse(int argc, char** argv) {
     }
     if (options.out.empty()) usage_error("--out DIR is required");
     return options;
-}
-
-/// One CSV file: a header, then rows of numbers and words.
-class Csv {
-public:
-    Csv(const fs::path& path, const std::string& header) : out_(path) {
-        if (!out_) fail<IoError>("cannot write \"", path.string(), "\"");
-        out_ << header << '\n';
-    }
-    template <typename... Values>
-    void row(const Values&... values) {
-        bool first = true;
-        ((out_ << (first ? "" : ",") << format(values), first = false), ...);
-        out_ << '\n';
-        out_.flush();
-    }
-
-private:
-    static std::string format(double value) {
-        char text[32];
-        std::snprintf(text, sizeof text, "%.6g", value);
-        return text;
-    }
-    static std::string format(int value) { return std::to_string(value); }
-    static std::string format(long value) { return std::to_string(value); }
-    static std::string format(long long value) { return std::to_string(value); }
-    static std::string format(unsigned long value) { return std::to_string(value); }
-    static std::string format(unsigned long long value) { return std::to_string(value); }
-    static std::string format(const std::string& value) { return value; }
-    static std::string format(const char* value) { return value; }
-    std::ofstream out_;
-};
-
-/// The ground truth every figure is measured against: exact (no early termination: the proxies
-/// stop only where T = 0 too), unshaded like the proxies' emission-absorption model, 1-voxel
-/// step, a fine table so colour steps at interval edges stay sharp.
-RenderSettings truth_settings() {
-    RenderSettings settings;
-    settings.early_termination_opacity = 1.0;
-    settings.tf_value_bins = 4096;
-    return settings;
-}
-
-/// The stored view of every experiment: orbit azimuth 30, elevation 20, orthographic.
-OrbitView stored_view(int image) {
-    OrbitView view;
-    view.azimuth_deg = 30.0;
-    view.elevation_deg = 20.0;
-    view.width = image;
-    view.height = image;
-    return view;
 }
 
 constexpr double kStoredAzimuth = 30.0, kStoredElevation = 20.0;
@@ -1221,17 +1187,7 @@ void section_light_fields(const std::vector<const Scene*>& scenes, const Options
         const std::vector<double> isovalues = scene_layers(*scene, 4);
         const Camera stored = Camera::orbit(stored_view(image), bounds);
         // The same random views for every case: uniform over the sphere of directions.
-        std::vector<std::pair<double, double>> angles;
-        std::uint32_t state = 12345u;
-        auto uniform = [&state] {
-            state = state * 1664525u + 1013904223u;
-            return (state >> 8) / double(1u << 24);
-        };
-        for (int v = 0; v < views; ++v) {
-            const double azimuth = 360.0 * uniform();
-            const double elevation = glm::degrees(std::asin(2.0 * uniform() - 1.0));
-            angles.emplace_back(azimuth, elevation);
-        }
+        const std::vector<std::pair<double, double>> angles = random_views(views);
         std::vector<Image> truths;
         for (const auto& [azimuth, elevation] : angles) {
             truths.push_back(renderer
@@ -1506,6 +1462,19 @@ int main(int argc, char** argv) {
         if (options.sections.count("light_fields")) {
             // The goal scenes: Gray-Scott and Marschner-Lobb.
             section_light_fields({&primary, &analytic[2]}, options, scratch, image);
+        }
+        if (options.sections.count("volume")) {
+            // The light-field section's scenes and views: the field beside the light fields.
+            section_volume({&primary, &analytic[2]}, options.smoke, options.out, image,
+                           options.smoke ? 3 : 30);
+        }
+        if (options.sections.count("crossover")) {
+            std::vector<int> sizes = options.sizes;
+            if (sizes.empty()) {
+                sizes =
+                    options.smoke ? std::vector<int>{24, 32} : std::vector<int>{64, 128, 256, 512};
+            }
+            section_crossover(sizes, options.smoke, options.out, scratch);
         }
         fs::remove_all(scratch);
         std::printf("insitu_evaluate: done in %.1f s\n", ms_since(start) / 1e3);

@@ -158,6 +158,22 @@ TransferFunction make_tf(const Scene& scene, const TfSpec& spec) {
     return TransferFunction(points, scene.unit_length);
 }
 
+TransferFunction make_sharp_tf(const Scene& scene, int peaks, double width) {
+    const double lo = scene.value_min, range = scene.value_max - scene.value_min;
+    const std::vector<glm::vec3> colours{
+        {0.2f, 0.4f, 1.0f}, {0.2f, 1.0f, 0.3f}, {1.0f, 0.3f, 0.1f}, {1.0f, 0.9f, 0.2f}};
+    std::vector<ControlPoint> points{{lo, glm::vec4(colours[0], 0.0f)}};
+    for (int p = 0; p < peaks; ++p) {
+        const double centre = peaks == 1 ? 0.5 : 0.3 + 0.4 * p / (peaks - 1);
+        const glm::vec3 rgb = colours[static_cast<std::size_t>(p) % colours.size()];
+        points.push_back({lo + range * (centre - 0.5 * width), glm::vec4(rgb, 0.0f)});
+        points.push_back({lo + range * centre, glm::vec4(rgb, 0.8f)});
+        points.push_back({lo + range * (centre + 0.5 * width), glm::vec4(rgb, 0.0f)});
+    }
+    points.push_back({scene.value_max, glm::vec4(colours[0], 0.0f)});
+    return TransferFunction(points, scene.unit_length);
+}
+
 IntervalSet scene_intervals(const Scene& scene, int count) {
     return IntervalSet::uniform(scene.value_min, scene.value_max, count);
 }

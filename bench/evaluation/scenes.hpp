@@ -57,6 +57,12 @@ struct TfSpec {
 /// one), and a step between the bands at x = 0.5, so band scales are constant per interval.
 TransferFunction make_tf(const Scene& scene, const TfSpec& spec = {});
 
+/// A sharp function the run never saw (issue 40): `peaks` narrow peaks at x = 0.3 .. 0.7, each
+/// `width` of the value range wide at its base (opacity rising linearly to 0.8 per unit length at
+/// its centre), a colour of its own each, nothing between them. Where the field's error moves a
+/// value across a peak, the colour moves: it shows what a compressed field's tolerance costs.
+TransferFunction make_sharp_tf(const Scene& scene, int peaks = 3, double width = 0.02);
+
 /// L uniform intervals over the scene's value range (what the Instrument chooses by default).
 IntervalSet scene_intervals(const Scene& scene, int count);
 
