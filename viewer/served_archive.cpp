@@ -45,6 +45,9 @@ void ServedArchive::require_files_inside_locked(std::int64_t step, int view) con
     for (const ArchivedLightField& light_field : explorer_->archive().light_fields(step)) {
         require_inside(light_field.exr_path);
     }
+    for (const ArchivedVolume& volume : explorer_->archive().volumes(step)) {
+        for (const std::string& file : volume.files) require_inside(file);
+    }
 }
 
 std::array<std::pair<std::int64_t, std::uintmax_t>, 2> ServedArchive::index_stamp() const {

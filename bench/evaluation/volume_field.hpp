@@ -1,8 +1,8 @@
 #pragma once
 // The compressed field as the evaluation harness measures it (issue 40): a scene's samples
 // through ZFP (fixed accuracy relative to the value range, or fixed rate) and back, with the
-// stream's bytes and the time each way. Raw libzfp calls, serial, as the archive writer's thread
-// would run them; the stream carries ZFP's full header, as the archive's block files do.
+// stream's bytes and the time each way, through the archive's own codec (archive/zfp_volume.hpp),
+// serial, as the writer's thread runs it: the bytes are those of the archive's block files.
 #include <cstdint>
 #include <string>
 #include <vector>

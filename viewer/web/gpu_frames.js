@@ -218,11 +218,12 @@ export class GpuFrames {
       .then(({ value, downloadMs }) => ({ lightField: value, downloadMs }));
   }
 
-  /// Starts downloading a step's light field (and its stored view's proxies, where they are
-  /// drawn here) ahead of need.
-  prefetch(step, view, volume = false) {
+  /// Starts downloading what the next step draws from ahead of need: its light field and its
+  /// compressed field where this step has them (steps of one run hold the same), and its stored
+  /// view's proxies where they are drawn here.
+  prefetch(step, view, { lightField = false, volume = false } = {}) {
     if (volume && this.volumeRenderer) this.volume(step, view).catch(() => {});
-    this.lightField(step, view).catch(() => {});
+    if (lightField) this.lightField(step, view).catch(() => {});
     if (this.proxyRenderer) this.proxies(step, view).catch(() => {});
   }
 

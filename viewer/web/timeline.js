@@ -49,9 +49,12 @@ export async function stepChanged() {
   // A compressed field of the view's field (/api/step lists it): the recipe may draw from it.
   const volume = Boolean(info.volume);
   if (viewer.gpu) {
-    lightField = await viewer.gpu.has(entry.step, state.view).catch(() => false);
+    // Only a step that lists a light field of the view's field (its segments) is asked for one:
+    // probing the others cost a 404 each.
+    lightField = info.light_field_segments > 0 &&
+      await viewer.gpu.has(entry.step, state.view).catch(() => false);
     const next = state.timeline[state.stepIndex + 1];
-    if ((lightField || volume) && next) viewer.gpu.prefetch(next.step, state.view, volume);
+    if ((lightField || volume) && next) viewer.gpu.prefetch(next.step, state.view, { lightField, volume });
   }
   if (state.timeline[state.stepIndex] !== entry) return;  // the slider moved on meanwhile
   state.lightField = lightField;

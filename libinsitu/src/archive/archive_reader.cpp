@@ -330,9 +330,10 @@ bool inside(const fs::path& root, const fs::path& path) {
 }  // namespace
 std::vector<ArchivedVolume> ArchiveReader::volumes(std::int64_t step) const {
     const nlohmann::json& step_entry = af::find_step(*manifest_, path_, step);
+    const std::string root = fs::absolute(path_).string();
     std::vector<ArchivedVolume> result;
     for (const nlohmann::json& entry : af::volume_entries(step_entry)) {
-        result.push_back(af::archived_volume(step_entry, entry));
+        result.push_back(af::archived_volume(root, step_entry, entry));
     }
     return result;
 }

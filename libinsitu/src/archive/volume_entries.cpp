@@ -215,7 +215,8 @@ nlohmann::json write_volume(const fs::path& archive, std::int64_t step, int fiel
             {"blocks", std::move(blocks)}};
 }
 
-ArchivedVolume archived_volume(const nlohmann::json& step_entry, const nlohmann::json& entry) {
+ArchivedVolume archived_volume(const std::string& archive, const nlohmann::json& step_entry,
+                               const nlohmann::json& entry) {
     ArchivedVolume volume;
     volume.step = step_entry.at("step").get<std::int64_t>();
     volume.time = step_entry.at("time").get<double>();
@@ -230,7 +231,10 @@ ArchivedVolume archived_volume(const nlohmann::json& step_entry, const nlohmann:
     volume.max = entry.at("max").get<double>();
     volume.nonfinite = entry.at("nonfinite").get<std::int64_t>();
     volume.blocks = static_cast<int>(entry.at("blocks").size());
-    for (const ListedFile& file : listed_volume_files("", entry)) volume.bytes += file.bytes;
+    for (const ListedFile& file : listed_volume_files(archive, entry)) {
+        volume.bytes += file.bytes;
+        volume.files.push_back(file.absolute_path);
+    }
     return volume;
 }
 

@@ -39,8 +39,9 @@ nlohmann::json write_volume(const std::filesystem::path& archive, std::int64_t s
                             int field_number, const VolumeRecord& volume,
                             std::vector<WrittenFile>& written);
 
-/// What a validated entry describes.
-ArchivedVolume archived_volume(const nlohmann::json& step_entry, const nlohmann::json& entry);
+/// What a validated entry of the archive at `archive` describes.
+ArchivedVolume archived_volume(const std::string& archive, const nlohmann::json& step_entry,
+                               const nlohmann::json& entry);
 /// The whole grid of a validated entry, every block's files checked against the index and
 /// decoded (IoError naming the file).
 VolumeGrid read_volume(const std::string& archive, const nlohmann::json& entry);

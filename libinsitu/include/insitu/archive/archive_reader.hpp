@@ -52,7 +52,8 @@ struct ArchivedVolume {
     double min = 0.0, max = 0.0;  ///< the finite values' range
     std::int64_t nonfinite = 0;   ///< NaN/Inf samples (kept: decoded as NaN)
     int blocks = 1;
-    std::uint64_t bytes = 0;  ///< every file of it
+    std::uint64_t bytes = 0;         ///< every file of it
+    std::vector<std::string> files;  ///< absolute: each block's ZFP stream, then its mask
 };
 
 /// A compressed field decoded: the grid, its values x fastest, NaN where the field was NaN/Inf.
