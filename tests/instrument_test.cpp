@@ -909,6 +909,54 @@ TEST_F(InstrumentTest, AnErrorBudgetChoosesTheColourModelsClusters) {
 // The cheapest rig meets an easy accuracy; an accuracy between the cheapest's and the best's
 // takes a costlier rig that meets it; the archive stores the rig chosen, and a configuration
 // that gives the cameras keeps them.
+// "volume" in the budget's "choose" (by default): a field whose compressed form meets the
+// accuracy within what the views leave is kept, and the light field, which it makes
+// unnecessary, is not captured; where the bytes do not allow it, no compressed field, and the
+// light field is chosen as before.
+TEST_F(InstrumentTest, AnErrorBudgetKeepsTheFieldWhereItFitsAndImagesWhereItDoesNot) {
+    const auto run = [&](const std::string& name, double bytes_per_step, std::string* log) {
+        InstrumentConfig config = small_config(directory_ / name, 48);
+        config.interval_count = 8;
+        LightFieldSettings light_field;
+        light_field.size = kBudgetMinLightFieldSide;
+        config.light_field = light_field;
+        BudgetConfig budget;
+        budget.psnr_db = 40.0;
+        budget.bytes_per_step = bytes_per_step;
+        budget.chooses_intervals = false;
+        budget.chooses_precision = false;
+        budget.chooses_size = false;
+        config.budget = budget;
+        return run_with_budget(config, volume_, 1, log);
+    };
+    std::string log;
+    const ArchiveReader fits = run("fits.cdb", 8e6, &log);
+    const BudgetRecord kept = fits.budget(0).at(0);
+    ASSERT_TRUE(kept.volume.has_value());
+    EXPECT_TRUE(kept.volume->met);
+    EXPECT_GE(kept.volume->psnr_db, 40.0);
+    EXPECT_GT(kept.volume->bytes, 0.0);
+    EXPECT_FALSE(kept.light_field.has_value());
+    EXPECT_THAT(log, HasSubstr("compressed field at"));
+    const std::vector<ArchivedVolume> stored = fits.volumes(0);
+    ASSERT_EQ(stored.size(), 1u);
+    const ValueRange range = volume_.field().value_range();
+    EXPECT_DOUBLE_EQ(stored[0].tolerance,
+                     kept.volume->relative_tolerance * (range.max - range.min));
+    EXPECT_TRUE(fits.light_fields(0).empty());
+    EXPECT_TRUE(fits.verify().empty());
+
+    // A byte budget the views' proxies take nearly whole: the field is measured, not kept.
+    const double views_bytes = kept.bytes;
+    const ArchiveReader tight = run("tight.cdb", views_bytes + 0.5 * kept.volume->bytes, nullptr);
+    const BudgetRecord images = tight.budget(0).at(0);
+    ASSERT_TRUE(images.volume.has_value());
+    EXPECT_FALSE(images.volume->met);
+    EXPECT_TRUE(tight.volumes(0).empty());
+    ASSERT_TRUE(images.light_field.has_value());  // chosen as without a compressed field
+    EXPECT_FALSE(tight.light_fields(0).empty());
+}
+
 TEST_F(InstrumentTest, AnErrorBudgetChoosesTheLightFieldsCamerasAndMapSize) {
     const auto run = [&](const std::string& name, BudgetConfig budget, bool given_cameras,
                          std::string* log, bool attenuation = false) {
@@ -922,6 +970,7 @@ TEST_F(InstrumentTest, AnErrorBudgetChoosesTheLightFieldsCamerasAndMapSize) {
         budget.chooses_precision = false;
         budget.chooses_size = false;
         budget.chooses_light_field = !given_cameras;
+        budget.chooses_volume = false;  // the compressed field would stand in for the light field
         config.budget = budget;
         return run_with_budget(config, volume_, 1, log);
     };

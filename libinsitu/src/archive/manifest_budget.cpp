@@ -47,6 +47,13 @@ nlohmann::json budget_entry(const BudgetRecord& choice) {
             {"met", light_field->met},         {"psnr_db", psnr_json(light_field->psnr_db)},
             {"bytes", light_field->bytes},     {"ms", light_field->milliseconds}};
     }
+    if (const auto& volume = choice.volume) {
+        entry["volume"] = {{"relative_tolerance", volume->relative_tolerance},
+                           {"met", volume->met},
+                           {"psnr_db", psnr_json(volume->psnr_db)},
+                           {"bytes", volume->bytes},
+                           {"ms", volume->milliseconds}};
+    }
     if (const auto& model = choice.colour_model) {
         entry["colour_model"] = {{"clusters", model->clusters},
                                  {"met", model->met},
@@ -103,6 +110,20 @@ BudgetRecord budget_from_entry(const nlohmann::json& entry) {
         light_field.bytes = chosen.at("bytes").get<double>();
         light_field.milliseconds = chosen.at("ms").get<double>();
         choice.light_field = light_field;
+    }
+    if (entry.contains("volume")) {  // only where the budget chose the compressed field
+        const nlohmann::json& chosen = entry.at("volume");
+        BudgetRecord::VolumeChoice volume;
+        volume.relative_tolerance = chosen.at("relative_tolerance").get<double>();
+        if (!(volume.relative_tolerance > 0.0 && volume.relative_tolerance < 1.0)) {
+            fail<ParseError>("volume.relative_tolerance ", volume.relative_tolerance,
+                             " is not in (0, 1)");
+        }
+        volume.met = chosen.at("met").get<bool>();
+        volume.psnr_db = psnr_from_json(chosen.at("psnr_db"));
+        volume.bytes = chosen.at("bytes").get<double>();
+        volume.milliseconds = chosen.at("ms").get<double>();
+        choice.volume = volume;
     }
     if (entry.contains("colour_model")) {  // only where the budget chose K
         const nlohmann::json& chosen = entry.at("colour_model");

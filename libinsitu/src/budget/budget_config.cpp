@@ -12,12 +12,13 @@ using namespace config_json;
 
 // "budget": {"psnr_db", "bytes_per_step", "ms_per_step", "check_every", "rotations",
 // "choose"}.
-enum class BudgetChoice { intervals, precision, size, light_field, colour_model };
+enum class BudgetChoice { intervals, precision, size, light_field, colour_model, volume };
 constexpr Choice<BudgetChoice> kBudgetChoices[] = {{"intervals", BudgetChoice::intervals},
                                                    {"precision", BudgetChoice::precision},
                                                    {"size", BudgetChoice::size},
                                                    {"light_field", BudgetChoice::light_field},
-                                                   {"colour_model", BudgetChoice::colour_model}};
+                                                   {"colour_model", BudgetChoice::colour_model},
+                                                   {"volume", BudgetChoice::volume}};
 // The BudgetConfig member each "choose" entry sets.
 bool BudgetConfig::*chooses(BudgetChoice choice) {
     switch (choice) {
@@ -31,6 +32,8 @@ bool BudgetConfig::*chooses(BudgetChoice choice) {
             return &BudgetConfig::chooses_light_field;
         case BudgetChoice::colour_model:
             return &BudgetConfig::chooses_colour_model;
+        case BudgetChoice::volume:
+            return &BudgetConfig::chooses_volume;
     }
     return &BudgetConfig::chooses_intervals;
 }
@@ -127,6 +130,12 @@ void BudgetConfig::keep_given_settings(const nlohmann::json& configuration) {
         configuration.contains("colour_model") ? &configuration["colour_model"] : nullptr;
     if (colour_model && colour_model->is_object() && colour_model->contains("clusters")) {
         chooses_colour_model = false;
+    }
+    const json* volume = configuration.contains("volume") ? &configuration["volume"] : nullptr;
+    if (volume && volume->is_object() &&
+        (volume->contains("tolerance") || volume->contains("relative_tolerance") ||
+         volume->contains("rate"))) {
+        chooses_volume = false;
     }
 }
 

@@ -41,8 +41,15 @@ void describe_views(std::ostream& out, const BudgetConfig& budget, const BudgetR
     out << (c.met ? ", met" : ", NOT met: the closest candidate");
 }
 
-/// "; light field 42 cameras at 128^2 chosen, ..." and "; colour model K = 8 chosen, ...".
+/// "; compressed field at 0.001 of the range kept, ...", "; light field 42 cameras at 128^2
+/// chosen, ..." and "; colour model K = 8 chosen, ...".
 void describe_other_choices(std::ostream& out, const BudgetRecord& c) {
+    if (const auto& volume = c.volume) {
+        out << "; compressed field at " << volume->relative_tolerance << " of the range "
+            << (volume->met ? "kept, " : "NOT kept (none met the budget; the closest: ")
+            << volume->psnr_db << " dB, " << volume->bytes / 1e6 << " MB, " << volume->milliseconds
+            << " ms per step" << (volume->met ? "" : ")");
+    }
     if (const auto& light_field = c.light_field) {
         out << "; light field " << light_field->cameras << " cameras at " << light_field->size
             << "^2 chosen, " << light_field->psnr_db << " dB, " << light_field->bytes / 1e6

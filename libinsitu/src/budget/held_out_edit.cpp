@@ -17,6 +17,23 @@ TransferFunction halved_opacity(const TransferFunction& tf) {
     return TransferFunction(points, tf.unit_length());
 }
 
+TransferFunction sharp_held_out(const TransferFunction& tf, double min, double max) {
+    const double range = max > min ? max - min : 1.0;  // a constant field: any width will do
+    const double half_width = 0.5 * kSharpPeakWidth * range;
+    std::vector<ControlPoint> points;
+    for (const double at : {0.25, 0.5, 0.75}) {
+        const double centre = min + at * range;
+        glm::vec4 colour = tf.evaluate(centre);
+        colour.a = 0.0f;
+        points.push_back({centre - half_width, colour});
+        colour.a = 1.0f;
+        points.push_back({centre, colour});
+        colour.a = 0.0f;
+        points.push_back({centre + half_width, colour});
+    }
+    return TransferFunction(points, tf.unit_length());
+}
+
 std::vector<BudgetView> budget_views(ProxyRenderer& renderer, const Camera& camera,
                                      const TransferFunction& held_out,
                                      const std::vector<double>& rotations_deg,

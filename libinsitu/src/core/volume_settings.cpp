@@ -65,12 +65,12 @@ double VolumeSettings::tolerance_for(double range) const {
     return relative > 0.0 && std::isfinite(relative) ? relative : std::numeric_limits<float>::min();
 }
 
-void VolumeSettings::validate() const {
+void VolumeSettings::validate(bool budget_chooses) const {
     if (codec != "zfp") {
         out_of_range("volume.codec", "\"" + codec + "\"", "the only codec is \"zfp\"");
     }
     const int given = (tolerance != 0.0) + (relative_tolerance != 0.0) + (rate != 0.0);
-    if (given != 1) {
+    if (given > 1 || (given == 0 && !budget_chooses)) {
         fail<InvalidArgument>(
             "configuration \"volume\": give exactly one of \"tolerance\", "
             "\"relative_tolerance\" and \"rate\" (",

@@ -26,7 +26,8 @@ public:
     virtual void choose(const FieldBudgetCheck& check, BudgetRecord& choice) const = 0;
 };
 
-/// Every representation, in capture order: the views' proxies first.
+/// Every representation, in capture order: the views' proxies first, then the compressed field,
+/// then the light field.
 const std::vector<std::unique_ptr<Representation>>& representations();
 
 }  // namespace insitu

@@ -10,8 +10,10 @@ const std::vector<std::unique_ptr<Representation>>& representations() {
     static const std::vector<std::unique_ptr<Representation>> registered = [] {
         std::vector<std::unique_ptr<Representation>> all;
         all.push_back(std::make_unique<ViewProxies>());
-        all.push_back(std::make_unique<LightFieldRepresentation>());
+        // The compressed field before the light field: where the budget keeps it, the light
+        // field is not needed.
         all.push_back(std::make_unique<VolumeRepresentation>());
+        all.push_back(std::make_unique<LightFieldRepresentation>());
         return all;
     }();
     return registered;

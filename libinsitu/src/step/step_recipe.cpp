@@ -67,6 +67,8 @@ ViewPasses view_passes(const InstrumentConfig& config, const FieldPlan& plan) {
 std::optional<LightFieldRequest> light_field_request(const InstrumentConfig& config,
                                                      const FieldPlan& plan) {
     if (!config.light_field) return std::nullopt;
+    // Where the budget keeps the compressed field, it makes every view the light field would.
+    if (plan.budget && plan.budget->volume && plan.budget->volume->met) return std::nullopt;
     // The light field takes the proxies' samples, layers and intervals, so its segments and
     // attenuation mean what the views' proxies mean.
     LightFieldRequest request;

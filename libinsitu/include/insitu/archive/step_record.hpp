@@ -86,6 +86,16 @@ struct BudgetRecord {
         double milliseconds = 0.0;  ///< the fit's time, at the check
     };
     std::optional<ColourModelChoice> colour_model;
+    /// The compressed field, where the budget chose whether to keep it
+    /// (BudgetConfig::chooses_volume): kept where `met`.
+    struct VolumeChoice {
+        double relative_tolerance = 0.0;  ///< one of kBudgetVolumeTolerances (x the range)
+        bool met = false;                 ///< it met the accuracy and what the views left
+        double psnr_db = 0.0;             ///< least over the measured views and held-out functions
+        double bytes = 0.0;               ///< its archived bytes per step, at the check
+        double milliseconds = 0.0;        ///< its compression's time per step, at the check
+    };
+    std::optional<VolumeChoice> volume;
 };
 
 /// One field's light field at one timestep (written as one multi-part EXR, a part per camera).

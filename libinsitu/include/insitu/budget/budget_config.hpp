@@ -2,7 +2,7 @@
 // The error budget's configuration, the "budget" object of an InstrumentConfig (insitu/config.hpp):
 // {"psnr_db": 40, "bytes_per_step": 8e6, "ms_per_step": 500, "check_every": 10,
 //  "rotations": [-20, 20],
-//  "choose": ["intervals", "precision", "size", "light_field", "colour_model"]}
+//  "choose": ["intervals", "precision", "size", "light_field", "colour_model", "volume"]}
 // and the candidates a budget check measures (kBudget*).
 #include <nlohmann/json_fwd.hpp>
 #include <optional>
@@ -84,6 +84,14 @@ struct BudgetConfig {
     /// "colour_model" in "choose": K (where the run fits a colour model); a "colour_model"
     /// object that gives "clusters" keeps it.
     bool chooses_colour_model = true;
+    /// "volume" in "choose": whether a step keeps the field itself, compressed (the compressed
+    /// field, insitu/core/volume_settings.hpp), and at which tolerance (kBudgetVolumeTolerances,
+    /// loosest first, each measured as a reader gets it back: decoded, rendered in the budget's
+    /// views with the held-out edit and with a sharp held-out function, sharp_held_out), within
+    /// what the views left; measured before the light field, which a met compressed field makes
+    /// unnecessary (it is then not captured). A "volume" object that gives "tolerance",
+    /// "relative_tolerance" or "rate" keeps it.
+    bool chooses_volume = true;
 
     /// Parses the "budget" object; its unknown keys are appended to `unknown_keys` as dotted
     /// paths ("budget.psnr_d"). Throws ParseError (wrong JSON type) or InvalidArgument naming
@@ -118,6 +126,10 @@ inline constexpr int kBudgetLightFieldCameraCounts[] = {12, 42, 162};
 /// the better buy. Only sizes of at least kBudgetMinLightFieldSide are measured.
 inline constexpr int kBudgetLightFieldSizeDivisors[] = {1, 2, 4};
 inline constexpr int kBudgetMinLightFieldSide = 64;
+
+/// Tolerances, as shares of the step's value range, at which a budget that chooses "volume"
+/// measures the compressed field, loosest (fewest bytes) first.
+inline constexpr double kBudgetVolumeTolerances[] = {1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5};
 
 /// Interval counts and modes a budget check measures: L in {4, 8, 16, 32}, uniform,
 /// histogram-equalised and opacity-adaptive (IntervalSet::opacity_adaptive).

@@ -61,4 +61,29 @@ const Candidate* choose_candidate(const std::vector<Candidate>& measured, bool a
     return chosen;
 }
 
+/// A representation's search: measures `parameters` in order, cheapest first, until one meets
+/// the budget (the first that does is the cheapest), then chooses among those measured by bytes
+/// (choose_candidate) and sets `met`. `Choice` has `bytes`, `milliseconds`, `psnr_db`, `met`.
+template <typename Choice, typename Parameter, typename Measure>
+Choice measure_and_choose(const BudgetShare& share, const std::vector<Parameter>& parameters,
+                          const Measure& measure) {
+    const auto affordable = [&](const Choice& c) {
+        return share.affords_bytes(c.bytes) && share.affords_time(c.milliseconds);
+    };
+    const auto accurate = [&](const Choice& c) { return share.accurate(c.psnr_db); };
+    std::vector<Choice> measured;
+    for (const Parameter& parameter : parameters) {
+        measured.push_back(measure(parameter));
+        if (share.accuracy_asked() && affordable(measured.back()) && accurate(measured.back())) {
+            break;
+        }
+    }
+    const Choice* chosen =
+        choose_candidate(measured, share.accuracy_asked(), affordable, accurate,
+                         [](const Choice& a, const Choice& b) { return a.bytes < b.bytes; });
+    Choice choice = *chosen;
+    choice.met = affordable(choice) && accurate(choice);
+    return choice;
+}
+
 }  // namespace insitu

@@ -16,6 +16,13 @@ namespace insitu {
 /// extinction, a' = 1 - (1 - a)^0.5 (the law opacity edits follow), colours kept.
 TransferFunction halved_opacity(const TransferFunction& tf);
 
+/// The sharp held-out function: three peaks, each kSharpPeakWidth of [min, max] wide at its
+/// base, at a quarter, a half and three quarters of it, in the run's colours there and opaque
+/// at their tips. Where a function is this steep a small error in the value moves the colour
+/// most: what a compressed field's tolerance must hold (a user looking for one value at a time).
+TransferFunction sharp_held_out(const TransferFunction& tf, double min, double max);
+inline constexpr double kSharpPeakWidth = 0.02;
+
 /// A view the budget measures: the stored one (offset 0) or a turn of it in azimuth
 /// (Camera::reorbit), with the held-out edit's ground truth in it.
 struct BudgetView {

@@ -37,8 +37,10 @@ struct VolumeSettings {
     /// A field whose values are all equal takes the smallest tolerance ZFP honours there.
     double tolerance_for(double range) const;
 
-    /// InvalidArgument naming "volume.<key>" and the value.
-    void validate() const;
+    /// InvalidArgument naming "volume.<key>" and the value; none of "tolerance",
+    /// "relative_tolerance" and "rate" is given only where `budget_chooses` (an error budget
+    /// chooses the tolerance).
+    void validate(bool budget_chooses = false) const;
     nlohmann::json to_json() const;
     /// Parses the "volume" object; unknown keys are appended to `unknown_keys` as "volume.<key>".
     static VolumeSettings from_json(const nlohmann::json& object,

@@ -120,6 +120,8 @@ void LightFieldRepresentation::capture(const InstrumentConfig&, const FieldPlan&
 
 void LightFieldRepresentation::choose(const FieldBudgetCheck& check, BudgetRecord& choice) const {
     if (!check.config.light_field || !check.budget.chooses_light_field) return;
+    // The compressed field the budget keeps makes every view the light field would.
+    if (choice.volume && choice.volume->met) return;
     LightFieldCandidates candidates(check, choice);
     choice.light_field = choose_light_field(
         check.share_after(choice), light_field_candidates(check.config.light_field->size),
