@@ -330,11 +330,15 @@ const Key<InstrumentConfig> kTopLevelKeys[] = {
          return config.light_field ? config.light_field->to_json() : json();
      }},
     {"volume",
-     [](const json& value, const std::string&, InstrumentConfig& config, Unknown& unknown) {
-         config.volume = VolumeSettings::from_json(value, unknown);
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
+         config.volume.reset();
+         config.no_volume = value.is_boolean() && !boolean(value, key);
+         if (value.is_boolean() && !config.no_volume) config.volume = VolumeSettings{};
+         if (!value.is_boolean()) config.volume = VolumeSettings::from_json(value, unknown);
      },
      [](const InstrumentConfig& config) {
-         return config.volume ? config.volume->to_json() : json();
+         return config.volume ? config.volume->to_json()
+                              : config.no_volume ? json(false) : json();
      }},
     {"budget",
      [](const json& value, const std::string&, InstrumentConfig& config, Unknown& unknown) {

@@ -146,7 +146,7 @@ void InstrumentConfig::validate() const {
     check_cadence(every, steps);
     if (archive.empty()) out_of_range("archive", "\"\"", "name the archive directory");
     if (light_field) light_field->validate();
-    if (volume) volume->validate(budget && budget->chooses_volume);
+    if (volume) volume->validate();
     check_writer(compression, writer_queue);
     if (budget) budget->validate(any_2d_transfer_function(*this));
     if (colour_model.clusters < 1 || colour_model.clusters > kMaxColourModelClusters) {

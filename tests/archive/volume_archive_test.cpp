@@ -374,7 +374,19 @@ TEST(VolumeSettings, ReadsEachModeAndWritesItBack) {
         InstrumentConfig::from_json_text(R"({"volume": {"rate": 8, "threads": 2}})");
     EXPECT_EQ(rate.volume->mode, VolumeMode::rate);
     EXPECT_EQ(rate.volume->threads, 2);
-    for (const InstrumentConfig* config : {&accuracy, &relative, &rate}) {
+    // None given: the feature rule, a share of the narrowest feature or of a sharp peak.
+    const InstrumentConfig feature = InstrumentConfig::from_json_text(R"({"volume": {}})");
+    ASSERT_TRUE(feature.volume);
+    EXPECT_DOUBLE_EQ(feature.volume->tolerance_for(10.0),
+                     kFeatureToleranceShare * kFeatureWidthShare * 10.0);
+    EXPECT_DOUBLE_EQ(feature.volume->tolerance_for(10.0, 0.05), kFeatureToleranceShare * 0.05);
+    const InstrumentConfig off = InstrumentConfig::from_json_text(R"({"volume": false})");
+    EXPECT_FALSE(off.volume);
+    EXPECT_TRUE(off.no_volume);
+    EXPECT_TRUE(InstrumentConfig::from_json_text(R"({"volume": true})").volume);
+    EXPECT_FALSE(InstrumentConfig().volume);
+    EXPECT_FALSE(InstrumentConfig().no_volume);
+    for (const InstrumentConfig* config : {&accuracy, &relative, &rate, &feature, &off}) {
         EXPECT_EQ(InstrumentConfig::from_json(config->to_json()).to_json(), config->to_json());
     }
 }
@@ -387,8 +399,7 @@ TEST(VolumeSettings, RefusesBadValuesNamingTheKey) {
     refused(R"({"volume": {"tolerance": -1}})", "volume.tolerance\" = -1");
     refused(R"({"volume": {"relative_tolerance": 2}})", "volume.relative_tolerance\" = 2");
     refused(R"({"volume": {"rate": 0.1}})", "volume.rate\" = 0.1");
-    refused(R"({"volume": {"rate": 8, "tolerance": 0.1}})", "exactly one of");
-    refused(R"({"volume": {}})", "exactly one of");
+    refused(R"({"volume": {"rate": 8, "tolerance": 0.1}})", "at most one of");
     refused(R"({"volume": {"codec": "sz", "rate": 8}})", "volume.codec\" = \"sz\"");
     refused(R"({"volume": {"rate": 8, "threads": 0}})", "volume.threads\" = 0");
     expect_error_naming<ParseError>(

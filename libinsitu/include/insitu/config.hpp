@@ -232,8 +232,11 @@ struct InstrumentConfig {
     std::optional<LightFieldSettings> light_field;
     /// "volume" (insitu/core/volume_settings.hpp): per step and field, the field's values
     /// compressed with ZFP (the compressed field: any view, any transfer function, from the
-    /// archive alone); none by default.
+    /// archive alone). Unset, the default rule there applies (fields of at most
+    /// kDefaultVolumeMaxSamples, by the feature rule, where one process holds the field and no
+    /// "budget" chooses); "volume": false (`no_volume`) keeps none.
     std::optional<VolumeSettings> volume;
+    bool no_volume = false;
     /// "budget" (insitu/budget/budget_config.hpp): none by default (the settings above, as
     /// given, are what runs).
     std::optional<BudgetConfig> budget;

@@ -1,5 +1,6 @@
 #include "insitu/core/volume_settings.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -57,24 +58,25 @@ std::string to_string(VolumeMode mode) {
     return name_of(mode, kVolumeModes);
 }
 
-double VolumeSettings::tolerance_for(double range) const {
+double VolumeSettings::tolerance_for(double range, double narrowest_feature) const {
     if (tolerance > 0.0) return tolerance;
+    const double chosen =
+        relative_tolerance > 0.0
+            ? relative_tolerance * range
+            : kFeatureToleranceShare * std::min(narrowest_feature, kFeatureWidthShare * range);
     // ZFP's accuracy mode takes any positive tolerance; an all-equal field is stored exactly by
     // any, so the smallest normal float keeps the decoded values equal to the given ones.
-    const double relative = relative_tolerance * range;
-    return relative > 0.0 && std::isfinite(relative) ? relative : std::numeric_limits<float>::min();
+    return chosen > 0.0 && std::isfinite(chosen) ? chosen : std::numeric_limits<float>::min();
 }
 
-void VolumeSettings::validate(bool budget_chooses) const {
+void VolumeSettings::validate() const {
     if (codec != "zfp") {
         out_of_range("volume.codec", "\"" + codec + "\"", "the only codec is \"zfp\"");
     }
     const int given = (tolerance != 0.0) + (relative_tolerance != 0.0) + (rate != 0.0);
-    if (given > 1 || (given == 0 && !budget_chooses)) {
-        fail<InvalidArgument>(
-            "configuration \"volume\": give exactly one of \"tolerance\", "
-            "\"relative_tolerance\" and \"rate\" (",
-            given, " given)");
+    if (given > 1) {
+        fail<InvalidArgument>("configuration \"volume\": give at most one of \"tolerance\", "
+                              "\"relative_tolerance\" and \"rate\" (", given, " given)");
     }
     if (tolerance != 0.0 && !(tolerance > 0.0 && std::isfinite(tolerance))) {
         out_of_range("volume.tolerance", text_of(tolerance), "field units, must be finite and > 0");

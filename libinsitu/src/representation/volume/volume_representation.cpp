@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 
 #include "archive/zfp_volume.hpp"
 #include "core/elapsed.hpp"
@@ -74,37 +75,67 @@ private:
     VolumeRenderer decoded_;
 };
 
+/// The smallest distance between two control points of `tf` that differ: how narrow a feature
+/// of the field it shows (infinite for a constant function).
+double narrowest_feature(const TransferFunction& tf) {
+    double narrowest = std::numeric_limits<double>::infinity();
+    for (const TransferRow& row : tf.rows()) {
+        for (std::size_t i = 1; i < row.points.size(); ++i) {
+            if (row.points[i].rgba != row.points[i - 1].rgba) {
+                narrowest = std::min(narrowest, row.points[i].value - row.points[i - 1].value);
+            }
+        }
+    }
+    return narrowest;
+}
+
+/// What this step keeps the field with, or none: the budget's choice where it chose whether to
+/// (at its tolerance), else the configuration's "volume", else the default rule
+/// (volume_settings.hpp).
+std::optional<VolumeSettings> kept_settings(const InstrumentConfig& config, const FieldPlan& plan,
+                                            StepPasses& passes) {
+    if (plan.budget && plan.budget->volume) {
+        if (!plan.budget->volume->met) return std::nullopt;
+        VolumeSettings chosen = config.volume.value_or(VolumeSettings{});
+        chosen.mode = VolumeMode::accuracy;
+        chosen.tolerance = 0.0;
+        chosen.rate = 0.0;
+        chosen.relative_tolerance = plan.budget->volume->relative_tolerance;
+        return chosen;
+    }
+    if (config.volume) return config.volume;
+    // Refused with a communicator at construction where asked; by default only where one process
+    // holds the field (rank 0 alone writes, and the field is not gathered to it).
+    const bool by_default = !config.no_volume && !config.budget && passes.holds_whole_field() &&
+                            passes.renderer().volume().host_values.size() <=
+                                static_cast<std::size_t>(kDefaultVolumeMaxSamples);
+    return by_default ? std::optional<VolumeSettings>(VolumeSettings{}) : std::nullopt;
+}
+
 }  // namespace
 
 void VolumeRepresentation::capture(const InstrumentConfig& config, const FieldPlan& plan,
                                    const FieldRecipe&, StepPasses& passes,
                                    StepRecord& record) const {
-    // A budget that chose whether to keep it decides (at the tolerance it chose); else the
-    // configuration.
-    const BudgetRecord::VolumeChoice* chosen =
-        plan.budget && plan.budget->volume ? &*plan.budget->volume : nullptr;
-    if (chosen ? !chosen->met : !config.volume) return;
-    // Refused with a communicator at construction: rank 0 alone writes, and the field is not
-    // gathered to it.
+    const std::optional<VolumeSettings> settings = kept_settings(config, plan, passes);
+    if (!settings) return;
     INSITU_CHECK(passes.holds_whole_field());
     const DeviceVolume& uploaded = passes.renderer().volume();
-    VolumeSettings settings = config.volume.value_or(VolumeSettings{});
-    if (chosen) {
-        settings.mode = VolumeMode::accuracy;
-        settings.tolerance = 0.0;
-        settings.relative_tolerance = chosen->relative_tolerance;
+    double narrowest = narrowest_feature(plan.transfer_function);
+    for (const TransferFunction& training : config.training_transfer_functions) {
+        narrowest = std::min(narrowest, narrowest_feature(training));
     }
     VolumeRecord volume;
     volume.field = plan.name;
     volume.dims = uploaded.dims;
     volume.origin = uploaded.origin;
     volume.spacing = uploaded.spacing;
-    volume.mode = settings.mode;
+    volume.mode = settings->mode;
     volume.min = plan.summary.histogram.min;
     volume.max = plan.summary.histogram.max;
-    volume.tolerance = settings.tolerance_for(value_range(plan));
-    volume.rate = settings.rate;
-    volume.threads = settings.threads;
+    volume.tolerance = settings->tolerance_for(value_range(plan), narrowest);
+    volume.rate = settings->rate;
+    volume.threads = settings->threads;
     // The uploaded copy is already the interior as float, NaN where the field is non-finite.
     volume.blocks.push_back({{0, 0, 0}, uploaded.dims, uploaded.host_values});
     record.volumes.push_back(std::move(volume));
