@@ -543,15 +543,16 @@ TEST_F(Archive, DataCsvIsCinemaSpecDWithFileLast) {
     std::istringstream csv(read_text(archive() / "data.csv"));
     std::string line;
     ASSERT_TRUE(std::getline(csv, line));
-    EXPECT_EQ(line, "time,step,view,phi,theta,proxy_exr,FILE");
+    EXPECT_EQ(line, "time,step,view,phi,theta,proxy_exr,volume_zfp,FILE");
     std::vector<std::string> rows;
     while (std::getline(csv, line)) rows.push_back(line);
     ASSERT_EQ(rows.size(), 4u);  // 2 steps x 2 views
+    // No compressed field configured: volume_zfp is empty.
     EXPECT_EQ(rows[0],
-              "1.35,10,0,30.0,20.0,proxies/step000010_view0.exr,"
+              "1.35,10,0,30.0,20.0,proxies/step000010_view0.exr,,"
               "previews/step000010_view0.png");
     EXPECT_EQ(rows[3],
-              "2.6,20,1,75.0,20.0,proxies/step000020_view1.exr,"
+              "2.6,20,1,75.0,20.0,proxies/step000020_view1.exr,,"
               "previews/step000020_view1.png");
     for (const std::string& row : rows) {
         const std::string file = row.substr(row.rfind(',') + 1);
@@ -971,7 +972,7 @@ TEST_F(Archive, SecondWriterIsRefusedNamingTheHolderUntilTheFirstCloses) {
 }
 
 TEST_F(Archive, StepsGoToAnAppendOnlyJournalFoldedIntoTheManifestAtClose) {
-    const std::string header = "time,step,view,phi,theta,proxy_exr,FILE\n";
+    const std::string header = "time,step,view,phi,theta,proxy_exr,volume_zfp,FILE\n";
     {
         ArchiveWriter writer(config_);
         writer.write(record(1));
@@ -1029,12 +1030,141 @@ TEST_F(Archive, VerifyChecksDataCsvAgainstTheManifest) {
     const std::string last_row = csv.substr(csv.rfind('\n', csv.size() - 2) + 1);
     ASSERT_THAT(last_row, HasSubstr(",2,1,"));
     write_text(archive() / "data.csv", csv.substr(0, csv.size() - last_row.size()) +
-                                           "0.3,5,0,30,20,proxies/step000005_view0.exr,"
+                                           "0.3,5,0,30,20,proxies/step000005_view0.exr,,"
                                            "../outside.png\n");
     EXPECT_THAT(problems(), ::testing::UnorderedElementsAre(
                                 HasSubstr("has no row for step 2 view 1"),
                                 HasSubstr("\"proxies/step000005_view0.exr\" does not exist"),
                                 HasSubstr("\"../outside.png\" is not a file inside the archive")));
+}
+
+// A step of "v" (field 0 of "fields") with its compressed field in two blocks along x.
+StepRecord with_volume(StepRecord step) {
+    VolumeRecord volume;
+    volume.field = "v";
+    volume.dims = {8, 4, 4};
+    volume.tolerance = 1e-2;
+    volume.max = 1.0;
+    for (int b = 0; b < 2; ++b) {
+        volume.blocks.push_back({{4 * b, 0, 0}, {4, 4, 4}, std::vector<float>(64, 0.5f * b)});
+    }
+    step.volumes.push_back(std::move(volume));
+    return step;
+}
+
+// The lines of data.csv after its header.
+std::vector<std::string> csv_rows(const std::filesystem::path& archive) {
+    std::istringstream csv(read_text(archive / "data.csv"));
+    std::string line;
+    std::getline(csv, line);
+    std::vector<std::string> rows;
+    while (std::getline(csv, line)) rows.push_back(line);
+    return rows;
+}
+
+TEST_F(Archive, DataCsvNamesTheStepsCompressedFieldInEachViewsRow) {
+    {
+        ArchiveWriter writer(config_);
+        writer.write(with_volume(record(10)));
+        writer.write(record(11));  // none: an empty volume_zfp
+    }
+    // The first block's stream; manifest.json lists both blocks.
+    const std::string volume = "volumes/step000010_field0_block0.zfp";
+    EXPECT_THAT(csv_rows(archive()),
+                ::testing::ElementsAre("1.35,10,0,30.0,20.0,proxies/step000010_view0.exr," +
+                                           volume + ",previews/step000010_view0.png",
+                                       "1.35,10,1,75.0,20.0,proxies/step000010_view1.exr," +
+                                           volume + ",previews/step000010_view1.png",
+                                       "1.475,11,0,30.0,20.0,proxies/step000011_view0.exr,,"
+                                       "previews/step000011_view0.png",
+                                       "1.475,11,1,75.0,20.0,proxies/step000011_view1.exr,,"
+                                       "previews/step000011_view1.png"));
+    EXPECT_TRUE(std::filesystem::is_regular_file(archive() / volume));
+    EXPECT_THAT(ArchiveReader(archive().string()).verify(), ::testing::ElementsAre());
+}
+
+// data.csv as archives written before volume_zfp have it: header and rows without the column.
+std::string without_volume_column(const std::string& csv) {
+    std::istringstream lines(csv);
+    std::string line, result;
+    while (std::getline(lines, line)) {
+        // proxy_exr is the 6th column, volume_zfp the 7th; no column holds a comma.
+        std::size_t comma = 0;
+        for (int k = 0; k < 6; ++k) comma = line.find(',', comma) + 1;
+        result += line.erase(comma, line.find(',', comma) + 1 - comma) + "\n";
+    }
+    return result;
+}
+
+TEST_F(Archive, AnArchiveWrittenBeforeVolumeZfpVerifiesCleanAndGetsItFromTheNextWriter) {
+    {
+        ArchiveWriter writer(config_);
+        writer.write(record(1));
+        writer.write(with_volume(record(2)));
+    }
+    const std::string csv = read_text(archive() / "data.csv");
+    const std::string old_csv = without_volume_column(csv);
+    ASSERT_THAT(old_csv, ::testing::StartsWith("time,step,view,phi,theta,proxy_exr,FILE\n"
+                                               "0.225,1,0,30.0,20.0,proxies/step000001_view0.exr,"
+                                               "previews/step000001_view0.png\n"));
+    write_text(archive() / "data.csv", old_csv);
+    // The old columns are still checked against the manifest; the compressed field, which the
+    // old header has no column for, is not asked of it.
+    EXPECT_THAT(ArchiveReader(archive().string()).verify(), ::testing::ElementsAre());
+    write_text(archive() / "data.csv", old_csv +
+                                           "1.35,3,0,30.0,20.0,proxies/step000003_view0.exr,,"
+                                           "previews/step000003_view0.png\n");
+    EXPECT_THAT(ArchiveReader(archive().string()).verify(),
+                ::testing::ElementsAre(HasSubstr("line 6: 8 columns, expected 7")));
+    write_text(archive() / "data.csv", old_csv);
+    // A writer continuing it rewrites data.csv whole, with the column, at open.
+    {
+        ArchiveWriter writer(config_);
+        EXPECT_EQ(read_text(archive() / "data.csv"), csv);
+        writer.write(record(3));
+    }
+    EXPECT_THAT(read_text(archive() / "data.csv"), ::testing::StartsWith(csv));
+    EXPECT_THAT(ArchiveReader(archive().string()).verify(), ::testing::ElementsAre());
+}
+
+TEST_F(Archive, VerifyReportsAVolumeZfpColumnThatIsMissingOrNotTheManifests) {
+    ArchiveWriter(config_).write(with_volume(record(2)));
+    const std::string csv = read_text(archive() / "data.csv");
+    const std::string volume = "volumes/step000002_field0_block0.zfp";
+    const auto replaced = [&](const std::string& from, const std::string& to) {
+        std::string text = csv;
+        text.replace(text.rfind(from), from.size(), to);  // the last row: step 2 view 1
+        return text;
+    };
+    const auto problems = [&] { return ArchiveReader(archive().string()).verify(); };
+    ASSERT_THAT(problems(), ::testing::ElementsAre());
+
+    // A file that does not exist (and is not the manifest's).
+    write_text(archive() / "data.csv", replaced(volume, "volumes/step000002_field0.zfp"));
+    EXPECT_THAT(problems(),
+                ::testing::UnorderedElementsAre(
+                    AllOf(HasSubstr("line 3"), HasSubstr("\"volumes/step000002_field0.zfp\" "
+                                                         "does not exist")),
+                    AllOf(HasSubstr("line 3: step 2 view 1 names other files than the manifest"),
+                          HasSubstr("(proxies/step000002_view1.exr, " + volume +
+                                    ", previews/step000002_view1.png)"))));
+    // Another file of the archive than the manifest names: the second block.
+    write_text(archive() / "data.csv", replaced(volume, "volumes/step000002_field0_block1.zfp"));
+    EXPECT_THAT(problems(), ::testing::ElementsAre(HasSubstr(
+                                "line 3: step 2 view 1 names other files than the manifest")));
+    // Left empty while the manifest has one; outside the archive.
+    write_text(archive() / "data.csv", replaced(volume, ""));
+    EXPECT_THAT(problems(), ::testing::ElementsAre(HasSubstr(
+                                "line 3: step 2 view 1 names other files than the manifest")));
+    write_text(archive() / "data.csv", replaced(volume, "../elsewhere.zfp"));
+    EXPECT_THAT(problems(),
+                ::testing::UnorderedElementsAre(
+                    HasSubstr("line 3: \"../elsewhere.zfp\" is not a file inside the archive"),
+                    HasSubstr("line 3: step 2 view 1 names other files than the manifest")));
+    // A stream that is gone is reported once, for the manifest, not again for data.csv.
+    write_text(archive() / "data.csv", csv);
+    std::filesystem::remove(archive() / volume);
+    EXPECT_THAT(problems(), ::testing::ElementsAre(HasSubstr(volume)));
 }
 
 TEST_F(Archive, VerifyRefusesFilesThatResolveOutsideTheArchive) {

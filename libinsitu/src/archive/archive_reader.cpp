@@ -10,9 +10,12 @@
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <stdexcept>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "archive/archive_format.hpp"
 #include "archive/atomic_file.hpp"
@@ -36,6 +39,30 @@ std::string view_file(const nlohmann::json& view, const char* kind) {
         if (file.at("kind") == kind) return file.at("path").get<std::string>();
     }
     return {};
+}
+/// A data.csv row's (step, view); a problem (and none) when it has another number of columns
+/// than the header or its step or view is not an integer.
+std::optional<std::pair<std::int64_t, int>> csv_row_key(const af::CsvTable& table,
+                                                        const af::CsvRow& row,
+                                                        const std::string& where,
+                                                        std::vector<std::string>& problems) {
+    if (row.columns.size() != table.columns) {
+        problems.push_back(where + std::to_string(row.columns.size()) + " columns, expected " +
+                           std::to_string(table.columns));
+        return std::nullopt;
+    }
+    try {
+        std::size_t used = 0;
+        const std::int64_t step = std::stoll(row.columns[1], &used);
+        if (used != row.columns[1].size()) throw std::invalid_argument("step");
+        const int view = std::stoi(row.columns[2], &used);
+        if (used != row.columns[2].size()) throw std::invalid_argument("view");
+        return std::pair{step, view};
+    } catch (const std::exception&) {
+        problems.push_back(where + "step \"" + row.columns[1] + "\" or view \"" + row.columns[2] +
+                           "\" is not an integer");
+        return std::nullopt;
+    }
 }
 /// The largest image `view` was configured with in any configuration the archive recorded (a
 /// restart may have changed it); the codec's general bound when one does not list the view.
@@ -445,52 +472,40 @@ void ArchiveReader::verify_cinema_csv(const fs::path& root, const std::set<fs::p
     // what a run killed between data.csv and the journal leaves (the next writer drops it):
     // not a problem while its files are there.
     const std::string file = (fs::path(path_) / af::kCsvFile).string();
-    std::vector<af::CsvRow> rows;
+    af::CsvTable table;
     try {
-        rows = af::read_cinema_csv(path_);
+        table = af::read_cinema_csv(path_);
     } catch (const Error& error) {
         problems.push_back(error.what());
         return;
     }
     std::map<std::pair<std::int64_t, int>, const af::CsvRow*> by_key;
-    for (const af::CsvRow& row : rows) {
+    for (const af::CsvRow& row : table.rows) {
         const std::string where = "\"" + file + "\" line " + std::to_string(row.line) + ": ";
-        if (row.columns.size() != 7) {
-            problems.push_back(where + std::to_string(row.columns.size()) + " columns, expected 7");
-            continue;
+        const std::optional<std::pair<std::int64_t, int>> key =
+            csv_row_key(table, row, where, problems);
+        if (!key) continue;
+        if (!by_key.emplace(*key, &row).second) {
+            problems.push_back(where + "step " + std::to_string(key->first) + " view " +
+                               std::to_string(key->second) + " is repeated");
         }
-        std::int64_t step = 0;
-        int view = 0;
-        try {
-            std::size_t used = 0;
-            step = std::stoll(row.columns[1], &used);
-            if (used != row.columns[1].size()) throw std::invalid_argument("step");
-            view = std::stoi(row.columns[2], &used);
-            if (used != row.columns[2].size()) throw std::invalid_argument("view");
-        } catch (const std::exception&) {
-            problems.push_back(where + "step \"" + row.columns[1] + "\" or view \"" +
-                               row.columns[2] + "\" is not an integer");
-            continue;
-        }
-        if (!by_key.emplace(std::pair{step, view}, &row).second) {
-            problems.push_back(where + "step " + std::to_string(step) + " view " +
-                               std::to_string(view) + " is repeated");
-        }
-        for (const std::size_t column : {std::size_t{5}, std::size_t{6}}) {
-            const fs::path named = fs::path(path_) / row.columns[column];
-            std::error_code error;
+        std::vector<std::size_t> columns{af::kCsvProxyColumn, table.file_column()};
+        if (table.has_volume_column()) columns.push_back(af::kCsvVolumeColumn);
+        for (const std::size_t column : columns) {
+            const std::string& named = row.columns[column];
+            // A view without proxies or a step without a compressed field has these columns
+            // empty; the comparison with the manifest below says whether it should name one.
+            if (named.empty() && column != table.file_column()) continue;
             // A file the manifest lists and that is missing, damaged or resolves elsewhere is
-            // reported once, above.
-            if (reported.count(fs::absolute(named).lexically_normal())) continue;
-            // A view without proxies has an empty proxy_exr column; the comparison with the
-            // manifest below says whether it should have one.
-            if (column == 5 && row.columns[column].empty()) continue;
-            if (row.columns[column].empty() || fs::path(row.columns[column]).is_absolute() ||
-                !inside(root, fs::absolute(named))) {
-                problems.push_back(where + "\"" + row.columns[column] +
-                                   "\" is not a file inside the archive");
-            } else if (!fs::is_regular_file(named, error)) {
-                problems.push_back(where + "\"" + row.columns[column] + "\" does not exist");
+            // reported once, in check().
+            const fs::path path = fs::path(path_) / named;
+            if (reported.count(fs::absolute(path).lexically_normal())) continue;
+            std::error_code error;
+            if (named.empty() || fs::path(named).is_absolute() ||
+                !inside(root, fs::absolute(path))) {
+                problems.push_back(where + "\"" + named + "\" is not a file inside the archive");
+            } else if (!fs::is_regular_file(path, error)) {
+                problems.push_back(where + "\"" + named + "\" does not exist");
             }
         }
     }
@@ -505,12 +520,20 @@ void ArchiveReader::verify_cinema_csv(const fs::path& root, const std::set<fs::p
                 problems.push_back("\"" + file + "\" has no row for " + what);
                 continue;
             }
-            const std::string exr = view_file(view, af::kProxyKind);
-            const std::string png = view_file(view, af::kPreviewKind);
-            if (row->second->columns[5] != exr || row->second->columns[6] != png) {
+            // data.csv written before volume_zfp does not name the compressed field; the
+            // manifest does, and the next writer's data.csv will.
+            std::vector<std::string> expected{view_file(view, af::kProxyKind)};
+            if (table.has_volume_column()) expected.push_back(af::cinema_volume_file(step, view));
+            expected.push_back(view_file(view, af::kPreviewKind));
+            std::vector<std::string> named(row->second->columns.begin() + af::kCsvProxyColumn,
+                                           row->second->columns.end());
+            if (named != expected) {
+                std::string files;
+                for (const std::string& name : expected)
+                    files += (files.empty() ? "" : ", ") + name;
                 problems.push_back("\"" + file + "\" line " + std::to_string(row->second->line) +
-                                   ": " + what + " names other files than the manifest (" + exr +
-                                   ", " + png + ")");
+                                   ": " + what + " names other files than the manifest (" + files +
+                                   ")");
             }
         }
     }

@@ -7,6 +7,7 @@
 
 #include "archive/archive_format.hpp"
 #include "archive/atomic_file.hpp"
+#include "archive/volume_entries.hpp"
 #include "insitu/error.hpp"
 
 namespace insitu::archive_format {
@@ -18,6 +19,16 @@ std::string number_text(const nlohmann::json& number) {
 }
 }  // namespace
 
+std::string cinema_volume_file(const nlohmann::json& step, const nlohmann::json& view) {
+    const nlohmann::json& field = view.contains("field") ? view.at("field") : step.at("field");
+    for (const nlohmann::json& entry : volume_entries(step)) {
+        if (entry.at("field") == field) {
+            return entry.at("blocks").at(0).at("file").get<std::string>();
+        }
+    }
+    return {};
+}
+
 std::string cinema_csv_rows(const nlohmann::json& step) {
     std::string rows;
     for (const nlohmann::json& view : step.at("views")) {
@@ -28,7 +39,8 @@ std::string cinema_csv_rows(const nlohmann::json& step) {
         }
         rows += number_text(step.at("time")) + "," + number_text(step.at("step")) + "," +
                 number_text(view.at("view")) + "," + number_text(view.at("phi")) + "," +
-                number_text(view.at("theta")) + "," + exr + "," + png + "\n";
+                number_text(view.at("theta")) + "," + exr + "," + cinema_volume_file(step, view) +
+                "," + png + "\n";
     }
     return rows;
 }
@@ -47,10 +59,10 @@ std::uint64_t append_cinema_rows(const std::string& archive_path, const nlohmann
     return append_to_file(std::filesystem::path(archive_path) / kCsvFile, cinema_csv_rows(step));
 }
 
-std::vector<CsvRow> read_cinema_csv(const std::string& archive_path) {
+CsvTable read_cinema_csv(const std::string& archive_path) {
     const std::string file = (std::filesystem::path(archive_path) / kCsvFile).string();
     const std::vector<char> bytes = read_whole_file(file);
-    std::vector<CsvRow> rows;
+    CsvTable table;
     std::size_t line_number = 0;
     for (auto begin = bytes.begin(); begin != bytes.end();) {
         const auto end = std::find(begin, bytes.end(), '\n');
@@ -61,9 +73,17 @@ std::vector<CsvRow> read_cinema_csv(const std::string& archive_path) {
         const std::string line(begin, end);
         begin = end + 1;
         if (line_number == 1) {
-            if (line + "\n" != kCsvHeader) {
-                fail<ParseError>("\"", file, "\": header \"", line, "\", expected \"",
-                                 std::string(kCsvHeader, std::strlen(kCsvHeader) - 1), "\"");
+            if (line + "\n" == kCsvHeader) {
+                table.columns = 8;
+            } else if (line + "\n" == kCsvHeaderWithoutVolume) {
+                table.columns = 7;
+            } else {
+                fail<ParseError>(
+                    "\"", file, "\": header \"", line, "\", expected \"",
+                    std::string(kCsvHeader, std::strlen(kCsvHeader) - 1),
+                    "\" (or, written before volume_zfp, \"",
+                    std::string(kCsvHeaderWithoutVolume, std::strlen(kCsvHeaderWithoutVolume) - 1),
+                    "\")");
             }
             continue;
         }
@@ -78,10 +98,10 @@ std::vector<CsvRow> read_cinema_csv(const std::string& archive_path) {
             }
         }
         row.columns = std::move(columns);
-        rows.push_back(std::move(row));
+        table.rows.push_back(std::move(row));
     }
     if (line_number == 0) fail<ParseError>("\"", file, "\": no header line");
-    return rows;
+    return table;
 }
 
 }  // namespace insitu::archive_format

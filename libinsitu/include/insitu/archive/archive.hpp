@@ -5,7 +5,11 @@
 // name complete files.
 //
 // Layout of ARCHIVE/:
-//   data.csv                         time,step,view,phi,theta,proxy_exr,FILE   (FILE last: PNG)
+//   data.csv                         time,step,view,phi,theta,proxy_exr,volume_zfp,FILE
+//                                    (FILE last: PNG; volume_zfp: the first block's stream of
+//                                    the step's compressed field of the view's field, empty
+//                                    without one. data.csv written before volume_zfp, without
+//                                    the column, still reads; the next writer adds it)
 //   manifest.json                    schema_version, producer, configuration, steps[...]
 //   manifest.journal                 steps since manifest.json was compacted, one JSON a line
 //   .lock                            flock()ed by the one writer, holding its pid
@@ -13,6 +17,9 @@
 //   proxies/step000010_lightfield1.exr  a light field (seed 001) of field 1 of "fields": a part
 //                                    per camera, so a reader decodes only the cameras it needs
 //   previews/step000010_view0.png    ground-truth rendering of the configured transfer function
+//   volumes/step000010_field0.zfp    the compressed field of field 0 of "fields": a ZFP stream
+//                                    (src/archive/volume_entries.hpp), with NaN/Inf a .mask
+//                                    beside it, "_block<b>" per block of a distributed run
 //
 // EXR parts (channel names start with the part name; libinsitu/src/archive/archive_format.hpp):
 //   depth (depth.layer0..), attenuation (attenuation.a00.., .zmean00.., .tau00.., .zentry00..,
