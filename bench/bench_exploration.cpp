@@ -104,6 +104,7 @@ int main(int argc, char** argv) {
         config.layers = std::vector<double>{0.25, 0.5, 0.75, 0.9};
         config.proxies.multi_attenuation = true;
         config.archive = (scratch / ("n" + std::to_string(n) + ".cdb")).string();
+        config.no_volume = true;  // the images' costs; the compressed field is measured apart
         fs::remove_all(config.archive);
 
         InstrumentOptions instrument_options;

@@ -76,6 +76,7 @@ InstrumentConfig make_config(const std::string& archive, int image, StoragePreci
     config.layers = std::vector<double>{0.2, 0.4, 0.6, 0.8};
     config.interval_count = 16;
     config.archive = archive;
+    config.no_volume = true;  // the images' costs; the compressed field is measured apart
     config.precision = precision;
     config.compression = compression;
     config.writer_queue = queue;

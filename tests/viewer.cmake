@@ -37,6 +37,7 @@ file(WRITE ${viewer_config} [=[
  "intervals": {"count": 8},
  "proxies": ["depth", "distortion", "attenuation", "multi_attenuation", "rendering", "interleaving",
              "entry_depth", "optical_depth"],
+ "volume": false,
  "every": 10}
 ]=])
 
@@ -91,6 +92,7 @@ function(viewer_light_field_archive name)
                        "unit_length": 1.0},
  "intervals": {"count": 8},
  "every": 300,
+ "volume": false,
  "light_field": ]=] "${light_field}}\n")
   add_test(NAME viewer.setup_${name}_archive
            COMMAND gray-scott --size 40 --steps 600 --config ${config}

@@ -191,6 +191,7 @@ InstrumentConfig proxies_config(const Scene& scene, int image, bool multi, const
         config.proxies.depth = config.proxies.attenuation = false;
     }
     config.archive = path.string();
+    config.no_volume = true;  // the images' costs; the compressed field is measured apart
     return config;
 }
 

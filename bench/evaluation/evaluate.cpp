@@ -640,6 +640,7 @@ InstrumentConfig budget_run_config(const fs::path& archive, int image, int every
     config.views[0].orbit = stored_view(image);
     config.every = every;
     config.archive = archive.string();
+    config.no_volume = true;  // the images' costs; the compressed field is measured apart
     if (psnr_db) {
         BudgetConfig budget;
         budget.psnr_db = psnr_db;
@@ -965,6 +966,7 @@ void section_configurations(const std::vector<const Scene*>& scenes, const Scene
             config.compression = c.compression;
             config.colour_model.clusters = c.clusters;
             config.archive = (scratch / ("archive" + std::to_string(archive_index++))).string();
+            config.no_volume = true;  // the images' costs; the compressed field is measured apart
             InstrumentStatistics statistics;
             {
                 InstrumentOptions instrument_options;
@@ -1065,6 +1067,7 @@ void section_storage(const Options& options, const fs::path& scratch) {
         config.transfer_function = make_tf(scene);
         config.layers = scene_layers(scene, 4);
         config.archive = (scratch / ("storage" + std::to_string(n))).string();
+        config.no_volume = true;  // the images' costs; the compressed field is measured apart
         InstrumentOptions instrument_options;
         instrument_options.rethrow_errors = true;
         instrument_options.log = false;
@@ -1238,6 +1241,7 @@ void section_light_fields(const std::vector<const Scene*>& scenes, const Options
             config.proxies.distortion = false;
             config.light_field = request.settings;
             config.archive = (scratch / ("lightfield" + std::to_string(archive_index++))).string();
+            config.no_volume = true;  // the images' costs; the compressed field is measured apart
             StepRecord record;
             record.step = 0;
             record.field = scene->volume.name;

@@ -337,8 +337,7 @@ const Key<InstrumentConfig> kTopLevelKeys[] = {
          if (!value.is_boolean()) config.volume = VolumeSettings::from_json(value, unknown);
      },
      [](const InstrumentConfig& config) {
-         return config.volume ? config.volume->to_json()
-                              : config.no_volume ? json(false) : json();
+         return config.volume ? config.volume->to_json() : config.no_volume ? json(false) : json();
      }},
     {"budget",
      [](const json& value, const std::string&, InstrumentConfig& config, Unknown& unknown) {

@@ -31,7 +31,7 @@ TEST(BudgetVolumeChooser, TakesTheLoosestToleranceThatMeetsTheBudgetAndMeasuresN
         return at(tolerance);
     });
     EXPECT_TRUE(choice.met);
-    EXPECT_EQ(choice.relative_tolerance, 1e-3);  // 60 dB; 3e-3 gives 50.5 dB
+    EXPECT_EQ(choice.relative_tolerance, 1e-3);                    // 60 dB; 3e-3 gives 50.5 dB
     EXPECT_EQ(measured, (std::vector<double>{1e-2, 3e-3, 1e-3}));  // loosest first, then stop
 }
 
@@ -46,8 +46,8 @@ TEST(BudgetVolumeChooser, IsNotMetWhereTheViewsLeftTooFewBytes) {
 }
 
 TEST(BudgetVolumeChooser, AConfigurationThatGivesTheToleranceKeepsIt) {
-    for (const char* given : {R"({"tolerance": 0.1})", R"({"relative_tolerance": 0.001})",
-                              R"({"rate": 4})"}) {
+    for (const char* given :
+         {R"({"tolerance": 0.1})", R"({"relative_tolerance": 0.001})", R"({"rate": 4})"}) {
         nlohmann::json configuration = {{"budget", nlohmann::json::object()}};
         configuration["volume"] = nlohmann::json::parse(given);
         BudgetConfig budget;

@@ -21,7 +21,7 @@ file(WRITE ${view_config} [=[
  "colour_model": {"clusters": 8},
  "layers": [0.2], "intervals": {"count": 8},
  "proxies": ["depth", "distortion", "attenuation", "multi_attenuation"],
- "precision": "float", "steps": [4, 8]}
+ "precision": "float", "steps": [4, 8], "volume": false}
 ]=])
 set(edited_tf ${CMAKE_CURRENT_BINARY_DIR}/insitu_view_edited_tf.json)
 file(WRITE ${edited_tf} [=[
@@ -117,6 +117,7 @@ file(WRITE ${lf_config} [=[
                        "unit_length": 1.0},
  "layers": [0.2], "intervals": {"count": 8}, "proxies": ["depth", "attenuation"],
  "steps": [8],
+ "volume": false,
  "light_field": {"cameras": 12, "size": 48, "segments": "layers", "depth_bits": 8}}
 ]=])
 add_test(NAME insitu_view.setup_lf_clean

@@ -59,6 +59,8 @@ protected:
         light_field.attenuation = true;
         config_.light_field = light_field;
         config_.archive = (directory_ / "run.cdb").string();
+        // Light fields and proxies, which "auto" serves where no compressed field does.
+        config_.no_volume = true;
         renderer_.upload(volume_.field());
     }
     void TearDown() override { fs::remove_all(directory_); }

@@ -164,6 +164,7 @@ TEST_F(ExplorerVolume, TheRecipeHandsTheClientTheFieldsSettings) {
 
 TEST_F(ExplorerVolume, WhatTheArchiveLacksOrTheVolumeCannotTakeIsNamed) {
     config_.volume.reset();
+    config_.no_volume = true;
     write_step();
     Explorer explorer(config_.archive);
     expect_error_naming<InvalidArgument>(

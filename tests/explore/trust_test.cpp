@@ -235,6 +235,7 @@ protected:
         config.layers = std::vector<double>{0.0};
         config.interval_count = 4;
         config.archive = (directory_ / "run.cdb").string();
+        config.no_volume = true;  // the proxies' trust, where no compressed field serves
         InstrumentOptions options;
         options.log = false;
         options.rethrow_errors = true;

@@ -75,8 +75,10 @@ void VolumeSettings::validate() const {
     }
     const int given = (tolerance != 0.0) + (relative_tolerance != 0.0) + (rate != 0.0);
     if (given > 1) {
-        fail<InvalidArgument>("configuration \"volume\": give at most one of \"tolerance\", "
-                              "\"relative_tolerance\" and \"rate\" (", given, " given)");
+        fail<InvalidArgument>(
+            "configuration \"volume\": give at most one of \"tolerance\", "
+            "\"relative_tolerance\" and \"rate\" (",
+            given, " given)");
     }
     if (tolerance != 0.0 && !(tolerance > 0.0 && std::isfinite(tolerance))) {
         out_of_range("volume.tolerance", text_of(tolerance), "field units, must be finite and > 0");

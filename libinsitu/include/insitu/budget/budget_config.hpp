@@ -90,7 +90,7 @@ struct BudgetConfig {
     /// views with the held-out edit and with a sharp held-out function, sharp_held_out), within
     /// what the views left; measured before the light field, which a met compressed field makes
     /// unnecessary (it is then not captured). A "volume" object that gives "tolerance",
-    /// "relative_tolerance" or "rate" keeps it.
+    /// "relative_tolerance" or "rate" keeps it; "volume": false keeps none.
     bool chooses_volume = true;
 
     /// Parses the "budget" object; its unknown keys are appended to `unknown_keys` as dotted

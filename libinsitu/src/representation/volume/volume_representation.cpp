@@ -142,7 +142,8 @@ void VolumeRepresentation::capture(const InstrumentConfig& config, const FieldPl
 }
 
 void VolumeRepresentation::choose(const FieldBudgetCheck& check, BudgetRecord& choice) const {
-    if (!check.budget.chooses_volume) return;
+    // "volume": false keeps none, whatever the budget may choose.
+    if (!check.budget.chooses_volume || check.config.no_volume) return;
     VolumeCandidates candidates(check);
     choice.volume = choose_volume(check.share_after(choice), [&](double relative_tolerance) {
         return candidates.measure(relative_tolerance);
