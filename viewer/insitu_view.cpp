@@ -420,7 +420,10 @@ int run_render(const std::vector<std::string>& args) {
     std::cerr << kProgram << ": " << out_path << " (" << frame.camera.width() << "x"
               << frame.camera.height() << ", " << (frame.synthesised_view ? "new" : "stored")
               << " view from " << insitu::to_string(frame.proxy_source) << ", colour by "
-              << insitu::to_string(frame.colour_source) << ", "
+              << (frame.proxy_source == insitu::ProxySource::volume
+                      ? std::string("the ground truth of the decoded field")
+                      : insitu::to_string(frame.colour_source))
+              << ", "
               << (frame.missing_cameras.empty()
                       ? std::string()
                       : std::to_string(frame.missing_cameras.size()) +
