@@ -4,6 +4,7 @@
 // field; what it refuses, it names.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -186,6 +187,39 @@ TEST_F(ExplorerVolume, OpacityScalesAreProxyEditsTheVolumeRefuses) {
                                          "takes an edited transfer function");
     scaled.source = ProxySource::automatic;  // auto leaves them to the proxies
     EXPECT_EQ(explorer.render(scaled).proxy_source, ProxySource::single);
+}
+
+// An int16 field (a CT scan's kind) with ghost layers on an odd grid: the interior is kept, as
+// the float the renderers read, within the tolerance in the field's own units.
+TEST_F(ExplorerVolume, IntegerFieldsWithGhostLayersKeepTheirInteriorWithinTheTolerance) {
+    const Index3 allocated{23, 18, 13};  // interior 21 x 16 x 11: no axis a multiple of 4
+    std::vector<std::int16_t> values(static_cast<std::size_t>(23 * 18 * 13));
+    for (std::size_t i = 0; i < values.size(); ++i) {
+        values[i] = static_cast<std::int16_t>(-1000 + static_cast<int>((i * 7919) % 3000));
+    }
+    Field field("f", values.data(), ScalarType::int16, allocated);
+    field.set_ghost_layers(1);
+    VolumeSettings settings;
+    settings.tolerance = 4.0;  // HU
+    config_.volume = settings;
+    InstrumentOptions options;
+    options.log = false;
+    options.rethrow_errors = true;
+    {
+        Instrument instrument(config_, options);
+        ASSERT_EQ(instrument.execute(1, 0.1, {field}), Status::ok);
+        ASSERT_EQ(instrument.finalize(), Status::ok);
+    }
+    const VolumeGrid grid = ArchiveReader(config_.archive).load_volume(1, "f");
+    ASSERT_EQ(grid.dims, (Index3{21, 16, 11}));
+    for (std::int64_t k = 0; k < 11; ++k) {
+        for (std::int64_t j = 0; j < 16; ++j) {
+            for (std::int64_t i = 0; i < 21; ++i) {
+                const float kept = grid.values[static_cast<std::size_t>(i + 21 * (j + 16 * k))];
+                ASSERT_LE(std::abs(kept - field.value(i, j, k)), 4.0) << i << " " << j << " " << k;
+            }
+        }
+    }
 }
 
 }  // namespace
