@@ -23,6 +23,37 @@ bool has_perspective(const nlohmann::json& manifest, std::int64_t step, int view
     return false;
 }
 
+namespace {
+
+/// Per step and field, the compressed field: how it was compressed and what it costs (its ratio
+/// to the grid's floats).
+nlohmann::json volume_descriptions(const ArchiveReader& archive,
+                                   const std::vector<std::int64_t>& steps) {
+    nlohmann::json volumes = nlohmann::json::array();
+    for (const std::int64_t step : steps) {
+        for (const ArchivedVolume& volume : archive.volumes(step)) {
+            const double raw_bytes = 4.0 * static_cast<double>(volume.dims[0]) *
+                                     static_cast<double>(volume.dims[1]) *
+                                     static_cast<double>(volume.dims[2]);
+            volumes.push_back({{"step", step},
+                               {"field", volume.field},
+                               {"codec", volume.codec},
+                               {"mode", to_string(volume.mode)},
+                               {"tolerance", volume.tolerance},
+                               {"rate", volume.rate},
+                               {"dims", volume.dims},
+                               {"min", volume.min},
+                               {"max", volume.max},
+                               {"nonfinite", volume.nonfinite},
+                               {"bytes", volume.bytes},
+                               {"ratio", raw_bytes / static_cast<double>(volume.bytes)}});
+        }
+    }
+    return volumes;
+}
+
+}  // namespace
+
 nlohmann::json describe_archive(const ArchiveReader& archive) {
     const nlohmann::json& manifest = archive.manifest();
     nlohmann::json description;
@@ -107,28 +138,7 @@ nlohmann::json describe_archive(const ArchiveReader& archive) {
     }
     description["light_fields"] = light_fields;
 
-    // Per step and field, the compressed field: how it was compressed and what it costs.
-    nlohmann::json volumes = nlohmann::json::array();
-    for (const std::int64_t step : steps) {
-        for (const ArchivedVolume& volume : archive.volumes(step)) {
-            const double raw_bytes = 4.0 * static_cast<double>(volume.dims[0]) *
-                                     static_cast<double>(volume.dims[1]) *
-                                     static_cast<double>(volume.dims[2]);
-            volumes.push_back({{"step", step},
-                               {"field", volume.field},
-                               {"codec", volume.codec},
-                               {"mode", to_string(volume.mode)},
-                               {"tolerance", volume.tolerance},
-                               {"rate", volume.rate},
-                               {"dims", volume.dims},
-                               {"min", volume.min},
-                               {"max", volume.max},
-                               {"nonfinite", volume.nonfinite},
-                               {"bytes", volume.bytes},
-                               {"ratio", raw_bytes / static_cast<double>(volume.bytes)}});
-        }
-    }
-    description["volumes"] = volumes;
+    description["volumes"] = volume_descriptions(archive, steps);
 
     // Per step with an error budget, what it chose for each field (the manifest's entries).
     nlohmann::json budget = nlohmann::json::array();
