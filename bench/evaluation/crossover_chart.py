@@ -171,7 +171,7 @@ def markdown(rows, machine, prefix):
              "from the same random views at 256² (views per size: %s) against the ground truth of "
              "the original field, with the held-out opacity edits (one per view) and with a sharp "
              "function no representation saw (three peaks 2 %% of the range wide). The compressed "
-             "field: raw ZFP 1.0, serial, full header, fixed accuracy 0.3–1e-4 of the range and "
+             "field: ZFP 1.0 through the archive's codec, serial, full header, fixed accuracy 0.3–1e-4 of the range and "
              "fixed rate 0.25–8 bits, decoded and rendered by the ground-truth renderer; bytes = "
              "the stream. Images: the Instrument's archive of the stored view (single-view "
              "proxies at 128² and 256², multi-perspective proxies the same), attenuation light "
