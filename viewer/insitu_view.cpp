@@ -104,9 +104,10 @@ const std::vector<OptionHelp>& render_options() {
         {"--segment-opacity", "S=F,...",
          "scale light-field segment S's opacity by F >= 0 (seed 001's per-layer fades)", "none"},
         {"--source", "auto|single|multi|lightfield|volume",
-         "the stored proxies a new view is made from; auto: the stored view's proxies at the "
-         "stored view, elsewhere the light field and the view's proxies fused per pixel by "
-         "confidence where the step has a light field, else the single-perspective proxies",
+         "what a new view is made from; auto: the stored view's proxies at the stored view, "
+         "elsewhere the step's compressed field where it has one (volume: the ground truth of "
+         "the decoded field), else the light field and the view's proxies fused per pixel "
+         "where the step has a light field, else the single-perspective proxies",
          "auto"},
         {"--light", "AZ,EL[,DIFFUSE[,SPECULAR]]|camera",
          "a directional light toward orbit angles AZ, EL in degrees (world space), DIFFUSE " +
@@ -274,8 +275,9 @@ const char* budget_met_text(const nlohmann::json& choice) {
     return choice.at("met").get<bool>() ? " met" : " NOT met";
 }
 
-/// What an error budget chose at each step: the views' intervals, precision and size, the light
-/// field's rig and the colour model's K, each with the PSNR it measured.
+/// What an error budget chose at each step: the views' intervals, precision and size, whether it
+/// kept the compressed field, the light field's rig and the colour model's K, each with the PSNR
+/// it measured.
 void print_budget(const nlohmann::json& description) {
     for (const auto& entry : description.value("budget", nlohmann::json::array())) {
         std::cout << "budget        step " << entry.at("step") << " "
@@ -292,6 +294,12 @@ void print_budget(const nlohmann::json& description) {
                       << light_field.at("size") << "^2, "
                       << budget_psnr_text(light_field.at("psnr_db"))
                       << budget_met_text(light_field);
+        }
+        if (entry.contains("volume")) {
+            const auto& volume = entry.at("volume");
+            std::cout << "; compressed field at " << volume.at("relative_tolerance")
+                      << " of the range, " << budget_psnr_text(volume.at("psnr_db"))
+                      << (volume.at("met").get<bool>() ? " met: kept" : " NOT met: not kept");
         }
         if (entry.contains("colour_model")) {
             const auto& model = entry.at("colour_model");
@@ -429,6 +437,7 @@ int run_render(const std::vector<std::string>& args) {
                       : std::to_string(frame.missing_cameras.size()) +
                             " light-field cameras missing (reconstructed from the rest), ")
               << frame.milliseconds << " ms)\n";
+    if (!frame.note.empty()) std::cerr << kProgram << ": " << frame.note << "\n";
     return 0;
 }
 
@@ -443,6 +452,11 @@ int run_verify(const std::vector<std::string>& args) {
     std::size_t files = 0;
     for (const auto& step : reader.manifest().at("steps")) {
         for (const auto& view : step.at("views")) files += view.at("files").size();
+        const std::int64_t number = step.at("step").get<std::int64_t>();
+        files += reader.light_fields(number).size();
+        for (const insitu::ArchivedVolume& volume : reader.volumes(number)) {
+            files += volume.files.size();
+        }
     }
     std::cout << args[0] << ": " << files << " files checked, " << problems.size() << " problem"
               << (problems.size() == 1 ? "" : "s") << "\n";

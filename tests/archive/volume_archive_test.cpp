@@ -399,6 +399,10 @@ TEST(VolumeSettings, RefusesBadValuesNamingTheKey) {
     refused(R"({"volume": {"tolerance": -1}})", "volume.tolerance\" = -1");
     refused(R"({"volume": {"relative_tolerance": 2}})", "volume.relative_tolerance\" = 2");
     refused(R"({"volume": {"rate": 0.1}})", "volume.rate\" = 0.1");
+    // Zero is a value given, not "unset": refused like any other out of range.
+    refused(R"({"volume": {"rate": 0}})", "volume.rate\" = 0");
+    refused(R"({"volume": {"tolerance": 0}})", "volume.tolerance\" = 0");
+    refused(R"({"volume": {"relative_tolerance": 0}})", "volume.relative_tolerance\" = 0");
     refused(R"({"volume": {"rate": 8, "tolerance": 0.1}})", "at most one of");
     refused(R"({"volume": {"codec": "sz", "rate": 8}})", "volume.codec\" = \"sz\"");
     refused(R"({"volume": {"rate": 8, "threads": 0}})", "volume.threads\" = 0");

@@ -189,6 +189,30 @@ TEST_F(ExplorerVolume, OpacityScalesAreProxyEditsTheVolumeRefuses) {
     EXPECT_EQ(explorer.render(scaled).proxy_source, ProxySource::single);
 }
 
+// A damaged compressed field: asked for by name, the error names the file; auto shows the frame
+// from the view's proxies instead. What a volume frame cannot do of a request, it says.
+TEST_F(ExplorerVolume, AutoLeavesADamagedFieldToTheImagesAndFramesSayWhatTheyIgnore) {
+    write_step();
+    {
+        Explorer explorer(config_.archive);
+        ExploreRequest lit = at(100.0, 0.0, ProxySource::volume);
+        lit.ambient_occlusion = AmbientOcclusionSettings{};
+        const ExploreFrame frame = explorer.render(lit);
+        EXPECT_NE(frame.note.find("ambient occlusion does not apply"), std::string::npos)
+            << frame.note;
+        EXPECT_TRUE(explorer.render(at(100.0, 0.0, ProxySource::volume)).note.empty());
+    }
+    const std::string file = ArchiveReader(config_.archive).volumes(1).at(0).files.at(0);
+    std::string bytes = testing::read_text(file);
+    bytes[bytes.size() / 2] = static_cast<char>(bytes[bytes.size() / 2] ^ 0x40);
+    testing::write_text(file, bytes);
+    Explorer explorer(config_.archive);
+    expect_error_naming<IoError>([&] { explorer.render(at(100.0, 0.0, ProxySource::volume)); },
+                                 "CRC-32");
+    EXPECT_EQ(explorer.render(at(100.0, 0.0, ProxySource::automatic)).proxy_source,
+              ProxySource::single);
+}
+
 // An int16 field (a CT scan's kind) with ghost layers on an odd grid: the interior is kept, as
 // the float the renderers read, within the tolerance in the field's own units.
 TEST_F(ExplorerVolume, IntegerFieldsWithGhostLayersKeepTheirInteriorWithinTheTolerance) {

@@ -27,7 +27,7 @@ const Key<VolumeSettings> kVolumeKeys[] = {
          settings.mode = VolumeMode::accuracy;
      },
      [](const VolumeSettings& settings) {
-         return settings.tolerance > 0.0 ? json(settings.tolerance) : json();
+         return settings.tolerance ? json(*settings.tolerance) : json();
      }},
     {"relative_tolerance",
      [](const json& value, const std::string& key, VolumeSettings& settings, Unknown&) {
@@ -35,16 +35,14 @@ const Key<VolumeSettings> kVolumeKeys[] = {
          settings.mode = VolumeMode::accuracy;
      },
      [](const VolumeSettings& settings) {
-         return settings.relative_tolerance > 0.0 ? json(settings.relative_tolerance) : json();
+         return settings.relative_tolerance ? json(*settings.relative_tolerance) : json();
      }},
     {"rate",
      [](const json& value, const std::string& key, VolumeSettings& settings, Unknown&) {
          settings.rate = number(value, key);
          settings.mode = VolumeMode::rate;
      },
-     [](const VolumeSettings& settings) {
-         return settings.rate > 0.0 ? json(settings.rate) : json();
-     }},
+     [](const VolumeSettings& settings) { return settings.rate ? json(*settings.rate) : json(); }},
     {"threads",
      [](const json& value, const std::string& key, VolumeSettings& settings, Unknown&) {
          settings.threads = small_integer(value, key);
@@ -59,10 +57,10 @@ std::string to_string(VolumeMode mode) {
 }
 
 double VolumeSettings::tolerance_for(double range, double narrowest_feature) const {
-    if (tolerance > 0.0) return tolerance;
+    if (tolerance) return *tolerance;
     const double chosen =
-        relative_tolerance > 0.0
-            ? relative_tolerance * range
+        relative_tolerance
+            ? *relative_tolerance * range
             : kFeatureToleranceShare * std::min(narrowest_feature, kFeatureWidthShare * range);
     // ZFP's accuracy mode takes any positive tolerance; an all-equal field is stored exactly by
     // any, so the smallest normal float keeps the decoded values equal to the given ones.
@@ -73,22 +71,23 @@ void VolumeSettings::validate() const {
     if (codec != "zfp") {
         out_of_range("volume.codec", "\"" + codec + "\"", "the only codec is \"zfp\"");
     }
-    const int given = (tolerance != 0.0) + (relative_tolerance != 0.0) + (rate != 0.0);
+    const int given = tolerance.has_value() + relative_tolerance.has_value() + rate.has_value();
     if (given > 1) {
         fail<InvalidArgument>(
             "configuration \"volume\": give at most one of \"tolerance\", "
             "\"relative_tolerance\" and \"rate\" (",
             given, " given)");
     }
-    if (tolerance != 0.0 && !(tolerance > 0.0 && std::isfinite(tolerance))) {
-        out_of_range("volume.tolerance", text_of(tolerance), "field units, must be finite and > 0");
+    if (tolerance && !(*tolerance > 0.0 && std::isfinite(*tolerance))) {
+        out_of_range("volume.tolerance", text_of(*tolerance),
+                     "field units, must be finite and > 0");
     }
-    if (relative_tolerance != 0.0 && !(relative_tolerance > 0.0 && relative_tolerance < 1.0)) {
-        out_of_range("volume.relative_tolerance", text_of(relative_tolerance),
+    if (relative_tolerance && !(*relative_tolerance > 0.0 && *relative_tolerance < 1.0)) {
+        out_of_range("volume.relative_tolerance", text_of(*relative_tolerance),
                      "a share of the step's value range, must be in (0, 1)");
     }
-    if (rate != 0.0 && !(rate >= 0.5 && rate <= 32.0)) {
-        out_of_range("volume.rate", text_of(rate), "bits per value, must be in [0.5, 32]");
+    if (rate && !(*rate >= 0.5 && *rate <= 32.0)) {
+        out_of_range("volume.rate", text_of(*rate), "bits per value, must be in [0.5, 32]");
     }
     if (threads < 1 || threads > 64) {
         out_of_range("volume.threads", text_of(threads), "must be in [1, 64]");

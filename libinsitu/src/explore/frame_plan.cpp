@@ -171,8 +171,16 @@ FrameInputs frame_inputs(const ExploreRequest& request, StepCache& steps,
         (plan.multi && (has_attenuation(*plan.multi) || has_layers(*plan.multi)));
     // The compressed field of the view's field, when the step has one: asked for by name, or in
     // auto, where it makes every frame but the stored view's as stored (plan_frame).
-    if (request.source == ProxySource::volume || request.source == ProxySource::automatic) {
+    if (request.source == ProxySource::volume) {
         plan.volume = steps.load_volume(request.step, plan.field);
+    } else if (request.source == ProxySource::automatic) {
+        // auto shows what it can: a damaged compressed field leaves the frame to the images
+        // (verify and check() report the file).
+        try {
+            plan.volume = steps.load_volume(request.step, plan.field);
+        } catch (const IoError&) {
+            plan.volume = nullptr;
+        }
     }
     if (request.source == ProxySource::volume && plan.volume == nullptr) {
         fail<InvalidArgument>("source = volume, but ", plan.where,

@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <glm/geometric.hpp>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -178,6 +179,17 @@ ExploreFrame volume_frame(const FramePlan& plan, const ExploreRequest& request,
     frame.camera = plan.target;
     frame.synthesised_view = !plan.same_view;
     frame.proxy_source = ProxySource::volume;
+    std::vector<std::string> ignored;
+    if (request.lighting) ignored.push_back("the lights' directions and strengths");
+    if (request.ambient_occlusion) ignored.push_back("ambient occlusion");
+    if (request.enhancement) ignored.push_back("enhancement");
+    for (std::size_t i = 0; i < ignored.size(); ++i) {
+        frame.note += (i == 0 ? "" : i + 1 == ignored.size() ? " and " : ", ") + ignored[i];
+    }
+    if (!ignored.empty()) {
+        frame.note = "the compressed field is shaded by the ground truth's headlight Phong only: " +
+                     frame.note + (ignored.size() == 1 ? " does" : " do") + " not apply";
+    }
     return frame;
 }
 

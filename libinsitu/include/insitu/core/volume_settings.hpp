@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <limits>
 #include <nlohmann/json_fwd.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,14 +48,14 @@ struct VolumeSettings {
     /// "codec": only "zfp" (a name, so that archives and configurations say which).
     std::string codec = "zfp";
     VolumeMode mode = VolumeMode::accuracy;
-    /// "tolerance": the largest error of a sample, in field units (> 0, finite); 0 = unset.
-    double tolerance = 0.0;
+    /// "tolerance": the largest error of a sample, in field units (> 0, finite).
+    std::optional<double> tolerance;
     /// "relative_tolerance": the tolerance as a share of the step's finite value range (in
-    /// (0, 1)); 0 = unset. At most one of "tolerance", "relative_tolerance" and "rate"; none:
-    /// the feature rule.
-    double relative_tolerance = 0.0;
-    /// "rate": bits per value in fixed-rate mode (in [0.5, 32]); 0 = unset.
-    double rate = 0.0;
+    /// (0, 1)). At most one of "tolerance", "relative_tolerance" and "rate"; none: the feature
+    /// rule.
+    std::optional<double> relative_tolerance;
+    /// "rate": bits per value in fixed-rate mode (in [0.5, 32]).
+    std::optional<double> rate;
     /// "threads": OpenMP threads the writer compresses with (in [1, 64]); 1 by default, since
     /// the simulation usually holds the other cores.
     int threads = 1;

@@ -110,6 +110,9 @@ struct ExploreFrame {
     /// Light-field cameras the frame needed but the archive lacks (see LightFieldReconstruction).
     std::vector<int> missing_cameras;
     double milliseconds = 0.0;  ///< wall time of render(), archive reads included
+    /// What the frame could not do of the request, for people (empty: everything): a frame of the
+    /// compressed field is shaded by the ground truth's headlight Phong only.
+    std::string note;
 };
 
 /// What a client that draws frames itself (the web viewer's WebGL2 renderer) needs besides the

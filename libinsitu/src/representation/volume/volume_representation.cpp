@@ -98,8 +98,8 @@ std::optional<VolumeSettings> kept_settings(const InstrumentConfig& config, cons
         if (!plan.budget->volume->met) return std::nullopt;
         VolumeSettings chosen = config.volume.value_or(VolumeSettings{});
         chosen.mode = VolumeMode::accuracy;
-        chosen.tolerance = 0.0;
-        chosen.rate = 0.0;
+        chosen.tolerance.reset();
+        chosen.rate.reset();
         chosen.relative_tolerance = plan.budget->volume->relative_tolerance;
         return chosen;
     }
@@ -134,7 +134,7 @@ void VolumeRepresentation::capture(const InstrumentConfig& config, const FieldPl
     volume.min = plan.summary.histogram.min;
     volume.max = plan.summary.histogram.max;
     volume.tolerance = settings->tolerance_for(value_range(plan), narrowest);
-    volume.rate = settings->rate;
+    volume.rate = settings->rate.value_or(0.0);
     volume.threads = settings->threads;
     // The uploaded copy is already the interior as float, NaN where the field is non-finite.
     volume.blocks.push_back({{0, 0, 0}, uploaded.dims, uploaded.host_values});
