@@ -70,14 +70,20 @@ export function setEditTrustTerms(gl, u, recipe, intervals, maxIntervals) {
   gl.uniform1fv(u('uStoredSpread'), perInterval(trust.stored_colour_spread, 0));
 }
 
-/// Sets the uniforms (`u`: name -> location) of `recipe`'s lights, occlusion and enhancement for
-/// `camera` (camera.js) drawn at width x height.
-export function setFrameTerms(gl, u, recipe, camera, width, height) {
+/// Sets the uniforms (`u`: name -> location) of `camera`'s (camera.js) basis and extent
+/// (uForward, uRight, uUp; uHalfExtent's z: 1 for perspective), which a shader's rays start from.
+export function setCameraBasis(gl, u, camera) {
   gl.uniform3fv(u('uForward'), camera.forward);
   gl.uniform3fv(u('uRight'), camera.right);
   gl.uniform3fv(u('uUp'), camera.up);
   gl.uniform3f(u('uHalfExtent'), camera.halfWidth, camera.halfHeight,
     camera.perspective ? 1 : 0);
+}
+
+/// Sets the uniforms (`u`: name -> location) of `recipe`'s lights, occlusion and enhancement for
+/// `camera` (camera.js) drawn at width x height.
+export function setFrameTerms(gl, u, recipe, camera, width, height) {
+  setCameraBasis(gl, u, camera);
   gl.uniform2i(u('uImageSize'), width, height);
   const lighting = recipe.lighting;
   gl.uniform1i(u('uLighting'), lighting ? 1 : 0);

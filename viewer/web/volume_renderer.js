@@ -8,6 +8,7 @@
 
 import { buildProgram, frameContext, gpuFinished, nearestTexture, readCanvas, shaderText } from
   './webgl.js';
+import { setCameraBasis } from './frame_terms.js';
 
 // Texture units of the field, its non-finite mask and the table (apart from the other
 // renderers' units, which bind their own again before they draw).
@@ -243,11 +244,7 @@ export class VolumeRenderer {
     gl.uniform3f(set('uTableDomain'), table.valueMin, 1 / (table.valueMax - table.valueMin),
       twoD && table.gradientMax > 0 ? 1 / table.gradientMax : 0);
     gl.uniform3fv(set('uEye'), camera.position);
-    gl.uniform3fv(set('uForward'), camera.forward);
-    gl.uniform3fv(set('uRight'), camera.right);
-    gl.uniform3fv(set('uUp'), camera.up);
-    gl.uniform3f(set('uHalfExtent'), camera.halfWidth, camera.halfHeight,
-      camera.perspective ? 1 : 0);
+    setCameraBasis(gl, set, camera);
     gl.uniform2i(set('uSize'), width, height);
     gl.uniform1f(set('uStep'), stepWorld);
     gl.uniform1f(set('uStopOpacity'), settings.stopOpacity);

@@ -297,7 +297,7 @@ std::vector<ArchivedLightField> ArchiveReader::light_fields(std::int64_t step) c
     for (const nlohmann::json& entry : af::light_field_entries(step_entry)) {
         result.push_back({step, step_entry.at("time").get<double>(),
                           entry.at("field").get<std::string>(),
-                          af::listed_light_field(root, entry).absolute_path,
+                          af::listed_entry_file(root, entry).absolute_path,
                           entry.at("cameras").get<int>(), entry.at("map_size").get<int>()});
     }
     return result;
@@ -306,7 +306,7 @@ std::vector<ArchivedLightField> ArchiveReader::light_fields(std::int64_t step) c
 LightField ArchiveReader::load_light_field(std::int64_t step, const std::string& field,
                                            const std::vector<int>& cameras) const {
     const nlohmann::json& entry = af::find_light_field(*manifest_, path_, step, field);
-    const af::ListedFile listed = af::listed_light_field(path_, entry);
+    const af::ListedFile listed = af::listed_entry_file(path_, entry);
     const int camera_count = entry.at("cameras").get<int>();
     // Refused before the file is read: the manifest records the rig's camera count.
     for (const int camera : cameras) {
@@ -396,7 +396,7 @@ ArchiveCheck ArchiveReader::check() const {
     std::multimap<std::string, std::pair<std::int64_t, std::string>> light_field_owners;
     for (const nlohmann::json& step : manifest_->at("steps")) {
         for (const nlohmann::json& entry : af::light_field_entries(step)) {
-            light_field_owners.emplace(af::listed_light_field(path_, entry).absolute_path,
+            light_field_owners.emplace(af::listed_entry_file(path_, entry).absolute_path,
                                        std::pair{step.at("step").get<std::int64_t>(),
                                                  entry.at("field").get<std::string>()});
         }

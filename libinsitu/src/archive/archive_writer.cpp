@@ -49,12 +49,6 @@ std::uint64_t StepWriteResult::bytes() const {
 
 namespace {
 
-WrittenFile place_file(const fs::path& archive, const std::string& relative_path,
-                       const std::string& bytes) {
-    af::write_file_atomically(archive / relative_path, bytes);
-    return {relative_path, bytes.size(), af::crc32_of(bytes.data(), bytes.size())};
-}
-
 /// write_png writes its own file, so it writes the temp file; then it is synced and renamed.
 WrittenFile place_png(const fs::path& archive, const std::string& relative_path,
                       const Image& preview) {
@@ -156,7 +150,7 @@ nlohmann::json write_view(const fs::path& archive, const InstrumentConfig& confi
         const std::string exr_path = af::proxy_relative_path(record.step, view.view_index);
         af::EncodedView exr = af::encode_view(
             record, view, view.precision.value_or(config.precision), config.compression, exr_path);
-        written.push_back(place_file(archive, exr_path, exr.bytes));
+        written.push_back(af::place_file(archive, exr_path, exr.bytes));
         files.push_back(af::file_entry(written.back(), af::kProxyKind));
         parts = std::move(exr.parts);
     }
@@ -183,7 +177,7 @@ nlohmann::json write_light_fields(const fs::path& archive, const InstrumentConfi
             record.step, field_number(config, light_field.field, record.step, "light field"));
         const af::EncodedLightField exr =
             af::encode_light_field(record, light_field, encoding, path);
-        written.push_back(place_file(archive, path, exr.bytes));
+        written.push_back(af::place_file(archive, path, exr.bytes));
         const LightFieldRig& rig = light_field.light_field.rig;
         entries.push_back(af::light_field_entry(light_field.field, written.back(),
                                                 rig.camera_count(), rig.map_size()));

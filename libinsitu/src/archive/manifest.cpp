@@ -337,6 +337,12 @@ std::vector<std::int64_t> manifest_steps(const nlohmann::json& manifest) {
     return steps;
 }
 
+WrittenFile place_file(const fs::path& archive, const std::string& relative_path,
+                       const std::string& bytes) {
+    write_file_atomically(archive / relative_path, bytes);
+    return {relative_path, bytes.size(), crc32_of(bytes.data(), bytes.size())};
+}
+
 nlohmann::json file_entry(const WrittenFile& file, const char* kind) {
     return {
         {"kind", kind}, {"path", file.relative_path}, {"bytes", file.bytes}, {"crc32", file.crc32}};
@@ -366,7 +372,7 @@ std::vector<ListedFile> listed_files(const std::string& archive, const nlohmann:
             }
         }
         for (const nlohmann::json& entry : light_field_entries(step)) {
-            files.push_back(listed_light_field(archive, entry));
+            files.push_back(listed_entry_file(archive, entry));
         }
         for (const nlohmann::json& entry : volume_entries(step)) {
             for (ListedFile& file : listed_volume_files(archive, entry)) {
@@ -389,7 +395,7 @@ nlohmann::json light_field_entry(const std::string& field, const WrittenFile& fi
             {"crc32", file.crc32}, {"cameras", cameras},         {"map_size", map_size}};
 }
 
-ListedFile listed_light_field(const std::string& archive, const nlohmann::json& entry) {
+ListedFile listed_entry_file(const std::string& archive, const nlohmann::json& entry) {
     return {(fs::path(archive) / entry.at("file").get<std::string>()).string(),
             entry.at("bytes").get<std::uint64_t>(), entry.at("crc32").get<std::uint32_t>()};
 }

@@ -32,6 +32,7 @@
 // opens the archive moves it, verbatim, to "malformed_steps" with the reason (kept for whoever
 // repairs the archive, never read as a step). A broken top level is still refused whole.
 #include <cstdint>
+#include <filesystem>
 #include <nlohmann/json.hpp>  // Index holds values
 #include <string>
 #include <vector>
@@ -100,6 +101,11 @@ void append_journal(const std::string& archive_path, const nlohmann::json& step_
 /// Step numbers of a validated manifest, sorted.
 std::vector<std::int64_t> manifest_steps(const nlohmann::json& manifest);
 
+/// Writes `bytes` as ARCHIVE/`relative_path` crash-safely (atomic_file.hpp) and returns what the
+/// index records of it: the path, size and CRC-32.
+WrittenFile place_file(const std::filesystem::path& archive, const std::string& relative_path,
+                       const std::string& bytes);
+
 /// The entry of `file` in a view's "files" list.
 nlohmann::json file_entry(const WrittenFile& file, const char* kind);
 
@@ -122,8 +128,9 @@ const nlohmann::json& light_field_entries(const nlohmann::json& step);
 /// The manifest entry of a written light field (`cameras` and `map_size`: the rig's).
 nlohmann::json light_field_entry(const std::string& field, const WrittenFile& file, int cameras,
                                  int map_size);
-/// The file a light-field entry (of a validated manifest) lists.
-ListedFile listed_light_field(const std::string& archive, const nlohmann::json& entry);
+/// The file an object of a validated manifest names with "file", "bytes" and "crc32" (a light
+/// field's entry, a compressed field's block or mask).
+ListedFile listed_entry_file(const std::string& archive, const nlohmann::json& entry);
 /// The step entry of `step`; InvalidArgument when the manifest has none.
 const nlohmann::json& find_step(const nlohmann::json& manifest, const std::string& archive,
                                 std::int64_t step);

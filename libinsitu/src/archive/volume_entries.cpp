@@ -3,7 +3,6 @@
 #include <set>
 
 #include "archive/archive_format.hpp"
-#include "archive/atomic_file.hpp"
 #include "archive/manifest_keys.hpp"
 #include "archive/zfp_volume.hpp"
 #include "insitu/error.hpp"
@@ -112,17 +111,6 @@ void check_volume_entry(const nlohmann::json& entry, const std::string& file,
     }
 }
 
-ListedFile listed(const std::string& archive, const nlohmann::json& object) {
-    return {(fs::path(archive) / object.at("file").get<std::string>()).string(),
-            object.at("bytes").get<std::uint64_t>(), object.at("crc32").get<std::uint32_t>()};
-}
-
-WrittenFile place(const fs::path& archive, const std::string& relative_path,
-                  const std::string& bytes) {
-    write_file_atomically(archive / relative_path, bytes);
-    return {relative_path, bytes.size(), crc32_of(bytes.data(), bytes.size())};
-}
-
 nlohmann::json file_keys(const WrittenFile& written) {
     return {{"file", written.relative_path}, {"bytes", written.bytes}, {"crc32", written.crc32}};
 }
@@ -164,8 +152,8 @@ std::vector<ListedFile> listed_volume_files(const std::string& archive,
                                             const nlohmann::json& entry) {
     std::vector<ListedFile> files;
     for (const nlohmann::json& block : entry.at("blocks")) {
-        files.push_back(listed(archive, block));
-        if (block.contains("mask")) files.push_back(listed(archive, block.at("mask")));
+        files.push_back(listed_entry_file(archive, block));
+        if (block.contains("mask")) files.push_back(listed_entry_file(archive, block.at("mask")));
     }
     return files;
 }
@@ -186,16 +174,16 @@ nlohmann::json write_volume(const fs::path& archive, std::int64_t step, int fiel
         }
         const EncodedVolumeBlock encoded =
             encode_volume_block(block.values.data(), block.dims, parameters);
-        written.push_back(place(archive, volume_relative_path(step, field_number, b, count, ".zfp"),
-                                encoded.stream));
+        written.push_back(place_file(
+            archive, volume_relative_path(step, field_number, b, count, ".zfp"), encoded.stream));
         nlohmann::json entry = file_keys(written.back());
         entry["offset"] = triple(block.offset);
         entry["dims"] = triple(block.dims);
         entry["nonfinite"] = encoded.nonfinite;
         if (encoded.nonfinite > 0) {
-            written.push_back(place(archive,
-                                    volume_relative_path(step, field_number, b, count, ".mask"),
-                                    encoded.mask));
+            written.push_back(
+                place_file(archive, volume_relative_path(step, field_number, b, count, ".mask"),
+                           encoded.mask));
             entry["mask"] = file_keys(written.back());
         }
         nonfinite += encoded.nonfinite;
@@ -248,10 +236,10 @@ VolumeGrid read_volume(const std::string& archive, const nlohmann::json& entry) 
     grid.values.assign(static_cast<std::size_t>(grid.dims[0] * grid.dims[1] * grid.dims[2]),
                        std::nanf(""));
     for (const nlohmann::json& block : entry.at("blocks")) {
-        const ListedFile stream = listed(archive, block);
-        const std::vector<char> mask = block.contains("mask")
-                                           ? read_listed_file(listed(archive, block.at("mask")))
-                                           : std::vector<char>();
+        const ListedFile stream = listed_entry_file(archive, block);
+        const std::vector<char> mask =
+            block.contains("mask") ? read_listed_file(listed_entry_file(archive, block.at("mask")))
+                                   : std::vector<char>();
         const Index3 offset = index_triple(block.at("offset"));
         const Index3 dims = index_triple(block.at("dims"));
         const std::vector<float> values =
