@@ -26,13 +26,13 @@
 #include <utility>
 #include <vector>
 
-#include "archive/zfp_volume.hpp"
 #include "arguments.hpp"
 #include "evaluation/harness.hpp"
 #include "evaluation/scenes.hpp"
 #include "insitu/render/volume_renderer.hpp"
 #include "insitu/testing/metrics.hpp"
 #include "median_time.hpp"
+#include "representation/volume/zfp_volume.hpp"
 
 namespace {
 

@@ -3,9 +3,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "archive/zfp_volume.hpp"
 #include "insitu/error.hpp"
 #include "median_time.hpp"
+#include "representation/volume/zfp_volume.hpp"
 
 namespace insitu::evaluation {
 

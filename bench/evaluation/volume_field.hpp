@@ -1,8 +1,9 @@
 #pragma once
 // The compressed field as the evaluation harness measures it (issue 40): a scene's samples
 // through ZFP (fixed accuracy relative to the value range, or fixed rate) and back, with the
-// stream's bytes and the time each way, through the archive's own codec (archive/zfp_volume.hpp),
-// serial, as the writer's thread runs it: the bytes are those of the archive's block files.
+// stream's bytes and the time each way, through the archive's own codec
+// (representation/volume/zfp_volume.hpp), serial, as the writer's thread runs it: the bytes are
+// those of the archive's block files.
 #include <cstdint>
 #include <string>
 #include <vector>

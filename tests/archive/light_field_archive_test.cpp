@@ -25,10 +25,10 @@
 #include <string>
 #include <vector>
 
-#include "archive/light_field_exr.hpp"
 #include "insitu/archive/archive.hpp"
 #include "insitu/error.hpp"
 #include "insitu/testing/analytic_fields.hpp"
+#include "representation/light_field/light_field_exr.hpp"
 #include "support/expect_error.hpp"
 #include "support/half_precision.hpp"
 #include "support/test_files.hpp"
@@ -449,7 +449,7 @@ TEST_F(LightFieldArchive, VerifyAndLoadNameATruncatedOrCorruptFile) {
     const ArchiveCheck truncated = reader.check();
     ASSERT_EQ(truncated.problems.size(), 1u);
     EXPECT_THAT(truncated.problems[0], AllOf(HasSubstr(name), HasSubstr("truncated")));
-    EXPECT_EQ(truncated.unreadable_light_fields,
+    EXPECT_EQ(truncated.unreadable_entries.at("light_fields"),
               (std::set<std::pair<std::int64_t, std::string>>{{10, "v"}}));
     EXPECT_TRUE(truncated.unreadable_proxies.empty());  // the view's files are intact
     expect_error_naming<IoError>([&] { reader.load_light_field(10, "v"); }, name);
@@ -538,7 +538,7 @@ TEST_F(LightFieldArchive, OpenDamagedCoversLightFields) {
     ASSERT_EQ(reader.light_fields(10).size(), 1u);
     expect_light_fields_match(field, reader.load_light_field(10, "v"), Stored::exact, Stored::half);
     const ArchiveCheck check = reader.check();
-    EXPECT_EQ(check.unreadable_light_fields,
+    EXPECT_EQ(check.unreadable_entries.at("light_fields"),
               (std::set<std::pair<std::int64_t, std::string>>{{20, "v"}}));
     EXPECT_THAT(check.problems, ::testing::Contains(AllOf(HasSubstr("step000020_lightfield1.exr"),
                                                           HasSubstr("truncated"))));

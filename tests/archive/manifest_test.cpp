@@ -10,9 +10,11 @@
 #include <filesystem>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 
 #include "archive/archive_format.hpp"
+#include "archive/entry_list.hpp"
 #include "archive/manifest_entries.hpp"
 #include "insitu/archive/step_record.hpp"
 #include "insitu/error.hpp"
@@ -101,6 +103,38 @@ TEST(Manifest, NeverWritesWhatItsReaderWouldRefuse) {
 // recomposition equals its ground truth) included: nlohmann writes +inf as null, which reads
 // back as +inf, not as an archive the reader refuses. Entries of archives written before the
 // rotated views and the precision read with those keys absent.
+// Every representation's list (entry_list.hpp) reaches the index's checks through the registry:
+// a list that is not one, an entry without its field and a field listed twice are refused,
+// naming the list's key and entry.
+TEST(Manifest, EveryRegisteredListIsCheckedByItsKey) {
+    std::set<std::string> keys;
+    std::set<std::string> folders;
+    for (const EntryList* list : entry_lists()) {
+        SCOPED_TRACE(list->key());
+        EXPECT_TRUE(keys.insert(list->key()).second) << "two lists share a key";
+        EXPECT_STRNE(list->noun(), "");
+        EXPECT_STRNE(list->folder(), kPreviewFolder);  // previews are the views' own
+        folders.insert(list->folder());
+        nlohmann::json entry = step_entry(10);
+        entry[list->key()] = 3;
+        expect_error_naming<ParseError>([&] { check_step_entry(entry, "m.json", "steps[0]"); },
+                                        std::string("steps[0].") + list->key());
+        entry[list->key()] = nlohmann::json::array({nlohmann::json::object()});
+        expect_error_naming<ParseError>([&] { check_step_entry(entry, "m.json", "steps[0]"); },
+                                        std::string("steps[0].") + list->key() + "[0].field");
+        entry[list->key()] = nlohmann::json::array({{{"field", 1}}});
+        expect_error_naming<ParseError>([&] { check_step_entry(entry, "m.json", "steps[0]"); },
+                                        std::string("steps[0].") + list->key() + "[0].field");
+        entry[list->key()] = nlohmann::json::array();
+        EXPECT_NO_THROW(check_step_entry(entry, "m.json", "steps[0]"));  // an empty list: none
+        EXPECT_TRUE(listed_entries(entry, list->key()).empty());
+        expect_error_naming<InvalidArgument>(
+            [&] { find_entry(entry, *list, "A", "v"); },
+            std::string("step 10 has no ") + list->noun() + " of \"v\"");
+    }
+    EXPECT_EQ(keys, (std::set<std::string>{kLightFieldsKey, kVolumesKey}));
+}
+
 TEST(Manifest, BudgetChoicesRoundTripWithInfinitePsnr) {
     const fs::path archive =
         fs::temp_directory_path() / ("insitu_manifest_budget_" + std::to_string(::getpid()));

@@ -1,8 +1,9 @@
-// The compressed field in the archive (issue 40; src/archive/zfp_volume.hpp, volume_entries.hpp):
-// the ZFP codec's error bound in accuracy mode and its size in rate mode, NaN/Inf kept through a
-// mask, odd grids, threads; the decoder's refusals (truncated, corrupt, foreign, mismatched
-// header or mask); the manifest's "volumes" entry, ArchiveReader::volumes/load_volume, verify()
-// and check() on damaged files; the "volume" configuration's keys and checks.
+// The compressed field in the archive (issue 40; src/representation/volume/zfp_volume.hpp,
+// volume_entries.hpp): the ZFP codec's error bound in accuracy mode and its size in rate mode,
+// NaN/Inf kept through a mask, odd grids, threads; the decoder's refusals (truncated, corrupt,
+// foreign, mismatched header or mask); the manifest's "volumes" entry,
+// ArchiveReader::volumes/load_volume, verify() and check() on damaged files; the "volume"
+// configuration's keys and checks.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -15,11 +16,11 @@
 #include <string>
 #include <vector>
 
-#include "archive/zfp_volume.hpp"
 #include "insitu/archive/archive.hpp"
 #include "insitu/config.hpp"
 #include "insitu/error.hpp"
 #include "insitu/testing/analytic_fields.hpp"
+#include "representation/volume/zfp_volume.hpp"
 #include "support/expect_error.hpp"
 #include "support/test_files.hpp"
 
@@ -304,7 +305,7 @@ TEST_F(VolumeArchive, VerifyAndCheckFindADamagedFileAndLoadingNamesIt) {
     const ArchiveCheck check = reader.check();
     ASSERT_EQ(check.problems.size(), 1u);
     EXPECT_THAT(check.problems[0], HasSubstr("step000010_field1.zfp"));
-    EXPECT_EQ(check.unreadable_volumes.count({10, "v"}), 1u);
+    EXPECT_EQ(check.unreadable_entries.at("volumes").count({10, "v"}), 1u);
     expect_error_naming<IoError>([&] { reader.load_volume(10, "v"); },
                                  "step000010_field1.zfp\": CRC-32");
     std::filesystem::resize_file(volume_file(".mask"), 3);

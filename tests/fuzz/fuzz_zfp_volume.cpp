@@ -1,14 +1,15 @@
-// libFuzzer harness: the compressed field's block decoder (src/archive/zfp_volume.hpp) on any
-// bytes. The first byte picks the grid the manifest would declare (so the header check passes
-// for inputs that keep a valid header and fails for the rest); the others are the ZFP stream.
-// An IoError is the documented outcome for a stream that is not one; anything else escaping, or
-// any sanitizer report (a read past the buffer above all), is a finding.
+// libFuzzer harness: the compressed field's block decoder
+// (src/representation/volume/zfp_volume.hpp) on any bytes. The first byte picks the grid the
+// manifest would declare (so the header check passes for inputs that keep a valid header and fails
+// for the rest); the others are the ZFP stream. An IoError is the documented outcome for a stream
+// that is not one; anything else escaping, or any sanitizer report (a read past the buffer above
+// all), is a finding.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
-#include "archive/zfp_volume.hpp"
 #include "insitu/error.hpp"
+#include "representation/volume/zfp_volume.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     if (size == 0) return 0;

@@ -21,11 +21,11 @@
 #include "archive/atomic_file.hpp"
 #include "archive/cinema_csv.hpp"
 #include "archive/exr_frame.hpp"
-#include "archive/light_field_exr.hpp"
 #include "archive/manifest.hpp"
 #include "archive/preview_png.hpp"
-#include "archive/volume_entries.hpp"
 #include "insitu/error.hpp"
+#include "representation/light_field/light_field_entries.hpp"
+#include "representation/volume/volume_entries.hpp"
 
 namespace insitu {
 
@@ -294,36 +294,19 @@ std::vector<ArchivedLightField> ArchiveReader::light_fields(std::int64_t step) c
     const nlohmann::json& step_entry = af::find_step(*manifest_, path_, step);
     const std::string root = fs::absolute(path_).string();
     std::vector<ArchivedLightField> result;
-    for (const nlohmann::json& entry : af::light_field_entries(step_entry)) {
-        result.push_back({step, step_entry.at("time").get<double>(),
-                          entry.at("field").get<std::string>(),
-                          af::listed_entry_file(root, entry).absolute_path,
-                          entry.at("cameras").get<int>(), entry.at("map_size").get<int>()});
+    for (const nlohmann::json& entry :
+         af::listed_entries(step_entry, af::light_field_entry_list().key())) {
+        result.push_back(af::archived_light_field(root, step_entry, entry));
     }
     return result;
 }
 
 LightField ArchiveReader::load_light_field(std::int64_t step, const std::string& field,
                                            const std::vector<int>& cameras) const {
-    const nlohmann::json& entry = af::find_light_field(*manifest_, path_, step, field);
-    const af::ListedFile listed = af::listed_entry_file(path_, entry);
-    const int camera_count = entry.at("cameras").get<int>();
-    // Refused before the file is read: the manifest records the rig's camera count.
-    for (const int camera : cameras) {
-        if (camera < 0 || camera >= camera_count) {
-            fail<InvalidArgument>("archive \"", path_, "\": step ", step, " light field of \"",
-                                  field, "\": camera ", camera, " is outside the rig (",
-                                  camera_count, " cameras, 0..", camera_count - 1, ")");
-        }
-    }
-    LightField light_field =
-        af::decode_light_field(af::read_listed_file(listed), listed.absolute_path, cameras,
-                               entry.at("map_size").get<int>());
-    if (light_field.rig.camera_count() != camera_count) {
-        fail<IoError>("\"", listed.absolute_path, "\": a rig of ", light_field.rig.camera_count(),
-                      " cameras, the manifest records ", camera_count);
-    }
-    return light_field;
+    const nlohmann::json& step_entry = af::find_step(*manifest_, path_, step);
+    return af::read_light_field(
+        path_, step_entry, af::find_entry(step_entry, af::light_field_entry_list(), path_, field),
+        cameras);
 }
 
 Image ArchiveReader::load_preview(std::int64_t step, int view) const {
@@ -359,7 +342,8 @@ std::vector<ArchivedVolume> ArchiveReader::volumes(std::int64_t step) const {
     const nlohmann::json& step_entry = af::find_step(*manifest_, path_, step);
     const std::string root = fs::absolute(path_).string();
     std::vector<ArchivedVolume> result;
-    for (const nlohmann::json& entry : af::volume_entries(step_entry)) {
+    for (const nlohmann::json& entry :
+         af::listed_entries(step_entry, af::volume_entry_list().key())) {
         result.push_back(af::archived_volume(root, step_entry, entry));
     }
     return result;
@@ -367,7 +351,8 @@ std::vector<ArchivedVolume> ArchiveReader::volumes(std::int64_t step) const {
 
 VolumeGrid ArchiveReader::load_volume(std::int64_t step, const std::string& field) const {
     const nlohmann::json& step_entry = af::find_step(*manifest_, path_, step);
-    return af::read_volume(path_, af::find_volume(step_entry, path_, field));
+    return af::read_volume(path_,
+                           af::find_entry(step_entry, af::volume_entry_list(), path_, field));
 }
 
 Field VolumeGrid::as_field() const {
@@ -393,21 +378,21 @@ ArchiveCheck ArchiveReader::check() const {
                 std::pair{step.at("step").get<std::int64_t>(), view.at("view").get<int>()});
         }
     }
-    std::multimap<std::string, std::pair<std::int64_t, std::string>> light_field_owners;
+    // Which (list key, step, field) each file of a registered list serves (entry_list.hpp).
+    struct EntryOwner {
+        const char* key;
+        std::pair<std::int64_t, std::string> step_field;
+    };
+    std::multimap<std::string, EntryOwner> entry_owners;
     for (const nlohmann::json& step : manifest_->at("steps")) {
-        for (const nlohmann::json& entry : af::light_field_entries(step)) {
-            light_field_owners.emplace(af::listed_entry_file(path_, entry).absolute_path,
-                                       std::pair{step.at("step").get<std::int64_t>(),
-                                                 entry.at("field").get<std::string>()});
-        }
-    }
-    std::multimap<std::string, std::pair<std::int64_t, std::string>> volume_owners;
-    for (const nlohmann::json& step : manifest_->at("steps")) {
-        for (const nlohmann::json& entry : af::volume_entries(step)) {
-            for (const af::ListedFile& file : af::listed_volume_files(path_, entry)) {
-                volume_owners.emplace(file.absolute_path,
-                                      std::pair{step.at("step").get<std::int64_t>(),
-                                                entry.at("field").get<std::string>()});
+        for (const af::EntryList* list : af::entry_lists()) {
+            for (const nlohmann::json& entry : af::listed_entries(step, list->key())) {
+                for (const af::ListedFile& file : list->files(path_, entry)) {
+                    entry_owners.emplace(file.absolute_path,
+                                         EntryOwner{list->key(),
+                                                    {step.at("step").get<std::int64_t>(),
+                                                     entry.at("field").get<std::string>()}});
+                }
             }
         }
     }
@@ -420,13 +405,9 @@ ArchiveCheck ArchiveReader::check() const {
         for (auto owner = first; owner != last; ++owner) {
             result.unreadable_proxies.insert(owner->second);
         }
-        const auto [first_field, last_field] = light_field_owners.equal_range(file.absolute_path);
-        for (auto owner = first_field; owner != last_field; ++owner) {
-            result.unreadable_light_fields.insert(owner->second);
-        }
-        const auto [first_volume, last_volume] = volume_owners.equal_range(file.absolute_path);
-        for (auto owner = first_volume; owner != last_volume; ++owner) {
-            result.unreadable_volumes.insert(owner->second);
+        const auto [first_entry, last_entry] = entry_owners.equal_range(file.absolute_path);
+        for (auto owner = first_entry; owner != last_entry; ++owner) {
+            result.unreadable_entries[owner->second.key].insert(owner->second.step_field);
         }
     };
     const fs::path root = resolved(fs::absolute(path_));

@@ -25,10 +25,9 @@
 #include "archive/archive_format.hpp"
 #include "archive/atomic_file.hpp"
 #include "archive/cinema_csv.hpp"
+#include "archive/entry_list.hpp"
 #include "archive/exr_frame.hpp"
-#include "archive/light_field_exr.hpp"
 #include "archive/manifest.hpp"
-#include "archive/volume_entries.hpp"
 #include "insitu/error.hpp"
 
 // libinsitu/CMakeLists.txt passes project(VERSION) as INSITU_VERSION.
@@ -111,16 +110,12 @@ void validate_record(const StepRecord& record, const ArchiveWriter& writer) {
                                   view.preview.channels, " channels (expected 1, 3 or 4)");
         }
     }
-    std::set<std::string> light_fields;
-    for (const LightFieldRecord& light_field : record.light_fields) {
-        if (!light_fields.insert(light_field.field).second) {
-            fail<InvalidArgument>(where, ": two light fields of field \"", light_field.field, "\"");
-        }
-    }
-    std::set<std::string> volumes;
-    for (const VolumeRecord& volume : record.volumes) {
-        if (!volumes.insert(volume.field).second) {
-            fail<InvalidArgument>(where, ": two compressed fields of field \"", volume.field, "\"");
+    for (const af::EntryList* list : af::entry_lists()) {
+        std::set<std::string> fields;
+        for (const std::string& field : list->fields(record)) {
+            if (!fields.insert(field).second) {
+                fail<InvalidArgument>(where, ": two ", list->noun(), "s of field \"", field, "\"");
+            }
         }
     }
 }
@@ -166,27 +161,8 @@ nlohmann::json write_view(const fs::path& archive, const InstrumentConfig& confi
             {"files", std::move(files)}};
 }
 
-/// Places the step's light fields, appended to `written`; returns their "light_fields" list.
-nlohmann::json write_light_fields(const fs::path& archive, const InstrumentConfig& config,
-                                  const StepRecord& record, std::vector<WrittenFile>& written) {
-    const af::LightFieldEncoding encoding =
-        af::light_field_encoding(config.precision, config.compression);
-    nlohmann::json entries = nlohmann::json::array();
-    for (const LightFieldRecord& light_field : record.light_fields) {
-        const std::string path = af::light_field_relative_path(
-            record.step, field_number(config, light_field.field, record.step, "light field"));
-        const af::EncodedLightField exr =
-            af::encode_light_field(record, light_field, encoding, path);
-        written.push_back(af::place_file(archive, path, exr.bytes));
-        const LightFieldRig& rig = light_field.light_field.rig;
-        entries.push_back(af::light_field_entry(light_field.field, written.back(),
-                                                rig.camera_count(), rig.map_size()));
-    }
-    return entries;
-}
-
 /// Places every file of the step, appended to `written` in the order they are placed (views,
-/// then light fields); returns the step's entry, which names them.
+/// then each registered list's: af::entry_lists()); returns the step's entry, which names them.
 nlohmann::json write_step_files(const fs::path& archive, const InstrumentConfig& config,
                                 const StepRecord& record, std::vector<WrittenFile>& written) {
     nlohmann::json step_entry{{"step", record.step},
@@ -196,18 +172,15 @@ nlohmann::json write_step_files(const fs::path& archive, const InstrumentConfig&
     for (const ViewRecord& view : record.views) {
         step_entry["views"].push_back(write_view(archive, config, record, view, written));
     }
-    if (!record.light_fields.empty()) {
-        step_entry[af::kLightFieldsKey] = write_light_fields(archive, config, record, written);
-    }
-    if (!record.volumes.empty()) {
-        nlohmann::json& volumes = step_entry[af::kVolumesKey];
-        volumes = nlohmann::json::array();
-        for (const VolumeRecord& volume : record.volumes) {
-            volumes.push_back(af::write_volume(
-                archive, record.step,
-                field_number(config, volume.field, record.step, "compressed field"), volume,
-                written));
-        }
+    const auto number = [&](const char* noun) {
+        return [&config, &record, noun](const std::string& field) {
+            return field_number(config, field, record.step, noun);
+        };
+    };
+    for (const af::EntryList* list : af::entry_lists()) {
+        if (list->fields(record).empty()) continue;
+        step_entry[list->key()] =
+            list->write(archive, config, record, number(list->noun()), written);
     }
     if (!record.fields.empty()) {
         nlohmann::json& summaries = step_entry[af::kFieldsKey];
@@ -248,8 +221,19 @@ void remove_unindexed_files(const fs::path& archive, std::optional<std::uint64_t
 }  // namespace
 
 namespace {
+/// The archive's own folders: the views' proxies and previews, then each registered list's.
+std::vector<std::string> archive_folders() {
+    std::vector<std::string> folders{af::kProxyFolder, af::kPreviewFolder};
+    for (const af::EntryList* list : af::entry_lists()) {
+        if (std::find(folders.begin(), folders.end(), list->folder()) == folders.end()) {
+            folders.push_back(list->folder());
+        }
+    }
+    return folders;
+}
+
 // "on_existing": "replace": removes what an archive consists of — its indexes, then every file
-// in its own proxies/ and previews/ folders — and nothing else the directory holds. The indexes
+// in its own folders (archive_folders) — and nothing else the directory holds. The indexes
 // go first: should the run die half-way, what is left is unindexed files, not an index naming
 // missing ones.
 void remove_archive_files(const fs::path& archive) {
@@ -261,7 +245,7 @@ void remove_archive_files(const fs::path& archive) {
                           ": ", error.message());
         }
     }
-    for (const char* folder : {af::kProxyFolder, af::kPreviewFolder, af::kVolumeFolder}) {
+    for (const std::string& folder : archive_folders()) {
         std::error_code error;
         for (const fs::directory_entry& entry : fs::directory_iterator(archive / folder, error)) {
             if (entry.is_regular_file()) fs::remove(entry.path(), error);
@@ -279,8 +263,8 @@ ArchiveWriter::ArchiveWriter(const InstrumentConfig& config)
     af::check_compression(config_.compression);  // fail early, before touching the disk
     if (path_.empty()) fail<InvalidArgument>("archive: empty path");
     const fs::path archive(path_);
-    const fs::path folders[] = {archive, archive / af::kProxyFolder, archive / af::kPreviewFolder,
-                                archive / af::kVolumeFolder};
+    std::vector<fs::path> folders{archive};
+    for (const std::string& folder : archive_folders()) folders.push_back(archive / folder);
     for (const fs::path& folder : folders) {
         std::error_code error;
         fs::create_directories(folder, error);

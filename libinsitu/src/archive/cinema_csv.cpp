@@ -7,8 +7,8 @@
 
 #include "archive/archive_format.hpp"
 #include "archive/atomic_file.hpp"
-#include "archive/volume_entries.hpp"
 #include "insitu/error.hpp"
+#include "representation/volume/volume_entries.hpp"
 
 namespace insitu::archive_format {
 
@@ -21,7 +21,7 @@ std::string number_text(const nlohmann::json& number) {
 
 std::string cinema_volume_file(const nlohmann::json& step, const nlohmann::json& view) {
     const nlohmann::json& field = view.contains("field") ? view.at("field") : step.at("field");
-    for (const nlohmann::json& entry : volume_entries(step)) {
+    for (const nlohmann::json& entry : listed_entries(step, kVolumesKey)) {
         if (entry.at("field") == field) {
             return entry.at("blocks").at(0).at("file").get<std::string>();
         }

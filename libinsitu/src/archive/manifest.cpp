@@ -9,11 +9,10 @@
 
 #include "archive/archive_format.hpp"
 #include "archive/atomic_file.hpp"
+#include "archive/entry_list.hpp"
 #include "archive/manifest_keys.hpp"
-#include "archive/volume_entries.hpp"
 #include "insitu/archive/step_record.hpp"
 #include "insitu/core/histogram.hpp"
-#include "insitu/core/light_field.hpp"
 #include "insitu/core/transfer_function.hpp"
 #include "insitu/error.hpp"
 
@@ -22,41 +21,6 @@ namespace insitu::archive_format {
 namespace fs = std::filesystem;
 
 namespace {
-
-/// The optional "light_fields" list of a step entry: one file per field, as views list theirs.
-void check_light_field_entries(const nlohmann::json& step, const std::string& file,
-                               const std::string& where) {
-    if (!step.contains(kLightFieldsKey)) return;  // archives without light fields
-    const auto& entries = require(step, kLightFieldsKey, Expect::array, file, where);
-    std::set<std::string> fields_seen;
-    for (std::size_t i = 0; i < entries.size(); ++i) {
-        const std::string entry_where =
-            where + "." + kLightFieldsKey + "[" + std::to_string(i) + "]";
-        const auto& entry = entries[i];
-        const auto& field = require(entry, "field", Expect::string, file, entry_where);
-        if (!fields_seen.insert(field.get<std::string>()).second) {
-            fail<ParseError>("\"", file, "\": ", entry_where, ": field ", field.dump(),
-                             " is repeated");
-        }
-        check_relative_path(require(entry, "file", Expect::string, file, entry_where), file,
-                            entry_where, "file");
-        require(entry, "bytes", Expect::count, file, entry_where);
-        require(entry, "crc32", Expect::crc32, file, entry_where);
-        const auto& cameras = require(entry, "cameras", Expect::count, file, entry_where);
-        if (std::find(kLightFieldCameraCounts.begin(), kLightFieldCameraCounts.end(),
-                      cameras.get<std::int64_t>()) == kLightFieldCameraCounts.end()) {
-            fail<ParseError>("\"", file, "\": ", entry_where, ".cameras ", cameras.dump(),
-                             " is not a light field's camera count (12, 42, 162 or 642)");
-        }
-        const auto& map_size = require(entry, "map_size", Expect::count, file, entry_where);
-        if (map_size.get<std::int64_t>() < kMinLightFieldMapSize ||
-            map_size.get<std::int64_t>() > kMaxLightFieldMapSize) {
-            fail<ParseError>("\"", file, "\": ", entry_where, ".map_size ", map_size.dump(),
-                             " is outside [", kMinLightFieldMapSize, ", ", kMaxLightFieldMapSize,
-                             "]");
-        }
-    }
-}
 
 /// The optional per-field summaries of a step entry: one per field, each a valid histogram.
 void check_field_summaries(const nlohmann::json& step, const std::string& file,
@@ -109,9 +73,7 @@ void check_step_entry(const nlohmann::json& step, const std::string& file,
     require(step, "time", Expect::number, file, where);
     require(step, "field", Expect::string, file, where);
     std::set<int> views_seen;
-    const auto light_fields = step.find(kLightFieldsKey);
-    const bool has_light_fields =
-        light_fields != step.end() && light_fields->is_array() && !light_fields->empty();
+    const bool has_light_fields = has_entries(step, kLightFieldsKey);
     const auto& views = require(step, "views", Expect::array, file, where);
     for (std::size_t v = 0; v < views.size(); ++v) {
         const std::string view_where = where + ".views[" + std::to_string(v) + "]";
@@ -160,8 +122,7 @@ void check_step_entry(const nlohmann::json& step, const std::string& file,
             }
         }
     }
-    check_light_field_entries(step, file, where);
-    check_volume_entries(step, file, where);
+    check_entry_lists(step, file, where);
     check_field_summaries(step, file, where);
     check_budget_entries(step, file, where);
 }
@@ -371,28 +332,15 @@ std::vector<ListedFile> listed_files(const std::string& archive, const nlohmann:
                 files.push_back(listed(archive, file));
             }
         }
-        for (const nlohmann::json& entry : light_field_entries(step)) {
-            files.push_back(listed_entry_file(archive, entry));
-        }
-        for (const nlohmann::json& entry : volume_entries(step)) {
-            for (ListedFile& file : listed_volume_files(archive, entry)) {
-                files.push_back(std::move(file));
+        for (const EntryList* list : entry_lists()) {
+            for (const nlohmann::json& entry : listed_entries(step, list->key())) {
+                for (ListedFile& file : list->files(archive, entry)) {
+                    files.push_back(std::move(file));
+                }
             }
         }
     }
     return files;
-}
-
-const nlohmann::json& light_field_entries(const nlohmann::json& step) {
-    static const nlohmann::json none = nlohmann::json::array();
-    const auto found = step.find(kLightFieldsKey);
-    return found == step.end() ? none : *found;
-}
-
-nlohmann::json light_field_entry(const std::string& field, const WrittenFile& file, int cameras,
-                                 int map_size) {
-    return {{"field", field},      {"file", file.relative_path}, {"bytes", file.bytes},
-            {"crc32", file.crc32}, {"cameras", cameras},         {"map_size", map_size}};
 }
 
 ListedFile listed_entry_file(const std::string& archive, const nlohmann::json& entry) {
@@ -406,16 +354,6 @@ const nlohmann::json& find_step(const nlohmann::json& manifest, const std::strin
         if (step_entry.at("step").get<std::int64_t>() == step) return step_entry;
     }
     fail<InvalidArgument>("archive \"", archive, "\" has no step ", step);
-}
-
-const nlohmann::json& find_light_field(const nlohmann::json& manifest, const std::string& archive,
-                                       std::int64_t step, const std::string& field) {
-    const nlohmann::json& step_entry = find_step(manifest, archive, step);
-    for (const nlohmann::json& entry : light_field_entries(step_entry)) {
-        if (entry.at("field") == field) return entry;
-    }
-    fail<InvalidArgument>("archive \"", archive, "\": step ", step, " has no light field of \"",
-                          field, "\"");
 }
 
 std::vector<char> read_listed_file(const ListedFile& file) {

@@ -5,8 +5,9 @@
 //    "steps": [{"step", "time", "field",
 //               "views": [{"view", "phi", "theta", "parts": [...], "transfer_function",
 //                          "files": [{"kind", "path", "bytes", "crc32"}, ...]}],
-//               "light_fields": [{"field", "file", "bytes", "crc32", "cameras", "map_size"}],
-//                   (only on steps with light fields; "cameras" and "map_size" are the rig's)
+//               "light_fields": [...], "volumes": [...]
+//                   (a registered representation's list, entry_list.hpp, on steps that hold it:
+//                   its room's *_entries.hpp gives the form)
 //               "fields": [{"field", "histogram": {"min", "max", "counts"}, "nonfinite"}],
 //                   (the values of each field at the step, core/histogram.hpp; "fields" and a
 //                   view's "transfer_function", the one it was made with, are absent from
@@ -117,28 +118,18 @@ struct ListedFile {
 };
 /// The file of `kind` that `view` (an entry of a validated manifest) lists.
 ListedFile listed_file(const std::string& archive, const nlohmann::json& view, const char* kind);
-/// Every file the manifest lists, light fields included.
+/// Every file the manifest lists: the views', then each registered list's.
 std::vector<ListedFile> listed_files(const std::string& archive, const nlohmann::json& manifest);
 /// The file's bytes, after checking size and CRC-32 against the manifest (a file replaced,
 /// truncated or damaged since it was written is reported before anything parses it).
 std::vector<char> read_listed_file(const ListedFile& file);
 
-/// The "light_fields" list of a validated step entry (an empty one when it has none).
-const nlohmann::json& light_field_entries(const nlohmann::json& step);
-/// The manifest entry of a written light field (`cameras` and `map_size`: the rig's).
-nlohmann::json light_field_entry(const std::string& field, const WrittenFile& file, int cameras,
-                                 int map_size);
 /// The file an object of a validated manifest names with "file", "bytes" and "crc32" (a light
 /// field's entry, a compressed field's block or mask).
 ListedFile listed_entry_file(const std::string& archive, const nlohmann::json& entry);
 /// The step entry of `step`; InvalidArgument when the manifest has none.
 const nlohmann::json& find_step(const nlohmann::json& manifest, const std::string& archive,
                                 std::int64_t step);
-/// The light-field entry of (step, field); InvalidArgument when the manifest has no such step
-/// or the step no light field of that field.
-const nlohmann::json& find_light_field(const nlohmann::json& manifest, const std::string& archive,
-                                       std::int64_t step, const std::string& field);
-
 /// The step and view entries of (step, view); InvalidArgument when the manifest has neither.
 struct ViewEntry {
     const nlohmann::json* step;

@@ -7,10 +7,11 @@
 #include <utility>
 
 #include "explore/frame_plan.hpp"
-#include "explore/frame_sources.hpp"
-#include "explore/volume_frames.hpp"
 #include "insitu/error.hpp"
 #include "insitu/explore/transfer_function_edit.hpp"
+#include "representation/light_field/light_field_frames.hpp"
+#include "representation/view_proxies/view_frames.hpp"
+#include "representation/volume/volume_frames.hpp"
 #include "step/step_recipe.hpp"
 
 namespace insitu {

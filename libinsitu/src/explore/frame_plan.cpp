@@ -257,6 +257,13 @@ bool has_attenuation(const ProxyFrame& frame) {
     return frame.attenuation.channels > 0;
 }
 
+ExploreFrame planned_frame(const FramePlan& plan) {
+    ExploreFrame frame;
+    frame.camera = plan.target;
+    frame.synthesised_view = !plan.same_view;
+    return frame;
+}
+
 std::vector<double> checked_scales(const std::vector<std::pair<int, double>>& requested, int count,
                                    const char* what, const char* value_what, const char* plural) {
     std::vector<double> scales(static_cast<std::size_t>(count), 1.0);

@@ -64,6 +64,9 @@ struct FramePlan : FrameInputs {
     const ColourModel* model = nullptr;  ///< the view's colour model, where stored
 };
 
+/// What every frame of the plan starts as: its camera, and whether that is another view.
+ExploreFrame planned_frame(const FramePlan& plan);
+
 /// "step S view V of "archive"".
 std::string frame_location(const ExploreRequest& request, const std::string& archive_path);
 

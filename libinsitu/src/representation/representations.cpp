@@ -1,7 +1,11 @@
-// The registry of representations: adding one is a folder beside these and a line here.
+// The registry of representations: adding one is a folder beside these and a line here (and,
+// where it stores files of its own, a line in entry_lists).
+#include "archive/entry_list.hpp"
+#include "representation/light_field/light_field_entries.hpp"
 #include "representation/light_field/light_field_representation.hpp"
 #include "representation/representation.hpp"
 #include "representation/view_proxies/view_proxies.hpp"
+#include "representation/volume/volume_entries.hpp"
 #include "representation/volume/volume_representation.hpp"
 
 namespace insitu {
@@ -20,3 +24,14 @@ const std::vector<std::unique_ptr<Representation>>& representations() {
 }
 
 }  // namespace insitu
+
+namespace insitu::archive_format {
+
+const std::vector<const EntryList*>& entry_lists() {
+    // The views' proxies and previews are the step entry's "views", not a list of these.
+    static const std::vector<const EntryList*> registered{&light_field_entry_list(),
+                                                          &volume_entry_list()};
+    return registered;
+}
+
+}  // namespace insitu::archive_format

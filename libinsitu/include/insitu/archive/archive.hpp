@@ -18,8 +18,8 @@
 //                                    per camera, so a reader decodes only the cameras it needs
 //   previews/step000010_view0.png    ground-truth rendering of the configured transfer function
 //   volumes/step000010_field0.zfp    the compressed field of field 0 of "fields": a ZFP stream
-//                                    (src/archive/volume_entries.hpp), with NaN/Inf a .mask
-//                                    beside it, "_block<b>" per block of a distributed run
+//                                    (src/representation/volume/volume_entries.hpp), with NaN/Inf a
+//                                    .mask beside it, "_block<b>" per block of a distributed run
 //
 // EXR parts (channel names start with the part name; libinsitu/src/archive/archive_format.hpp):
 //   depth (depth.layer0..), attenuation (attenuation.a00.., .zmean00.., .tau00.., .zentry00..,

@@ -3,6 +3,7 @@
 // <nlohmann/json.hpp> to look into manifest().
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <optional>
@@ -74,10 +75,10 @@ struct ArchiveCheck {
     /// (step, view) of the entries whose proxy EXR cannot be used: missing, outside the archive,
     /// or not the size and CRC-32 the index records.
     std::set<std::pair<std::int64_t, int>> unreadable_proxies;
-    /// (step, field) of the light fields whose EXR cannot be used, for the same reasons.
-    std::set<std::pair<std::int64_t, std::string>> unreadable_light_fields;
-    /// (step, field) of the compressed fields with a file that cannot be used.
-    std::set<std::pair<std::int64_t, std::string>> unreadable_volumes;
+    /// (step, field) of the entries of a step's representation list with a file that cannot be
+    /// used, for the same reasons, by the list's key: "light_fields" (the EXR), "volumes" (a
+    /// block's stream or mask).
+    std::map<std::string, std::set<std::pair<std::int64_t, std::string>>> unreadable_entries;
     bool clean() const { return problems.empty(); }
 };
 

@@ -3,12 +3,12 @@
 #include <limits>
 #include <set>
 
-#include "archive/light_field_exr.hpp"
 #include "core/elapsed.hpp"
 #include "insitu/budget/light_field_chooser.hpp"
 #include "insitu/core/check.hpp"
 #include "insitu/explore/light_field_reconstruction.hpp"
 #include "insitu/explore/transfer_function_edit.hpp"
+#include "representation/light_field/light_field_exr.hpp"
 
 namespace insitu {
 

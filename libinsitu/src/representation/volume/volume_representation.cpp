@@ -4,12 +4,12 @@
 #include <limits>
 #include <optional>
 
-#include "archive/zfp_volume.hpp"
 #include "core/elapsed.hpp"
 #include "insitu/budget/volume_chooser.hpp"
 #include "insitu/core/check.hpp"
 #include "insitu/explore/transfer_function_edit.hpp"
 #include "insitu/render/volume_renderer.hpp"
+#include "representation/volume/zfp_volume.hpp"
 
 namespace insitu {
 

@@ -1,7 +1,8 @@
 #pragma once
 // The compressed field ("volume", insitu/core/volume_settings.hpp): the field's values
 // themselves, handed to the writer, which compresses them with ZFP on its thread
-// (archive/zfp_volume.hpp); any view and any transfer function are then rendered from them.
+// (representation/volume/zfp_volume.hpp); any view and any transfer function are then rendered from
+// them.
 #include "representation/representation.hpp"
 
 namespace insitu {

@@ -1,11 +1,11 @@
-#include "archive/volume_entries.hpp"
+#include "representation/volume/volume_entries.hpp"
 
 #include <set>
 
 #include "archive/archive_format.hpp"
 #include "archive/manifest_keys.hpp"
-#include "archive/zfp_volume.hpp"
 #include "insitu/error.hpp"
+#include "representation/volume/zfp_volume.hpp"
 
 namespace insitu::archive_format {
 
@@ -115,49 +115,8 @@ nlohmann::json file_keys(const WrittenFile& written) {
     return {{"file", written.relative_path}, {"bytes", written.bytes}, {"crc32", written.crc32}};
 }
 
-}  // namespace
-
-void check_volume_entries(const nlohmann::json& step, const std::string& file,
-                          const std::string& where) {
-    if (!step.contains(kVolumesKey)) return;  // steps without a compressed field
-    const auto& entries = require(step, kVolumesKey, Expect::array, file, where);
-    std::set<std::string> fields_seen;
-    for (std::size_t i = 0; i < entries.size(); ++i) {
-        const std::string entry_where = where + "." + kVolumesKey + "[" + std::to_string(i) + "]";
-        const auto& field = require(entries[i], "field", Expect::string, file, entry_where);
-        if (!fields_seen.insert(field.get<std::string>()).second) {
-            fail<ParseError>("\"", file, "\": ", entry_where, ": field ", field.dump(),
-                             " is repeated");
-        }
-        check_volume_entry(entries[i], file, entry_where);
-    }
-}
-
-const nlohmann::json& volume_entries(const nlohmann::json& step) {
-    static const nlohmann::json none = nlohmann::json::array();
-    const auto found = step.find(kVolumesKey);
-    return found == step.end() ? none : *found;
-}
-
-const nlohmann::json& find_volume(const nlohmann::json& step_entry, const std::string& archive,
-                                  const std::string& field) {
-    for (const nlohmann::json& entry : volume_entries(step_entry)) {
-        if (entry.at("field") == field) return entry;
-    }
-    fail<InvalidArgument>("archive \"", archive, "\": step ", step_entry.at("step").dump(),
-                          " has no compressed field of \"", field, "\"");
-}
-
-std::vector<ListedFile> listed_volume_files(const std::string& archive,
-                                            const nlohmann::json& entry) {
-    std::vector<ListedFile> files;
-    for (const nlohmann::json& block : entry.at("blocks")) {
-        files.push_back(listed_entry_file(archive, block));
-        if (block.contains("mask")) files.push_back(listed_entry_file(archive, block.at("mask")));
-    }
-    return files;
-}
-
+/// Compresses and places the blocks of `volume` (the field at position `field_number` of the
+/// configuration's "fields"), appended to `written`; returns its entry.
 nlohmann::json write_volume(const fs::path& archive, std::int64_t step, int field_number,
                             const VolumeRecord& volume, std::vector<WrittenFile>& written) {
     const ZfpParameters parameters{volume.mode, volume.tolerance, volume.rate, volume.threads};
@@ -201,6 +160,57 @@ nlohmann::json write_volume(const fs::path& archive, std::int64_t step, int fiel
             {"max", volume.max},
             {"nonfinite", nonfinite},
             {"blocks", std::move(blocks)}};
+}
+
+class VolumeEntries final : public EntryList {
+public:
+    const char* key() const override { return kVolumesKey; }
+    const char* noun() const override { return "compressed field"; }
+    const char* folder() const override { return kVolumeFolder; }
+
+    std::vector<std::string> fields(const StepRecord& record) const override {
+        std::vector<std::string> fields;
+        for (const VolumeRecord& volume : record.volumes) fields.push_back(volume.field);
+        return fields;
+    }
+
+    nlohmann::json write(const fs::path& archive, const InstrumentConfig&, const StepRecord& record,
+                         const std::function<int(const std::string&)>& field_number,
+                         std::vector<WrittenFile>& written) const override {
+        nlohmann::json entries = nlohmann::json::array();
+        for (const VolumeRecord& volume : record.volumes) {
+            entries.push_back(
+                write_volume(archive, record.step, field_number(volume.field), volume, written));
+        }
+        return entries;
+    }
+
+    void check(const nlohmann::json& entry, const std::string& file,
+               const std::string& where) const override {
+        check_volume_entry(entry, file, where);
+    }
+
+    std::vector<ListedFile> files(const std::string& archive,
+                                  const nlohmann::json& entry) const override {
+        return listed_volume_files(archive, entry);
+    }
+};
+
+}  // namespace
+
+const EntryList& volume_entry_list() {
+    static const VolumeEntries list;
+    return list;
+}
+
+std::vector<ListedFile> listed_volume_files(const std::string& archive,
+                                            const nlohmann::json& entry) {
+    std::vector<ListedFile> files;
+    for (const nlohmann::json& block : entry.at("blocks")) {
+        files.push_back(listed_entry_file(archive, block));
+        if (block.contains("mask")) files.push_back(listed_entry_file(archive, block.at("mask")));
+    }
+    return files;
 }
 
 ArchivedVolume archived_volume(const std::string& archive, const nlohmann::json& step_entry,

@@ -3,7 +3,7 @@
 // checksums what it encodes and stores it through the crash-safe path, and the reader parses
 // only bytes it already checked against the manifest, and of those only the parts of the
 // cameras it was asked for.
-#include "archive/light_field_exr.hpp"
+#include "representation/light_field/light_field_exr.hpp"
 
 #include <Imath/half.h>
 #include <OpenEXR/ImfChannelList.h>

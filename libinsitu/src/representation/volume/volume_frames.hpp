@@ -1,11 +1,12 @@
 #pragma once
-// Frames of a step's compressed field (ProxySource::volume): the decoded grid on the
-// ground-truth VolumeRenderer, uploaded once per (step, field) and kept while frames of it are
+// Frames of a step's compressed field for the Explorer (ProxySource::volume): the decoded grid on
+// the ground-truth VolumeRenderer, uploaded once per (step, field) and kept while frames of it are
 // asked, so that turning the view or editing the function re-renders without re-uploading.
 #include <cstdint>
 #include <memory>
 #include <string>
 
+#include "explore/frame_plan.hpp"
 #include "insitu/archive/archive_reader.hpp"
 #include "insitu/render/volume_renderer.hpp"
 
@@ -24,5 +25,11 @@ private:
     std::int64_t uploaded_step_ = -1;
     std::string uploaded_field_;
 };
+
+/// The compressed field's frame: the ground truth of the shown function in the target camera,
+/// with the step's preview settings (steps_voxels from `configuration`), shaded by the
+/// renderer's headlight Phong where the request asks lighting; confidence 1.
+ExploreFrame volume_frame(const FramePlan& plan, const ExploreRequest& request,
+                          const InstrumentConfig& configuration, VolumeFrames& frames);
 
 }  // namespace insitu::detail

@@ -1,4 +1,4 @@
-#include "archive/zfp_volume.hpp"
+#include "representation/volume/zfp_volume.hpp"
 
 #include <zfp.h>
 #include <zlib.h>
