@@ -3,13 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <iomanip>
 #include <iostream>
 #include <limits>
 #include <optional>
 #include <set>
-#include <sstream>
 
+#include "archive/archive_format.hpp"
 #include "archive/asynchronous_writer.hpp"
 #include "budget/field_budget_check.hpp"
 #include "core/elapsed.hpp"
@@ -50,18 +49,6 @@ std::ostream& operator<<(std::ostream& out, Status status) {
 std::ostream& operator<<(std::ostream& out, const InstrumentOptions& options) {
     return out << "InstrumentOptions{rethrow_errors " << std::boolalpha << options.rethrow_errors
                << ", log " << options.log << std::noboolalpha << "}";
-}
-
-std::ostream& operator<<(std::ostream& out, const InstrumentStatistics& s) {
-    std::ostringstream line;
-    line << std::fixed << std::setprecision(3) << "executed " << s.steps_executed << ", written "
-         << s.steps_written << ", dropped " << s.steps_dropped << ", errors " << s.errors << ", "
-         << s.bytes_written << " bytes, compute " << s.compute_seconds << " s, blocked "
-         << s.blocked_seconds << " s, writing " << s.write_seconds << " s";
-    if (s.steps_replayed > 0) line << ", replayed " << s.steps_replayed << " (skipped)";
-    if (s.nonfinite_samples > 0) line << ", " << s.nonfinite_samples << " NaN/Inf samples";
-    if (s.composite_seconds > 0.0) line << ", compositing " << s.composite_seconds << " s";
-    return out << line.str();
 }
 
 namespace {
@@ -134,6 +121,10 @@ struct Instrument::Impl {
     /// rank 0 opens the archive, and all agree (one failure fails every rank) and learn the
     /// archived steps.
     void open_distributed(InstrumentConfig distributed_config);
+    /// Where the compressed field may be kept: every rank must reach the archive (each places its
+    /// own blocks). Asked for, a rank that cannot is an error on every rank; by default the
+    /// field is then not kept.
+    void agree_on_volume_folder();
     /// Opens (or continues) the archive, notes the steps it holds and starts its writer.
     void open_archive();
     Status execute(std::int64_t step, double time, const std::vector<Field>& fields);
@@ -211,12 +202,6 @@ void Instrument::Impl::open_distributed(InstrumentConfig distributed_config) {
                 "and first hits depend on the opacity in front of a block, which the block "
                 "cannot know); capture them in a run without a communicator");
         }
-        if (distributed_config.volume) {
-            fail<InvalidArgument>(
-                "\"volume\": a distributed run does not store the compressed field yet (each "
-                "rank would write its own blocks, and only rank 0 writes); keep it in a run "
-                "without a communicator");
-        }
     });
     config = std::move(distributed_config);
     failure.guard([&] { renderer = std::make_unique<ProxyRenderer>(); });
@@ -232,6 +217,23 @@ void Instrument::Impl::open_distributed(InstrumentConfig distributed_config) {
     for (double step : bytes_doubles(said.at(0))) {
         archived_steps.insert(static_cast<std::int64_t>(step));
     }
+    if (!config.no_volume) agree_on_volume_folder();
+}
+
+void Instrument::Impl::agree_on_volume_folder() {
+    const fs::path folder = fs::path(config.archive) / archive_format::kVolumeFolder;
+    const std::string unreached = ranks_that_cannot_reach(*communicator, folder);
+    if (unreached.empty()) return;
+    const std::string why = "rank(s) " + unreached + " cannot reach the archive's folder \"" +
+                            folder.string() +
+                            "\", and each rank writes its own blocks of the compressed field";
+    if (config.volume) {
+        fail<InvalidArgument>("\"volume\": ", why,
+                              "; put the archive on a file system every rank shares, or leave "
+                              "\"volume\" out");
+    }
+    config.no_volume = true;
+    log("note: " + why + ": the field is not kept (\"volume\": false)");
 }
 
 void Instrument::Impl::agree_on_step(std::int64_t step, double time, double& composite_seconds) {

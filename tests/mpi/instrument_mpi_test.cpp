@@ -8,6 +8,7 @@
 #include <mpi.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -111,6 +112,32 @@ std::vector<Field> views_of(const std::vector<VolumeBlock>& blocks) {
     return fields;
 }
 
+// The compressed field (kept by default: the grid is small): the ranks' blocks tile the grid
+// (a block per rank that has one, each rank's own file, nothing of the field gathered) and read
+// back as the field within the tolerance, as the one process's does.
+void expect_same_compressed_field(const ArchiveReader& single, const ArchiveReader& ranks,
+                                  std::int64_t step) {
+    const std::vector<ArchivedVolume> kept = ranks.volumes(step);
+    ASSERT_EQ(kept.size(), 1u) << "step " << step;
+    ASSERT_EQ(single.volumes(step).size(), 1u) << "step " << step;
+    EXPECT_EQ(kept[0].tolerance, single.volumes(step)[0].tolerance) << "step " << step;
+    EXPECT_GE(kept[0].blocks, 1);
+    EXPECT_LE(kept[0].blocks, world_size());
+    const SampledVolume truth = field_at(step);
+    for (const ArchiveReader* archive : {&single, &ranks}) {
+        const VolumeGrid grid = archive->load_volume(step, "f");
+        ASSERT_EQ(grid.dims, truth.dims);
+        EXPECT_EQ(grid.origin, truth.origin);
+        EXPECT_EQ(grid.spacing, truth.spacing);
+        double worst = 0.0;
+        for (std::size_t i = 0; i < grid.values.size(); ++i) {
+            worst = std::max(worst, std::abs(static_cast<double>(grid.values[i]) -
+                                             static_cast<double>(truth.values[i])));
+        }
+        EXPECT_LE(worst, kept[0].tolerance) << "step " << step;
+    }
+}
+
 // Runs three steps distributed over `parts`, then (rank 0) the same steps in one process, and
 // compares the archives.
 void expect_same_archive_as_one_process(const std::string& name, Index3 parts,
@@ -174,7 +201,9 @@ void expect_same_archive_as_one_process(const std::string& name, Index3 parts,
                           ranks.transfer_function(step, view).to_json())
                     << "step " << step << " view " << view;
             }
+            expect_same_compressed_field(single, ranks, step);
         }
+        EXPECT_TRUE(ranks.verify().empty());
     }
     EXPECT_TRUE(on_every_rank(same));
 }
@@ -322,6 +351,49 @@ TEST(InstrumentMpi, RefusesLightFields) {
         EXPECT_NE(std::string(error.what()).find("rank 0: \"light_field\""), std::string::npos)
             << error.what();
     }
+}
+
+// Each rank places its own blocks of the compressed field, so every rank must reach the archive.
+// Rank 1 here runs in another working directory with a relative archive path, as a node without
+// the shared file system would: an asked-for "volume" is refused on every rank naming it, and by
+// default the run goes on without the field. At one rank both keep it.
+TEST(InstrumentMpi, ARankThatCannotReachTheArchiveKeepsNoCompressedField) {
+    const std::filesystem::path directory = shared_directory("unreached");
+    const std::filesystem::path here = std::filesystem::current_path();
+    const std::filesystem::path elsewhere = directory / ("rank" + std::to_string(world_rank()));
+    std::filesystem::create_directories(elsewhere);
+    std::filesystem::current_path(world_rank() == 1 ? elsewhere : directory);
+    const bool unreached = world_size() > 1;
+    std::string asked = configuration("asked.cdb", "[0.35]", "uniform");
+    asked.insert(asked.size() - 1, R"(, "volume": {"relative_tolerance": 0.01})");
+    const SampledVolume volume = field_at(0);
+    const std::vector<VolumeBlock> blocks = my_blocks(volume, {world_size(), 1, 1});
+    try {
+        auto instrument = mpi::instrument_from_json_text(asked, MPI_COMM_WORLD);
+        EXPECT_FALSE(unreached) << "a rank that cannot reach the archive was asked to write to it";
+        EXPECT_EQ(instrument->execute(0, 0.0, views_of(blocks)), Status::ok);
+        EXPECT_EQ(instrument->finalize(), Status::ok);
+    } catch (const InvalidArgument& error) {
+        EXPECT_TRUE(unreached) << error.what();
+        EXPECT_NE(std::string(error.what()).find("\"volume\": rank(s) 1 cannot reach"),
+                  std::string::npos)
+            << error.what();
+    }
+    {
+        InstrumentOptions quiet;
+        quiet.log = false;
+        auto instrument = mpi::instrument_from_json_text(
+            configuration("default.cdb", "[0.35]", "uniform"), MPI_COMM_WORLD, quiet);
+        EXPECT_EQ(instrument->execute(0, 0.0, views_of(blocks)), Status::ok);
+        EXPECT_EQ(instrument->finalize(), Status::ok);
+    }
+    if (world_rank() == 0) {
+        EXPECT_EQ(ArchiveReader("default.cdb").volumes(0).size(), unreached ? 0u : 1u);
+        if (!unreached) {
+            EXPECT_EQ(ArchiveReader("asked.cdb").volumes(0).size(), 1u);
+        }
+    }
+    std::filesystem::current_path(here);
 }
 
 // An error budget is measured against the whole field's ground truth on one process: refused

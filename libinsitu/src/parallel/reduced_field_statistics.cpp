@@ -111,4 +111,23 @@ IntervalSet ReducedFieldStatistics::intervals(int count, IntervalMode mode,
                : IntervalSet::from_equalization_histogram(histogram, min(), max(), count);
 }
 
+BlockPlacement ReducedFieldStatistics::placement() const {
+    BlockPlacement mine;
+    mine.grid_dims = grid_->dims;
+    mine.origin = grid_->first_sample;
+    mine.spacing = grid_->spacing;
+    mine.count = 0;
+    for (std::size_t r = 0; r < grid_->parts.size(); ++r) {
+        const Decomposition::Part& part = grid_->parts[r];
+        if (!part.present) continue;
+        if (static_cast<int>(r) == ranks_.rank()) {
+            mine.index = mine.count;
+            mine.offset = part.interior_lower;
+            mine.dims = part.interior_dims;
+        }
+        ++mine.count;
+    }
+    return mine;
+}
+
 }  // namespace insitu

@@ -27,6 +27,7 @@ public:
 
     const Bounds& bounds() const override { return grid_->bounds; }
     bool has_block() const override { return block_.has_value(); }
+    BlockPlacement placement() const override;
     const ValueRange& range() const override { return range_; }
     ValueHistogram histogram() override;
     IntervalSet intervals(int count, IntervalMode mode, const TransferFunction& tf) override;
