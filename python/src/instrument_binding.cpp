@@ -16,10 +16,10 @@ namespace {
 /// otherwise say for every array.
 struct FieldSpec {
     py::array data;
-    py::object ghost_layers;
-    py::object spacing;
-    py::object origin;
-    py::object centering;
+    py::object ghost_layers = py::none();
+    py::object spacing = py::none();
+    py::object origin = py::none();
+    py::object centering = py::none();
 };
 
 /// The grid keywords of execute, for the arrays given without a Field.
