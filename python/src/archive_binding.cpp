@@ -317,6 +317,7 @@ py::array volume_array(Archive& a, std::int64_t step, const std::string& field_o
 }  // namespace
 
 void bind_archive_methods(py::class_<Archive, std::shared_ptr<Archive>>& archive);
+void bind_archive_representations(py::class_<Archive, std::shared_ptr<Archive>>& archive);
 
 void bind_archive(py::module_& module) {
     bind_proxies(module);
@@ -400,7 +401,12 @@ void bind_archive_methods(py::class_<Archive, std::shared_ptr<Archive>>& archive
                 return image_view(*static_cast<Image*>(owner.get_pointer()), owner);
             },
             py::arg("step"), py::arg("view") = 0,
-            "The preview PNG as linear premultiplied float32 (height, width, channels).")
+            "The preview PNG as linear premultiplied float32 (height, width, channels).");
+    bind_archive_representations(archive);
+}
+
+void bind_archive_representations(py::class_<Archive, std::shared_ptr<Archive>>& archive) {
+    archive
         .def(
             "light_fields",
             [](const Archive& a, std::int64_t step) {
