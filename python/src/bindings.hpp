@@ -6,11 +6,13 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "insitu/core/image.hpp"
+#include "insitu/parallel/communicator.hpp"
 
 namespace insitu::python {
 
@@ -34,5 +36,10 @@ py::array image_view(const Image& image, py::handle owner, bool squeeze = false)
 /// `images` (one channel each, one size) stacked into a new (height, width, count) float32
 /// array: a copy, since each lives in its own buffer.
 py::array stack_images(const std::vector<Image>& images);
+
+/// The Communicator over an mpi4py communicator's ranks (mpi_binding.cpp; collective over
+/// them), or InvalidArgument when `comm` is not one or the module was built without MPI
+/// (no_mpi_binding.cpp).
+std::shared_ptr<Communicator> communicator_of(py::handle comm);
 
 }  // namespace insitu::python

@@ -153,10 +153,12 @@ HandedFields hand_over(const py::dict& fields, const GridDefaults& defaults) {
     return handed;
 }
 
-std::unique_ptr<Instrument> make_instrument(py::object config, bool raise_errors, bool log) {
+std::unique_ptr<Instrument> make_instrument(py::object config, bool raise_errors, bool log,
+                                            py::object comm) {
     InstrumentOptions options;
     options.rethrow_errors = raise_errors;
     options.log = log;
+    if (!comm.is_none()) options.communicator = communicator_of(comm);
     if (py::isinstance<py::dict>(config)) {
         const std::string text = from_python(config, "config").dump();
         py::gil_scoped_release release;
@@ -182,6 +184,7 @@ py::dict statistics_of(const Instrument& instrument) {
     out["execute_seconds"] = s.execute_seconds;
     out["simulation_seconds"] = s.simulation_seconds;
     out["nonfinite_samples"] = s.nonfinite_samples;
+    out["composite_seconds"] = s.composite_seconds;
     return out;
 }
 
@@ -226,9 +229,11 @@ void bind_instrument(py::module_& module) {
         "step. Failures of execute and finalize are a Status (and last_error), never an "
         "exception, unless raise_errors=True; the constructor raises on a bad configuration.")
         .def(py::init(&make_instrument), py::arg("config"), py::kw_only(),
-             py::arg("raise_errors") = false, py::arg("log") = true,
+             py::arg("raise_errors") = false, py::arg("log") = true, py::arg("comm") = py::none(),
              "config: a dict (the JSON configuration) or the path of a .json file. log: print "
-             "warnings and finalize's summary to stderr.")
+             "warnings and finalize's summary to stderr. comm: an mpi4py communicator; then "
+             "every rank of it constructs its Instrument (collective) and hands execute its own "
+             "block(s) of each field (insitu.Field with origin and ghost layers).")
         .def(
             "execute",
             [](Instrument& instrument, std::int64_t step, double time, const py::dict& fields,

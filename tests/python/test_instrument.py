@@ -145,3 +145,8 @@ def test_execute_releases_the_gil(tmp_path):
     # Held through the call, the GIL would let the counter run only at its ends (switches every
     # 5 ms): far fewer rounds than a counter running alongside the whole call.
     assert during > 10, f"{during} thousand counts in {seconds:.3f} s"
+
+
+def test_a_comm_that_is_not_an_mpi4py_communicator_is_refused(tmp_path):
+    with pytest.raises(insitu.InvalidArgument, match="comm.*(mpi4py|without MPI)"):
+        insitu.Instrument(config(tmp_path / "comm.cdb"), comm=3)
