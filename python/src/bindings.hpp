@@ -22,6 +22,7 @@ void bind_errors(py::module_& module);
 void bind_archive(py::module_& module);
 void bind_frames(py::module_& module);
 void bind_instrument(py::module_& module);
+void bind_cinema(py::module_& module);
 
 /// `value` as Python objects (dict, list, str, float, int, bool, None).
 py::object to_python(const nlohmann::json& value);

@@ -10,5 +10,6 @@ PYBIND11_MODULE(insitu, module) {
     insitu::python::bind_errors(module);
     insitu::python::bind_archive(module);
     insitu::python::bind_frames(module);
+    insitu::python::bind_cinema(module);
     insitu::python::bind_instrument(module);
 }
