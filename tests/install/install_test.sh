@@ -5,7 +5,9 @@
 # with the build, examples/makefile/ builds the C and (given FC) Fortran heat examples with each
 # of them, a CMake project finds insitu::insitu_c and insitu::insitu_fortran, and every program
 # writes an archive with a manifest. Fails, rather than skips, when make or pkg-config is missing
-# (scripts/setup installs both).
+# (scripts/setup installs both). With INSITU_PYTHON set (the interpreter the Python module was
+# built for), the module installed into the prefix, at the path the install prints, imports with
+# that path on PYTHONPATH and opens the C example's archive.
 set -euo pipefail
 if [ $# -lt 6 ] || [ $# -gt 7 ]; then
   echo "usage: install_test.sh CMAKE BUILD_DIR SOURCE_DIR LIBDIR VERSION CC [FC]" >&2
@@ -36,6 +38,7 @@ quietly() {
 }
 
 quietly "$cmake" --install "$build_dir" --prefix "$prefix"
+cp "$work/command.log" "$work/install.log"
 # No library path from the environment: what runs must find libinsitu through its own RPATH.
 unset LD_LIBRARY_PATH
 
@@ -83,5 +86,19 @@ if [ -n "$fc" ]; then consumer+=(-DCMAKE_Fortran_COMPILER="$fc"); fi
 quietly "$cmake" "${consumer[@]}"
 quietly "$cmake" --build "$work/cmake"
 run_programs "$work/cmake"
+if [ -n "${INSITU_PYTHON:-}" ]; then
+  site=$(sed -n 's/.*insitu: Python module in \(.*\) (PYTHONPATH.*/\1/p' "$work/install.log")
+  [ -n "$site" ] || fail "cmake --install printed no path for the Python module"
+  quietly env PYTHONPATH="$site" "$INSITU_PYTHON" -c '
+import os, sys, insitu
+prefix, archive = sys.argv[1:]
+assert os.path.realpath(insitu.__file__).startswith(os.path.realpath(prefix)), insitu.__file__
+assert os.path.exists(os.path.join(os.path.dirname(insitu.__file__), "insitu.pyi"))
+a = insitu.open(archive)
+assert a.steps == [10] and a.fields, (a.steps, a.fields)
+assert a.proxies(10)["attenuation"].max() > 0
+' "$prefix" "$work/pkg-config/heat_c.cdb"
+  echo "install_test: insitu (Python) imported from $site and opened an archive"
+fi
 echo "install_test: ${programs[*]} built and run from $prefix by make (pkg-config, insitu-config)"\
      "and by CMake"
