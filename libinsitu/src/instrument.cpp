@@ -52,18 +52,6 @@ std::ostream& operator<<(std::ostream& out, const InstrumentOptions& options) {
                << ", log " << options.log << std::noboolalpha << "}";
 }
 
-std::ostream& operator<<(std::ostream& out, const InstrumentStatistics& s) {
-    std::ostringstream line;
-    line << std::fixed << std::setprecision(3) << "executed " << s.steps_executed << ", written "
-         << s.steps_written << ", dropped " << s.steps_dropped << ", errors " << s.errors << ", "
-         << s.bytes_written << " bytes, compute " << s.compute_seconds << " s, blocked "
-         << s.blocked_seconds << " s, writing " << s.write_seconds << " s";
-    if (s.steps_replayed > 0) line << ", replayed " << s.steps_replayed << " (skipped)";
-    if (s.nonfinite_samples > 0) line << ", " << s.nonfinite_samples << " NaN/Inf samples";
-    if (s.composite_seconds > 0.0) line << ", compositing " << s.composite_seconds << " s";
-    return out << line.str();
-}
-
 namespace {
 
 namespace fs = std::filesystem;
@@ -93,7 +81,10 @@ struct Instrument::Impl {
     std::optional<std::int64_t> last_step;  ///< the last step execute() accepted
     bool finalized = false;
     bool nonfinite_reported = false;
+    // Replayed steps noted (by execute() or, in a rerun that asks first, by selects()): each
+    // counted once, one notice for the run.
     bool replay_reported = false;
+    std::set<std::int64_t> replayed_steps;
     std::vector<float> joined_blocks;  ///< storage of a field joined from several blocks
     /// When the last execute() returned: the simulation's own time runs from there.
     std::optional<SteadyClock::time_point> last_return;
@@ -122,9 +113,25 @@ struct Instrument::Impl {
         if (!warning.empty()) log("warning: " + warning);
     }
 
-    bool selects(std::int64_t step) const {
-        return !finalized && (!last_step || step > *last_step) && config.selects(step) &&
-               archived_steps.count(step) == 0;
+    /// Instrument::selects, const for the caller, notes a replayed step here.
+    bool selects(std::int64_t step) {
+        if (finalized || (last_step && step <= *last_step) || !config.selects(step)) return false;
+        if (archived_steps.count(step) == 0) return true;
+        note_replay(step);
+        return false;
+    }
+
+    /// A restarted simulation replays steps an earlier run already archived: those are kept as
+    /// they are ("on_existing": "append") and skipped, counted and noticed once, whether the
+    /// simulation asks selects() first (then it never calls execute() for them) or not.
+    void note_replay(std::int64_t step) {
+        if (!replayed_steps.insert(step).second) return;
+        run.update([](InstrumentStatistics& s) { ++s.steps_replayed; });
+        if (replay_reported) return;
+        replay_reported = true;
+        log("notice: step " + std::to_string(step) + " is already in archive \"" + config.archive +
+            "\" (a restarted run replaying it): archived steps are skipped, counted in "
+            "statistics (\"on_existing\": \"replace\" starts the archive anew)");
     }
 
     /// The constructor's work on one process: the compute device first (without one nothing is
@@ -294,18 +301,9 @@ Status Instrument::Impl::execute_distributed(std::int64_t step, double time,
 }
 
 bool Instrument::Impl::skips(std::int64_t step) {
-    // A restarted simulation replays steps an earlier run already archived: those are kept as
-    // they are ("on_existing": "append") and skipped, with one notice.
     if (archived_steps.count(step) != 0) {
         last_step = step;
-        run.update([](InstrumentStatistics& s) { ++s.steps_replayed; });
-        if (!replay_reported) {
-            replay_reported = true;
-            log("notice: step " + std::to_string(step) + " is already in archive \"" +
-                config.archive +
-                "\" (a restarted run replaying it): archived steps are skipped, counted in "
-                "statistics (\"on_existing\": \"replace\" starts the archive anew)");
-        }
+        note_replay(step);
         return true;
     }
     if (!config.selects(step)) {
