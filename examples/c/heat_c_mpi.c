@@ -1,7 +1,7 @@
 /* heat_c_mpi: heat_c's simulation on MPI ranks, cell-centred, with two ghost layers, through
  * the C API of insitu_mpi.h.
  *
- *   mpiexec -n RANKS heat_c_mpi ARCHIVE [STEPS]
+ *   mpiexec -n RANKS heat_c_mpi ARCHIVE [STEPS] [--stale-halos]
  *
  * Heat diffuses from three hot spots held at temperature 1 through a unit cube of 32^3 cells
  * (the values at the cells' centres, as finite-volume codes keep them), cut into slabs along z:
@@ -12,6 +12,10 @@
  * before the step is handed to libinsitu (the halo rule: libinsitu renders the cells between two
  * ranks' blocks from the lower rank's high ghost layer, so it must hold the neighbour's current
  * values).
+ *
+ * --stale-halos breaks the rule on purpose: the halos are exchanged before the update instead
+ * of after it, so the array handed over holds older ghosts than its neighbours' interiors, and
+ * libinsitu's halo check warns at the first step stored, naming the ranks and the side.
  *
  * Every rank hands its slab to the distributed instrument with insitu_add_block(...,
  * INSITU_CELL): origin is the low corner of its first interior cell. Rank 0 writes the archive.
@@ -118,7 +122,7 @@ static int make_config(const char* archive, char* config, size_t capacity) {
 }
 
 /* Runs the simulation on this rank's slab; returns the number of failed calls. */
-static int run(insitu_instrument* instrument, int steps, int rank, int ranks) {
+static int run(insitu_instrument* instrument, int steps, int stale_halos, int rank, int ranks) {
     int nz_local = kCells / ranks;
     const int z_first = rank * nz_local + (rank < kCells % ranks ? rank : kCells % ranks);
     if (rank < kCells % ranks) ++nz_local;
@@ -144,12 +148,16 @@ static int run(insitu_instrument* instrument, int steps, int rank, int ranks) {
     apply_sources(current, nz_local, z_first);
     exchange_halos(current, nz_local, below, above);
     for (int step = 1; step <= steps; ++step) {
+        if (stale_halos) exchange_halos(current, nz_local, below, above);
         diffuse(current, next, nz_local, diffusion_number);
         apply_sources(next, nz_local, z_first);
         double* swap = current;
         current = next;
         next = swap;
-        exchange_halos(current, nz_local, below, above); /* before the hand-over: the halo rule */
+        /* After the update, before the hand-over: the halo rule. (--stale-halos exchanges before
+         * the stencil instead, where it reads them: the simulation is the same, but the array
+         * handed over keeps the ghosts of two steps before.) */
+        if (!stale_halos) exchange_halos(current, nz_local, below, above);
 
         int status = INSITU_OK;
         if (insitu_selects(instrument, step) == INSITU_OK) {
@@ -177,10 +185,12 @@ int main(int argc, char** argv) {
     int rank = 0, ranks = 1;
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &ranks);
-    const int steps = argc == 3 ? atoi(argv[2]) : 40;
+    const int stale_halos = argc > 2 && strcmp(argv[argc - 1], "--stale-halos") == 0;
+    const int counted = argc - stale_halos;
+    const int steps = counted == 3 ? atoi(argv[2]) : 40;
     static char config[8192];
     int usage = 0;
-    if (argc < 2 || argc > 3 || steps < 1 || ranks > kCells / kGhosts) {
+    if (counted < 2 || counted > 3 || steps < 1 || ranks > kCells / kGhosts) {
         usage = 1;
     } else if (!make_config(argv[1], config, sizeof config)) {
         usage = 1;
@@ -188,7 +198,9 @@ int main(int argc, char** argv) {
     if (usage) {
         if (rank == 0) {
             /* At most one rank per kGhosts planes: a halo is a neighbour's interior planes. */
-            fprintf(stderr, "usage: heat_c_mpi ARCHIVE [STEPS] (STEPS > 0, at most %d ranks)\n",
+            fprintf(stderr,
+                    "usage: heat_c_mpi ARCHIVE [STEPS] [--stale-halos] (STEPS > 0, at most %d "
+                    "ranks)\n",
                     kCells / kGhosts);
         }
         MPI_Finalize();
@@ -206,7 +218,7 @@ int main(int argc, char** argv) {
         MPI_Finalize();
         return 1;
     }
-    int failures = run(instrument, steps, rank, ranks);
+    int failures = run(instrument, steps, stale_halos, rank, ranks);
     const int finalized = insitu_finalize(instrument);
     if (finalized != INSITU_OK) {
         fprintf(stderr, "heat_c_mpi: rank %d: finalize: %s: %s\n", rank,

@@ -29,29 +29,6 @@
 
 namespace insitu {
 
-std::string to_string(Status status) {
-    switch (status) {
-        case Status::ok:
-            return "ok";
-        case Status::not_selected:
-            return "not_selected";
-        case Status::dropped:
-            return "dropped";
-        case Status::error:
-            return "error";
-    }
-    return "unknown";
-}
-
-std::ostream& operator<<(std::ostream& out, Status status) {
-    return out << to_string(status);
-}
-
-std::ostream& operator<<(std::ostream& out, const InstrumentOptions& options) {
-    return out << "InstrumentOptions{rethrow_errors " << std::boolalpha << options.rethrow_errors
-               << ", log " << options.log << std::noboolalpha << "}";
-}
-
 namespace {
 
 namespace fs = std::filesystem;
@@ -81,6 +58,7 @@ struct Instrument::Impl {
     std::optional<std::int64_t> last_step;  ///< the last step execute() accepted
     bool finalized = false;
     bool nonfinite_reported = false;
+    std::optional<std::int64_t> halo_step;  ///< the step the halo check ran at ("first")
     // Replayed steps noted (by execute() or, in a rerun that asks first, by selects()): each
     // counted once, one notice for the run.
     bool replay_reported = false;
@@ -158,7 +136,7 @@ struct Instrument::Impl {
                        double& composite_seconds);
     /// Uploads field `name` (its one block, its tiles joined, or this rank's block) and returns
     /// the statistics its plan is chosen from: this process's, or reduced over the ranks.
-    std::unique_ptr<FieldStatistics> upload(const std::string& name,
+    std::unique_ptr<FieldStatistics> upload(std::int64_t step, const std::string& name,
                                             const std::vector<const Field*>& blocks,
                                             double& composite_seconds);
     /// Checks the value range and reports NaN/Inf samples (once per run).
@@ -368,7 +346,8 @@ StepRecord Instrument::Impl::compute(std::int64_t step, double time,
         for (const Field& field : fields) {
             if (field.name() == name) blocks.push_back(&field);
         }
-        const std::unique_ptr<FieldStatistics> statistics = upload(name, blocks, composite_seconds);
+        const std::unique_ptr<FieldStatistics> statistics =
+            upload(step, name, blocks, composite_seconds);
         check_range(name, statistics->range(), step);
         FieldPlan plan = plan_field(config, name, *statistics);
         if (budget) apply_budget(plan, *statistics);
@@ -377,13 +356,21 @@ StepRecord Instrument::Impl::compute(std::int64_t step, double time,
     return record;
 }
 
-std::unique_ptr<FieldStatistics> Instrument::Impl::upload(const std::string& name,
+std::unique_ptr<FieldStatistics> Instrument::Impl::upload(std::int64_t step,
+                                                          const std::string& name,
                                                           const std::vector<const Field*>& blocks,
                                                           double& composite_seconds) {
     // A rank may own nothing of a field: it passes no block, and marches nothing.
     if (communicator) {
-        return std::make_unique<ReducedFieldStatistics>(*communicator, *renderer, name, blocks,
-                                                        joined_blocks, composite_seconds);
+        auto reduced = std::make_unique<ReducedFieldStatistics>(
+            *communicator, *renderer, name, blocks, joined_blocks, composite_seconds);
+        // "halo_check": every field of the first step computed (halo_step), or of every step.
+        if (config.halo_check == HaloCheck::every ||
+            (config.halo_check == HaloCheck::first && halo_step.value_or(step) == step)) {
+            halo_step = step;
+            for (const std::string& line : reduced->check_halos(step)) log("warning: " + line);
+        }
+        return reduced;
     }
     // One block is marched where it lies (zero-copy up to the upload); tiles are joined.
     if (blocks.size() == 1) return std::make_unique<LocalFieldStatistics>(*renderer, *blocks[0]);

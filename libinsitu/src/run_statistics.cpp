@@ -5,7 +5,31 @@
 
 namespace insitu {
 
-// The summary line's statistics (finalize's log, the statistics' printer).
+// The instrument's printers: Status, InstrumentOptions, and the summary line's statistics
+// (finalize's log).
+std::string to_string(Status status) {
+    switch (status) {
+        case Status::ok:
+            return "ok";
+        case Status::not_selected:
+            return "not_selected";
+        case Status::dropped:
+            return "dropped";
+        case Status::error:
+            return "error";
+    }
+    return "unknown";
+}
+
+std::ostream& operator<<(std::ostream& out, Status status) {
+    return out << to_string(status);
+}
+
+std::ostream& operator<<(std::ostream& out, const InstrumentOptions& options) {
+    return out << "InstrumentOptions{rethrow_errors " << std::boolalpha << options.rethrow_errors
+               << ", log " << options.log << std::noboolalpha << "}";
+}
+
 std::ostream& operator<<(std::ostream& out, const InstrumentStatistics& s) {
     std::ostringstream line;
     line << std::fixed << std::setprecision(3) << "executed " << s.steps_executed << ", written "

@@ -140,6 +140,15 @@ enum class OnExisting {
     fail,     ///< refuse to start (IoError naming the archive)
 };
 
+/// "halo_check": in a distributed run, whether neighbouring ranks compare the ghost layer each
+/// draws from (its first high one) with the owner's interior and warn, naming the ranks, the
+/// side and the largest difference, when they disagree (parallel/halo_check.hpp).
+enum class HaloCheck {
+    first,  ///< at the first step computed (the default)
+    every,  ///< at every step computed
+    off,
+};
+
 /// A field's own settings, for a field written as an object in "fields":
 /// {"name": "energy", "views": [...], "transfer_function": {...}, "layers": [...] | "auto"}.
 /// What it leaves out comes from the top level. Training transfer functions (and the colour
@@ -227,6 +236,7 @@ struct InstrumentConfig {
     /// them warnings.
     bool strict = true;
     OnExisting on_existing = OnExisting::append;  ///< "on_existing"
+    HaloCheck halo_check = HaloCheck::first;      ///< "halo_check": "first" | "every" | "off"
     /// "light_field": per step and field, a light field (seed 001) from an icosphere of cameras
     /// (insitu/core/light_field.hpp), captured in the proxy pass; none by default.
     std::optional<LightFieldSettings> light_field;
