@@ -19,6 +19,7 @@
 #include "insitu/render/proxy_renderer.hpp"
 #include "parallel/agreement.hpp"
 #include "parallel/composited_passes.hpp"
+#include "parallel/distributed_config.hpp"
 #include "parallel/reduced_field_statistics.hpp"
 #include "representation/representation.hpp"
 #include "run_statistics.hpp"
@@ -184,26 +185,15 @@ void Instrument::Impl::open_distributed(InstrumentConfig distributed_config) {
     LocalFailure failure;
     failure.guard([&] {
         distributed_config.validate();
-        if (distributed_config.budget) {
-            fail<InvalidArgument>(
-                "\"budget\": an error budget is measured against a ground truth of the whole "
-                "field, which one process of a distributed run does not hold; give the settings "
-                "themselves, or measure them in a run without a communicator");
-        }
-        if (distributed_config.light_field) {
-            fail<InvalidArgument>(
-                "\"light_field\": light fields are not composited across ranks (their segments "
-                "and first hits depend on the opacity in front of a block, which the block "
-                "cannot know); capture them in a run without a communicator");
-        }
-        if (distributed_config.volume) {
-            fail<InvalidArgument>(
-                "\"volume\": a distributed run does not store the compressed field yet (each "
-                "rank would write its own blocks, and only rank 0 writes); keep it in a run "
-                "without a communicator");
-        }
+        refuse_what_ranks_cannot_composite(distributed_config);
     });
     config = std::move(distributed_config);
+    if (config.proxies.attenuation && (config.proxies.interleaving || config.proxies.entry_depth)) {
+        config.proxies.interleaving = config.proxies.entry_depth = false;
+        log("notice: a distributed run writes no \"interleaving\" or \"entry_depth\" (the "
+            "default \"proxies\" name them; a block cannot count what the ray met in front of "
+            "it): the archive's configuration lists neither");
+    }
     failure.guard([&] { renderer = std::make_unique<ProxyRenderer>(); });
     std::vector<double> archived;
     if (writes()) {
