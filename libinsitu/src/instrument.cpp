@@ -192,7 +192,8 @@ void Instrument::Impl::open_distributed(InstrumentConfig distributed_config) {
         config.proxies.interleaving = config.proxies.entry_depth = false;
         log("notice: a distributed run writes no \"interleaving\" or \"entry_depth\" (the "
             "default \"proxies\" name them; a block cannot count what the ray met in front of "
-            "it): the archive's configuration lists neither");
+            "it): the archive's configuration lists neither, and the viewer's edit trust goes "
+            "without them");
     }
     failure.guard([&] { renderer = std::make_unique<ProxyRenderer>(); });
     std::vector<double> archived;

@@ -404,41 +404,30 @@ TEST(InstrumentMpi, RefusesAnErrorBudget) {
 }
 
 // "interleaving" and "entry_depth" count what the ray met in front of a block, which a block
-// cannot know: listed, they are refused at construction naming them; left to the default list,
-// the archive's configuration says they were not written (no silent drop).
-TEST(InstrumentMpi, RefusesListedInterleavingAndEntryDepth) {
+// cannot know: listed or left to the default list, a distributed run drops them with a notice,
+// and the archive's configuration says they were not written (no silent drop, no false echo).
+TEST(InstrumentMpi, DropsInterleavingAndEntryDepthAndSaysSo) {
     const std::string directory = shared_directory("interleaving");
-    const auto without_proxies = [&](const std::string& archive) {
-        std::string config = configuration(archive, "[0.35]", "uniform");
-        const std::size_t at = config.find("\"proxies\"");
-        return config.erase(at, config.find(']', at) - at + 2);  // "proxies": [...],
-    };
-    for (const std::string proxy : {"interleaving", "entry_depth"}) {
-        std::string config = without_proxies(directory + "/listed.cdb");
-        config.insert(config.size() - 1,
-                      R"(, "proxies": ["depth", "attenuation", ")" + proxy + R"("])");
-        try {
-            mpi::instrument_from_json_text(config, MPI_COMM_WORLD);
-            ADD_FAILURE() << "a distributed instrument took " << proxy;
-        } catch (const InvalidArgument& error) {
-            EXPECT_NE(std::string(error.what()).find("rank 0: \"proxies\": \"" + proxy + "\""),
-                      std::string::npos)
-                << error.what();
-        }
-    }
-    InstrumentOptions quiet;
-    quiet.log = false;
-    // The default list names both.
-    auto instrument = mpi::instrument_from_json_text(without_proxies(directory + "/defaults.cdb"),
-                                                     MPI_COMM_WORLD, quiet);
+    std::string config = configuration(directory + "/dropped.cdb", "[0.35]", "uniform");
+    const std::size_t at = config.find("\"proxies\"");
+    config.erase(at, config.find(']', at) - at + 2);  // "proxies": [...],
+    config.insert(config.size() - 1,
+                  R"(, "proxies": ["depth", "attenuation", "interleaving", "entry_depth"])");
+    if (world_rank() == 0) ::testing::internal::CaptureStderr();
+    auto instrument = mpi::instrument_from_json_text(config, MPI_COMM_WORLD);
     const SampledVolume volume = field_at(0);
     EXPECT_EQ(instrument->execute(0, 0.0, views_of(my_blocks(volume, {world_size(), 1, 1}))),
               Status::ok);
     EXPECT_EQ(instrument->finalize(), Status::ok);
     instrument.reset();
     if (world_rank() == 0) {
+        const std::string log = ::testing::internal::GetCapturedStderr();
+        EXPECT_NE(log.find("notice: a distributed run writes no \"interleaving\" or "
+                           "\"entry_depth\""),
+                  std::string::npos)
+            << log;
         const ProxySelection written =
-            ArchiveReader(directory + "/defaults.cdb").configuration().proxies;
+            ArchiveReader(directory + "/dropped.cdb").configuration().proxies;
         EXPECT_TRUE(written.attenuation);
         EXPECT_FALSE(written.interleaving);
         EXPECT_FALSE(written.entry_depth);

@@ -97,8 +97,7 @@ struct ProxySelection {
     /// it costs a small share of the archive's bytes and no measurable time (bench/RESULTS.md,
     /// "Interleaving counts on by default").
     /// Not written by distributed runs: a block cannot count what the ray met in front of it
-    /// (listed there, refused at construction; the default list's dropped with a notice and
-    /// left out of the archive's configuration).
+    /// (dropped there with a notice, and left out of the archive's configuration).
     bool interleaving = true;
     /// "entry_depth" (with "attenuation"): per pixel and interval, the depth where the
     /// interval first took light, counted in the attenuation pass. Opacity edits that thicken

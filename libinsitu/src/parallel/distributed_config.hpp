@@ -1,7 +1,8 @@
 #pragma once
 // What a distributed run refuses at construction, on every rank alike: what one process of it
-// cannot make (a budget's ground truth, light fields, the compressed field, the interleaving
-// counts and entry depths a block cannot count), each named by its key.
+// cannot make (a budget's ground truth, light fields, the compressed field), each named by its
+// key. (The interleaving counts and entry depths, which a block cannot count either, are on in
+// every default selection, the C++ one included, so the Instrument drops them with a notice.)
 #include "insitu/config.hpp"
 
 namespace insitu {
