@@ -4,10 +4,15 @@
 # the installed tools run from the prefix (relative RPATH), pkg-config and insitu-config agree
 # with the build, examples/makefile/ builds the C and (given FC) Fortran heat examples with each
 # of them, a CMake project finds insitu::insitu_c and insitu::insitu_fortran, and every program
-# writes an archive with a manifest. Fails, rather than skips, when make or pkg-config is missing
-# (scripts/setup installs both). With INSITU_PYTHON set (the interpreter the Python module was
-# built for), the module installed into the prefix, at the path the install prints, imports with
-# that path on PYTHONPATH and opens the C example's archive.
+# writes an archive with a manifest. The Makefile is the installed one
+# (share/insitu/examples/makefile/, with the example sources beside it). Given
+# INSITU_TEST_MPI_PROGRAMS (heat_c_mpi, heat_fortran_mpi) and INSITU_TEST_MPIEXEC (mpiexec -n 2
+# ...), the MPI examples are built by the plain CC and FC from insitu-mpi.pc,
+# insitu-mpi-fortran.pc and insitu-config --mpi alone, and run. Fails, rather than skips, when
+# make or pkg-config is missing (scripts/setup installs both).
+# With INSITU_PYTHON set (the interpreter the Python module was built for), the module installed
+# into the prefix, at the path the install prints, imports with that path on PYTHONPATH and opens
+# the C example's archive.
 set -euo pipefail
 if [ $# -lt 6 ] || [ $# -gt 7 ]; then
   echo "usage: install_test.sh CMAKE BUILD_DIR SOURCE_DIR LIBDIR VERSION CC [FC]" >&2
@@ -72,13 +77,38 @@ run_programs() {
   done
 }
 
-makefile="$source_dir/examples/makefile/Makefile"
+makefile="$prefix/share/insitu/examples/makefile/Makefile"
+[ -f "$makefile" ] || fail "share/insitu/examples/makefile/Makefile missing"
 mkdir "$work/pkg-config" "$work/insitu-config"
 quietly make -C "$work/pkg-config" -f "$makefile" CC="$cc" FC="$fc" "${programs[@]}"
 run_programs "$work/pkg-config"
 quietly make -C "$work/insitu-config" -f "$makefile" CC="$cc" FC="$fc" \
   INSITU_CONFIG="$prefix/bin/insitu-config" "${programs[@]}"
 run_programs "$work/insitu-config"
+
+# The MPI examples, linked by the plain compilers (MPICC=CC): every flag, MPI's included, comes
+# from the installed files; run at 2 ranks, rank 0 writes the archive.
+read -r -a mpi_programs <<<"${INSITU_TEST_MPI_PROGRAMS:-}"
+read -r -a mpiexec <<<"${INSITU_TEST_MPIEXEC:-}"
+if [ ${#mpi_programs[@]} -gt 0 ]; then
+  for pc in insitu-mpi insitu-mpi-fortran; do
+    if [[ $pc == *fortran && ${#mpi_programs[@]} -lt 2 ]]; then continue; fi
+    [ "$(pkg-config --modversion "$pc")" = "$version" ] || fail "$pc.pc: version is not $version"
+  done
+  for dir in pkg-config insitu-config; do
+    config=()
+    if [ "$dir" = insitu-config ]; then config=(INSITU_CONFIG="$prefix/bin/insitu-config"); fi
+    quietly make -C "$work/$dir" -f "$makefile" MPICC="$cc" MPIFC="$fc" "${config[@]}" \
+      "${mpi_programs[@]}"
+    for program in "${mpi_programs[@]}"; do
+      quietly "${mpiexec[@]}" "$work/$dir/$program" "$work/$dir/$program.cdb" 10
+      [ -s "$work/$dir/$program.cdb/proxies/step000010_view0.exr" ] ||
+        fail "$work/$dir/$program.cdb: no proxy of step 10"
+    done
+  done
+  echo "install_test: ${mpi_programs[*]} linked by $cc${fc:+ and $fc} from insitu-mpi.pc and" \
+       "insitu-config --mpi, run by ${mpiexec[*]}"
+fi
 
 consumer=(-S "$source_dir/tests/install/consumer" -B "$work/cmake" -DCMAKE_C_COMPILER="$cc"
           -DCMAKE_PREFIX_PATH="$prefix" -DEXAMPLES="$source_dir/examples")

@@ -339,6 +339,70 @@ TEST(InstrumentMpi, ARankZeroWriteFailureIsEveryRanksError) {
     }
 }
 
+// Runs steps 0 and 1 over slabs along x with rank 0's high x ghost layer stale (0.5 off the
+// neighbour's values) and returns what rank 0 logged (empty elsewhere).
+std::string log_with_a_stale_halo(const std::string& name, const std::string& halo_check) {
+    const std::string directory = shared_directory(name);
+    std::string config = configuration(directory + "/halo.cdb", "[0.35]", "uniform");
+    if (!halo_check.empty()) {
+        config.insert(config.size() - 1, R"(, "halo_check": ")" + halo_check + "\"");
+    }
+    auto instrument = mpi::instrument_from_json_text(config, MPI_COMM_WORLD);
+    if (world_rank() == 0) ::testing::internal::CaptureStderr();
+    for (int step = 0; step < 2; ++step) {
+        std::vector<VolumeBlock> blocks = my_blocks(field_at(step), {world_size(), 1, 1});
+        if (world_rank() == 0 && world_size() > 1) {
+            VolumeBlock& block = blocks.front();
+            const std::int64_t last = block.allocated[0] - 1;  // the ghost layer rank 0 draws from
+            for (std::int64_t k = 0; k < block.allocated[2]; ++k) {
+                for (std::int64_t j = 0; j < block.allocated[1]; ++j) {
+                    block.values[static_cast<std::size_t>(
+                        last + block.allocated[0] * (j + block.allocated[1] * k))] += 0.5f;
+                }
+            }
+        }
+        EXPECT_EQ(instrument->execute(step, step, views_of(blocks)), Status::ok)
+            << instrument->last_error();
+    }
+    EXPECT_EQ(instrument->finalize(), Status::ok);
+    instrument.reset();
+    return world_rank() == 0 ? ::testing::internal::GetCapturedStderr() : std::string();
+}
+
+std::size_t occurrences(const std::string& text, const std::string& part) {
+    std::size_t count = 0;
+    for (std::size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) {
+        ++count;
+    }
+    return count;
+}
+
+// The halo check: at the first step computed, rank 0 is told that the ghost layer rank 0 draws
+// from is not rank 1's interior, with the side and the largest difference; once, by default.
+TEST(InstrumentMpi, AStaleHaloIsNamedAtTheFirstStep) {
+    const std::string log = log_with_a_stale_halo("stale_halo", "");
+    if (world_rank() != 0) return;
+    const std::string warning =
+        "the ghost layer rank 0 hands over on its high x side differs from rank 1's interior";
+    if (world_size() == 1) {
+        EXPECT_EQ(log.find("ghost layer"), std::string::npos) << log;  // no neighbour
+        return;
+    }
+    EXPECT_EQ(occurrences(log, warning), 1u) << log;
+    EXPECT_NE(log.find("step 0: field \"f\""), std::string::npos) << log;
+    EXPECT_NE(log.find("largest difference 0.5"), std::string::npos) << log;
+    EXPECT_NE(log.find("in 990 of 990 samples"), std::string::npos) << log;  // 33 x 30, all off
+}
+
+TEST(InstrumentMpi, TheHaloCheckRunsEveryStepOrNeverOnRequest) {
+    const std::string every = log_with_a_stale_halo("halo_every", "every");
+    const std::string off = log_with_a_stale_halo("halo_off", "off");
+    if (world_rank() != 0) return;
+    EXPECT_EQ(occurrences(every, "hands over on its high x side"), world_size() > 1 ? 2u : 0u)
+        << every;
+    EXPECT_EQ(off.find("ghost layer"), std::string::npos) << off;
+}
+
 // Light fields have no exact composite: refused on every rank, at construction.
 TEST(InstrumentMpi, RefusesLightFields) {
     const std::string directory = shared_directory("light_field");
@@ -408,6 +472,37 @@ TEST(InstrumentMpi, RefusesAnErrorBudget) {
     } catch (const InvalidArgument& error) {
         EXPECT_NE(std::string(error.what()).find("rank 0: \"budget\""), std::string::npos)
             << error.what();
+    }
+}
+
+// "interleaving" and "entry_depth" count what the ray met in front of a block, which a block
+// cannot know: listed or left to the default list, a distributed run drops them with a notice,
+// and the archive's configuration says they were not written (no silent drop, no false echo).
+TEST(InstrumentMpi, DropsInterleavingAndEntryDepthAndSaysSo) {
+    const std::string directory = shared_directory("interleaving");
+    std::string config = configuration(directory + "/dropped.cdb", "[0.35]", "uniform");
+    const std::size_t at = config.find("\"proxies\"");
+    config.erase(at, config.find(']', at) - at + 2);  // "proxies": [...],
+    config.insert(config.size() - 1,
+                  R"(, "proxies": ["depth", "attenuation", "interleaving", "entry_depth"])");
+    if (world_rank() == 0) ::testing::internal::CaptureStderr();
+    auto instrument = mpi::instrument_from_json_text(config, MPI_COMM_WORLD);
+    const SampledVolume volume = field_at(0);
+    EXPECT_EQ(instrument->execute(0, 0.0, views_of(my_blocks(volume, {world_size(), 1, 1}))),
+              Status::ok);
+    EXPECT_EQ(instrument->finalize(), Status::ok);
+    instrument.reset();
+    if (world_rank() == 0) {
+        const std::string log = ::testing::internal::GetCapturedStderr();
+        EXPECT_NE(log.find("notice: a distributed run writes no \"interleaving\" or "
+                           "\"entry_depth\""),
+                  std::string::npos)
+            << log;
+        const ProxySelection written =
+            ArchiveReader(directory + "/dropped.cdb").configuration().proxies;
+        EXPECT_TRUE(written.attenuation);
+        EXPECT_FALSE(written.interleaving);
+        EXPECT_FALSE(written.entry_depth);
     }
 }
 

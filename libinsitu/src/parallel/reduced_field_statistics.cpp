@@ -3,6 +3,7 @@
 #include <limits>
 
 #include "core/elapsed.hpp"
+#include "parallel/halo_check.hpp"
 
 namespace insitu {
 
@@ -128,6 +129,19 @@ BlockPlacement ReducedFieldStatistics::placement() const {
         ++mine.count;
     }
     return mine;
+}
+
+std::vector<std::string> ReducedFieldStatistics::check_halos(std::int64_t step) {
+    const auto start = SteadyClock::now();
+    agree(ranks_, failure_);  // every rank uploaded its block, or all raise the failure
+    const std::vector<HaloMismatch> mismatches =
+        compare_halos(ranks_, *grid_, block_ ? &renderer_.volume() : nullptr);
+    collective_seconds_ += seconds_since(start);
+    std::vector<std::string> lines;
+    for (const HaloMismatch& mismatch : mismatches) {
+        lines.push_back(describe(mismatch, *grid_, step, max() - min()));
+    }
+    return lines;
 }
 
 }  // namespace insitu
