@@ -10,7 +10,7 @@ import { currentOptions } from './explore_options.js';
 import { requestFrame, updateMask } from './frames.js';
 import { forgetTrust, installOrbitDrag, resetView } from './orbit.js';
 import { loadTf, resetTf, saveTf } from './tf_editor.js';
-import { loadArchive, setPlaying, stepChanged } from './timeline.js';
+import { askedStep, loadArchive, setPlaying, stepChanged } from './timeline.js';
 import { GpuFrames } from './gpu_frames.js';
 
 viewer.options = () => currentOptions();
@@ -65,6 +65,12 @@ async function start() {
   installControls();
   installOrbitDrag();
   viewer.gpu = await GpuFrames.create($('gpu-frame'));
+  if (viewer.gpu) {
+    viewer.gpu.wanted = (step, view) => {
+      const now = askedStep();
+      return Boolean(now && now.step === step && now.view === view);
+    };
+  }
   $('gpu-toggle').disabled = !viewer.gpu;
   // ?gpu=off opens the page with the server's frames only (to compare, or on a slow GPU).
   if (new URLSearchParams(window.location.search).get('gpu') === 'off') {

@@ -8,7 +8,7 @@
 import { $, FPS_WINDOW_MS, errorText, session, showError, state, viewer } from './page.js';
 import { currentOptions, sameOptions } from './explore_options.js';
 import { baseTf } from './transfer_function.js';
-import { schedulePlay } from './timeline.js';
+import { askedStep, schedulePlay } from './timeline.js';
 
 let inFlight = false;
 const READOUT_EVERY_MS = 250;
@@ -68,9 +68,23 @@ function recipeFor(options) {
   return recipes.get(key);
 }
 
+// Whether a frame of `options` is one of the step and view the page asks for now; a frame of
+// another (asked for before the slider moved on) is dropped, not shown under the new label.
+export function asked(options) {
+  const now = askedStep();
+  return Boolean(now && options.step === String(now.step) && options.view === String(now.view));
+}
+
+// Whether the page holds the description (/api/step) of the step and view of `options`: until
+// then no frame is made for them (stepChanged asks for it once it has it).
+function described(options) {
+  return Boolean(state.info && String(state.info.step) === options.step &&
+    String(state.info.view) === options.view);
+}
+
 export function requestFrame() {
   const options = currentOptions();
-  if (!options || inFlight) return;
+  if (!options || inFlight || !described(options)) return;
   // While dragging, what the browser draws may be a preview (gpu_frames.js: the full frame
   // once the pointer rests).
   const dragging = state.dragging && (drawnInBrowser(options) || proxiesInBrowser());
@@ -101,6 +115,7 @@ function serverFrame(options) {
         return;
       }
       const png = new Uint8Array(await response.arrayBuffer());
+      if (!asked(options)) return;  // late: the page asks for another step now
       await display(options, png, response.headers, performance.now() - sent);
       showError('');
     })
@@ -138,6 +153,7 @@ async function drawProxies(options, dragging) {
   viewer.gpu.drawProxies(entry.step, state.view, recipe, Number(options.azimuth),
     Number(options.elevation), dragging, true, !unedited(options))
     .then((timing) => {
+      if (timing && timing.dropped) return frameDone();
       if (!timing) {
         serverFrame(options);
         return null;
@@ -165,6 +181,7 @@ function drawVolume(options, dragging, recipe) {
   viewer.gpu.drawVolume(entry.step, state.view, recipe, state.info.camera, volumeTf(options),
     !atStoredView(options), Number(options.azimuth), Number(options.elevation), dragging)
     .then((timing) => {
+      if (timing && timing.dropped) return frameDone();
       if (!timing) {
         serverFrame(options);
         return null;
@@ -209,6 +226,7 @@ function drawInBrowser(options, dragging, recipe = null) {
   viewer.gpu.draw(entry.step, state.view, state.info.camera, Number(options.azimuth),
     Number(options.elevation), state.segmentScales.slice(), dragging, recipe, !unedited(options))
     .then((timing) => {
+      if (timing && timing.dropped) return frameDone();
       if (!timing) {
         serverFrame(options);
         return null;
@@ -223,6 +241,8 @@ function drawInBrowser(options, dragging, recipe = null) {
 
 // Shows the canvas the GPU just drew (`what`: light field or stored view).
 function showGpuFrame(options, timing, what, colourSource) {
+  // The step moved on while the GPU drew: the next frame (frameDone) is the asked step's.
+  if (!asked(options)) return Promise.resolve();
   const preview = timing.preview;
   showCanvas(true);
   // A preview is smaller than the view: scaled up smoothly, not in blocks.

@@ -40,11 +40,24 @@ function updateStepLabel() {
     : 'no steps yet';
 }
 
+// Each stepChanged call's number: its replies are used only while it is the latest, so a step
+// that loads slower than the index's refresh (which replaces the timeline's objects) is still
+// shown, and a reply for a step or view no longer asked for is dropped.
+let stepRequests = 0;
+
+/// The (step, view) the page asks for now: the slider's step and the view selected.
+export function askedStep() {
+  const entry = state.timeline[state.stepIndex];
+  return entry ? { step: entry.step, view: state.view } : null;
+}
+
 export async function stepChanged() {
   updateStepLabel();
-  const entry = state.timeline[state.stepIndex];
-  if (!entry) return;
-  const info = await getJson(`api/step?step=${entry.step}&view=${state.view}`);
+  const asked = askedStep();
+  if (!asked) return;
+  const request = ++stepRequests;
+  const { step, view } = asked;
+  const info = await getJson(`api/step?step=${step}&view=${view}`);
   let lightField = false;
   // A compressed field of the view's field (/api/step lists it): the recipe may draw from it.
   const volume = Boolean(info.volume);
@@ -52,11 +65,11 @@ export async function stepChanged() {
     // Only a step that lists a light field of the view's field (its segments) is asked for one:
     // probing the others cost a 404 each.
     lightField = info.light_field_segments > 0 &&
-      await viewer.gpu.has(entry.step, state.view).catch(() => false);
+      await viewer.gpu.has(step, view).catch(() => false);
     const next = state.timeline[state.stepIndex + 1];
-    if ((lightField || volume) && next) viewer.gpu.prefetch(next.step, state.view, { lightField, volume });
+    if ((lightField || volume) && next) viewer.gpu.prefetch(next.step, view, { lightField, volume });
   }
-  if (state.timeline[state.stepIndex] !== entry) return;  // the slider moved on meanwhile
+  if (request !== stepRequests) return;  // another step or view was asked for meanwhile
   state.lightField = lightField;
   state.volume = volume;
   const count = info.intervals ? info.intervals.length - 1 : 0;
