@@ -12,6 +12,7 @@ import { forgetTrust, installOrbitDrag, resetView } from './orbit.js';
 import { loadTf, resetTf, saveTf } from './tf_editor.js';
 import { askedStep, loadArchive, setPlaying, stepChanged } from './timeline.js';
 import { GpuFrames } from './gpu_frames.js';
+import { paintLegend } from './overlay.js';
 
 viewer.options = () => currentOptions();
 
@@ -64,6 +65,7 @@ function installControls() {
 async function start() {
   installControls();
   installOrbitDrag();
+  paintLegend($('overlay-legend'));
   viewer.gpu = await GpuFrames.create($('gpu-frame'));
   if (viewer.gpu) {
     viewer.gpu.wanted = (step, view) => {

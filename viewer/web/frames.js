@@ -8,6 +8,7 @@
 import { $, FPS_WINDOW_MS, errorText, session, showError, state, viewer } from './page.js';
 import { currentOptions, sameOptions } from './explore_options.js';
 import { baseTf } from './transfer_function.js';
+import { paintOverlay, shownAlpha } from './overlay.js';
 import { askedStep, schedulePlay } from './timeline.js';
 
 let inFlight = false;
@@ -239,6 +240,19 @@ function drawInBrowser(options, dragging, recipe = null) {
     });
 }
 
+// Where a frame's colour comes from, in words: a frame from the compressed field is classified
+// by the transfer function itself (the engine's colour source names how proxies' frames are
+// coloured and does not apply to it).
+export function colourWords(drawnFrom, colourSource) {
+  if (drawnFrom === 'compressed field') return 'colour: transfer function on the field';
+  return {
+    recompose: 'colour: recomposed from the intervals',
+    model: 'colour: colour model',
+    captured: 'colour: as the light field captured it',
+    stored: 'colour: the stored picture',
+  }[colourSource] || `colour: ${colourSource}`;
+}
+
 // Shows the canvas the GPU just drew (`what`: light field or stored view).
 function showGpuFrame(options, timing, what, colourSource) {
   // The step moved on while the GPU drew: the next frame (frameDone) is the asked step's.
@@ -261,7 +275,7 @@ function showGpuFrame(options, timing, what, colourSource) {
     `frame ${timing.milliseconds.toFixed(1)} ms (WebGL2, ${what}` +
     `${preview ? `, preview ${timing.size[0]}x${timing.size[1]}` : ''})` +
     ` · ${fps.toFixed(1)} fps · step opened in ${(open.downloadMs + open.uploadMs).toFixed(0)} ms` +
-    ` (${(open.bytes / 1e6).toFixed(1)} MB)` + ` · colour ${colourSource}`;
+    ` (${(open.bytes / 1e6).toFixed(1)} MB)` + ` · ${colourWords(what, colourSource)}`;
   showError('');
   return updateMask();
 }
@@ -286,6 +300,7 @@ async function display(options, png, headers, roundTripMs) {
     encodeMilliseconds: Number(header('X-Insitu-Encode-Milliseconds')),
     confidence: Number(header('X-Insitu-Confidence')),
     colourSource: header('X-Insitu-Colour-Source'),
+    proxySource: header('X-Insitu-Proxy-Source'),
     synthesised: header('X-Insitu-Synthesised') === '1',
   };
   const fps = countFrame();
@@ -294,7 +309,8 @@ async function display(options, png, headers, roundTripMs) {
     `frame ${d.milliseconds.toFixed(1)} ms (engine) + ${d.encodeMilliseconds.toFixed(1)} ms (PNG)` +
     ` · ${roundTripMs.toFixed(1)} ms (round trip)` +
     ` · ${fps.toFixed(1)} fps · mean confidence ${d.confidence.toFixed(3)}` +
-    ` · colour ${d.colourSource}${d.synthesised ? ' · synthesised view' : ' · stored view'}`;
+    ` · ${colourWords(d.proxySource === 'volume' ? 'compressed field' : '', d.colourSource)}` +
+    `${d.synthesised ? ' · synthesised view' : ' · stored view'}`;
   await updateMask();
 }
 
@@ -306,6 +322,7 @@ function unedited(options) {
 export async function updateMask() {
   const canvas = $('mask-overlay');
   canvas.hidden = !state.mask;
+  $('overlay-legend').hidden = !state.mask;
   if (!state.mask || !viewer.displayed) return;
   const displayed = viewer.displayed;
   // A preview keeps the overlay it has: the full frame follows once the pointer rests.
@@ -350,18 +367,10 @@ export async function updateMask() {
     viewer.maskFrom = 'server';
   }
   if (!sameOptions(options, viewer.displayed.options)) return;
-  canvas.width = width;
-  canvas.height = height;
-  const context = canvas.getContext('2d');
-  // Untrusted pixels in red, as opaque as they are untrusted; trusted ones clear.
-  const pixels = context.createImageData(width, height);
-  for (let p = 0; p < confidence.length; ++p) {
-    pixels.data[4 * p] = 255;
-    pixels.data[4 * p + 1] = 40;
-    pixels.data[4 * p + 2] = 40;
-    pixels.data[4 * p + 3] = Math.round((255 - confidence[p]) * 0.7);
-  }
-  context.putImageData(pixels, 0, 0);
+  // Where the frame shows nothing and the data vouches for that, nothing is painted; where it
+  // shows nothing but no stored view saw the space, "unknown" (overlay.js).
+  const shownElement = displayed.gpu ? $('gpu-frame') : $('frame');
+  paintOverlay(canvas, confidence, shownAlpha(shownElement, width, height), width, height);
   viewer.maskConfidence = confidence;  // for tests
   viewer.maskCount = (viewer.maskCount || 0) + 1;
 }
