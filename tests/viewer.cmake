@@ -65,7 +65,7 @@ set_tests_properties(viewer.frame_cost PROPERTIES TIMEOUT 60)
 # canvas with `insitu-view render`; confidence.test.mjs compares the page's confidence overlay
 # with `render --mask`. The archive stores every proxy an edit's trust and estimate read (the
 # rendering, interleaving, entry and optical depth), so both sides take every term.
-foreach(suite IN ITEMS browser api colour_model confidence timeline)
+foreach(suite IN ITEMS browser api colour_model confidence timeline meaning)
   add_test(NAME viewer.${suite}
            COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/${suite}.test.mjs
            WORKING_DIRECTORY ${viewer_tests_dir})

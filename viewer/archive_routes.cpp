@@ -53,6 +53,7 @@ json step_description(const ArchiveReader& reader, const StepKey& key) {
     const Camera& camera = frame.camera;
     json info{{"step", key.step},
               {"view", key.view},
+              {"field", reader.entry(key.step, key.view).field},
               {"time", reader.entry(key.step, key.view).time},
               {"size", {camera.width(), camera.height()}},
               {"projection", to_string(camera.projection())},

@@ -9,6 +9,8 @@ import { $, FPS_WINDOW_MS, errorText, session, showError, state, viewer } from '
 import { currentOptions, sameOptions } from './explore_options.js';
 import { baseTf } from './transfer_function.js';
 import { paintOverlay, shownAlpha } from './overlay.js';
+import { drawAnnotations } from './annotations.js';
+import { writeViewQuery } from './view_state.js';
 import { askedStep, schedulePlay } from './timeline.js';
 
 let inFlight = false;
@@ -83,17 +85,33 @@ function described(options) {
     String(state.info.view) === options.view);
 }
 
+// How frames are drawn now: "draw in the browser" checked, and with a GPU ready.
+function drawingToggle() {
+  return `${$('gpu-toggle').checked}/${Boolean(viewer.gpu)}`;
+}
+
+// How the frame in flight was asked to be drawn (drawingToggle when it was requested).
+let requestedToggle = '';
+
+// Whether a frame is being made (tests wait until none is).
+viewer.busy = () => inFlight;
+
 export function requestFrame() {
   const options = currentOptions();
-  if (!options || inFlight || !described(options)) return;
+  if (!options) return;
+  drawAnnotations();
+  writeViewQuery();
+  if (inFlight || !described(options)) return;
   // While dragging, what the browser draws may be a preview (gpu_frames.js: the full frame
   // once the pointer rests).
   const dragging = state.dragging && (drawnInBrowser(options) || proxiesInBrowser());
-  // The same options drawn the same way (toggling "draw in the browser" redraws them).
+  // The same options drawn the same way (toggling "draw in the browser", or the browser's
+  // WebGL2 becoming ready after the first frame, redraws them).
   if (viewer.displayed && sameOptions(viewer.displayed.options, options) &&
     !(viewer.displayed.preview && !dragging) &&
-    viewer.displayed.toggle === $('gpu-toggle').checked) return;
+    viewer.displayed.toggle === drawingToggle()) return;
   inFlight = true;
+  requestedToggle = drawingToggle();
   if (drawnInBrowser(options)) {
     drawInBrowser(options, dragging);
   } else if (proxiesInBrowser()) {
@@ -199,8 +217,11 @@ function drawVolume(options, dragging, recipe) {
 function frameDone() {
   inFlight = false;
   const next = currentOptions();
+  // Also redrawn: a preview once the pointer rests, and a frame drawn before the browser's
+  // WebGL2 was ready (or before "draw in the browser" was toggled).
   if (!viewer.displayed || !sameOptions(viewer.displayed.options, next) ||
-    (viewer.displayed.preview && !state.dragging)) requestFrame();
+    (viewer.displayed.preview && !state.dragging) ||
+    viewer.displayed.toggle !== drawingToggle()) requestFrame();
   else if (state.playing) schedulePlay();
 }
 
@@ -208,6 +229,7 @@ function frameDone() {
 function countFrame() {
   viewer.frameCount += 1;
   const now = performance.now();
+  if (viewer.frameCount === 1) viewer.firstFrameAt = now;
   viewer.frameTimes.push(now);
   while (viewer.frameTimes.length && viewer.frameTimes[0] < now - FPS_WINDOW_MS) viewer.frameTimes.shift();
   return viewer.frameTimes.length > 1
@@ -263,7 +285,7 @@ function showGpuFrame(options, timing, what, colourSource) {
   $('gpu-frame').style.imageRendering = preview ? 'auto' : '';
   if (viewer.displayed && viewer.displayed.url) URL.revokeObjectURL(viewer.displayed.url);
   viewer.displayed = { options, gpu: true, drawnFrom: what, preview, size: timing.size,
-    toggle: $('gpu-toggle').checked, milliseconds: timing.milliseconds,
+    toggle: requestedToggle, milliseconds: timing.milliseconds,
     synthesised: what !== 'stored view', colourSource };
   const fps = countFrame();
   const open = viewer.gpu.lastOpen;
@@ -293,7 +315,7 @@ async function display(options, png, headers, roundTripMs) {
   const header = (name) => headers.get(name);
   viewer.displayed = {
     options,
-    toggle: $('gpu-toggle').checked,
+    toggle: requestedToggle,
     png,
     url,
     milliseconds: Number(header('X-Insitu-Milliseconds')),

@@ -156,7 +156,8 @@ export function installOrbitDrag() {
   const viewport = $('viewport');
   let drag = null;
   viewport.addEventListener('pointerdown', (event) => {
-    if (!state.info) return;
+    // Shift-drag and the middle button pan (zoom.js).
+    if (!state.info || event.shiftKey || event.button !== 0) return;
     const [az, el] = storedAngles();
     drag = { x: event.clientX, y: event.clientY, azimuth: state.azimuth ?? az,
       elevation: state.elevation ?? el };

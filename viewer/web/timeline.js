@@ -5,6 +5,7 @@ import { showSegmentFaders } from './segment_faders.js';
 import { requestFrame } from './frames.js';
 import { drawTfEditor } from './tf_editor.js';
 import { requestTrust, syncOrbitInputs } from './orbit.js';
+import { applyValueEdits } from './value_edits.js';
 
 export async function loadArchive() {
   const archive = await getJson('api/archive');
@@ -57,6 +58,9 @@ export async function stepChanged() {
   if (!asked) return;
   const request = ++stepRequests;
   const { step, view } = asked;
+  // Until the step's description comes, the picture is still the step before: said so.
+  $('step-label').classList.toggle('loading', !state.info || state.info.step !== step ||
+    state.info.view !== view);
   const info = await getJson(`api/step?step=${step}&view=${view}`);
   let lightField = false;
   // A compressed field of the view's field (/api/step lists it): the recipe may draw from it.
@@ -70,13 +74,11 @@ export async function stepChanged() {
     if ((lightField || volume) && next) viewer.gpu.prefetch(next.step, view, { lightField, volume });
   }
   if (request !== stepRequests) return;  // another step or view was asked for meanwhile
+  $('step-label').classList.remove('loading');
   state.lightField = lightField;
   state.volume = volume;
-  const count = info.intervals ? info.intervals.length - 1 : 0;
-  if (count !== state.scales.length) {
-    state.scales = new Array(count).fill(1);
-    state.colours = new Array(count).fill(null);
-  }
+  // The edits stay on the field values they were made at (value_edits.js).
+  applyValueEdits(info.intervals || [0]);
   state.info = info;
   // Faders for a light field captured in segments; the same run keeps its segments, and the
   // factors set, from step to step.

@@ -8,8 +8,18 @@ export function storedTf() {
   if (state.info && state.info.transfer_function) return state.info.transfer_function;
   return state.archive ? state.archive.transfer_function : null;
 }
+/// The function chosen for every step: a loaded one, or with "same colours at every step" the
+/// first step's (the archive's, so that a colour means one value across the run where
+/// "transfer_function" is "auto" and each step has its own); null: each step's own.
+export function chosenTf() {
+  if (state.baseTf) return state.baseTf;
+  if (state.runColours && state.archive && state.archive.transfer_function) {
+    return state.archive.transfer_function;
+  }
+  return null;
+}
 export function baseTf() {
-  return state.baseTf || storedTf();
+  return chosenTf() || storedTf();
 }
 export function isEditable(tf) {
   return tf && Array.isArray(tf.points);
