@@ -3,7 +3,7 @@
 // frames only; each RUNS times in a fresh page, printed as best, median and spread:
 //  * first frame: from navigation to the first frame shown (the server's exact stored view);
 //  * page ready: from navigation until the page draws in the browser (its shaders built);
-//  * step change: from moving the slider to the next step to its whole frame shown (the step's
+//  * step change: from moving the slider to the next step to its first frame shown (the step's
 //    data not downloaded before: each run opens a new page);
 //  * opacity edit: from setting an interval's opacity scale to the edited frame shown.
 //
@@ -49,7 +49,13 @@ async function oneRun(browser, url) {
     slider.dispatchEvent(new Event('input'));
     return t;
   });
-  waits['step change'] = await settledAfter(page, count) - start;
+  // The new step's first frame (the server's exact stored view while its proxies download).
+  await page.waitForFunction((n) => {
+    const v = window.insituViewer;
+    return v.frameCount > n && v.displayed.options.step === v.options().step;
+  }, count, { timeout: 120000 });
+  waits['step change'] = await page.evaluate(() => performance.now()) - start;
+  await settledAfter(page, count);
   count = await page.evaluate(() => window.insituViewer.frameCount);
   // The middle interval's opacity x 0.25, as the handle's drag sets it.
   start = await page.evaluate(() => window.insituViewer.setOpacityScale(

@@ -125,3 +125,40 @@ test('a reply for a step no longer asked for is not shown', async () => {
   assert.deepEqual(errors, []);
   await page.close();
 });
+
+test('a step change shows the stored view before the step\'s proxies have come', async () => {
+  const steps = await timeline();
+  const errors = [];
+  const page = await openViewerPage(session.browser, session.server.url, errors);
+  await waitForSettledFrame(page);
+  assert.equal(await page.evaluate(() => window.insituViewer.displayed.drawnFrom),
+    'stored view', 'the browser draws the stored view from its proxies');
+  // The second step's proxies are held until its frame is shown.
+  let release;
+  const released = new Promise((resolve) => { release = resolve; });
+  let held = false;
+  await page.route((url) => url.pathname.endsWith('/api/proxies') &&
+    url.searchParams.get('step') === String(steps[1]), async (route) => {
+    held = true;
+    await released;
+    await route.continue();
+  });
+  await setStepIndex(page, 1);
+  const shownWhileHeld = await page.waitForFunction((step) => {
+    const v = window.insituViewer;
+    return v.displayed.options.step === step;
+  }, String(steps[1]), { timeout: 15000 }).then(() => true, () => false);
+  const first = await page.evaluate(() => ({ gpu: Boolean(window.insituViewer.displayed.gpu),
+    provisional: window.insituViewer.displayed.provisional }));
+  release();
+  assert.ok(held, 'the proxies were asked for');
+  assert.ok(shownWhileHeld, 'the new step\'s frame came without its proxies');
+  assert.deepEqual(first, { gpu: false, provisional: true }, 'the server\'s exact stored view');
+  // Once they come, the browser draws the step from them (edits and drags start from there).
+  await waitForSettledFrame(page);
+  const settled = await page.evaluate(() => ({ step: window.insituViewer.displayed.options.step,
+    drawnFrom: window.insituViewer.displayed.drawnFrom }));
+  assert.deepEqual(settled, { step: String(steps[1]), drawnFrom: 'stored view' });
+  assert.deepEqual(errors, []);
+  await page.close();
+});

@@ -108,7 +108,7 @@ export function requestFrame() {
   // The same options drawn the same way (toggling "draw in the browser", or the browser's
   // WebGL2 becoming ready after the first frame, redraws them).
   if (viewer.displayed && sameOptions(viewer.displayed.options, options) &&
-    !(viewer.displayed.preview && !dragging) &&
+    !(viewer.displayed.preview && !dragging) && !upgradable() &&
     viewer.displayed.toggle === drawingToggle()) return;
   inFlight = true;
   requestedToggle = drawingToggle();
@@ -121,7 +121,14 @@ export function requestFrame() {
   }
 }
 
-function serverFrame(options) {
+// A provisional frame: the server's, shown while the data the browser draws it from downloads.
+function upgradable() {
+  const d = viewer.displayed;
+  return Boolean(d && d.provisional && viewer.gpu &&
+    viewer.gpu.proxiesArrived(d.options.step, d.options.view));
+}
+
+function serverFrame(options, provisional = false) {
   const sent = performance.now();
   const body = new URLSearchParams({ ...options, session });
   fetch('api/frame', { method: 'POST', body })
@@ -135,7 +142,7 @@ function serverFrame(options) {
       }
       const png = new Uint8Array(await response.arrayBuffer());
       if (!asked(options)) return;  // late: the page asks for another step now
-      await display(options, png, response.headers, performance.now() - sent);
+      await display(options, png, response.headers, performance.now() - sent, provisional);
       showError('');
     })
     .catch((error) => showError(String(error)))
@@ -165,8 +172,18 @@ async function drawProxies(options, dragging) {
     drawVolume(options, dragging, recipe);
     return;
   }
-  if (!viewer.gpu.proxyRenderer) {
-    serverFrame(options);
+  // The stored rendering of a step whose proxies have not arrived yet: the server's frame, exact
+  // and quick, while they download for the edits and drags to come.
+  // They are drawn here once they come (the same picture, which the page's overlay, edits and
+  // drags then start from).
+  const waiting = !viewer.gpu.proxiesArrived(entry.step, state.view);
+  if (!viewer.gpu.proxyRenderer || (recipe.stored_rendering && waiting && !dragging)) {
+    if (viewer.gpu.proxyRenderer) {
+      viewer.gpu.proxies(entry.step, state.view).then(() => {
+        if (!inFlight && upgradable()) requestFrame();
+      }, () => {});
+    }
+    serverFrame(options, viewer.gpu.proxyRenderer !== null);
     return;
   }
   viewer.gpu.drawProxies(entry.step, state.view, recipe, Number(options.azimuth),
@@ -220,7 +237,7 @@ function frameDone() {
   // Also redrawn: a preview once the pointer rests, and a frame drawn before the browser's
   // WebGL2 was ready (or before "draw in the browser" was toggled).
   if (!viewer.displayed || !sameOptions(viewer.displayed.options, next) ||
-    (viewer.displayed.preview && !state.dragging) ||
+    (viewer.displayed.preview && !state.dragging) || upgradable() ||
     viewer.displayed.toggle !== drawingToggle()) requestFrame();
   else if (state.playing) schedulePlay();
 }
@@ -302,7 +319,7 @@ function showGpuFrame(options, timing, what, colourSource) {
   return updateMask();
 }
 
-async function display(options, png, headers, roundTripMs) {
+async function display(options, png, headers, roundTripMs, provisional) {
   const url = URL.createObjectURL(new Blob([png], { type: 'image/png' }));
   const image = $('frame');
   await new Promise((resolve, reject) => {
@@ -324,6 +341,7 @@ async function display(options, png, headers, roundTripMs) {
     colourSource: header('X-Insitu-Colour-Source'),
     proxySource: header('X-Insitu-Proxy-Source'),
     synthesised: header('X-Insitu-Synthesised') === '1',
+    provisional,
   };
   const fps = countFrame();
   const d = viewer.displayed;

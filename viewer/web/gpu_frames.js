@@ -90,6 +90,11 @@ export class GpuFrames {
     return this.costs.get(kind);
   }
 
+  /// Whether the proxies of (step, view) have arrived (a draw from them waits for no download).
+  proxiesArrived(step, view) {
+    return arrived(this.proxyCache).has(`${step}/${view}`);
+  }
+
   /// The parsed proxies of (step, view) with their download time; null without attenuation.
   proxies(step, view) {
     return cached(this.proxyCache, `${step}/${view}`, () => fetchProxies(step, view))
@@ -289,15 +294,30 @@ export class GpuFrames {
 function cached(cache, key, load) {
   if (!cache.has(key)) {
     const started = performance.now();
-    cache.set(key, load()
-      .then((value) => ({ value, downloadMs: performance.now() - started }))
+    const pending = load()
+      .then((value) => {
+        if (cache.get(key) === pending) arrived(cache).add(key);
+        return { value, downloadMs: performance.now() - started };
+      })
       .catch((error) => {
         cache.delete(key);
         throw error;
-      }));
-    while (cache.size > KEPT_STEPS) cache.delete(cache.keys().next().value);
+      });
+    cache.set(key, pending);
+    while (cache.size > KEPT_STEPS) {
+      const oldest = cache.keys().next().value;
+      cache.delete(oldest);
+      arrived(cache).delete(oldest);
+    }
   }
   return cache.get(key);
+}
+
+const arrivedKeys = new WeakMap();  // cache -> the keys whose payload has arrived
+
+function arrived(cache) {
+  if (!arrivedKeys.has(cache)) arrivedKeys.set(cache, new Set());
+  return arrivedKeys.get(cache);
 }
 
 /// What VolumeRenderer.render takes of a volume recipe (/api/recipe: the archive's preview
