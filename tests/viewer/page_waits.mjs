@@ -42,6 +42,7 @@ async function oneRun(browser, url) {
     { timeout: 120000 });
   const ready = await page.evaluate(() => window.insituViewer.readyAt);
   const waits = { 'first frame': first, 'page ready': ready };
+  await settledAfter(page, 0);  // nothing in flight: the user looks, then moves the slider
   let count = await page.evaluate(() => window.insituViewer.frameCount);
   let start = await page.$eval('#step', (slider) => {
     slider.value = '1';
