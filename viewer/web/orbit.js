@@ -80,7 +80,7 @@ export function trustWords(t) {
   }
   if (t.basis === 'light field') {
     return `trusted at any angle: this step's light field (${t.cameras} cameras around the ` +
-      'object) makes every view';
+      'object) makes every view alike; the overlay marks the pixels its cameras disagree on';
   }
   const [a0, a1] = t.trusted_offsets.azimuth;
   const [e0, e1] = t.trusted_offsets.elevation;
