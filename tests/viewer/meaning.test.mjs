@@ -143,12 +143,120 @@ test('a link reopens the whole view; the PNG says it in its name', async () => {
 
   const [download] = await Promise.all([page.waitForEvent('download'), page.click('#save-png')]);
   const name = download.suggestedFilename();
-  assert.equal(name, 'viewer_v_step20_view0_az55.00_el12.00_opacity-edited_lit.png');
+  assert.equal(name, 'viewer_v_step20_view0_az55.00_el12.00_opacity-edited_lit_512x512.png');
   const saved = path.join(workDir, name);
   await download.saveAs(saved);
   const png = decodePng(readFileSync(saved));
   assert.equal(png.width, 512, 'a 256-pixel frame saved twice as large, whole pixels');
   assert.equal(png.height, 512 + 52, 'with a footer: caption and colour bar');
+
+  // At a chosen size, with or without the legend and the time stamp.
+  const save = async () => {
+    const [file] = await Promise.all([page.waitForEvent('download'), page.click('#save-png')]);
+    const where = path.join(workDir, `sized-${file.suggestedFilename()}`);
+    await file.saveAs(where);
+    return { name: file.suggestedFilename(), png: decodePng(readFileSync(where)) };
+  };
+  await page.selectOption('#png-scale', '4');
+  await page.uncheck('#png-legend');
+  await page.uncheck('#png-stamp');
+  let sized = await save();
+  assert.match(sized.name, /_1024x1024\.png$/);
+  assert.deepEqual([sized.png.width, sized.png.height], [1024, 1024], '4x, nothing under it');
+  // Whole pixels: each of the frame's pixels is a 4x4 block.
+  const at = (x, y) => Array.from(sized.png.data.subarray(4 * (y * 1024 + x), 4 * (y * 1024 + x) + 4));
+  for (const [x, y] of [[400, 520], [513, 602], [130, 131]]) {
+    const corner = [x - (x % 4), y - (y % 4)];
+    assert.deepEqual(at(x, y), at(...corner), `pixel ${x},${y} in its block`);
+  }
+  await page.check('#png-stamp');
+  await page.selectOption('#png-scale', '1');
+  sized = await save();
+  assert.match(sized.name, /_256x256\.png$/);
+  assert.deepEqual([sized.png.width, sized.png.height], [256, 256 + 22], '1x, the caption only');
+  await page.check('#png-legend');
+  await page.uncheck('#png-stamp');
+  sized = await save();
+  assert.deepEqual([sized.png.width, sized.png.height], [256, 256 + 30], 'the colour bar only');
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('side by side: another step or the step\'s own function, with linked orbit', async () => {
+  const { server, browser } = session;
+  const errors = [];
+  const page = await openViewerPage(browser, `${server.url}?gpu=off`, errors);
+  await waitForSettledFrame(page);
+  const compared = () => page.evaluate(() => window.insituViewer.compare);
+  const waitCompared = (count) => page.waitForFunction(
+    (n) => window.insituViewer.compare.count > n, count, { timeout: 30000 });
+  assert.ok(await page.locator('#compare-pane').isHidden());
+  await page.check('#compare-toggle');
+  await waitCompared(0);
+  assert.ok(await page.locator('#compare-pane').isVisible());
+  let shown = await compared();
+  assert.equal(shown.options.step, '20', 'the last step beside the first');
+  assert.equal((await page.evaluate(() => window.insituViewer.options())).step, '10');
+  assert.match(await page.locator('#compare-caption').textContent(), /^v · step 20 · t = 20/);
+  const pixels = (id) => page.evaluate(async (which) => {
+    const image = document.getElementById(which);
+    const canvas = document.createElement('canvas');
+    [canvas.width, canvas.height] = [image.naturalWidth, image.naturalHeight];
+    canvas.getContext('2d').drawImage(image, 0, 0);
+    return Array.from(canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data);
+  }, id);
+  assert.notDeepEqual(await pixels('compare-frame'), await pixels('frame'), 'another picture');
+
+  // Dragging the comparison turns both.
+  let count = shown.count;
+  let frames = await page.evaluate(() => window.insituViewer.frameCount);
+  const box = await page.locator('#compare-pane').boundingBox();
+  await page.mouse.move(box.x + 200, box.y + 200);
+  await page.mouse.down();
+  await page.mouse.move(box.x + 260, box.y + 220, { steps: 4 });
+  await page.mouse.up();
+  await waitForSettledFrame(page, frames);
+  await page.waitForFunction(() => {
+    const c = window.insituViewer.compare.options;
+    const o = window.insituViewer.options();
+    return c && c.azimuth === o.azimuth && c.elevation === o.elevation;
+  }, null, { timeout: 30000 });
+  const main = await page.evaluate(() => window.insituViewer.options());
+  shown = await compared();
+  assert.notEqual(main.azimuth, undefined, 'the drag on the comparison turned the first');
+  assert.equal(shown.options.azimuth, main.azimuth);
+  assert.equal(shown.options.step, '20');
+  // And dragging the first turns the comparison.
+  count = shown.count;
+  frames = await page.evaluate(() => window.insituViewer.frameCount);
+  const first = await page.locator('#viewport').boundingBox();
+  await page.mouse.move(first.x + 200, first.y + 200);
+  await page.mouse.down();
+  await page.mouse.move(first.x + 150, first.y + 170, { steps: 4 });
+  await page.mouse.up();
+  await waitForSettledFrame(page, frames);
+  await page.waitForFunction(() => {
+    const c = window.insituViewer.compare.options;
+    return c && c.azimuth === window.insituViewer.options().azimuth;
+  }, null, { timeout: 30000 });
+  assert.notEqual((await compared()).options.azimuth, shown.options.azimuth);
+
+  // Two functions: the step with an opacity edit beside its own function.
+  frames = await page.evaluate(() => window.insituViewer.frameCount);
+  await page.evaluate(() => window.insituViewer.setOpacityScale(6, 0.05));
+  await waitForSettledFrame(page, frames);
+  await page.selectOption('#compare-what', 'function');
+  // (a frame of step 20 with the edit may still come first)
+  await page.waitForFunction(() => {
+    const c = window.insituViewer.compare.options;
+    return c && c.step === window.insituViewer.options().step;
+  }, null, { timeout: 30000 });
+  shown = await compared();
+  const edited = await page.evaluate(() => window.insituViewer.options());
+  assert.equal(shown.options.step, edited.step);
+  assert.equal(shown.options.azimuth, edited.azimuth);
+  assert.ok(edited['opacity-scale'] && !shown.options['opacity-scale'], 'unedited beside edited');
+  assert.match(await page.locator('#compare-caption').textContent(), /own function, unedited$/);
   assert.deepEqual(errors, []);
   await page.close();
 });
@@ -204,17 +312,31 @@ test('one function for the whole run where each step has its own', async () => {
     await setStepIndex(page, 1);
     assert.equal((await page.evaluate(() => window.insituViewer.options())).tf, undefined);
     const ownBar = await scalarBar(page);
-    const count = await page.evaluate(() => window.insituViewer.frameCount);
+    let count = await page.evaluate(() => window.insituViewer.frameCount);
     await page.check('#run-colours');
     await waitForSettledFrame(page, count);
-    const options = await page.evaluate(() => window.insituViewer.options());
-    assert.deepEqual(JSON.parse(options.tf), first.transfer_function,
-      'step 20 drawn with step 10\'s function');
+    const atSecond = await page.evaluate(() => window.insituViewer.options());
     const runBar = await scalarBar(page);
     assert.notDeepEqual(runBar.colour, ownBar.colour, 'the bar shows the run\'s function');
+    // The run's function: the first step's spread over every step's values (the union of the
+    // steps' histograms' ranges).
+    const lo = Math.min(first.histogram.min, second.histogram.min);
+    const hi = Math.max(first.histogram.max, second.histogram.max);
+    const tf = JSON.parse(atSecond.tf);
+    const near = (a, b) => Math.abs(a - b) < 1e-6 * (hi - lo);
+    assert.ok(near(tf.points[0][0], lo), `starts at ${lo}`);
+    assert.ok(near(tf.points[tf.points.length - 1][0], hi), `ends at ${hi}`);
+    assert.deepEqual(tf.points.map((p) => p.slice(1)),
+      first.transfer_function.points.map((p) => p.slice(1)), 'the first step\'s colours');
+    assert.ok(near(runBar.lo, lo) && near(runBar.hi, hi), 'the bar spans the run\'s values');
+    count = await page.evaluate(() => window.insituViewer.frameCount);
     await setStepIndex(page, 0);
-    assert.equal((await page.evaluate(() => window.insituViewer.options())).tf, undefined,
-      'nothing to send at the step whose function it is');
+    const atFirst = await page.evaluate(() => window.insituViewer.options());
+    assert.equal(atFirst.tf, atSecond.tf, 'the same function sent at both steps');
+    // A value maps to one colour at both steps: the bars' pixels (the same value at each x).
+    const firstBar = await scalarBar(page);
+    assert.ok(near(firstBar.lo, lo) && near(firstBar.hi, hi), 'at both steps');
+    assert.deepEqual(firstBar.colour, runBar.colour);
     assert.deepEqual(errors, []);
     await page.close();
   } finally {

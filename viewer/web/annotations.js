@@ -39,6 +39,18 @@ function project(camera, point) {
   return [(x + 1) / 2 * camera.width, (1 - y) / 2 * camera.height];
 }
 
+/// The field's units from the run's configuration ("units": {"v": "mol/L"}), or ''.
+export function unitsOf(field) {
+  const config = state.archive && state.archive.configuration;
+  return (config && config.units && config.units[field]) || '';
+}
+
+/// The field's name with its units: "v [mol/L]", or the name alone.
+export function fieldLabel(field) {
+  const units = unitsOf(field);
+  return `${field ?? 'value'}${units ? ` [${units}]` : ''}`;
+}
+
 export function drawCaption() {
   const info = state.info;
   const caption = $('caption');
@@ -48,7 +60,7 @@ export function drawCaption() {
   }
   const angles = state.azimuth === null ? 'stored view'
     : `azimuth ${state.azimuth.toFixed(0)}°, elevation ${state.elevation.toFixed(0)}°`;
-  caption.textContent = `${info.field ?? 'field'} · step ${info.step} · t = ${short(info.time)}` +
+  caption.textContent = `${fieldLabel(info.field)} · step ${info.step} · t = ${short(info.time)}` +
     ` · view ${info.view} (${angles})`;
 }
 
@@ -67,7 +79,7 @@ export function drawScalarBar() {
   const hi = Math.max(points[points.length - 1][0], histogram ? histogram.max : -Infinity);
   // Drawn again only when the function or the range changed (not at each frame of a drag).
   const key = JSON.stringify([points, lo, hi, histogram && [histogram.min, histogram.max],
-    state.info.field, Boolean(state.baseTf)]);
+    fieldLabel(state.info.field), Boolean(state.baseTf)]);
   if (key === barKey) return;
   barKey = key;
   const canvas = $('scalar-bar-canvas');
@@ -90,7 +102,7 @@ export function drawScalarBar() {
   }
   $('scalar-bar-lo').textContent = short(lo);
   $('scalar-bar-hi').textContent = short(hi);
-  $('scalar-bar-field').textContent = `${state.info.field ?? 'value'}` +
+  $('scalar-bar-field').textContent = fieldLabel(state.info.field) +
     (state.baseTf ? ' (loaded function)' : '');
   const data = $('scalar-bar-data');
   data.hidden = !histogram;

@@ -5,7 +5,7 @@
 // confidence overlay), overlay.js (its paint and legend), orbit.js (drag, trusted range),
 // tf_editor.js, value_edits.js (edits kept on field values), timeline.js (archive, steps, play),
 // segment_faders.js, annotations.js (caption, colour bar, box & axes), zoom.js, view_state.js
-// (the view in the address), export_png.js; the WebGL2 side: gpu_frames.js,
+// (the view in the address), export_png.js, compare.js (side by side); the WebGL2 side: gpu_frames.js,
 // light_field_data.js, light_field_renderer.js, camera.js and the shaders beside them.
 import { $, ARCHIVE_POLL_MS, showError, state, viewer } from './page.js';
 import { currentOptions } from './explore_options.js';
@@ -20,6 +20,7 @@ import { savePng } from './export_png.js';
 import { readViewQuery, viewQuery, writeViewQuery } from './view_state.js';
 import { applyZoom, installZoom } from './zoom.js';
 import { setScale } from './value_edits.js';
+import { installCompare } from './compare.js';
 
 viewer.options = () => currentOptions();
 viewer.intervalCount = () => state.scales.length;
@@ -92,6 +93,8 @@ function installControls() {
 async function start() {
   installControls();
   installOrbitDrag();
+  installOrbitDrag($('compare-pane'));
+  installCompare();
   installZoom(writeViewQuery);
   paintLegend($('overlay-legend'));
   const linkedStep = readViewQuery();

@@ -11,6 +11,7 @@ import { baseTf } from './transfer_function.js';
 import { paintOverlay, shownAlpha } from './overlay.js';
 import { drawAnnotations } from './annotations.js';
 import { writeViewQuery } from './view_state.js';
+import { requestCompare } from './compare.js';
 import { askedStep, schedulePlay } from './timeline.js';
 
 let inFlight = false;
@@ -101,6 +102,7 @@ export function requestFrame() {
   if (!options) return;
   drawAnnotations();
   writeViewQuery();
+  requestCompare();
   if (inFlight || !described(options)) return;
   // While dragging, what the browser draws may be a preview (gpu_frames.js: the full frame
   // once the pointer rests).

@@ -152,8 +152,8 @@ export function drawTrustMap() {
   label.textContent = `Δaz ${da.toFixed(1)}°  Δel ${de.toFixed(1)}°`;
 }
 
-export function installOrbitDrag() {
-  const viewport = $('viewport');
+/// Orbit drags on `viewport` (the picture; side by side, the comparison's too: linked orbit).
+export function installOrbitDrag(viewport = $('viewport')) {
   let drag = null;
   viewport.addEventListener('pointerdown', (event) => {
     // Shift-drag and the middle button pan (zoom.js).
@@ -190,6 +190,7 @@ export function installOrbitDrag() {
   viewport.addEventListener('pointerup', end);
   viewport.addEventListener('pointercancel', end);
   viewport.addEventListener('dblclick', resetView);
+  if (viewport !== $('viewport')) return;  // the angles' fields once
   for (const id of ['azimuth', 'elevation']) {
     $(id).addEventListener('change', () => {
       const az = Number($('azimuth').value);
