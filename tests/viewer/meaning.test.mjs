@@ -344,6 +344,29 @@ test('one function for the whole run where each step has its own', async () => {
   }
 });
 
+test('a field\'s units from the configuration, in the caption and the colour bar', async () => {
+  const { browser } = session;
+  const config = path.join(workDir, 'units.json');
+  writeFileSync(config, JSON.stringify({ fields: ['v'], units: { v: 'mol/L' },
+    views: [{ size: [32, 32] }], volume: false, every: 10 }));
+  const archived = path.join(workDir, 'units.cdb');
+  const run = spawnSync(env('GRAY_SCOTT'), ['--size', '16', '--steps', '10', '--config', config,
+    '--out', archived], { encoding: 'utf8' });
+  assert.equal(run.status, 0, run.stderr);
+  const server = await startServer(binary, archived);
+  try {
+    const errors = [];
+    const page = await openViewerPage(browser, `${server.url}?gpu=off`, errors);
+    await waitForSettledFrame(page);
+    assert.match(await page.locator('#caption').textContent(), /^v \[mol\/L\] · step 10 · /);
+    assert.equal(await page.locator('#scalar-bar-field').textContent(), 'v [mol/L]');
+    assert.deepEqual(errors, []);
+    await page.close();
+  } finally {
+    await stopServer(server);
+  }
+});
+
 test('every control says what it does', async () => {
   const { server, browser } = session;
   const page = await openViewerPage(browser, `${server.url}?gpu=off`, []);
