@@ -195,6 +195,15 @@ const Key<InstrumentConfig> kTopLevelKeys[] = {
          }
          return list;
      }},
+    {"units",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         if (!value.is_object()) wrong_type(key, value, "an object of field name: units");
+         config.units.clear();
+         for (const auto& entry : value.items()) {
+             config.units[entry.key()] = text(entry.value(), child_key(key, entry.key()));
+         }
+     },
+     [](const InstrumentConfig& config) { return json(config.units); }},
     {"views",
      [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
          config.views = parse_views(value, key, unknown);

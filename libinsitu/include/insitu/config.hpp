@@ -196,6 +196,9 @@ struct InstrumentConfig {
     /// function and layers unless field_styles gives it its own; all in one archive.
     std::vector<std::string> fields{"v"};
     std::map<std::string, FieldStyle> field_styles;  ///< by field name; none by default
+    /// "units": a field's units by its name ({"v": "mol/L"}), for captions and colour bars
+    /// (the viewer reads them from the manifest's copy of the configuration); none by default.
+    std::map<std::string, std::string> units;
     std::vector<ViewConfig> views{ViewConfig{}};
     /// "transfer_function": a function in the data's units, or "auto" (nullopt, the default):
     /// at every archived step, default_transfer_function() over the 1st to 99th percentiles of
