@@ -556,8 +556,8 @@ TEST(InstrumentConfig, UnitsNameListedFieldsAndRoundTrip) {
     expect_error<InvalidArgument>(R"({"fields": ["v"], "units": {"w": "K"}})",
                                   {"units.w", "\"K\"", "names no field"});
     expect_error<InvalidArgument>(R"({"fields": ["v"], "units": {"v": ""}})", {"units.v"});
-    expect_error<InvalidArgument>(R"({"fields": ["v"], "units": {"v": 3}})", {"units.v", "3"});
-    expect_error<InvalidArgument>(R"({"fields": ["v"], "units": "K"})", {"units", "\"K\""});
+    expect_error<ParseError>(R"({"fields": ["v"], "units": {"v": 3}})", {"units.v", "3"});
+    expect_error<ParseError>(R"({"fields": ["v"], "units": "K"})", {"units", "\"K\""});
 }
 
 TEST(InstrumentConfig, StoragePrecisionIsNamedHalfOrFloat) {
