@@ -1,7 +1,5 @@
 #include "representation/volume/volume_entries.hpp"
 
-#include <set>
-
 #include "archive/archive_format.hpp"
 #include "archive/manifest_keys.hpp"
 #include "insitu/error.hpp"

@@ -7,7 +7,6 @@
 
 #include "core/elapsed.hpp"
 #include "insitu/budget/volume_chooser.hpp"
-#include "insitu/core/check.hpp"
 #include "insitu/explore/transfer_function_edit.hpp"
 #include "insitu/render/volume_renderer.hpp"
 #include "representation/volume/volume_entries.hpp"
