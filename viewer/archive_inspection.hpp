@@ -15,8 +15,8 @@ namespace insitu::viewer {
 struct ArchiveInspection {
     /// describe_archive of the readable part: the (step, view) entries in `unreadable` left out.
     nlohmann::json description;
-    /// One line per problem (ArchiveReader::check(), then proxies that do not decode although
-    /// their checksum matches); empty for a sound archive.
+    /// One line per problem (ArchiveReader::check(CheckDepth::sizes), then the first step's
+    /// proxies that do not decode although their size matches); empty for a sound archive.
     std::vector<std::string> damage;
     /// (step, view) entries whose proxies cannot be loaded.
     std::set<std::pair<std::int64_t, int>> unreadable;
@@ -24,8 +24,9 @@ struct ArchiveInspection {
     bool manifest_readable = true;
 };
 
-/// Checks every file of the archive at `path` (sizes and CRC-32, as verify does) and describes
-/// what stays readable.
+/// Checks that every file of the archive at `path` is there with its recorded size, without
+/// reading it (a 12,000-step run opens as fast as a 10-step one; CRC-32s are `verify`'s and each
+/// read's), decodes the first step and describes what stays readable.
 ArchiveInspection inspect_archive(const std::string& path);
 
 }  // namespace insitu::viewer

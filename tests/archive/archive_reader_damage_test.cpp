@@ -92,6 +92,23 @@ TEST_F(ArchiveReaderDamage, EachDamagedFileIsListedAndMarksOnlyItsEntry) {
     EXPECT_THROW(readable.load(4, 1), InvalidArgument);
 }
 
+TEST_F(ArchiveReaderDamage, CheckingSizesReadsNoFileAndLeavesChecksumsToTheRead) {
+    const fs::path path = archive();
+    fs::remove(archives::proxy_file(path, 2, 0));
+    archives::truncate_half(archives::preview_file(path, 3, 1));
+    archives::flip_byte(archives::proxy_file(path, 4, 1));
+    const ArchiveReader reader = ArchiveReader::open_damaged(path.string());
+    const ArchiveCheck sizes = reader.check(CheckDepth::sizes);
+    // The same missing and truncated files as a full check, in its words; the flipped byte
+    // keeps the size, so only reading the file finds it.
+    const ArchiveCheck bytes = reader.check(CheckDepth::bytes);
+    ASSERT_EQ(bytes.problems.size(), 3u);
+    EXPECT_THAT(sizes.problems, ElementsAre(bytes.problems[0], bytes.problems[1]));
+    EXPECT_EQ(sizes.unreadable_proxies, (Entries{{2, 0}}));
+    const ArchiveReader listed = reader.without_views(sizes.unreadable_proxies);
+    insitu::testing::expect_error_naming<IoError>([&] { listed.load(4, 1); }, "CRC-32");
+}
+
 TEST_F(ArchiveReaderDamage, StepLeftWithoutViewsGoes) {
     const ArchiveReader reader(archive().string());
     EXPECT_EQ(reader.without_views({{2, 0}, {2, 1}, {3, 0}}).steps(), (Steps{1, 3, 4}));

@@ -6,12 +6,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "archive/archive_format.hpp"
 #include "archive/entry_list.hpp"
@@ -56,6 +58,29 @@ TEST(Manifest, WhatIsWrittenReadsBackValidated) {
     EXPECT_EQ(again, manifest);
     EXPECT_THAT(manifest_steps(again), ElementsAre(10, 20, 30));
     fs::remove_all(archive);
+}
+
+TEST(Manifest, TextHoldsAStepALineAndTheRestIndented) {
+    nlohmann::json manifest = empty_manifest();
+    manifest["configuration"] = {{"fields", {"v"}}, {"views", {{{"size", {8, 8}}}}}};
+    EXPECT_EQ(nlohmann::json::parse(manifest_text(manifest)), manifest);  // no steps yet
+    for (std::int64_t step : {10, 20, 30}) insert_step(manifest, step_entry(step));
+    const std::string text = manifest_text(manifest);
+    EXPECT_EQ(nlohmann::json::parse(text), manifest);
+    std::vector<std::string> lines;
+    for (std::size_t start = 0, end = 0; start < text.size(); start = end + 1) {
+        end = text.find('\n', start);
+        lines.push_back(text.substr(start, end - start));
+    }
+    // Each step entry whole on its own line, the journal's form; the configuration indented.
+    for (std::int64_t step : {10, 20, 30}) {
+        const std::string line = "    " + step_entry(step).dump();
+        EXPECT_EQ(std::count(lines.begin(), lines.end(), line) +
+                      std::count(lines.begin(), lines.end(), line + ","),
+                  1)
+            << step;
+    }
+    EXPECT_THAT(lines, ::testing::Contains("    \"fields\": ["));
 }
 
 TEST(Manifest, ListsFilesUnderTheArchiveAndFindsViews) {

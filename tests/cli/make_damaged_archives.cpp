@@ -7,6 +7,8 @@
 //   OUT/damaged.cdb   the same, then: step 4 view 0's EXR deleted, step 6 view 1's PNG
 //                     truncated, a byte of step 8 view 0's EXR flipped (CRC-32 mismatch), step
 //                     10's manifest entry malformed (time null), data.csv unreadable (garbage)
+//   OUT/first_corrupt.cdb  steps 2, 4, view 0, a byte of step 2's EXR flipped: the step info
+//                          decodes to describe the archive
 //   OUT/journal.cdb   steps 2, 4, 6 in manifest.journal, manifest.json corrupt
 //   OUT/no_index.cdb  manifest.json corrupt and no journal: nothing left to read
 #include <exception>
@@ -33,6 +35,10 @@ int main(int argc, char** argv) {
         archives::flip_byte(archives::proxy_file(damaged, 8, 0));
         archives::break_step_entry(damaged, 10);
         archives::write_text(damaged / "data.csv", "not,a,cinema,header\n");
+
+        const std::filesystem::path first_corrupt = out / "first_corrupt.cdb";
+        archives::write_small_archive(first_corrupt, {2, 4}, 1);
+        archives::flip_byte(archives::proxy_file(first_corrupt, 2, 0));
 
         const std::filesystem::path journal = out / "journal.cdb";
         archives::write_small_archive(journal, {2, 4, 6}, 1);

@@ -365,7 +365,7 @@ std::vector<std::string> ArchiveReader::verify() const {
     return check().problems;
 }
 
-ArchiveCheck ArchiveReader::check() const {
+ArchiveCheck ArchiveReader::check(CheckDepth depth) const {
     ArchiveCheck result;
     result.problems = diagnostics_;
     // Which (step, view) each proxy EXR serves, so that a file found unusable marks its entry.
@@ -420,7 +420,11 @@ ArchiveCheck ArchiveReader::check() const {
             continue;
         }
         try {
-            af::read_listed_file(file);
+            if (depth == CheckDepth::bytes) {
+                af::read_listed_file(file);
+            } else {
+                af::check_listed_file_size(file);
+            }
         } catch (const IoError& error) {
             unusable(file, error.what());
         }

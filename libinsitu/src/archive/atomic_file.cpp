@@ -11,7 +11,6 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 
 #include "archive/archive_format.hpp"
 #include "insitu/error.hpp"
@@ -235,10 +234,18 @@ std::vector<char> read_whole_file(const std::string& path) {
         fail<IoError>("cannot read \"", path,
                       "\": ", fs::exists(path, error) ? "not a regular file" : "no such file");
     }
-    std::ifstream in(path, std::ios::binary);
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
     if (!in) fail<IoError>("cannot open \"", path, "\"");
-    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // One read of the size the file has now (a character at a time was a third of opening a
+    // long run's index); a journal that grows meanwhile is read up to that size, one cut
+    // meanwhile up to its end.
+    const std::streamoff size = in.tellg();
+    if (size < 0) fail<IoError>("cannot read \"", path, "\"");
+    std::vector<char> bytes(static_cast<std::size_t>(size));
+    in.seekg(0);
+    in.read(bytes.data(), size);
     if (in.bad()) fail<IoError>("cannot read \"", path, "\"");
+    bytes.resize(static_cast<std::size_t>(in.gcount()));
     return bytes;
 }
 

@@ -167,6 +167,29 @@ std::vector<std::size_t> check_manifest(const nlohmann::json& manifest, const st
     return malformed;
 }
 
+bool step_before(const nlohmann::json& a, const nlohmann::json& b) {
+    return a.at("step").get<std::int64_t>() < b.at("step").get<std::int64_t>();
+}
+
+/// Steps in ascending order, as find_step's binary search needs them (stable: a repeated step's
+/// entries keep their order for the checks that report it).
+void sort_steps(nlohmann::json& steps) {
+    if (!std::is_sorted(steps.begin(), steps.end(), step_before)) {
+        std::stable_sort(steps.begin(), steps.end(), step_before);
+    }
+}
+
+/// The entry of `step` in the sorted "steps" of a validated manifest; nullptr when none.
+const nlohmann::json* step_entry_of(const nlohmann::json& manifest, std::int64_t step) {
+    const nlohmann::json& steps = manifest.at("steps");
+    const auto found = std::lower_bound(steps.begin(), steps.end(), step,
+                                        [](const nlohmann::json& entry, std::int64_t number) {
+                                            return entry.at("step").get<std::int64_t>() < number;
+                                        });
+    return found != steps.end() && found->at("step").get<std::int64_t>() == step ? &*found
+                                                                                 : nullptr;
+}
+
 }  // namespace
 
 nlohmann::json read_manifest(const std::string& archive_path, nlohmann::json* skipped) {
@@ -185,6 +208,7 @@ nlohmann::json read_manifest(const std::string& archive_path, nlohmann::json* sk
     const std::vector<std::size_t> malformed = check_manifest(manifest, file, skipped);
     nlohmann::json& steps = manifest["steps"];
     for (auto it = malformed.rbegin(); it != malformed.rend(); ++it) steps.erase(*it);
+    sort_steps(steps);  // the writer's order already; a hand-edited index may not keep it
     return manifest;
 }
 
@@ -232,10 +256,7 @@ std::size_t replay_journal(const std::vector<char>& bytes, const std::string& jo
         begin = end + 1;
     }
     // Journal lines arrive in write order; keep the steps sorted as manifest.json has them.
-    std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
-        return a.at("step").template get<std::int64_t>() <
-               b.at("step").template get<std::int64_t>();
-    });
+    sort_steps(entries);
     return added;
 }
 
@@ -248,6 +269,32 @@ void describe_skipped(const nlohmann::json& manifest, const nlohmann::json& skip
     for (const nlohmann::json& entry : skipped) {
         diagnostics.push_back("step entry skipped: " + entry.at("problem").get<std::string>());
     }
+}
+
+std::string manifest_text(const nlohmann::json& manifest) {
+    std::string text = "{";
+    const char* separator = "\n";
+    for (const auto& [key, value] : manifest.items()) {
+        text += separator;
+        separator = ",\n";
+        text += "  " + nlohmann::json(key).dump() + ": ";
+        if (key == "steps" && value.is_array() && !value.empty()) {
+            text += "[";
+            const char* line_separator = "\n    ";
+            for (const nlohmann::json& step : value) {
+                text += line_separator + step.dump();
+                line_separator = ",\n    ";
+            }
+            text += "\n  ]";
+            continue;
+        }
+        // Nested values indented as dump(2) would, one level in.
+        for (const char c : value.dump(2)) {
+            text += c;
+            if (c == '\n') text += "  ";
+        }
+    }
+    return text + "\n}\n";
 }
 
 Index read_index(const std::string& archive_path) {
@@ -280,7 +327,7 @@ void write_manifest(const std::string& archive_path, const nlohmann::json& manif
     // strict, before anything reaches the disk.
     const std::string file = (fs::path(archive_path) / kManifestFile).string();
     check_manifest(manifest, file, nullptr);
-    write_file_atomically(fs::path(archive_path) / kManifestFile, manifest.dump(2) + "\n");
+    write_file_atomically(fs::path(archive_path) / kManifestFile, manifest_text(manifest));
 }
 
 void append_journal(const std::string& archive_path, const nlohmann::json& step_entry) {
@@ -350,18 +397,38 @@ ListedFile listed_entry_file(const std::string& archive, const nlohmann::json& e
 
 const nlohmann::json& find_step(const nlohmann::json& manifest, const std::string& archive,
                                 std::int64_t step) {
-    for (const nlohmann::json& step_entry : manifest.at("steps")) {
-        if (step_entry.at("step").get<std::int64_t>() == step) return step_entry;
+    const nlohmann::json* step_entry = step_entry_of(manifest, step);
+    if (step_entry == nullptr)
+        fail<InvalidArgument>("archive \"", archive, "\" has no step ", step);
+    return *step_entry;
+}
+
+namespace {
+
+void require_recorded_size(const ListedFile& file, std::uintmax_t size) {
+    if (size != file.bytes) {
+        fail<IoError>("\"", file.absolute_path, "\": ", size, " bytes, the manifest records ",
+                      file.bytes, " (truncated or replaced)");
     }
-    fail<InvalidArgument>("archive \"", archive, "\" has no step ", step);
+}
+
+}  // namespace
+
+void check_listed_file_size(const ListedFile& file) {
+    std::error_code error;
+    const fs::file_status status = fs::status(file.absolute_path, error);
+    if (!fs::is_regular_file(status)) {
+        fail<IoError>("cannot read \"", file.absolute_path,
+                      "\": ", fs::exists(status) ? "not a regular file" : "no such file");
+    }
+    const std::uintmax_t size = fs::file_size(file.absolute_path, error);
+    if (error) fail<IoError>("cannot read \"", file.absolute_path, "\": ", error.message());
+    require_recorded_size(file, size);
 }
 
 std::vector<char> read_listed_file(const ListedFile& file) {
     std::vector<char> bytes = read_whole_file(file.absolute_path);
-    if (bytes.size() != file.bytes) {
-        fail<IoError>("\"", file.absolute_path, "\": ", bytes.size(),
-                      " bytes, the manifest records ", file.bytes, " (truncated or replaced)");
-    }
+    require_recorded_size(file, bytes.size());
     const std::uint32_t crc = crc32_of(bytes.data(), bytes.size());
     if (crc != file.crc32) {
         fail<IoError>("\"", file.absolute_path, "\": CRC-32 ", crc, ", the manifest records ",
@@ -372,14 +439,11 @@ std::vector<char> read_listed_file(const ListedFile& file) {
 
 ViewEntry find_view(const nlohmann::json& manifest, const std::string& archive, std::int64_t step,
                     int view) {
-    for (const nlohmann::json& step_entry : manifest.at("steps")) {
-        if (step_entry.at("step").get<std::int64_t>() != step) continue;
-        for (const nlohmann::json& view_entry : step_entry.at("views")) {
-            if (view_entry.at("view").get<int>() == view) return {&step_entry, &view_entry};
-        }
-        fail<InvalidArgument>("archive \"", archive, "\": step ", step, " has no view ", view);
+    const nlohmann::json& step_entry = find_step(manifest, archive, step);
+    for (const nlohmann::json& view_entry : step_entry.at("views")) {
+        if (view_entry.at("view").get<int>() == view) return {&step_entry, &view_entry};
     }
-    fail<InvalidArgument>("archive \"", archive, "\" has no step ", step);
+    fail<InvalidArgument>("archive \"", archive, "\": step ", step, " has no view ", view);
 }
 
 }  // namespace insitu::archive_format

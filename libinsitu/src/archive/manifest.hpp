@@ -92,6 +92,11 @@ std::size_t replay_journal(const std::vector<char>& bytes, const std::string& jo
 void describe_skipped(const nlohmann::json& manifest, const nlohmann::json& skipped,
                       std::vector<std::string>& diagnostics);
 
+/// manifest.json's text: every key but "steps" indented as JSON usually is, each step entry on
+/// a line of its own, as the journal writes them. Readable and diffable a step at a time, and a
+/// long run's index a fifth of its fully indented size (a step's histogram was 260 lines).
+std::string manifest_text(const nlohmann::json& manifest);
+
 /// Replaces ARCHIVE/manifest.json atomically, after checking it as strictly as read_manifest()
 /// would (ParseError naming the key; nothing written then).
 void write_manifest(const std::string& archive_path, const nlohmann::json& manifest);
@@ -123,11 +128,15 @@ std::vector<ListedFile> listed_files(const std::string& archive, const nlohmann:
 /// The file's bytes, after checking size and CRC-32 against the manifest (a file replaced,
 /// truncated or damaged since it was written is reported before anything parses it).
 std::vector<char> read_listed_file(const ListedFile& file);
+/// read_listed_file()'s checks that need no read: the file exists, is a regular file and has
+/// the size the manifest records (IoError naming it otherwise).
+void check_listed_file_size(const ListedFile& file);
 
 /// The file an object of a validated manifest names with "file", "bytes" and "crc32" (a light
 /// field's entry, a compressed field's block or mask).
 ListedFile listed_entry_file(const std::string& archive, const nlohmann::json& entry);
-/// The step entry of `step`; InvalidArgument when the manifest has none.
+/// The step entry of `step` (a binary search: a manifest read here keeps its steps sorted);
+/// InvalidArgument when the manifest has none.
 const nlohmann::json& find_step(const nlohmann::json& manifest, const std::string& archive,
                                 std::int64_t step);
 /// The step and view entries of (step, view); InvalidArgument when the manifest has neither.

@@ -68,6 +68,10 @@ struct VolumeGrid {
     Field as_field() const;
 };
 
+/// How much of each listed file ArchiveReader::check() reads: every byte (its CRC-32, verify's
+/// depth) or only its size (what the viewer and `info` check when they open an archive).
+enum class CheckDepth { bytes, sizes };
+
 /// What ArchiveReader::check() found.
 struct ArchiveCheck {
     /// One line per problem, each naming its file (verify()'s list).
@@ -167,8 +171,10 @@ public:
     /// data.csv.
     std::vector<std::string> verify() const;
     /// verify()'s checks, with the (step, view) entries whose proxies and the (step, field)
-    /// light fields whose files they found unusable.
-    ArchiveCheck check() const;
+    /// light fields whose files they found unusable. CheckDepth::sizes reads no file: each must
+    /// exist inside the archive with the size recorded, and its CRC-32 is left to the read that
+    /// uses it (load() and the other readers check it) — what opening a long run may afford.
+    ArchiveCheck check(CheckDepth depth = CheckDepth::bytes) const;
 
     /// The same archive with the (step, view) entries in `views` left out of the index (a step
     /// left without views goes too): what stays readable of a damaged archive, for tools that
