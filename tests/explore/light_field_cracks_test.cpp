@@ -165,7 +165,7 @@ Scene spots() {
 
 // The same balls through a semi-transparent function as Gray-Scott's: a ray grazing a ball
 // gathers colour no camera recorded a depth for. Base (e9ae600): 0.07-0.35 % cracked, every
-// view above the goal; occlusion-aware: 0.02-0.09 %, two views above it. Held to 0.15 % until
+// view above the goal; occlusion-aware: 0.02-0.08 %, two views above it. Held to 0.15 % until
 // the issue's goal is met here too (bench/RESULTS.md, "Light-field cracks (issue 41)").
 Scene translucent_spots() {
     Scene scene{"translucent spots", spots_volume(), kSpotViews, translucent_tf()};

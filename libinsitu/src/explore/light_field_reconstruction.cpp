@@ -160,7 +160,8 @@ private:
         // footprint at a time, unless the ray cannot pass from in front of a recorded surface to
         // behind one in it (its farthest point from the eye nearer than every surface recorded
         // where it projects, or its nearest point farther than all of them):
-        // as accurate as walking the whole ray so, at 1/2-1/4 of the time (bench/RESULTS.md).
+        // as accurate as walking the whole ray so, in less time (bench/RESULTS.md, "Light-field
+        // cracks (issue 41)").
         const DepthBounds& bounds = bounds_.at(&depth);
         const double coarse_step = (t1 - t0) / (settings_.search_steps - 1);
         const double footprint = 2.0 * rig_.camera_radius() / rig_.map_size();
