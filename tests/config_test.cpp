@@ -547,6 +547,19 @@ TEST(InstrumentConfig, BadFieldEntriesAreNamed) {
     EXPECT_THAT(unknown, ElementsAre("fields[0].colour"));
 }
 
+TEST(InstrumentConfig, UnitsNameListedFieldsAndRoundTrip) {
+    const InstrumentConfig config = InstrumentConfig::from_json_text(
+        R"({"fields": ["u", "v"], "units": {"v": "mol/L"}})", nullptr);
+    EXPECT_EQ(config.units.at("v"), "mol/L");
+    EXPECT_EQ(config.units.count("u"), 0u);
+    EXPECT_EQ(InstrumentConfig::from_json(config.to_json(), nullptr).units, config.units);
+    expect_error<InvalidArgument>(R"({"fields": ["v"], "units": {"w": "K"}})",
+                                  {"units.w", "\"K\"", "names no field"});
+    expect_error<InvalidArgument>(R"({"fields": ["v"], "units": {"v": ""}})", {"units.v"});
+    expect_error<ParseError>(R"({"fields": ["v"], "units": {"v": 3}})", {"units.v", "3"});
+    expect_error<ParseError>(R"({"fields": ["v"], "units": "K"})", {"units", "\"K\""});
+}
+
 TEST(InstrumentConfig, StoragePrecisionIsNamedHalfOrFloat) {
     EXPECT_EQ(to_string(StoragePrecision::single), "float");
     EXPECT_EQ(parse_storage_precision("half"), StoragePrecision::half);

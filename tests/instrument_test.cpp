@@ -435,6 +435,32 @@ TEST_F(InstrumentTest, ARestartContinuesTheArchiveAndSkipsTheStepsItHolds) {
     EXPECT_EQ(fs::file_size(archive() / "proxies" / "step000001_view0.exr"), step_one_bytes);
 }
 
+// A rerun that asks selects() first never calls execute() for the archived steps: it must be
+// told all the same (the notice, and the replayed steps in its statistics and summary line).
+TEST_F(InstrumentTest, ARerunThatAsksSelectsIsToldTheArchivedStepsAreSkipped) {
+    {
+        Instrument first(small_config(archive(), 16), quiet());
+        ASSERT_EQ(first.execute(0, 0.0, {volume_.field()}), Status::ok);
+        ASSERT_EQ(first.execute(1, 1.0, {volume_.field()}), Status::ok);
+    }
+    ::testing::internal::CaptureStderr();
+    {
+        Instrument second(small_config(archive(), 16), InstrumentOptions{});
+        for (std::int64_t step = 0; step < 2; ++step) {
+            // Asked twice for the same step (once per field, say): counted once.
+            EXPECT_FALSE(second.selects(step));
+            EXPECT_FALSE(second.selects(step));
+        }
+        ASSERT_EQ(second.finalize(), Status::ok) << second.last_error();
+        EXPECT_EQ(second.statistics().steps_replayed, 2);
+        EXPECT_EQ(second.statistics().steps_executed, 0);
+    }
+    const std::string log = ::testing::internal::GetCapturedStderr();
+    EXPECT_THAT(log, HasSubstr("step 0 is already in archive")) << log;
+    EXPECT_EQ(log.find("already in archive"), log.rfind("already in archive")) << log;
+    EXPECT_THAT(log, HasSubstr("replayed 2 (skipped)")) << log;
+}
+
 TEST_F(InstrumentTest, OnExistingReplaceStartsTheArchiveAnewAndKeepsOtherFiles) {
     {
         Instrument first(small_config(archive(), 16), quiet());

@@ -65,7 +65,7 @@ set_tests_properties(viewer.frame_cost PROPERTIES TIMEOUT 60)
 # canvas with `insitu-view render`; confidence.test.mjs compares the page's confidence overlay
 # with `render --mask`. The archive stores every proxy an edit's trust and estimate read (the
 # rendering, interleaving, entry and optical depth), so both sides take every term.
-foreach(suite IN ITEMS browser api colour_model confidence)
+foreach(suite IN ITEMS browser api colour_model confidence timeline meaning)
   add_test(NAME viewer.${suite}
            COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/${suite}.test.mjs
            WORKING_DIRECTORY ${viewer_tests_dir})
@@ -193,3 +193,10 @@ viewer_serve_case(no_opencl_device 1 STDERR "INSITU_OPENCL_DEVICE" ${viewer_arch
 set_tests_properties(viewer.serve_no_opencl_device PROPERTIES
                      ENVIRONMENT INSITU_OPENCL_DEVICE=no-such-opencl-device
                      FIXTURES_REQUIRED viewer_archive)
+
+# Truthful trust (issue 42): the trusted range of a step with one view, a light field and a
+# compressed field; the warning near the picture; the overlay's kinds of pixel and its legend.
+viewer_browser_test(trust volume
+                    ENVIRONMENT ARCHIVE_LIGHT_FIELD=${viewer_lf_archive}
+                                ARCHIVE_ONE_VIEW=${viewer_archive}
+                    FIXTURES viewer_archive viewer_lf_archive)

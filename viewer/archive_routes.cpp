@@ -1,5 +1,6 @@
 #include "archive_routes.hpp"
 
+#include <algorithm>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <vector>
@@ -15,8 +16,30 @@ namespace {
 
 using json = nlohmann::json;
 
+/// Per field, the union of the steps' value ranges (the manifest's per-step histograms): the
+/// range "same colours at every step" spreads one function over.
+json run_value_ranges(const json& manifest) {
+    json ranges = json::object();
+    for (const json& step : manifest.at("steps")) {
+        for (const json& field : step.value("fields", json::array())) {
+            const json& histogram = field.value("histogram", json::object());
+            if (!histogram.value("min", json()).is_number() ||
+                !histogram.value("max", json()).is_number()) {
+                continue;  // a field of no finite values at this step
+            }
+            const double lo = histogram.at("min").get<double>();
+            const double hi = histogram.at("max").get<double>();
+            json& range = ranges[field.at("field").get<std::string>()];
+            range = range.is_null() ? json{{"min", lo}, {"max", hi}}
+                                    : json{{"min", std::min(lo, range["min"].get<double>())},
+                                           {"max", std::max(hi, range["max"].get<double>())}};
+        }
+    }
+    return ranges;
+}
+
 /// The archive's description for the page: describe_archive, each step's time, the archive's
-/// name and the function the editor starts from.
+/// name, the function the editor starts from and the run's value range per field.
 std::string archive_description(const ArchiveReader& reader, const std::string& name) {
     const std::vector<std::int64_t> steps = reader.steps();
     json description = describe_archive(reader);
@@ -26,6 +49,7 @@ std::string archive_description(const ArchiveReader& reader, const std::string& 
     }
     description["timeline"] = timeline;
     description["name"] = name;
+    description["value_ranges"] = run_value_ranges(reader.manifest());
     // The editor starts from the first step's function ("auto" makes one per step; /api/step
     // says each step's).
     if (!steps.empty()) {
@@ -53,6 +77,7 @@ json step_description(const ArchiveReader& reader, const StepKey& key) {
     const Camera& camera = frame.camera;
     json info{{"step", key.step},
               {"view", key.view},
+              {"field", reader.entry(key.step, key.view).field},
               {"time", reader.entry(key.step, key.view).time},
               {"size", {camera.width(), camera.height()}},
               {"projection", to_string(camera.projection())},

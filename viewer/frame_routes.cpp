@@ -88,13 +88,54 @@ json trust_json(const StepKey& key, const OrbitTrust& trust) {
     }
     const json range{{"azimuth", trust.azimuth_range_deg},
                      {"elevation", trust.elevation_range_deg}};
-    return json{{"step", key.step},
+    return json{{"basis", "view"},
+                {"step", key.step},
                 {"view", key.view},
                 {"threshold", trust.threshold},
                 {"azimuth", trust.azimuth_deg},
                 {"elevation", trust.elevation_deg},
                 {"trusted_offsets", range},
                 {"samples", samples}};
+}
+
+/// The trusted range of a step whose data makes every view (auto source, no edits): a
+/// compressed field of the view's field (ray-marched at any angle, its error bounded by its
+/// codec), else a light field of it (cameras around the object, each view reconstructed from
+/// the nearest); nullopt where only the stored view's proxies make other views (then probed).
+/// Elevation stops at +-89 degrees, as the page's orbit does.
+std::optional<json> whole_orbit_trust(ServedArchive& archive, const StepKey& key) {
+    const ArchiveReader& reader = archive.reader_locked();
+    const ArchivedView entry = reader.entry(key.step, key.view);
+    json held;
+    for (const ArchivedVolume& volume : reader.volumes(key.step)) {
+        if (volume.field != entry.field) continue;
+        held = {{"basis", "volume"},
+                {"codec", volume.codec},
+                {"mode", to_string(volume.mode)},
+                {"tolerance", volume.tolerance},
+                {"rate", volume.rate}};
+    }
+    if (held.is_null() && archive.light_field_segments_locked(key) > 0) {
+        for (const ArchivedLightField& light_field : reader.light_fields(key.step)) {
+            if (light_field.field != entry.field) continue;
+            held = {{"basis", "light field"}, {"cameras", light_field.cameras}};
+        }
+    }
+    if (held.is_null()) return std::nullopt;
+    ExploreRequest stored;
+    stored.step = key.step;
+    stored.view = key.view;
+    const Camera camera = archive.explorer_locked().render(stored).camera;
+    const double elevation = camera.elevation_deg();
+    held.update(
+        {{"step", key.step},
+         {"view", key.view},
+         {"azimuth", camera.azimuth_deg()},
+         {"elevation", elevation},
+         {"trusted_offsets",
+          {{"azimuth", {-180.0, 180.0}}, {"elevation", {-89.0 - elevation, 89.0 - elevation}}}},
+         {"samples", json::array()}});
+    return held;
 }
 
 /// The frame's timings, provenance and mean confidence, in the X-Insitu-* headers.
@@ -187,7 +228,15 @@ void FrameRoutes::trust(const httplib::Request& request, httplib::Response& resp
     const StepKey key = step_key(request, archive_);
     {
         std::lock_guard<std::mutex> lock(archive_.mutex());
-        const auto found = trust_.find(key);
+        auto found = trust_.find(key);
+        if (found == trust_.end()) {
+            archive_.require_files_inside_locked(key.step, key.view);
+            const std::optional<json> whole = whole_orbit_trust(archive_, key);
+            if (whole) {
+                if (trust_.size() >= kMaxStepInfos) trust_.clear();
+                found = trust_.emplace(key, whole->dump()).first;
+            }
+        }
         if (found != trust_.end()) {
             response.set_content(found->second, "application/json");
             return;

@@ -8,6 +8,7 @@
 //               [--ao] [--ao-radius PIXELS] [--ao-strength S] [--enhance LAMBDA,GAMMA]
 //               [--fill PIXELS] [--mask OUT.png] --out OUT.png|exr
 //   insitu-view verify ARCHIVE
+//   insitu-view compare ONE.cdb OTHER.cdb [--attenuation-tolerance A] [--depth-tolerance R] ...
 //   insitu-view serve ARCHIVE [--port P] [--bind ADDR]
 //   insitu-view COMMAND --help      (or -h, anywhere among the arguments; or: help COMMAND)
 //
@@ -40,6 +41,7 @@
 #include "archive_inspection.hpp"
 #include "arguments.hpp"
 #include "cli.hpp"
+#include "compare_command.hpp"
 #include "explore_options.hpp"
 #include "insitu/archive/archive_reader.hpp"
 #include "insitu/core/image.hpp"
@@ -474,6 +476,7 @@ const std::vector<Command>& commands() {
         {"info", info_help, run_info},
         {"render", render_help, run_render},
         {"verify", verify_help, run_verify},
+        {"compare", insitu::viewer::compare_help, insitu::viewer::compare_main},
         {"serve", insitu::viewer::serve_help, insitu::viewer::serve_main}};
     return table;
 }
@@ -486,7 +489,8 @@ const Command* find_command(const std::string& name) {
 }
 
 UsageError unknown_command(const std::string& name) {
-    return UsageError("unknown command \"" + name + "\" (expected info, render, verify or serve)");
+    return UsageError("unknown command \"" + name +
+                      "\" (expected info, render, verify, compare or serve)");
 }
 
 void print_help(std::ostream& out) {
@@ -497,7 +501,7 @@ void print_help(std::ostream& out) {
     out << "\n'insitu-view COMMAND --help' (or 'insitu-view help COMMAND') lists a command's\n"
            "options and their defaults.\n"
            "Exit status: 0 success, 2 bad arguments or input, 3 damage found by info or verify,\n"
-           "1 other failures.\n";
+           "1 other failures (and differences beyond tolerance found by compare).\n";
 }
 
 }  // namespace
@@ -506,7 +510,7 @@ int main(int argc, char** argv) {
     const std::vector<std::string> all = insitu::cli::program_arguments(argc, argv);
     if (all.empty()) {
         return insitu::cli::report(
-            kProgram, "missing command (info, render, verify or serve; --help for usage)",
+            kProgram, "missing command (info, render, verify, compare or serve; --help for usage)",
             insitu::cli::kExitBadInput);
     }
     // "help [COMMAND]", "--help [COMMAND]": the overview, or the command's own help.

@@ -21,7 +21,9 @@
 //                           Explorer::render; headers X-Insitu-Milliseconds (render),
 //                           -Encode-Milliseconds, -Synthesised, -Colour-Source, -Confidence
 //   /api/mask?KEY=VALUE..   PNG of the frame's confidence as grey (as `render --mask`)
-//   /api/trust?step=S&view=V  orbit offsets where synthesis stays trustworthy (mean confidence)
+//   /api/trust?step=S&view=V  orbit offsets where frames stay trustworthy: "basis" volume or
+//                             light field (any angle: the step's data makes every view), else
+//                             view (probed: mean confidence of views synthesised from it)
 //   /api/status             frames rendered, superseded, refused, failed; whether a frame
 //                           renders now and how many requests wait
 // KEY is an explore_options key, plus `session` (letters, digits, '-', '_'; default: the client

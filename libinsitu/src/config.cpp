@@ -157,6 +157,8 @@ const Key<FieldEntry> kFieldKeys[] = {
 
 constexpr Choice<OnExisting> kOnExisting[] = {
     {"append", OnExisting::append}, {"replace", OnExisting::replace}, {"fail", OnExisting::fail}};
+constexpr Choice<HaloCheck> kHaloCheck[] = {
+    {"first", HaloCheck::first}, {"every", HaloCheck::every}, {"off", HaloCheck::off}};
 
 const Key<InstrumentConfig> kTopLevelKeys[] = {
     {"fields",
@@ -193,6 +195,15 @@ const Key<InstrumentConfig> kTopLevelKeys[] = {
          }
          return list;
      }},
+    {"units",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         if (!value.is_object()) wrong_type(key, value, "an object of field name: units");
+         config.units.clear();
+         for (const auto& entry : value.items()) {
+             config.units[entry.key()] = text(entry.value(), child_key(key, entry.key()));
+         }
+     },
+     [](const InstrumentConfig& config) { return json(config.units); }},
     {"views",
      [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
          config.views = parse_views(value, key, unknown);
@@ -321,6 +332,11 @@ const Key<InstrumentConfig> kTopLevelKeys[] = {
          config.on_existing = choose(value, key, kOnExisting);
      },
      [](const InstrumentConfig& config) { return json(name_of(config.on_existing, kOnExisting)); }},
+    {"halo_check",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.halo_check = choose(value, key, kHaloCheck);
+     },
+     [](const InstrumentConfig& config) { return json(name_of(config.halo_check, kHaloCheck)); }},
     {"light_field",
      [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
          require_object(value, key);

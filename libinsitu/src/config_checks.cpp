@@ -58,6 +58,22 @@ void check_field_styles(const InstrumentConfig& config) {
     }
 }
 
+// "units": each names a listed field and says something a caption can show on one line.
+void check_units(const InstrumentConfig& config) {
+    for (const auto& entry : config.units) {
+        const std::string key = child_key("units", entry.first);
+        if (std::find(config.fields.begin(), config.fields.end(), entry.first) ==
+            config.fields.end()) {
+            out_of_range(key, "\"" + entry.second + "\"", "names no field in \"fields\"");
+        }
+        const bool printable = std::all_of(entry.second.begin(), entry.second.end(),
+                                           [](char c) { return c != '\n' && c != '\r'; });
+        if (entry.second.empty() || entry.second.size() > 32 || !printable) {
+            out_of_range(key, "\"" + entry.second + "\"", "expected 1 to 32 characters, one line");
+        }
+    }
+}
+
 // "layers", "max_layers", "intervals" and "step": what the rays sample and what they store.
 void check_sampling(const InstrumentConfig& config) {
     if (config.layers) {
@@ -142,6 +158,7 @@ void InstrumentConfig::validate() const {
     validate_views(views, "views");
     check_fields_distinct(fields);
     check_field_styles(*this);
+    check_units(*this);
     check_sampling(*this);
     check_cadence(every, steps);
     if (archive.empty()) out_of_range("archive", "\"\"", "name the archive directory");

@@ -3,13 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <iomanip>
 #include <iostream>
 #include <limits>
 #include <optional>
 #include <set>
-#include <sstream>
 
+#include "archive/archive_format.hpp"
 #include "archive/asynchronous_writer.hpp"
 #include "budget/field_budget_check.hpp"
 #include "core/elapsed.hpp"
@@ -19,6 +18,7 @@
 #include "insitu/render/proxy_renderer.hpp"
 #include "parallel/agreement.hpp"
 #include "parallel/composited_passes.hpp"
+#include "parallel/distributed_config.hpp"
 #include "parallel/reduced_field_statistics.hpp"
 #include "representation/representation.hpp"
 #include "run_statistics.hpp"
@@ -28,41 +28,6 @@
 #include "step/step_recipe.hpp"
 
 namespace insitu {
-
-std::string to_string(Status status) {
-    switch (status) {
-        case Status::ok:
-            return "ok";
-        case Status::not_selected:
-            return "not_selected";
-        case Status::dropped:
-            return "dropped";
-        case Status::error:
-            return "error";
-    }
-    return "unknown";
-}
-
-std::ostream& operator<<(std::ostream& out, Status status) {
-    return out << to_string(status);
-}
-
-std::ostream& operator<<(std::ostream& out, const InstrumentOptions& options) {
-    return out << "InstrumentOptions{rethrow_errors " << std::boolalpha << options.rethrow_errors
-               << ", log " << options.log << std::noboolalpha << "}";
-}
-
-std::ostream& operator<<(std::ostream& out, const InstrumentStatistics& s) {
-    std::ostringstream line;
-    line << std::fixed << std::setprecision(3) << "executed " << s.steps_executed << ", written "
-         << s.steps_written << ", dropped " << s.steps_dropped << ", errors " << s.errors << ", "
-         << s.bytes_written << " bytes, compute " << s.compute_seconds << " s, blocked "
-         << s.blocked_seconds << " s, writing " << s.write_seconds << " s";
-    if (s.steps_replayed > 0) line << ", replayed " << s.steps_replayed << " (skipped)";
-    if (s.nonfinite_samples > 0) line << ", " << s.nonfinite_samples << " NaN/Inf samples";
-    if (s.composite_seconds > 0.0) line << ", compositing " << s.composite_seconds << " s";
-    return out << line.str();
-}
 
 namespace {
 
@@ -93,7 +58,11 @@ struct Instrument::Impl {
     std::optional<std::int64_t> last_step;  ///< the last step execute() accepted
     bool finalized = false;
     bool nonfinite_reported = false;
+    std::optional<std::int64_t> halo_step;  ///< the step the halo check ran at ("first")
+    // Replayed steps noted (by execute() or, in a rerun that asks first, by selects()): each
+    // counted once, one notice for the run.
     bool replay_reported = false;
+    std::set<std::int64_t> replayed_steps;
     std::vector<float> joined_blocks;  ///< storage of a field joined from several blocks
     /// When the last execute() returned: the simulation's own time runs from there.
     std::optional<SteadyClock::time_point> last_return;
@@ -122,9 +91,25 @@ struct Instrument::Impl {
         if (!warning.empty()) log("warning: " + warning);
     }
 
-    bool selects(std::int64_t step) const {
-        return !finalized && (!last_step || step > *last_step) && config.selects(step) &&
-               archived_steps.count(step) == 0;
+    /// Instrument::selects, const for the caller, notes a replayed step here.
+    bool selects(std::int64_t step) {
+        if (finalized || (last_step && step <= *last_step) || !config.selects(step)) return false;
+        if (archived_steps.count(step) == 0) return true;
+        note_replay(step);
+        return false;
+    }
+
+    /// A restarted simulation replays steps an earlier run already archived: those are kept as
+    /// they are ("on_existing": "append") and skipped, counted and noticed once, whether the
+    /// simulation asks selects() first (then it never calls execute() for them) or not.
+    void note_replay(std::int64_t step) {
+        if (!replayed_steps.insert(step).second) return;
+        run.update([](InstrumentStatistics& s) { ++s.steps_replayed; });
+        if (replay_reported) return;
+        replay_reported = true;
+        log("notice: step " + std::to_string(step) + " is already in archive \"" + config.archive +
+            "\" (a restarted run replaying it): archived steps are skipped, counted in "
+            "statistics (\"on_existing\": \"replace\" starts the archive anew)");
     }
 
     /// The constructor's work on one process: the compute device first (without one nothing is
@@ -134,6 +119,10 @@ struct Instrument::Impl {
     /// rank 0 opens the archive, and all agree (one failure fails every rank) and learn the
     /// archived steps.
     void open_distributed(InstrumentConfig distributed_config);
+    /// Where the compressed field may be kept: every rank must reach the archive (each places its
+    /// own blocks). Asked for, a rank that cannot is an error on every rank; by default the
+    /// field is then not kept.
+    void agree_on_volume_folder();
     /// Opens (or continues) the archive, notes the steps it holds and starts its writer.
     void open_archive();
     Status execute(std::int64_t step, double time, const std::vector<Field>& fields);
@@ -151,7 +140,7 @@ struct Instrument::Impl {
                        double& composite_seconds);
     /// Uploads field `name` (its one block, its tiles joined, or this rank's block) and returns
     /// the statistics its plan is chosen from: this process's, or reduced over the ranks.
-    std::unique_ptr<FieldStatistics> upload(const std::string& name,
+    std::unique_ptr<FieldStatistics> upload(std::int64_t step, const std::string& name,
                                             const std::vector<const Field*>& blocks,
                                             double& composite_seconds);
     /// Checks the value range and reports NaN/Inf samples (once per run).
@@ -199,26 +188,16 @@ void Instrument::Impl::open_distributed(InstrumentConfig distributed_config) {
     LocalFailure failure;
     failure.guard([&] {
         distributed_config.validate();
-        if (distributed_config.budget) {
-            fail<InvalidArgument>(
-                "\"budget\": an error budget is measured against a ground truth of the whole "
-                "field, which one process of a distributed run does not hold; give the settings "
-                "themselves, or measure them in a run without a communicator");
-        }
-        if (distributed_config.light_field) {
-            fail<InvalidArgument>(
-                "\"light_field\": light fields are not composited across ranks (their segments "
-                "and first hits depend on the opacity in front of a block, which the block "
-                "cannot know); capture them in a run without a communicator");
-        }
-        if (distributed_config.volume) {
-            fail<InvalidArgument>(
-                "\"volume\": a distributed run does not store the compressed field yet (each "
-                "rank would write its own blocks, and only rank 0 writes); keep it in a run "
-                "without a communicator");
-        }
+        refuse_what_ranks_cannot_composite(distributed_config);
     });
     config = std::move(distributed_config);
+    if (config.proxies.attenuation && (config.proxies.interleaving || config.proxies.entry_depth)) {
+        config.proxies.interleaving = config.proxies.entry_depth = false;
+        log("notice: a distributed run writes no \"interleaving\" or \"entry_depth\" (the "
+            "default \"proxies\" name them; a block cannot count what the ray met in front of "
+            "it): the archive's configuration lists neither, and the viewer's edit trust goes "
+            "without them");
+    }
     failure.guard([&] { renderer = std::make_unique<ProxyRenderer>(); });
     std::vector<double> archived;
     if (writes()) {
@@ -232,6 +211,23 @@ void Instrument::Impl::open_distributed(InstrumentConfig distributed_config) {
     for (double step : bytes_doubles(said.at(0))) {
         archived_steps.insert(static_cast<std::int64_t>(step));
     }
+    if (!config.no_volume) agree_on_volume_folder();
+}
+
+void Instrument::Impl::agree_on_volume_folder() {
+    const fs::path folder = fs::path(config.archive) / archive_format::kVolumeFolder;
+    const std::string unreached = ranks_that_cannot_reach(*communicator, folder);
+    if (unreached.empty()) return;
+    const std::string why = "rank(s) " + unreached + " cannot reach the archive's folder \"" +
+                            folder.string() +
+                            "\", and each rank writes its own blocks of the compressed field";
+    if (config.volume) {
+        fail<InvalidArgument>("\"volume\": ", why,
+                              "; put the archive on a file system every rank shares, or leave "
+                              "\"volume\" out");
+    }
+    config.no_volume = true;
+    log("note: " + why + ": the field is not kept (\"volume\": false)");
 }
 
 void Instrument::Impl::agree_on_step(std::int64_t step, double time, double& composite_seconds) {
@@ -294,18 +290,9 @@ Status Instrument::Impl::execute_distributed(std::int64_t step, double time,
 }
 
 bool Instrument::Impl::skips(std::int64_t step) {
-    // A restarted simulation replays steps an earlier run already archived: those are kept as
-    // they are ("on_existing": "append") and skipped, with one notice.
     if (archived_steps.count(step) != 0) {
         last_step = step;
-        run.update([](InstrumentStatistics& s) { ++s.steps_replayed; });
-        if (!replay_reported) {
-            replay_reported = true;
-            log("notice: step " + std::to_string(step) + " is already in archive \"" +
-                config.archive +
-                "\" (a restarted run replaying it): archived steps are skipped, counted in "
-                "statistics (\"on_existing\": \"replace\" starts the archive anew)");
-        }
+        note_replay(step);
         return true;
     }
     if (!config.selects(step)) {
@@ -370,7 +357,8 @@ StepRecord Instrument::Impl::compute(std::int64_t step, double time,
         for (const Field& field : fields) {
             if (field.name() == name) blocks.push_back(&field);
         }
-        const std::unique_ptr<FieldStatistics> statistics = upload(name, blocks, composite_seconds);
+        const std::unique_ptr<FieldStatistics> statistics =
+            upload(step, name, blocks, composite_seconds);
         check_range(name, statistics->range(), step);
         FieldPlan plan = plan_field(config, name, *statistics);
         if (budget) apply_budget(plan, *statistics);
@@ -379,13 +367,21 @@ StepRecord Instrument::Impl::compute(std::int64_t step, double time,
     return record;
 }
 
-std::unique_ptr<FieldStatistics> Instrument::Impl::upload(const std::string& name,
+std::unique_ptr<FieldStatistics> Instrument::Impl::upload(std::int64_t step,
+                                                          const std::string& name,
                                                           const std::vector<const Field*>& blocks,
                                                           double& composite_seconds) {
     // A rank may own nothing of a field: it passes no block, and marches nothing.
     if (communicator) {
-        return std::make_unique<ReducedFieldStatistics>(*communicator, *renderer, name, blocks,
-                                                        joined_blocks, composite_seconds);
+        auto reduced = std::make_unique<ReducedFieldStatistics>(
+            *communicator, *renderer, name, blocks, joined_blocks, composite_seconds);
+        // "halo_check": every field of the first step computed (halo_step), or of every step.
+        if (config.halo_check == HaloCheck::every ||
+            (config.halo_check == HaloCheck::first && halo_step.value_or(step) == step)) {
+            halo_step = step;
+            for (const std::string& line : reduced->check_halos(step)) log("warning: " + line);
+        }
+        return reduced;
     }
     // One block is marched where it lies (zero-copy up to the upload); tiles are joined.
     if (blocks.size() == 1) return std::make_unique<LocalFieldStatistics>(*renderer, *blocks[0]);

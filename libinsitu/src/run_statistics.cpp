@@ -1,9 +1,47 @@
 #include "run_statistics.hpp"
 
 #include <iomanip>
+#include <ostream>
 #include <sstream>
 
 namespace insitu {
+
+// The instrument's printers: Status, InstrumentOptions, and the summary line's statistics
+// (finalize's log).
+std::string to_string(Status status) {
+    switch (status) {
+        case Status::ok:
+            return "ok";
+        case Status::not_selected:
+            return "not_selected";
+        case Status::dropped:
+            return "dropped";
+        case Status::error:
+            return "error";
+    }
+    return "unknown";
+}
+
+std::ostream& operator<<(std::ostream& out, Status status) {
+    return out << to_string(status);
+}
+
+std::ostream& operator<<(std::ostream& out, const InstrumentOptions& options) {
+    return out << "InstrumentOptions{rethrow_errors " << std::boolalpha << options.rethrow_errors
+               << ", log " << options.log << std::noboolalpha << "}";
+}
+
+std::ostream& operator<<(std::ostream& out, const InstrumentStatistics& s) {
+    std::ostringstream line;
+    line << std::fixed << std::setprecision(3) << "executed " << s.steps_executed << ", written "
+         << s.steps_written << ", dropped " << s.steps_dropped << ", errors " << s.errors << ", "
+         << s.bytes_written << " bytes, compute " << s.compute_seconds << " s, blocked "
+         << s.blocked_seconds << " s, writing " << s.write_seconds << " s";
+    if (s.steps_replayed > 0) line << ", replayed " << s.steps_replayed << " (skipped)";
+    if (s.nonfinite_samples > 0) line << ", " << s.nonfinite_samples << " NaN/Inf samples";
+    if (s.composite_seconds > 0.0) line << ", compositing " << s.composite_seconds << " s";
+    return out << line.str();
+}
 
 void RunStatistics::record_error(const std::string& message, ErrorKind kind, bool from_writer) {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -182,7 +182,8 @@ archive_case(insitu_view_budget_archive info_budget_rig 0 STDOUT
              "light field   v: 12 cameras, 64^2 maps" info ${budget_archive})
 
 # The compressed field (issue 40), on volume_interop.cmake's archive: info lists it, render
-# draws any view of it with any function, and a source it lacks is named.
+# draws any view of it with any function (beside that archive: insitu_view.outputs counts its
+# folder's PNGs), and a source it lacks is named.
 if(TARGET insitu-capture)
   set(volume_archive ${CMAKE_CURRENT_BINARY_DIR}/volume_interop/run.cdb)
   function(volume_case name exit_status stream text)
@@ -192,9 +193,10 @@ if(TARGET insitu-capture)
               info ${volume_archive})
   volume_case(render_volume 0 STDERR "new view from volume, colour by the ground truth" render
               ${volume_archive} --step 0 --azimuth 200 --elevation -30 --source volume
-              --tf ${edited_tf} --out ${view_output}/volume.png)
+              --tf ${edited_tf} --out ${CMAKE_CURRENT_BINARY_DIR}/volume_interop/volume.png)
   volume_case(render_volume_auto 0 STDERR "new view from volume" render ${volume_archive}
-              --step 0 --azimuth 100 --out ${view_output}/volume_auto.png)
+              --step 0 --azimuth 100
+              --out ${CMAKE_CURRENT_BINARY_DIR}/volume_interop/volume_auto.png)
   view_case(render_volume_missing 2 STDERR "source = volume, but step 4 view 0" render
             ${view_archive} --step 4 --source volume --out ${view_output}/no_volume.png)
 endif()

@@ -8,6 +8,7 @@
 #include <mpi.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -111,6 +112,32 @@ std::vector<Field> views_of(const std::vector<VolumeBlock>& blocks) {
     return fields;
 }
 
+// The compressed field (kept by default: the grid is small): the ranks' blocks tile the grid
+// (a block per rank that has one, each rank's own file, nothing of the field gathered) and read
+// back as the field within the tolerance, as the one process's does.
+void expect_same_compressed_field(const ArchiveReader& single, const ArchiveReader& ranks,
+                                  std::int64_t step) {
+    const std::vector<ArchivedVolume> kept = ranks.volumes(step);
+    ASSERT_EQ(kept.size(), 1u) << "step " << step;
+    ASSERT_EQ(single.volumes(step).size(), 1u) << "step " << step;
+    EXPECT_EQ(kept[0].tolerance, single.volumes(step)[0].tolerance) << "step " << step;
+    EXPECT_GE(kept[0].blocks, 1);
+    EXPECT_LE(kept[0].blocks, world_size());
+    const SampledVolume truth = field_at(step);
+    for (const ArchiveReader* archive : {&single, &ranks}) {
+        const VolumeGrid grid = archive->load_volume(step, "f");
+        ASSERT_EQ(grid.dims, truth.dims);
+        EXPECT_EQ(grid.origin, truth.origin);
+        EXPECT_EQ(grid.spacing, truth.spacing);
+        double worst = 0.0;
+        for (std::size_t i = 0; i < grid.values.size(); ++i) {
+            worst = std::max(worst, std::abs(static_cast<double>(grid.values[i]) -
+                                             static_cast<double>(truth.values[i])));
+        }
+        EXPECT_LE(worst, kept[0].tolerance) << "step " << step;
+    }
+}
+
 // Runs three steps distributed over `parts`, then (rank 0) the same steps in one process, and
 // compares the archives.
 void expect_same_archive_as_one_process(const std::string& name, Index3 parts,
@@ -174,7 +201,9 @@ void expect_same_archive_as_one_process(const std::string& name, Index3 parts,
                           ranks.transfer_function(step, view).to_json())
                     << "step " << step << " view " << view;
             }
+            expect_same_compressed_field(single, ranks, step);
         }
+        EXPECT_TRUE(ranks.verify().empty());
     }
     EXPECT_TRUE(on_every_rank(same));
 }
@@ -310,6 +339,70 @@ TEST(InstrumentMpi, ARankZeroWriteFailureIsEveryRanksError) {
     }
 }
 
+// Runs steps 0 and 1 over slabs along x with rank 0's high x ghost layer stale (0.5 off the
+// neighbour's values) and returns what rank 0 logged (empty elsewhere).
+std::string log_with_a_stale_halo(const std::string& name, const std::string& halo_check) {
+    const std::string directory = shared_directory(name);
+    std::string config = configuration(directory + "/halo.cdb", "[0.35]", "uniform");
+    if (!halo_check.empty()) {
+        config.insert(config.size() - 1, R"(, "halo_check": ")" + halo_check + "\"");
+    }
+    auto instrument = mpi::instrument_from_json_text(config, MPI_COMM_WORLD);
+    if (world_rank() == 0) ::testing::internal::CaptureStderr();
+    for (int step = 0; step < 2; ++step) {
+        std::vector<VolumeBlock> blocks = my_blocks(field_at(step), {world_size(), 1, 1});
+        if (world_rank() == 0 && world_size() > 1) {
+            VolumeBlock& block = blocks.front();
+            const std::int64_t last = block.allocated[0] - 1;  // the ghost layer rank 0 draws from
+            for (std::int64_t k = 0; k < block.allocated[2]; ++k) {
+                for (std::int64_t j = 0; j < block.allocated[1]; ++j) {
+                    block.values[static_cast<std::size_t>(
+                        last + block.allocated[0] * (j + block.allocated[1] * k))] += 0.5f;
+                }
+            }
+        }
+        EXPECT_EQ(instrument->execute(step, step, views_of(blocks)), Status::ok)
+            << instrument->last_error();
+    }
+    EXPECT_EQ(instrument->finalize(), Status::ok);
+    instrument.reset();
+    return world_rank() == 0 ? ::testing::internal::GetCapturedStderr() : std::string();
+}
+
+std::size_t occurrences(const std::string& text, const std::string& part) {
+    std::size_t count = 0;
+    for (std::size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) {
+        ++count;
+    }
+    return count;
+}
+
+// The halo check: at the first step computed, rank 0 is told that the ghost layer rank 0 draws
+// from is not rank 1's interior, with the side and the largest difference; once, by default.
+TEST(InstrumentMpi, AStaleHaloIsNamedAtTheFirstStep) {
+    const std::string log = log_with_a_stale_halo("stale_halo", "");
+    if (world_rank() != 0) return;
+    const std::string warning =
+        "the ghost layer rank 0 hands over on its high x side differs from rank 1's interior";
+    if (world_size() == 1) {
+        EXPECT_EQ(log.find("ghost layer"), std::string::npos) << log;  // no neighbour
+        return;
+    }
+    EXPECT_EQ(occurrences(log, warning), 1u) << log;
+    EXPECT_NE(log.find("step 0: field \"f\""), std::string::npos) << log;
+    EXPECT_NE(log.find("largest difference 0.5"), std::string::npos) << log;
+    EXPECT_NE(log.find("in 990 of 990 samples"), std::string::npos) << log;  // 33 x 30, all off
+}
+
+TEST(InstrumentMpi, TheHaloCheckRunsEveryStepOrNeverOnRequest) {
+    const std::string every = log_with_a_stale_halo("halo_every", "every");
+    const std::string off = log_with_a_stale_halo("halo_off", "off");
+    if (world_rank() != 0) return;
+    EXPECT_EQ(occurrences(every, "hands over on its high x side"), world_size() > 1 ? 2u : 0u)
+        << every;
+    EXPECT_EQ(off.find("ghost layer"), std::string::npos) << off;
+}
+
 // Light fields have no exact composite: refused on every rank, at construction.
 TEST(InstrumentMpi, RefusesLightFields) {
     const std::string directory = shared_directory("light_field");
@@ -324,6 +417,49 @@ TEST(InstrumentMpi, RefusesLightFields) {
     }
 }
 
+// Each rank places its own blocks of the compressed field, so every rank must reach the archive.
+// Rank 1 here runs in another working directory with a relative archive path, as a node without
+// the shared file system would: an asked-for "volume" is refused on every rank naming it, and by
+// default the run goes on without the field. At one rank both keep it.
+TEST(InstrumentMpi, ARankThatCannotReachTheArchiveKeepsNoCompressedField) {
+    const std::filesystem::path directory = shared_directory("unreached");
+    const std::filesystem::path here = std::filesystem::current_path();
+    const std::filesystem::path elsewhere = directory / ("rank" + std::to_string(world_rank()));
+    std::filesystem::create_directories(elsewhere);
+    std::filesystem::current_path(world_rank() == 1 ? elsewhere : directory);
+    const bool unreached = world_size() > 1;
+    std::string asked = configuration("asked.cdb", "[0.35]", "uniform");
+    asked.insert(asked.size() - 1, R"(, "volume": {"relative_tolerance": 0.01})");
+    const SampledVolume volume = field_at(0);
+    const std::vector<VolumeBlock> blocks = my_blocks(volume, {world_size(), 1, 1});
+    try {
+        auto instrument = mpi::instrument_from_json_text(asked, MPI_COMM_WORLD);
+        EXPECT_FALSE(unreached) << "a rank that cannot reach the archive was asked to write to it";
+        EXPECT_EQ(instrument->execute(0, 0.0, views_of(blocks)), Status::ok);
+        EXPECT_EQ(instrument->finalize(), Status::ok);
+    } catch (const InvalidArgument& error) {
+        EXPECT_TRUE(unreached) << error.what();
+        EXPECT_NE(std::string(error.what()).find("\"volume\": rank(s) 1 cannot reach"),
+                  std::string::npos)
+            << error.what();
+    }
+    {
+        InstrumentOptions quiet;
+        quiet.log = false;
+        auto instrument = mpi::instrument_from_json_text(
+            configuration("default.cdb", "[0.35]", "uniform"), MPI_COMM_WORLD, quiet);
+        EXPECT_EQ(instrument->execute(0, 0.0, views_of(blocks)), Status::ok);
+        EXPECT_EQ(instrument->finalize(), Status::ok);
+    }
+    if (world_rank() == 0) {
+        EXPECT_EQ(ArchiveReader("default.cdb").volumes(0).size(), unreached ? 0u : 1u);
+        if (!unreached) {
+            EXPECT_EQ(ArchiveReader("asked.cdb").volumes(0).size(), 1u);
+        }
+    }
+    std::filesystem::current_path(here);
+}
+
 // An error budget is measured against the whole field's ground truth on one process: refused
 // on every rank, at construction, naming the key.
 TEST(InstrumentMpi, RefusesAnErrorBudget) {
@@ -336,6 +472,37 @@ TEST(InstrumentMpi, RefusesAnErrorBudget) {
     } catch (const InvalidArgument& error) {
         EXPECT_NE(std::string(error.what()).find("rank 0: \"budget\""), std::string::npos)
             << error.what();
+    }
+}
+
+// "interleaving" and "entry_depth" count what the ray met in front of a block, which a block
+// cannot know: listed or left to the default list, a distributed run drops them with a notice,
+// and the archive's configuration says they were not written (no silent drop, no false echo).
+TEST(InstrumentMpi, DropsInterleavingAndEntryDepthAndSaysSo) {
+    const std::string directory = shared_directory("interleaving");
+    std::string config = configuration(directory + "/dropped.cdb", "[0.35]", "uniform");
+    const std::size_t at = config.find("\"proxies\"");
+    config.erase(at, config.find(']', at) - at + 2);  // "proxies": [...],
+    config.insert(config.size() - 1,
+                  R"(, "proxies": ["depth", "attenuation", "interleaving", "entry_depth"])");
+    if (world_rank() == 0) ::testing::internal::CaptureStderr();
+    auto instrument = mpi::instrument_from_json_text(config, MPI_COMM_WORLD);
+    const SampledVolume volume = field_at(0);
+    EXPECT_EQ(instrument->execute(0, 0.0, views_of(my_blocks(volume, {world_size(), 1, 1}))),
+              Status::ok);
+    EXPECT_EQ(instrument->finalize(), Status::ok);
+    instrument.reset();
+    if (world_rank() == 0) {
+        const std::string log = ::testing::internal::GetCapturedStderr();
+        EXPECT_NE(log.find("notice: a distributed run writes no \"interleaving\" or "
+                           "\"entry_depth\""),
+                  std::string::npos)
+            << log;
+        const ProxySelection written =
+            ArchiveReader(directory + "/dropped.cdb").configuration().proxies;
+        EXPECT_TRUE(written.attenuation);
+        EXPECT_FALSE(written.interleaving);
+        EXPECT_FALSE(written.entry_depth);
     }
 }
 

@@ -399,5 +399,46 @@ TEST(Decomposition, ErrorsNameTheRanks) {
     EXPECT_NE(none.find("no rank passed a block"), std::string::npos) << none;
 }
 
+// A cell-centred tile of 16 cells with 2 halo cells per side, as a finite-volume code holds it,
+// at its global position (origin: the low corner of its first interior cell).
+BlockExtent cell_tile(double first_cell, std::int64_t cells, std::int64_t ghosts) {
+    BlockExtent block = extent({first_cell + 0.5, 0.5, 0.5}, {cells, 8, 8}, ghosts);
+    block.centering = Centering::cell;
+    return block;
+}
+
+TEST(Decomposition, ForgottenGhostLayersAreNamedAsSuch) {
+    // Two ranks' arrays of 16 + 2 + 2 cells along x handed over without ghost layers: each
+    // "interior" is then 20 cells, starting 2 cells early, and the two share 4 cells.
+    const std::string forgotten = decomposition_error({cell_tile(-2, 20, 0), cell_tile(14, 20, 0)});
+    EXPECT_NE(forgotten.find("ranks 0 and 1 overlap by 4 cells along x"), std::string::npos)
+        << forgotten;
+    EXPECT_NE(forgotten.find("ghosts_low"), std::string::npos) << forgotten;
+    EXPECT_NE(forgotten.find("rank 0 passed no ghost layer on its high x side"), std::string::npos)
+        << forgotten;
+    // Tiles that overlap although their ghost layers were given: no such hint.
+    const std::string overlap = decomposition_error({cell_tile(0, 16, 2), cell_tile(14, 16, 2)});
+    EXPECT_NE(overlap.find("overlap by 2 cells along x"), std::string::npos) << overlap;
+    EXPECT_EQ(overlap.find("no ghost layer"), std::string::npos) << overlap;
+}
+
+TEST(Decomposition, ErrorsDescribeBlocksInTheCallersCells) {
+    // A 16-cell tile is cells 0-15 of the grid, not "[0, 15) (grid samples)".
+    const std::string overlap = decomposition_error({cell_tile(0, 16, 2), cell_tile(14, 16, 2)});
+    EXPECT_NE(overlap.find("rank 0's interior is cells x 0-15, y 0-7, z 0-7"), std::string::npos)
+        << overlap;
+    EXPECT_NE(overlap.find("rank 1's is cells x 14-29"), std::string::npos) << overlap;
+    EXPECT_EQ(overlap.find("grid samples"), std::string::npos) << overlap;
+    // Node-centred blocks are described by their samples.
+    const std::string nodes =
+        decomposition_error({extent({0, 0, 0}, {10, 8, 8}), extent({8, 0, 0}, {8, 8, 8})});
+    EXPECT_NE(nodes.find("rank 0's interior is samples x 0-9"), std::string::npos) << nodes;
+    EXPECT_NE(nodes.find("overlap by 2 samples along x"), std::string::npos) << nodes;
+    // A gap is counted in the caller's units too.
+    const std::string gap = decomposition_error({cell_tile(0, 16, 2), cell_tile(18, 14, 2)});
+    EXPECT_NE(gap.find("cells"), std::string::npos) << gap;
+    EXPECT_EQ(gap.find("-sample grid"), std::string::npos) << gap;
+}
+
 }  // namespace
 }  // namespace insitu

@@ -179,11 +179,14 @@ export async function openViewerPage(context, url, errors) {
 }
 
 /// Waits until `page` shows a whole frame (not a drag's preview) newer than frame number `count`
-/// whose options are the page's current ones: nothing is left to request or redraw.
+/// whose options are the page's current ones: nothing is left to request or redraw, and the page
+/// is ready (it draws in the browser where it can; its first frame may come before, and the
+/// server's provisional frame while the step's proxies download).
 export function waitForSettledFrame(page, count = 0, timeout = 60000) {
   return page.waitForFunction((n) => {
     const v = window.insituViewer;
-    return v.frameCount > n && v.displayed && !v.displayed.preview &&
+    return v.readyAt !== undefined && !v.busy() &&
+      v.frameCount > n && v.displayed && !v.displayed.preview && !v.displayed.provisional &&
       JSON.stringify(v.displayed.options) === JSON.stringify(v.options());
   }, count, { timeout });
 }

@@ -90,6 +90,8 @@ async function serverPixels(page) {
 test('segment faders fade the WebGL2 frame as insitu-view render --segment-opacity does', async () => {
   const context = await browser.newContext();
   const page = await openPage(context, server.url);
+  // The first frame is the server's; the page has tried WebGL2 once it is ready.
+  await page.waitForFunction(() => window.insituViewer.readyAt !== undefined);
   assert.ok(await page.evaluate(() => Boolean(window.insituViewer.gpu)), 'WebGL2 (SwiftShader)');
   const info = await (await fetch(`${server.url}api/step?step=300`)).json();
   assert.equal(info.light_field_segments, 2, '/api/step: segments of the light field');

@@ -60,6 +60,8 @@ function compareWithCli(page, what) {
 test('orbit views drawn with WebGL2 match insitu-view render --source lightfield', async () => {
   const context = await browser.newContext();
   const page = await openPage(context);
+  // The first frame is the server's; the page has tried WebGL2 once it is ready.
+  await page.waitForFunction(() => window.insituViewer.readyAt !== undefined);
   const gpu = await page.evaluate(() => Boolean(window.insituViewer.gpu));
   assert.ok(gpu, 'WebGL2 is available in headless chromium (SwiftShader)');
   const info = await (await fetch(`${server.url}api/step?step=300`)).json();

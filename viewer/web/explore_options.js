@@ -2,7 +2,7 @@
 // keys as its --key value), made from the page's state and controls.
 import { $, state } from './page.js';
 import { segmentOpacityOption } from './segment_faders.js';
-import { baseTf, editedTf, isEditable } from './transfer_function.js';
+import { baseTf, chosenTf, editedTf, isEditable, storedTf } from './transfer_function.js';
 
 export function currentOptions() {
   if (!state.timeline.length) return null;
@@ -16,6 +16,8 @@ export function currentOptions() {
     options.tf = JSON.stringify(editedTf(false));
   } else if (state.baseTf) {
     options.tf = JSON.stringify(state.baseTf);
+  } else if (chosenTf() && JSON.stringify(chosenTf()) !== JSON.stringify(storedTf())) {
+    options.tf = JSON.stringify(chosenTf());  // the run's colours on a step with its own
   }
   const scales = state.scales.map((s, j) => [j, s]).filter(([, s]) => s !== 1);
   if (scales.length) options['opacity-scale'] = scales.map(([j, s]) => `${j}=${s.toFixed(3)}`).join(',');

@@ -8,7 +8,11 @@
 import { $, FPS_WINDOW_MS, errorText, session, showError, state, viewer } from './page.js';
 import { currentOptions, sameOptions } from './explore_options.js';
 import { baseTf } from './transfer_function.js';
-import { schedulePlay } from './timeline.js';
+import { paintOverlay, shownAlpha } from './overlay.js';
+import { drawAnnotations } from './annotations.js';
+import { writeViewQuery } from './view_state.js';
+import { requestCompare } from './compare.js';
+import { askedStep, schedulePlay } from './timeline.js';
 
 let inFlight = false;
 const READOUT_EVERY_MS = 250;
@@ -68,17 +72,48 @@ function recipeFor(options) {
   return recipes.get(key);
 }
 
+// Whether a frame of `options` is one of the step and view the page asks for now; a frame of
+// another (asked for before the slider moved on) is dropped, not shown under the new label.
+export function asked(options) {
+  const now = askedStep();
+  return Boolean(now && options.step === String(now.step) && options.view === String(now.view));
+}
+
+// Whether the page holds the description (/api/step) of the step and view of `options`: until
+// then no frame is made for them (stepChanged asks for it once it has it).
+function described(options) {
+  return Boolean(state.info && String(state.info.step) === options.step &&
+    String(state.info.view) === options.view);
+}
+
+// How frames are drawn now: "draw in the browser" checked, and with a GPU ready.
+function drawingToggle() {
+  return `${$('gpu-toggle').checked}/${Boolean(viewer.gpu)}`;
+}
+
+// How the frame in flight was asked to be drawn (drawingToggle when it was requested).
+let requestedToggle = '';
+
+// Whether a frame is being made (tests wait until none is).
+viewer.busy = () => inFlight;
+
 export function requestFrame() {
   const options = currentOptions();
-  if (!options || inFlight) return;
+  if (!options) return;
+  drawAnnotations();
+  writeViewQuery();
+  requestCompare();
+  if (inFlight || !described(options)) return;
   // While dragging, what the browser draws may be a preview (gpu_frames.js: the full frame
   // once the pointer rests).
   const dragging = state.dragging && (drawnInBrowser(options) || proxiesInBrowser());
-  // The same options drawn the same way (toggling "draw in the browser" redraws them).
+  // The same options drawn the same way (toggling "draw in the browser", or the browser's
+  // WebGL2 becoming ready after the first frame, redraws them).
   if (viewer.displayed && sameOptions(viewer.displayed.options, options) &&
-    !(viewer.displayed.preview && !dragging) &&
-    viewer.displayed.toggle === $('gpu-toggle').checked) return;
+    !(viewer.displayed.preview && !dragging) && !upgradable() &&
+    viewer.displayed.toggle === drawingToggle()) return;
   inFlight = true;
+  requestedToggle = drawingToggle();
   if (drawnInBrowser(options)) {
     drawInBrowser(options, dragging);
   } else if (proxiesInBrowser()) {
@@ -88,7 +123,14 @@ export function requestFrame() {
   }
 }
 
-function serverFrame(options) {
+// A provisional frame: the server's, shown while the data the browser draws it from downloads.
+function upgradable() {
+  const d = viewer.displayed;
+  return Boolean(d && d.provisional && viewer.gpu &&
+    viewer.gpu.proxiesArrived(d.options.step, d.options.view));
+}
+
+function serverFrame(options, provisional = false) {
   const sent = performance.now();
   const body = new URLSearchParams({ ...options, session });
   fetch('api/frame', { method: 'POST', body })
@@ -101,7 +143,8 @@ function serverFrame(options) {
         return;
       }
       const png = new Uint8Array(await response.arrayBuffer());
-      await display(options, png, response.headers, performance.now() - sent);
+      if (!asked(options)) return;  // late: the page asks for another step now
+      await display(options, png, response.headers, performance.now() - sent, provisional);
       showError('');
     })
     .catch((error) => showError(String(error)))
@@ -131,13 +174,24 @@ async function drawProxies(options, dragging) {
     drawVolume(options, dragging, recipe);
     return;
   }
-  if (!viewer.gpu.proxyRenderer) {
-    serverFrame(options);
+  // The stored rendering of a step whose proxies have not arrived yet: the server's frame, exact
+  // and quick, while they download for the edits and drags to come.
+  // They are drawn here once they come (the same picture, which the page's overlay, edits and
+  // drags then start from).
+  const waiting = !viewer.gpu.proxiesArrived(entry.step, state.view);
+  if (!viewer.gpu.proxyRenderer || (recipe.stored_rendering && waiting && !dragging)) {
+    if (viewer.gpu.proxyRenderer) {
+      viewer.gpu.proxies(entry.step, state.view).then(() => {
+        if (!inFlight && upgradable()) requestFrame();
+      }, () => {});
+    }
+    serverFrame(options, viewer.gpu.proxyRenderer !== null);
     return;
   }
   viewer.gpu.drawProxies(entry.step, state.view, recipe, Number(options.azimuth),
     Number(options.elevation), dragging, true, !unedited(options))
     .then((timing) => {
+      if (timing && timing.dropped) return frameDone();
       if (!timing) {
         serverFrame(options);
         return null;
@@ -165,6 +219,7 @@ function drawVolume(options, dragging, recipe) {
   viewer.gpu.drawVolume(entry.step, state.view, recipe, state.info.camera, volumeTf(options),
     !atStoredView(options), Number(options.azimuth), Number(options.elevation), dragging)
     .then((timing) => {
+      if (timing && timing.dropped) return frameDone();
       if (!timing) {
         serverFrame(options);
         return null;
@@ -181,8 +236,11 @@ function drawVolume(options, dragging, recipe) {
 function frameDone() {
   inFlight = false;
   const next = currentOptions();
+  // Also redrawn: a preview once the pointer rests, and a frame drawn before the browser's
+  // WebGL2 was ready (or before "draw in the browser" was toggled).
   if (!viewer.displayed || !sameOptions(viewer.displayed.options, next) ||
-    (viewer.displayed.preview && !state.dragging)) requestFrame();
+    (viewer.displayed.preview && !state.dragging) || upgradable() ||
+    viewer.displayed.toggle !== drawingToggle()) requestFrame();
   else if (state.playing) schedulePlay();
 }
 
@@ -190,6 +248,7 @@ function frameDone() {
 function countFrame() {
   viewer.frameCount += 1;
   const now = performance.now();
+  if (viewer.frameCount === 1) viewer.firstFrameAt = now;
   viewer.frameTimes.push(now);
   while (viewer.frameTimes.length && viewer.frameTimes[0] < now - FPS_WINDOW_MS) viewer.frameTimes.shift();
   return viewer.frameTimes.length > 1
@@ -209,6 +268,7 @@ function drawInBrowser(options, dragging, recipe = null) {
   viewer.gpu.draw(entry.step, state.view, state.info.camera, Number(options.azimuth),
     Number(options.elevation), state.segmentScales.slice(), dragging, recipe, !unedited(options))
     .then((timing) => {
+      if (timing && timing.dropped) return frameDone();
       if (!timing) {
         serverFrame(options);
         return null;
@@ -221,15 +281,30 @@ function drawInBrowser(options, dragging, recipe = null) {
     });
 }
 
+// Where a frame's colour comes from, in words: a frame from the compressed field is classified
+// by the transfer function itself (the engine's colour source names how proxies' frames are
+// coloured and does not apply to it).
+export function colourWords(drawnFrom, colourSource) {
+  if (drawnFrom === 'compressed field') return 'colour: transfer function on the field';
+  return {
+    recompose: 'colour: recomposed from the intervals',
+    model: 'colour: colour model',
+    captured: 'colour: as the light field captured it',
+    stored: 'colour: the stored picture',
+  }[colourSource] || `colour: ${colourSource}`;
+}
+
 // Shows the canvas the GPU just drew (`what`: light field or stored view).
 function showGpuFrame(options, timing, what, colourSource) {
+  // The step moved on while the GPU drew: the next frame (frameDone) is the asked step's.
+  if (!asked(options)) return Promise.resolve();
   const preview = timing.preview;
   showCanvas(true);
   // A preview is smaller than the view: scaled up smoothly, not in blocks.
   $('gpu-frame').style.imageRendering = preview ? 'auto' : '';
   if (viewer.displayed && viewer.displayed.url) URL.revokeObjectURL(viewer.displayed.url);
   viewer.displayed = { options, gpu: true, drawnFrom: what, preview, size: timing.size,
-    toggle: $('gpu-toggle').checked, milliseconds: timing.milliseconds,
+    toggle: requestedToggle, milliseconds: timing.milliseconds,
     synthesised: what !== 'stored view', colourSource };
   const fps = countFrame();
   const open = viewer.gpu.lastOpen;
@@ -241,12 +316,12 @@ function showGpuFrame(options, timing, what, colourSource) {
     `frame ${timing.milliseconds.toFixed(1)} ms (WebGL2, ${what}` +
     `${preview ? `, preview ${timing.size[0]}x${timing.size[1]}` : ''})` +
     ` · ${fps.toFixed(1)} fps · step opened in ${(open.downloadMs + open.uploadMs).toFixed(0)} ms` +
-    ` (${(open.bytes / 1e6).toFixed(1)} MB)` + ` · colour ${colourSource}`;
+    ` (${(open.bytes / 1e6).toFixed(1)} MB)` + ` · ${colourWords(what, colourSource)}`;
   showError('');
   return updateMask();
 }
 
-async function display(options, png, headers, roundTripMs) {
+async function display(options, png, headers, roundTripMs, provisional) {
   const url = URL.createObjectURL(new Blob([png], { type: 'image/png' }));
   const image = $('frame');
   await new Promise((resolve, reject) => {
@@ -259,14 +334,16 @@ async function display(options, png, headers, roundTripMs) {
   const header = (name) => headers.get(name);
   viewer.displayed = {
     options,
-    toggle: $('gpu-toggle').checked,
+    toggle: requestedToggle,
     png,
     url,
     milliseconds: Number(header('X-Insitu-Milliseconds')),
     encodeMilliseconds: Number(header('X-Insitu-Encode-Milliseconds')),
     confidence: Number(header('X-Insitu-Confidence')),
     colourSource: header('X-Insitu-Colour-Source'),
+    proxySource: header('X-Insitu-Proxy-Source'),
     synthesised: header('X-Insitu-Synthesised') === '1',
+    provisional,
   };
   const fps = countFrame();
   const d = viewer.displayed;
@@ -274,7 +351,8 @@ async function display(options, png, headers, roundTripMs) {
     `frame ${d.milliseconds.toFixed(1)} ms (engine) + ${d.encodeMilliseconds.toFixed(1)} ms (PNG)` +
     ` · ${roundTripMs.toFixed(1)} ms (round trip)` +
     ` · ${fps.toFixed(1)} fps · mean confidence ${d.confidence.toFixed(3)}` +
-    ` · colour ${d.colourSource}${d.synthesised ? ' · synthesised view' : ' · stored view'}`;
+    ` · ${colourWords(d.proxySource === 'volume' ? 'compressed field' : '', d.colourSource)}` +
+    `${d.synthesised ? ' · synthesised view' : ' · stored view'}`;
   await updateMask();
 }
 
@@ -286,6 +364,7 @@ function unedited(options) {
 export async function updateMask() {
   const canvas = $('mask-overlay');
   canvas.hidden = !state.mask;
+  $('overlay-legend').hidden = !state.mask;
   if (!state.mask || !viewer.displayed) return;
   const displayed = viewer.displayed;
   // A preview keeps the overlay it has: the full frame follows once the pointer rests.
@@ -330,18 +409,10 @@ export async function updateMask() {
     viewer.maskFrom = 'server';
   }
   if (!sameOptions(options, viewer.displayed.options)) return;
-  canvas.width = width;
-  canvas.height = height;
-  const context = canvas.getContext('2d');
-  // Untrusted pixels in red, as opaque as they are untrusted; trusted ones clear.
-  const pixels = context.createImageData(width, height);
-  for (let p = 0; p < confidence.length; ++p) {
-    pixels.data[4 * p] = 255;
-    pixels.data[4 * p + 1] = 40;
-    pixels.data[4 * p + 2] = 40;
-    pixels.data[4 * p + 3] = Math.round((255 - confidence[p]) * 0.7);
-  }
-  context.putImageData(pixels, 0, 0);
+  // Where the frame shows nothing and the data vouches for that, nothing is painted; where it
+  // shows nothing but no stored view saw the space, "unknown" (overlay.js).
+  const shownElement = displayed.gpu ? $('gpu-frame') : $('frame');
+  paintOverlay(canvas, confidence, shownAlpha(shownElement, width, height), width, height);
   viewer.maskConfidence = confidence;  // for tests
   viewer.maskCount = (viewer.maskCount || 0) + 1;
 }

@@ -34,6 +34,7 @@ const FULL_SEARCH_STEPS = 64;  // LightFieldReconstructionSettings::search_steps
 // A volume's preview marches this many times the recipe's step (its table corrected for that
 // step, so the picture keeps its opacity), on the preview's fewer pixels.
 const PREVIEW_STEP_FACTOR = 2;
+const DROPPED = Object.freeze({ dropped: true });  // a draw's answer for data no longer wanted
 
 export class GpuFrames {
   /// null when this browser has no WebGL2 (the page then uses the server's frames only).
@@ -79,11 +80,19 @@ export class GpuFrames {
     this.lastOpen = null;    // {key, downloadMs, uploadMs, bytes}
     this.costs = new Map();  // kind of frame -> FrameCost
     this.dragFrameMs = DRAG_FRAME_MS;  // tests change it to force previews or full frames
+    // Whether (step, view) is still wanted once its data has come: a draw of one no longer
+    // wanted resolves to {dropped: true} without touching the canvas (the page sets it).
+    this.wanted = () => true;
   }
 
   cost(kind, fullFactor = 1) {
     if (!this.costs.has(kind)) this.costs.set(kind, new FrameCost(fullFactor));
     return this.costs.get(kind);
+  }
+
+  /// Whether the proxies of (step, view) have arrived (a draw from them waits for no download).
+  proxiesArrived(step, view) {
+    return arrived(this.proxyCache).has(`${step}/${view}`);
   }
 
   /// The parsed proxies of (step, view) with their download time; null without attenuation.
@@ -100,6 +109,7 @@ export class GpuFrames {
   async drawProxies(step, view, recipe, azimuthDeg, elevationDeg, dragging = false,
     withConfidence = false, edited = false) {
     const { proxies, downloadMs } = await this.proxies(step, view);
+    if (!this.wanted(step, view)) return DROPPED;
     if (!proxies) return null;
     let uploadMs = 0;
     const { width, height } = proxies.header;
@@ -152,6 +162,7 @@ export class GpuFrames {
     if (!this.volumeRenderer) return null;
     const key = `${step}/${view}`;
     const { volume, downloadMs } = await this.volume(step, view);
+    if (!this.wanted(step, view)) return DROPPED;
     if (!volume) return null;
     const renderer = this.volumeRenderer;
     let uploadMs = 0;
@@ -242,6 +253,7 @@ export class GpuFrames {
     recipe = null, withTrust = false) {
     const key = `${step}/${view}`;
     const { lightField, downloadMs } = await this.lightField(step, view);
+    if (!this.wanted(step, view)) return DROPPED;
     if (!lightField) return null;
     let uploadMs = 0;
     if (this.uploaded !== key) {
@@ -282,15 +294,30 @@ export class GpuFrames {
 function cached(cache, key, load) {
   if (!cache.has(key)) {
     const started = performance.now();
-    cache.set(key, load()
-      .then((value) => ({ value, downloadMs: performance.now() - started }))
+    const pending = load()
+      .then((value) => {
+        if (cache.get(key) === pending) arrived(cache).add(key);
+        return { value, downloadMs: performance.now() - started };
+      })
       .catch((error) => {
         cache.delete(key);
         throw error;
-      }));
-    while (cache.size > KEPT_STEPS) cache.delete(cache.keys().next().value);
+      });
+    cache.set(key, pending);
+    while (cache.size > KEPT_STEPS) {
+      const oldest = cache.keys().next().value;
+      cache.delete(oldest);
+      arrived(cache).delete(oldest);
+    }
   }
   return cache.get(key);
+}
+
+const arrivedKeys = new WeakMap();  // cache -> the keys whose payload has arrived
+
+function arrived(cache) {
+  if (!arrivedKeys.has(cache)) arrivedKeys.set(cache, new Set());
+  return arrivedKeys.get(cache);
 }
 
 /// What VolumeRenderer.render takes of a volume recipe (/api/recipe: the archive's preview

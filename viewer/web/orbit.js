@@ -1,6 +1,6 @@
 // Orbit: the drag and the angle inputs, and the trusted range around the stored view
 // (/api/trust), drawn as a map of offsets.
-import { $, DEGREES_PER_PIXEL, REST_MS, getJson, state, svg } from './page.js';
+import { $, DEGREES_PER_PIXEL, REST_MS, getJson, short, state, svg } from './page.js';
 import { requestFrame } from './frames.js';
 
 let trust = null;
@@ -55,12 +55,7 @@ export async function requestTrust() {
     const result = await getJson(`api/trust?step=${entry.step}&view=${state.view}`);
     if (trustKey !== key) return;
     trust = result;
-    const [a0, a1] = trust.trusted_offsets.azimuth;
-    const [e0, e1] = trust.trusted_offsets.elevation;
-    const range = (lo, hi) => `${lo}…${hi > 0 ? '+' : ''}${hi}°`;
-    $('trust-label').textContent =
-      `trusted (mean confidence ≥ ${trust.threshold}): azimuth ${range(a0, a1)}, ` +
-      `elevation ${range(e0, e1)} around the stored view`;
+    $('trust-label').textContent = trustWords(trust);
   } catch (error) {
     if (trustKey === key) {
       trustKey = null;
@@ -68,6 +63,45 @@ export async function requestTrust() {
     }
   }
   drawTrustMap();
+}
+
+function signed(degrees) {
+  return `${degrees > 0 ? '+' : ''}${degrees}°`;
+}
+
+/// What the trusted range rests on, in words: the step's compressed field or light field makes
+/// every view; else the probe of views synthesised from the stored view's proxies.
+export function trustWords(t) {
+  if (t.basis === 'volume') {
+    const accuracy = t.mode === 'rate' ? `${t.rate} bits per value`
+      : `each value within ${short(t.tolerance)}`;
+    return `trusted at any angle: this step keeps its field (compressed, ${accuracy}), ` +
+      'which is ray-marched for every view';
+  }
+  if (t.basis === 'light field') {
+    return `trusted at any angle: this step's light field (${t.cameras} cameras around the ` +
+      'object) makes every view alike; the overlay marks the pixels its cameras disagree on';
+  }
+  const [a0, a1] = t.trusted_offsets.azimuth;
+  const [e0, e1] = t.trusted_offsets.elevation;
+  if (a0 === 0 && a1 === 0 && e0 === 0 && e1 === 0) {
+    const best = Math.max(...t.samples.map((sample) => sample.mean_confidence));
+    return `trusted only at the stored view: this step keeps one view, and views made from it ` +
+      `keep a mean confidence of at most ${best.toFixed(2)} (< ${t.threshold}) even ` +
+      `${Math.min(...t.samples.map((sample) => Math.abs(sample.offset)))}° away`;
+  }
+  return `trusted (mean confidence ≥ ${t.threshold}): azimuth ${signed(a0)}…${signed(a1)}, ` +
+    `elevation ${signed(e0)}…${signed(e1)} around the stored view (views made from it)`;
+}
+
+// Near the picture: whether the view shown lies outside the trusted range, and what that means.
+function showViewNote(inside, da, de) {
+  const note = $('view-note');
+  note.hidden = inside;
+  if (inside) return;
+  note.textContent = `outside the trusted range (Δazimuth ${da.toFixed(0)}°, Δelevation ` +
+    `${de.toFixed(0)}°): this view is made from the stored one and may miss what it did not ` +
+    'see. Double-click to go back.';
 }
 
 /// Orbit offsets from the stored view: +-90 deg azimuth across, +-90 deg elevation up and down.
@@ -83,8 +117,10 @@ export function drawTrustMap() {
   if (trust) {
     const [a0, a1] = trust.trusted_offsets.azimuth;
     const [e0, e1] = trust.trusted_offsets.elevation;
+    const clamp = (offset) => Math.max(-90, Math.min(90, offset));
     svg('rect', {
-      id: 'trusted-range', x: x(a0), y: y(e1), width: x(a1) - x(a0), height: y(e0) - y(e1),
+      id: 'trusted-range', x: x(clamp(a0)), y: y(clamp(e1)), width: x(clamp(a1)) - x(clamp(a0)),
+      height: y(clamp(e0)) - y(clamp(e1)),
       fill: 'rgba(108,180,255,0.25)', stroke: '#6cb4ff',
     }, map);
   }
@@ -107,6 +143,7 @@ export function drawTrustMap() {
   const inside = !trust || (da >= trust.trusted_offsets.azimuth[0] - 1e-9 &&
     da <= trust.trusted_offsets.azimuth[1] + 1e-9 && de >= trust.trusted_offsets.elevation[0] - 1e-9 &&
     de <= trust.trusted_offsets.elevation[1] + 1e-9);
+  showViewNote(inside, da, de);
   svg('circle', {
     cx: x(Math.max(-90, Math.min(90, da))), cy: y(Math.max(-90, Math.min(90, de))), r: 4,
     fill: inside ? '#7ee787' : '#ffae57',
@@ -115,11 +152,12 @@ export function drawTrustMap() {
   label.textContent = `Δaz ${da.toFixed(1)}°  Δel ${de.toFixed(1)}°`;
 }
 
-export function installOrbitDrag() {
-  const viewport = $('viewport');
+/// Orbit drags on `viewport` (the picture; side by side, the comparison's too: linked orbit).
+export function installOrbitDrag(viewport = $('viewport')) {
   let drag = null;
   viewport.addEventListener('pointerdown', (event) => {
-    if (!state.info) return;
+    // Shift-drag and the middle button pan (zoom.js).
+    if (!state.info || event.shiftKey || event.button !== 0) return;
     const [az, el] = storedAngles();
     drag = { x: event.clientX, y: event.clientY, azimuth: state.azimuth ?? az,
       elevation: state.elevation ?? el };
@@ -152,6 +190,7 @@ export function installOrbitDrag() {
   viewport.addEventListener('pointerup', end);
   viewport.addEventListener('pointercancel', end);
   viewport.addEventListener('dblclick', resetView);
+  if (viewport !== $('viewport')) return;  // the angles' fields once
   for (const id of ['azimuth', 'elevation']) {
     $(id).addEventListener('change', () => {
       const az = Number($('azimuth').value);

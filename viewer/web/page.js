@@ -30,6 +30,11 @@ export const state = {
   lightField: false,      // whether the shown step has a light field the browser can draw
   volume: false,          // whether the shown step has a compressed field of the view's field
   dragging: false,        // an orbit drag moved within the last REST_MS: previews will do
+  zoom: 1,                // the picture magnified (zoom.js), 1 = whole
+  pan: [0, 0],            // its offset in CSS pixels
+  scaleEdits: [],         // opacity edits in value space: [{lo, hi, value}] (value_edits.js)
+  colourEdits: [],        // colour edits in value space: [{lo, hi, value: linear RGB}]
+  runColours: false,      // one function for every step: the first step's (transfer_function.js)
 };
 export const viewer = {
   gpu: null,              // GpuFrames, or null without WebGL2

@@ -2,13 +2,14 @@
 // field's value histogram at the step (stored in situ); loading and saving functions.
 import { $, MAX_OPACITY_SCALE, short, showError, state, svg } from './page.js';
 import { hexToLinear, linearToHex } from './colour.js';
-import { baseTf, editedTf, evaluateTf, isEditable } from './transfer_function.js';
+import { baseTf, chosenTf, editedTf, evaluateTf, isEditable } from './transfer_function.js';
 import { requestFrame } from './frames.js';
+import { clearValueEdits, setColour, setScale } from './value_edits.js';
 
 function intervalColour(j) {
   if (state.colours[j]) return state.colours[j];
   const base = baseTf();
-  if (!state.baseTf && state.info.interval_colours) {
+  if (!chosenTf() && state.info.interval_colours) {
     return state.info.interval_colours.slice(3 * j, 3 * j + 3);
   }
   // A loaded function: its colour at the interval's centre (display only).
@@ -47,6 +48,22 @@ function drawHistogram(chart, histogram, x, lo, hi, top, bottom) {
     `values at this step: ${total} samples in [${short(histogram.min)}, ${short(histogram.max)}], ${bins} bins (log scale)`;
 }
 
+/// The value ranges the edits hold (value_edits.js), as bands along the top of the chart, so
+/// that it shows where an edit stays when the step's intervals change.
+function drawEditRanges(chart, x, lo, hi) {
+  const bands = [...state.scaleEdits.map((e) => [e, `opacity × ${e.value}`, 0]),
+    ...state.colourEdits.map((e) => [e, 'colour', 4])];
+  for (const [edit, what, offset] of bands) {
+    const a = Math.max(lo, edit.lo);
+    const b = Math.min(hi, edit.hi);
+    if (!(b > a)) continue;
+    const band = svg('rect', { class: 'edit-range', x: x(a), y: offset, width: x(b) - x(a),
+      height: 3, fill: '#6cb4ff' }, chart);
+    svg('title', {}, band).textContent =
+      `${what} on the values [${short(edit.lo)}, ${short(edit.hi)}) at every step`;
+  }
+}
+
 export function drawTfEditor() {
   const chart = $('tf-chart');
   chart.replaceChildren();
@@ -67,6 +84,7 @@ export function drawTfEditor() {
   const x = (v) => 6 + ((v - lo) / (hi - lo || 1)) * (w - 12);
   const scaleY = (s) => bottom - (s / MAX_OPACITY_SCALE) * (bottom - top);
   drawHistogram(chart, info.histogram, x, lo, hi, top, bottom);
+  drawEditRanges(chart, x, lo, hi);
   const attenuation = info.mean_attenuation || new Array(count).fill(0);
   const largest = Math.max(...attenuation, 1e-12);
   for (let j = 0; j < count; ++j) {
@@ -99,7 +117,7 @@ export function drawTfEditor() {
       const move = (e) => {
         const box = chart.getBoundingClientRect();
         const s = ((bottom - (e.clientY - box.top)) / (bottom - top)) * MAX_OPACITY_SCALE;
-        state.scales[j] = Math.max(0, Math.min(MAX_OPACITY_SCALE, Math.round(s * 1000) / 1000));
+        setScale(j, Math.max(0, Math.min(MAX_OPACITY_SCALE, Math.round(s * 1000) / 1000)));
         handle.setAttribute('cy', scaleY(state.scales[j]));
         requestFrame();
       };
@@ -112,7 +130,7 @@ export function drawTfEditor() {
       handle.addEventListener('pointerup', up);
     });
     handle.addEventListener('dblclick', () => {
-      state.scales[j] = 1;
+      setScale(j, 1);
       drawTfEditor();
       requestFrame();
     });
@@ -123,7 +141,7 @@ export function drawTfEditor() {
     input.dataset.interval = j;
     if (state.colours[j]) input.classList.add('edited');
     input.addEventListener('input', () => {
-      state.colours[j] = hexToLinear(input.value);
+      setColour(j, hexToLinear(input.value));
       input.classList.add('edited');
       requestFrame();
     });
@@ -134,8 +152,7 @@ export function drawTfEditor() {
 
 export function resetTf() {
   state.baseTf = null;
-  state.scales.fill(1);
-  state.colours.fill(null);
+  clearValueEdits();
   drawTfEditor();
   requestFrame();
 }
@@ -153,8 +170,7 @@ export async function loadTf(file) {
   try {
     const tf = JSON.parse(await file.text());
     state.baseTf = tf;
-    state.scales.fill(1);
-    state.colours.fill(null);
+    clearValueEdits();
     drawTfEditor();
     requestFrame();
   } catch (error) {

@@ -5,6 +5,7 @@ import { showSegmentFaders } from './segment_faders.js';
 import { requestFrame } from './frames.js';
 import { drawTfEditor } from './tf_editor.js';
 import { requestTrust, syncOrbitInputs } from './orbit.js';
+import { applyValueEdits } from './value_edits.js';
 
 export async function loadArchive() {
   const archive = await getJson('api/archive');
@@ -40,11 +41,27 @@ function updateStepLabel() {
     : 'no steps yet';
 }
 
+// Each stepChanged call's number: its replies are used only while it is the latest, so a step
+// that loads slower than the index's refresh (which replaces the timeline's objects) is still
+// shown, and a reply for a step or view no longer asked for is dropped.
+let stepRequests = 0;
+
+/// The (step, view) the page asks for now: the slider's step and the view selected.
+export function askedStep() {
+  const entry = state.timeline[state.stepIndex];
+  return entry ? { step: entry.step, view: state.view } : null;
+}
+
 export async function stepChanged() {
   updateStepLabel();
-  const entry = state.timeline[state.stepIndex];
-  if (!entry) return;
-  const info = await getJson(`api/step?step=${entry.step}&view=${state.view}`);
+  const asked = askedStep();
+  if (!asked) return;
+  const request = ++stepRequests;
+  const { step, view } = asked;
+  // Until the step's description comes, the picture is still the step before: said so.
+  $('step-label').classList.toggle('loading', !state.info || state.info.step !== step ||
+    state.info.view !== view);
+  const info = await getJson(`api/step?step=${step}&view=${view}`);
   let lightField = false;
   // A compressed field of the view's field (/api/step lists it): the recipe may draw from it.
   const volume = Boolean(info.volume);
@@ -52,18 +69,16 @@ export async function stepChanged() {
     // Only a step that lists a light field of the view's field (its segments) is asked for one:
     // probing the others cost a 404 each.
     lightField = info.light_field_segments > 0 &&
-      await viewer.gpu.has(entry.step, state.view).catch(() => false);
+      await viewer.gpu.has(step, view).catch(() => false);
     const next = state.timeline[state.stepIndex + 1];
-    if ((lightField || volume) && next) viewer.gpu.prefetch(next.step, state.view, { lightField, volume });
+    if ((lightField || volume) && next) viewer.gpu.prefetch(next.step, view, { lightField, volume });
   }
-  if (state.timeline[state.stepIndex] !== entry) return;  // the slider moved on meanwhile
+  if (request !== stepRequests) return;  // another step or view was asked for meanwhile
+  $('step-label').classList.remove('loading');
   state.lightField = lightField;
   state.volume = volume;
-  const count = info.intervals ? info.intervals.length - 1 : 0;
-  if (count !== state.scales.length) {
-    state.scales = new Array(count).fill(1);
-    state.colours = new Array(count).fill(null);
-  }
+  // The edits stay on the field values they were made at (value_edits.js).
+  applyValueEdits(info.intervals || [0]);
   state.info = info;
   // Faders for a light field captured in segments; the same run keeps its segments, and the
   // factors set, from step to step.

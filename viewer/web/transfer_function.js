@@ -8,8 +8,34 @@ export function storedTf() {
   if (state.info && state.info.transfer_function) return state.info.transfer_function;
   return state.archive ? state.archive.transfer_function : null;
 }
+/// The run's function for "same colours at every step": where the run made one function per step
+/// ("transfer_function": "auto"), the first step's spread over the union of every step's values
+/// (/api/archive's value_ranges, from the manifest's per-step histograms), so that a colour means
+/// one value across the run and no step's values fall off its ends; else the run's one function.
+export function runTf() {
+  const first = state.archive && state.archive.transfer_function;
+  const config = state.archive && state.archive.configuration;
+  const field = state.info && state.info.field;
+  const range = field && state.archive.value_ranges && state.archive.value_ranges[field];
+  if (!isEditable(first) || !config || config.transfer_function !== 'auto' || !range ||
+      !(range.max > range.min)) {
+    return first;
+  }
+  const [lo, hi] = [first.points[0][0], first.points[first.points.length - 1][0]];
+  const spread = (v) => (hi > lo ? range.min + (v - lo) / (hi - lo) * (range.max - range.min)
+    : range.min);
+  return { ...first,
+    points: first.points.map(([v, ...rgba]) => [Number(spread(v).toPrecision(9)), ...rgba]) };
+}
+/// The function chosen for every step: a loaded one, or the run's (runTf) with "same colours at
+/// every step"; null: each step's own.
+export function chosenTf() {
+  if (state.baseTf) return state.baseTf;
+  if (state.runColours && state.archive && state.archive.transfer_function) return runTf();
+  return null;
+}
 export function baseTf() {
-  return state.baseTf || storedTf();
+  return chosenTf() || storedTf();
 }
 export function isEditable(tf) {
   return tf && Array.isArray(tf.points);

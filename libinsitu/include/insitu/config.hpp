@@ -96,7 +96,8 @@ struct ProxySelection {
     /// for edits reads it (issue 17; bench/RESULTS.md, "Where the methods fail"). On by default:
     /// it costs a small share of the archive's bytes and no measurable time (bench/RESULTS.md,
     /// "Interleaving counts on by default").
-    /// Not written by distributed runs: a block cannot count what the ray met in front of it.
+    /// Not written by distributed runs: a block cannot count what the ray met in front of it
+    /// (dropped there with a notice, and left out of the archive's configuration).
     bool interleaving = true;
     /// "entry_depth" (with "attenuation"): per pixel and interval, the depth where the
     /// interval first took light, counted in the attenuation pass. Opacity edits that thicken
@@ -138,6 +139,15 @@ enum class OnExisting {
     append,   ///< continue it (the default): a restarted run's replayed steps are skipped
     replace,  ///< remove the archive's own files (nothing else in the directory) and start anew
     fail,     ///< refuse to start (IoError naming the archive)
+};
+
+/// "halo_check": in a distributed run, whether neighbouring ranks compare the ghost layer each
+/// draws from (its first high one) with the owner's interior and warn, naming the ranks, the
+/// side and the largest difference, when they disagree (parallel/halo_check.hpp).
+enum class HaloCheck {
+    first,  ///< at the first step computed (the default)
+    every,  ///< at every step computed
+    off,
 };
 
 /// A field's own settings, for a field written as an object in "fields":
@@ -186,6 +196,9 @@ struct InstrumentConfig {
     /// function and layers unless field_styles gives it its own; all in one archive.
     std::vector<std::string> fields{"v"};
     std::map<std::string, FieldStyle> field_styles;  ///< by field name; none by default
+    /// "units": a field's units by its name ({"v": "mol/L"}), for captions and colour bars
+    /// (the viewer reads them from the manifest's copy of the configuration); none by default.
+    std::map<std::string, std::string> units;
     std::vector<ViewConfig> views{ViewConfig{}};
     /// "transfer_function": a function in the data's units, or "auto" (nullopt, the default):
     /// at every archived step, default_transfer_function() over the 1st to 99th percentiles of
@@ -227,6 +240,7 @@ struct InstrumentConfig {
     /// them warnings.
     bool strict = true;
     OnExisting on_existing = OnExisting::append;  ///< "on_existing"
+    HaloCheck halo_check = HaloCheck::first;      ///< "halo_check": "first" | "every" | "off"
     /// "light_field": per step and field, a light field (seed 001) from an icosphere of cameras
     /// (insitu/core/light_field.hpp), captured in the proxy pass; none by default.
     std::optional<LightFieldSettings> light_field;

@@ -100,7 +100,8 @@ public:
     /// The Fields are not referenced after execute() returns.
     Status execute(std::int64_t step, double time, const std::vector<Field>& fields);
     /// Whether execute(step, ...) would compute proxies: not finalized, after the last step,
-    /// selected by the cadence and not already archived. Fields need only be made then.
+    /// selected by the cadence and not already archived (a step a restarted run replays is
+    /// counted in steps_replayed, with the one notice). Fields need only be made then.
     bool selects(std::int64_t step) const;
     /// Counts a failure met at a boundary before execute() (a C API set_field, say) as an error
     /// of the run: logged like execute()'s first error, kept as the first root cause.

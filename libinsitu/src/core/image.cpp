@@ -124,6 +124,25 @@ std::string extension_of(const std::string& path) {
 }
 }  // namespace
 
+std::vector<std::uint8_t> to_srgb8(const Image& image) {
+    std::vector<std::uint8_t> bytes(image.pixels.size());
+    for (std::size_t p = 0; p < image.pixel_count(); ++p) {
+        const float* in = &image.pixels[p * image.channels];
+        std::uint8_t* out = &bytes[p * image.channels];
+        if (image.channels == 4) {
+            // Premultiplied linear -> straight-alpha sRGB, as PNG defines alpha.
+            const float alpha = std::clamp(in[3], 0.0f, 1.0f);
+            for (int c = 0; c < 3; ++c) {
+                out[c] = to_byte(linear_to_srgb(alpha > 0.0f ? in[c] / alpha : 0.0f));
+            }
+            out[3] = to_byte(alpha);
+        } else {
+            for (int c = 0; c < image.channels; ++c) out[c] = to_byte(linear_to_srgb(in[c]));
+        }
+    }
+    return bytes;
+}
+
 namespace {
 /// 8-bit sRGB samples of `image` as PNG stores them, and the libpng description of them;
 /// `where` names the caller in errors.
@@ -140,21 +159,7 @@ PngPixels png_pixels(const Image& image, const std::string& where) {
         fail<InvalidArgument>(where, ": empty image ", image.width, "x", image.height);
     }
     PngPixels png;
-    png.bytes.resize(image.pixels.size());
-    for (std::size_t p = 0; p < image.pixel_count(); ++p) {
-        const float* in = &image.pixels[p * image.channels];
-        std::uint8_t* out = &png.bytes[p * image.channels];
-        if (image.channels == 4) {
-            // Premultiplied linear -> straight-alpha sRGB, as PNG defines alpha.
-            const float alpha = std::clamp(in[3], 0.0f, 1.0f);
-            for (int c = 0; c < 3; ++c) {
-                out[c] = to_byte(linear_to_srgb(alpha > 0.0f ? in[c] / alpha : 0.0f));
-            }
-            out[3] = to_byte(alpha);
-        } else {
-            for (int c = 0; c < image.channels; ++c) out[c] = to_byte(linear_to_srgb(in[c]));
-        }
-    }
+    png.bytes = to_srgb8(image);
     png.description.version = PNG_IMAGE_VERSION;
     png.description.width = static_cast<png_uint_32>(image.width);
     png.description.height = static_cast<png_uint_32>(image.height);

@@ -73,4 +73,17 @@ std::vector<double> bytes_doubles(const Bytes& bytes) {
     return values;
 }
 
+std::string ranks_that_cannot_reach(Communicator& communicator,
+                                    const std::filesystem::path& folder) {
+    std::error_code error;
+    const bool reaches = std::filesystem::is_directory(folder, error);
+    const std::vector<Bytes> said =
+        agree(communicator, LocalFailure{}, Bytes{static_cast<std::uint8_t>(reaches ? 1 : 0)});
+    std::string unreached;
+    for (std::size_t r = 0; r < said.size(); ++r) {
+        if (said[r] != Bytes{1}) unreached += (unreached.empty() ? "" : ", ") + std::to_string(r);
+    }
+    return unreached;
+}
+
 }  // namespace insitu

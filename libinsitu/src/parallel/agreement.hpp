@@ -4,6 +4,7 @@
 // LocalFailure and goes on, and the next agreement raises it on every rank: the same error,
 // naming the rank.
 #include <exception>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,11 @@ struct LocalFailure {
 /// no extra collective).
 std::vector<Bytes> agree(Communicator& communicator, const LocalFailure& failure,
                          const Bytes& payload = {});
+
+/// The ranks (", "-separated, by rank; empty: none) that do not see `folder` as a directory: a
+/// collective, so every rank learns the same list.
+std::string ranks_that_cannot_reach(Communicator& communicator,
+                                    const std::filesystem::path& folder);
 
 /// Doubles as the bytes a collective carries, and back (same machine representation on every
 /// rank).

@@ -72,6 +72,13 @@ ProxyFrame CompositedPasses::proxies(const OrbitView& orbit, const Bounds& bound
     return frame;
 }
 
+std::vector<Bytes> CompositedPasses::gather(const Bytes& payload) {
+    std::vector<Bytes> payloads =
+        timed(composite_seconds_, [&] { return agree(ranks_, failure_, payload); });
+    if (!holds_results()) payloads.clear();
+    return payloads;
+}
+
 void CompositedPasses::finish() {
     const auto start = SteadyClock::now();
     agree(ranks_, failure_);

@@ -24,6 +24,7 @@ public:
     bool holds_whole_field() const override { return false; }
     void finish() override;
     ProxyRenderer& renderer() override { return renderer_; }
+    std::vector<Bytes> gather(const Bytes& payload) override;
 
 private:
     Communicator& ranks_;

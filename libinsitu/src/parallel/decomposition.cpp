@@ -35,11 +35,20 @@ double finite_upper(const Decomposition::Part& part, int axis, const Index3& dim
                                               : part.owned_upper[axis];
 }
 
-std::string owned_text(const Decomposition::Part& part, const Index3& dims) {
+/// What the caller calls the samples: cells (cell-centred data) or samples (node-centred).
+const char* unit_name(Centering centering) {
+    return centering == Centering::cell ? "cells" : "samples";
+}
+
+/// A block's interior as the caller passed it, in grid indices from the grid's first sample:
+/// "cells x 0-15, y 0-31, z 0-10" for a tile of 16 x 32 x 11 cells.
+std::string interior_text(const Decomposition& grid, const BlockExtent& block,
+                          const Decomposition::Part& part) {
     std::ostringstream out;
+    out << unit_name(grid.centering);
     for (int axis = 0; axis < 3; ++axis) {
-        out << (axis ? ", " : "") << axis_name(axis) << " [" << finite_lower(part, axis) << ", "
-            << finite_upper(part, axis, dims) << ")";
+        out << (axis ? ", " : " ") << axis_name(axis) << " " << part.interior_lower[axis] << "-"
+            << part.interior_lower[axis] + block.dims[axis] - 1;
     }
     return out.str();
 }
@@ -197,11 +206,13 @@ void assign_ownership(Decomposition& grid, const std::vector<BlockExtent>& block
                 continue;
             }
             if (blocks[r].ghost_high[axis] < 1) {
+                const char* unit = grid.centering == Centering::cell ? " cell " : " sample ";
                 fail<InvalidArgument>(
                     what, "rank ", r, "'s block needs a ghost layer on its high ", axis_name(axis),
                     " side: rank ", ghost_neighbour, "'s interior starts at ", axis_name(axis),
-                    " sample ", high + 1, ", right after rank ", r, "'s last, and rank ", r,
-                    " marches the samples between them (pass its values as one ghost layer)");
+                    unit, high + 1, ", right after rank ", r, "'s last, and rank ", r,
+                    " draws the space between the two from its first high ghost layer (pass it ",
+                    "with rank ", ghost_neighbour, "'s current values: ghosts_high)");
             }
             part.owned_upper[axis] = static_cast<double>(high + 1);
             part.marched_ghosts[axis] = 1;
@@ -209,8 +220,94 @@ void assign_ownership(Decomposition& grid, const std::vector<BlockExtent>& block
     }
 }
 
+/// Ranks r and s own overlapping boxes: says by how many cells (samples) along the axis where
+/// their interiors share the fewest, each interior in the caller's terms, and, where a rank
+/// passed no ghost layer on the facing side, that halo cells counted as interior do this.
+[[noreturn]] void fail_overlap(const Decomposition& grid, const std::vector<BlockExtent>& blocks,
+                               std::size_t r, std::size_t s, const std::string& what) {
+    int axis = 0;
+    std::int64_t common[3] = {0, 0, 0};
+    for (int a = 0; a < 3; ++a) {
+        const std::int64_t r_low = grid.parts[r].interior_lower[a];
+        const std::int64_t s_low = grid.parts[s].interior_lower[a];
+        common[a] =
+            std::min(r_low + blocks[r].dims[a], s_low + blocks[s].dims[a]) - std::max(r_low, s_low);
+        if (common[a] < common[axis]) axis = a;
+    }
+    // The rank whose interior starts first along that axis faces the other with its high side.
+    const bool r_first = grid.parts[r].interior_lower[axis] <= grid.parts[s].interior_lower[axis];
+    const std::size_t low = r_first ? r : s;
+    const std::size_t high = r_first ? s : r;
+    const char* units = unit_name(grid.centering);
+    std::ostringstream hint;
+    if (blocks[low].ghost_high[axis] == 0) {
+        hint << "; rank " << low << " passed no ghost layer on its high " << axis_name(axis)
+             << " side";
+    }
+    if (blocks[high].ghost_low[axis] == 0) {
+        hint << (hint.tellp() > 0 ? " and" : ";") << " rank " << high
+             << " passed no ghost layer on its low " << axis_name(axis) << " side";
+    }
+    if (hint.tellp() > 0) {
+        hint << ": if the arrays carry halo " << units << ", pass them as ghosts_low/ghosts_high "
+             << "(Field::set_ghost_layers) so that each interior is the " << units
+             << " its rank owns";
+    }
+    fail<InvalidArgument>(
+        what, "the blocks of ranks ", r, " and ", s, " overlap by ", common[axis], " ", units,
+        " along ", axis_name(axis), ": rank ", r, "'s interior is ",
+        interior_text(grid, blocks[r], grid.parts[r]), ", rank ", s, "'s is ",
+        interior_text(grid, blocks[s], grid.parts[s]), " (interiors must not share ", units,
+        grid.centering == Centering::node ? " beyond a shared face" : "", ")", hint.str());
+}
+
+/// Whether grid index `at` lies in rank r's interior.
+bool in_interior(const Decomposition& grid, const std::vector<BlockExtent>& blocks, std::size_t r,
+                 const Index3& at) {
+    const Decomposition::Part& part = grid.parts[r];
+    for (int axis = 0; axis < 3; ++axis) {
+        if (at[axis] < part.interior_lower[axis] ||
+            at[axis] >= part.interior_lower[axis] + blocks[r].dims[axis]) {
+            return false;
+        }
+    }
+    return part.present;
+}
+
+/// The blocks leave a gap: names a cell (sample) no interior holds, right after a rank's
+/// interior, where one is found, else the share of the grid they cover.
+[[noreturn]] void fail_gap(const Decomposition& grid, const std::vector<BlockExtent>& blocks,
+                           double owned_volume, double grid_volume, const std::string& what) {
+    const char* units = unit_name(grid.centering);
+    for (std::size_t r = 0; r < blocks.size(); ++r) {
+        if (!grid.parts[r].present) continue;
+        for (int axis = 0; axis < 3; ++axis) {
+            Index3 next = grid.parts[r].interior_lower;
+            next[axis] += blocks[r].dims[axis];
+            if (next[axis] >= grid.dims[axis]) continue;
+            bool held = false;
+            for (std::size_t s = 0; s < blocks.size() && !held; ++s) {
+                held = in_interior(grid, blocks, s, next);
+            }
+            if (held) continue;
+            fail<InvalidArgument>(
+                what, "the blocks leave a gap: no rank's interior holds ", units, " x ", next[0],
+                ", y ", next[1], ", z ", next[2], ", right after rank ", r, "'s interior (",
+                interior_text(grid, blocks[r], grid.parts[r]), ") along ", axis_name(axis),
+                " (interiors must together hold every one of ", "the grid's ", grid.dims[0], "x",
+                grid.dims[1], "x", grid.dims[2], " ", units, ")");
+        }
+    }
+    fail<InvalidArgument>(what, "the blocks leave a gap: their interiors cover ", owned_volume,
+                          " of the ", grid_volume, " spans between neighbouring ", units,
+                          " of the grid of ", grid.dims[0], "x", grid.dims[1], "x", grid.dims[2],
+                          " ", units, " from ", vector_text(grid.first_sample),
+                          " (interiors must together hold every one)");
+}
+
 /// The owned boxes must partition the grid: no two overlap and together they fill it.
-void check_partition(const Decomposition& grid, const std::string& what) {
+void check_partition(const Decomposition& grid, const std::vector<BlockExtent>& blocks,
+                     const std::string& what) {
     const std::size_t ranks = grid.parts.size();
     double owned_volume = 0.0;
     for (std::size_t r = 0; r < ranks; ++r) {
@@ -230,21 +327,13 @@ void check_partition(const Decomposition& grid, const std::string& what) {
                                                  finite_upper(b, axis, grid.dims)) -
                                             std::max(finite_lower(a, axis), finite_lower(b, axis)));
             }
-            if (shared > 0.0) {
-                fail<InvalidArgument>(what, "the blocks of ranks ", r, " and ", s,
-                                      " overlap: rank ", r, " owns ", owned_text(a, grid.dims),
-                                      ", rank ", s, " owns ", owned_text(b, grid.dims),
-                                      " (grid samples; interiors must not share samples)");
-            }
+            if (shared > 0.0) fail_overlap(grid, blocks, r, s, what);
         }
     }
     double grid_volume = 1.0;
     for (int axis = 0; axis < 3; ++axis) grid_volume *= static_cast<double>(grid.dims[axis] - 1);
     if (owned_volume < grid_volume * (1.0 - 1e-12)) {
-        fail<InvalidArgument>(what, "the blocks leave a gap: they cover ", owned_volume, " of the ",
-                              grid_volume, " cells of the ", grid.dims[0], "x", grid.dims[1], "x",
-                              grid.dims[2], "-sample grid from ", vector_text(grid.first_sample),
-                              " (interiors must together hold every sample)");
+        fail_gap(grid, blocks, owned_volume, grid_volume, what);
     }
 }
 
@@ -257,7 +346,7 @@ Decomposition decompose(const std::string& field, const std::vector<BlockExtent>
     check_shared_grid(grid, blocks, what);
     place_blocks(grid, blocks, what);
     assign_ownership(grid, blocks, what);
-    check_partition(grid, what);
+    check_partition(grid, blocks, what);
     grid.bounds.lower = grid.first_sample;
     for (int axis = 0; axis < 3; ++axis) {
         grid.bounds.upper[axis] =

@@ -3,6 +3,7 @@
 #include <limits>
 
 #include "core/elapsed.hpp"
+#include "parallel/halo_check.hpp"
 
 namespace insitu {
 
@@ -109,6 +110,38 @@ IntervalSet ReducedFieldStatistics::intervals(int count, IntervalMode mode,
     return mode == IntervalMode::opacity_adaptive
                ? IntervalSet::opacity_adaptive(histogram, min(), max(), count, tf)
                : IntervalSet::from_equalization_histogram(histogram, min(), max(), count);
+}
+
+BlockPlacement ReducedFieldStatistics::placement() const {
+    BlockPlacement mine;
+    mine.grid_dims = grid_->dims;
+    mine.origin = grid_->first_sample;
+    mine.spacing = grid_->spacing;
+    mine.count = 0;
+    for (std::size_t r = 0; r < grid_->parts.size(); ++r) {
+        const Decomposition::Part& part = grid_->parts[r];
+        if (!part.present) continue;
+        if (static_cast<int>(r) == ranks_.rank()) {
+            mine.index = mine.count;
+            mine.offset = part.interior_lower;
+            mine.dims = part.interior_dims;
+        }
+        ++mine.count;
+    }
+    return mine;
+}
+
+std::vector<std::string> ReducedFieldStatistics::check_halos(std::int64_t step) {
+    const auto start = SteadyClock::now();
+    agree(ranks_, failure_);  // every rank uploaded its block, or all raise the failure
+    const std::vector<HaloMismatch> mismatches =
+        compare_halos(ranks_, *grid_, block_ ? &renderer_.volume() : nullptr);
+    collective_seconds_ += seconds_since(start);
+    std::vector<std::string> lines;
+    for (const HaloMismatch& mismatch : mismatches) {
+        lines.push_back(describe(mismatch, *grid_, step, max() - min()));
+    }
+    return lines;
 }
 
 }  // namespace insitu

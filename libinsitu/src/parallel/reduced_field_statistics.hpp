@@ -27,9 +27,13 @@ public:
 
     const Bounds& bounds() const override { return grid_->bounds; }
     bool has_block() const override { return block_.has_value(); }
+    BlockPlacement placement() const override;
     const ValueRange& range() const override { return range_; }
     ValueHistogram histogram() override;
     IntervalSet intervals(int count, IntervalMode mode, const TransferFunction& tf) override;
+    /// The halo check (parallel/halo_check.hpp) of the uploaded blocks, collective: one warning
+    /// line per ghost layer that differs from its owner's interior, on every rank.
+    std::vector<std::string> check_halos(std::int64_t step);
 
 private:
     /// Sums `counts` over the ranks and agrees (raising any rank's failure since the last).

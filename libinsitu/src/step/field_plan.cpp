@@ -10,6 +10,7 @@ FieldPlan plan_field(const InstrumentConfig& config, const std::string& name,
     plan.name = name;
     plan.bounds = statistics.bounds();
     plan.has_block = statistics.has_block();
+    plan.placement = statistics.placement();
     plan.summary.field = name;
     plan.summary.nonfinite_samples = statistics.range().nonfinite_count;
     plan.summary.histogram = statistics.histogram();

@@ -16,6 +16,18 @@
 
 namespace insitu {
 
+/// Where this process's block of a field lies in the whole grid: all of it for one process; a
+/// rank's interior in a distributed run (what the rank keeps of the compressed field).
+struct BlockPlacement {
+    Index3 grid_dims{0, 0, 0};  ///< the whole grid's samples
+    glm::dvec3 origin{0.0};     ///< world position of the whole grid's sample (0, 0, 0)
+    glm::dvec3 spacing{1.0};    ///< world units between samples
+    Index3 offset{0, 0, 0};     ///< of the block's first interior sample
+    Index3 dims{0, 0, 0};       ///< the block's interior samples (none where it has no block)
+    int index = 0;              ///< among the ranks with a block, by rank
+    int count = 1;              ///< how many ranks have a block
+};
+
 /// The values of one field at one step, as the planner reads them: the field uploaded to this
 /// process's renderer, or every rank's block of it (each call a collective every rank makes).
 class FieldStatistics {
@@ -25,6 +37,8 @@ public:
     virtual const Bounds& bounds() const = 0;
     /// False on a rank of a distributed run that owns nothing of the field.
     virtual bool has_block() const = 0;
+    /// Where the uploaded block's interior lies in the whole grid.
+    virtual BlockPlacement placement() const = 0;
     /// The whole grid's value range and sample counts.
     virtual const ValueRange& range() const = 0;
     /// The whole grid's histogram over range() (ValueHistogram::of).
@@ -41,6 +55,7 @@ struct FieldPlan {
     std::vector<double> isovalues;
     IntervalSet intervals = IntervalSet::uniform(0.0, 1.0, 1);
     bool has_block = true;  ///< false: a rank that owns nothing of the field
+    BlockPlacement placement;
     /// The whole grid's values at this step (stored with the step, and what "auto" spans).
     FieldSummaryRecord summary;
     /// The configured function, or for "auto" default_transfer_function(summary.histogram).

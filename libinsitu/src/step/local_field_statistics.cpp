@@ -19,4 +19,14 @@ IntervalSet LocalFieldStatistics::intervals(int count, IntervalMode mode,
     return renderer_.choose_intervals(count, mode, &tf);
 }
 
+BlockPlacement LocalFieldStatistics::placement() const {
+    const DeviceVolume& volume = renderer_.volume();
+    BlockPlacement whole;
+    whole.grid_dims = volume.dims;
+    whole.origin = volume.origin;
+    whole.spacing = volume.spacing;
+    whole.dims = volume.dims;
+    return whole;
+}
+
 }  // namespace insitu

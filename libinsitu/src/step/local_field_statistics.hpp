@@ -14,6 +14,7 @@ public:
 
     const Bounds& bounds() const override { return renderer_.volume().bounds; }
     bool has_block() const override { return true; }
+    BlockPlacement placement() const override;
     const ValueRange& range() const override { return renderer_.volume().range; }
     ValueHistogram histogram() override;
     IntervalSet intervals(int count, IntervalMode mode, const TransferFunction& tf) override;

@@ -26,6 +26,10 @@ public:
     virtual void finish() = 0;
     /// The renderer with the field (or this rank's block of it) uploaded.
     virtual ProxyRenderer& renderer() = 0;
+    /// Every rank's `payload` by rank where the results are held (this process's alone for one
+    /// process), none elsewhere; in a distributed run a collective that raises, on every rank,
+    /// any rank's failure since the last.
+    virtual std::vector<Bytes> gather(const Bytes& payload) = 0;
     /// Runs local work on the results (where held); a failure is raised by finish(), so that a
     /// rank that fails still takes part in every collective before it.
     template <typename Work>
@@ -51,6 +55,10 @@ public:
     bool holds_whole_field() const override { return true; }
     void finish() override { failure_.raise(); }
     ProxyRenderer& renderer() override { return renderer_; }
+    std::vector<Bytes> gather(const Bytes& payload) override {
+        failure_.raise();
+        return {payload};
+    }
 
 private:
     ProxyRenderer& renderer_;

@@ -109,6 +109,10 @@ std::vector<ProxyMeasurement> compare_frames(ProxyFrame& one, ProxyFrame& other,
                                              const ArchiveTolerances& tolerances) {
     mask_unseen(one, other);
     const double depth = tolerances.depth;
+    // The channels stored at the archive's precision: relative differences are absolute below
+    // 1 (difference()), so the larger of the two steps bounds them.
+    const double stored_depth =
+        depth + std::max(tolerances.stored_step_absolute, tolerances.stored_step_relative);
     std::vector<ProxyMeasurement> measurements = {
         compare_values("isovalues", one.isovalues, other.isovalues, tolerances.value),
         compare_values("intervals", one.intervals ? one.intervals->edges() : std::vector<double>{},
@@ -116,9 +120,10 @@ std::vector<ProxyMeasurement> compare_frames(ProxyFrame& one, ProxyFrame& other,
                        tolerances.value),
         compare_images("depth", one.depth_layers, other.depth_layers, true, depth),
         compare_images("attenuation", {one.attenuation}, {other.attenuation}, false,
-                       tolerances.attenuation),
-        compare_images("mean_depth", {one.mean_depth}, {other.mean_depth}, true, depth),
-        compare_images("optical_depth", {one.optical_depth}, {other.optical_depth}, true, depth),
+                       tolerances.attenuation + tolerances.stored_step_absolute),
+        compare_images("mean_depth", {one.mean_depth}, {other.mean_depth}, true, stored_depth),
+        compare_images("optical_depth", {one.optical_depth}, {other.optical_depth}, true,
+                       stored_depth),
     };
     if (one.multi_perspective || other.multi_perspective) {
         measurements.push_back(compare_images("distortion", one.distortion_layers,
@@ -165,7 +170,40 @@ void keep_largest(std::vector<ProxyMeasurement>& largest, ProxyMeasurement measu
     }
 }
 
+/// Whether an archive's proxies may be stored at half: its "precision", or a budget's choice.
+bool may_store_half(const ArchiveReader& reader) {
+    const InstrumentConfig config = reader.configuration();
+    return config.precision == StoragePrecision::half ||
+           (config.budget && config.budget->chooses_precision);
+}
+
 }  // namespace
+
+ArchiveTolerances ArchiveTolerances::for_precision(StoragePrecision precision) {
+    ArchiveTolerances tolerances;
+    // The spacing of representable values just below 1, and relative to a value (2^-p for p
+    // fraction bits): half has 10 fraction bits, float 23.
+    const int fraction_bits = precision == StoragePrecision::half ? 10 : 23;
+    tolerances.stored_step_absolute = std::ldexp(1.0, -(fraction_bits + 1));
+    tolerances.stored_step_relative = std::ldexp(1.0, -fraction_bits);
+    return tolerances;
+}
+
+ArchiveTolerances ArchiveTolerances::for_archives(const ArchiveReader& one,
+                                                  const ArchiveReader& other) {
+    const bool half = may_store_half(one) || may_store_half(other);
+    return for_precision(half ? StoragePrecision::half : StoragePrecision::single);
+}
+
+std::string to_string(const ArchiveTolerances& tolerances) {
+    std::ostringstream text;
+    text << std::setprecision(3) << "attenuation " << tolerances.attenuation << " + "
+         << tolerances.stored_step_absolute << " (stored step), depth " << tolerances.depth
+         << " relative (mean and optical depth + "
+         << std::max(tolerances.stored_step_absolute, tolerances.stored_step_relative)
+         << "), preview " << tolerances.preview << ", values " << tolerances.value;
+    return text.str();
+}
 
 std::ostream& operator<<(std::ostream& out, const ProxyMeasurement& measurement) {
     std::ostringstream text;

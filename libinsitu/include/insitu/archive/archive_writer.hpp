@@ -15,13 +15,6 @@ namespace archive_format {
 class FileLock;
 }
 
-/// Sizes and checksums of what one write produced (also recorded in the manifest).
-struct WrittenFile {
-    std::string relative_path;
-    std::uint64_t bytes = 0;
-    std::uint32_t crc32 = 0;  ///< zlib CRC-32 of the whole file
-};
-
 struct StepWriteResult {
     /// The step's EXR and PNG files, then its light-field EXRs (not the indexes).
     std::vector<WrittenFile> files;

@@ -18,6 +18,13 @@ namespace insitu {
 
 constexpr int kArchiveSchemaVersion = 1;
 
+/// Sizes and checksums of what one write produced (also recorded in the manifest).
+struct WrittenFile {
+    std::string relative_path;
+    std::uint64_t bytes = 0;
+    std::uint32_t crc32 = 0;  ///< zlib CRC-32 of the whole file
+};
+
 /// Everything of one view at one timestep, copied off the simulation's memory.
 struct ViewRecord {
     int view_index = 0;
@@ -105,15 +112,24 @@ struct LightFieldRecord {
 };
 
 /// One field's values at one timestep, kept as the compressed field ("volume",
-/// insitu/core/volume_settings.hpp): blocks of the whole grid, each compressed by the writer
-/// (on its thread) into a file of its own. One process holds one block, the whole grid; a rank
-/// of a distributed run would hold its own (no gather of the field).
+/// insitu/core/volume_settings.hpp): blocks of the whole grid, each compressed into a file of
+/// its own. One process holds one block, the whole grid, which the writer compresses on its
+/// thread; in a distributed run each rank compresses and places its own block (nothing of the
+/// field is gathered), and rank 0's record lists the files they placed.
 struct VolumeRecord {
     struct Block {
         Index3 offset{0, 0, 0};  ///< of its first sample in the whole grid
         Index3 dims{0, 0, 0};
-        /// Copied off the simulation's memory: x fastest, non-finite where the field was.
+        /// Copied off the simulation's memory: x fastest, non-finite where the field was (empty
+        /// where `placed`).
         std::vector<float> values;
+        /// Files its rank compressed and placed already (a distributed run): the ZFP stream,
+        /// then the mask where `nonfinite` > 0; the writer indexes them as they are.
+        struct Placed {
+            std::vector<WrittenFile> files;
+            std::int64_t nonfinite = 0;
+        };
+        std::optional<Placed> placed = std::nullopt;
     };
     std::string field;
     Index3 dims{0, 0, 0};     ///< the whole grid's samples

@@ -51,6 +51,9 @@ Image resize_bilinear(const Image& image, int width, int height);
 /// Linear -> sRGB transfer curve for one component in [0, 1] (IEC 61966-2-1).
 float linear_to_srgb(float linear);
 
+/// The 8-bit sRGB samples write_png stores for `image`, row-major, `image.channels` per pixel:
+/// RGBA un-premultiplied into straight alpha, every other channel count encoded as it is.
+std::vector<std::uint8_t> to_srgb8(const Image& image);
 /// Writes a 1-channel (grey), 3-channel (RGB) or 4-channel (premultiplied RGBA) linear image as
 /// an 8-bit sRGB PNG via libpng. RGBA is un-premultiplied into PNG's straight alpha.
 /// Throws IoError naming the path on failure, InvalidArgument for other channel counts.

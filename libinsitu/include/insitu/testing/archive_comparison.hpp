@@ -9,12 +9,15 @@
 #include <string>
 #include <vector>
 
+#include "insitu/config.hpp"
+
 namespace insitu {
 
+class ArchiveReader;
+
 struct ArchiveTolerances {
-    /// Attenuation a_j is a fraction in [0, 1]: an absolute difference. Half-precision archives
-    /// resolve 2^-11 near 1 (two values rounding either side of a step differ by 5e-4 there):
-    /// compare float archives at this default, or loosen it for half ones.
+    /// Attenuation a_j is a fraction in [0, 1]: an absolute difference, what compositing in
+    /// another order may change. The stored precision's step is added (stored_step).
     double attenuation = 1e-4;
     /// Depths (layers, distortion, mean depth) and optical depths: relative to the larger
     /// magnitude, at least 1, so depths near 0 are held to an absolute 1e-3.
@@ -24,7 +27,22 @@ struct ArchiveTolerances {
     double preview = 0.02;
     /// Isovalues and interval edges (relative, at least 1).
     double value = 1e-6;
+    /// One step of the precision the HALF-or-FLOAT channels (attenuation, mean and optical
+    /// depth) were stored at: two values that round either side of a step differ by one step
+    /// however close they were. Added to the tolerances of those channels (not to depth layers,
+    /// distortion and previews, whose storage is fixed). Absolute for values in [0, 1]
+    /// (half: 2^-11, its step below 1), relative above (half: 2^-10, 10 fraction bits);
+    /// for_precision sets them.
+    double stored_step_absolute = 0.0;
+    double stored_step_relative = 0.0;
+
+    /// The defaults above with one step of `precision` (StoragePrecision) added.
+    static ArchiveTolerances for_precision(StoragePrecision precision);
+    /// for_precision of the coarser of the precisions two archives store (a budget that
+    /// chooses the precision counts as half): what comparing them may allow.
+    static ArchiveTolerances for_archives(const ArchiveReader& one, const ArchiveReader& other);
 };
+std::string to_string(const ArchiveTolerances& tolerances);  ///< one line, for reports
 
 /// One quantity of one (step, view, perspective): its largest difference, or why the two could
 /// not be compared at all.

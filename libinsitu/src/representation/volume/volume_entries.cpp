@@ -1,7 +1,5 @@
 #include "representation/volume/volume_entries.hpp"
 
-#include <set>
-
 #include "archive/archive_format.hpp"
 #include "archive/manifest_keys.hpp"
 #include "insitu/error.hpp"
@@ -10,6 +8,23 @@
 namespace insitu::archive_format {
 
 namespace fs = std::filesystem;
+
+VolumeRecord::Block::Placed place_volume_block(const fs::path& archive, const VolumeBlockName& name,
+                                               const float* values, const Index3& dims,
+                                               const ZfpParameters& parameters) {
+    const EncodedVolumeBlock encoded = encode_volume_block(values, dims, parameters);
+    VolumeRecord::Block::Placed placed;
+    placed.nonfinite = encoded.nonfinite;
+    placed.files.push_back(place_file(
+        archive, volume_relative_path(name.step, name.field, name.block, name.blocks, ".zfp"),
+        encoded.stream));
+    if (encoded.nonfinite > 0) {
+        placed.files.push_back(place_file(
+            archive, volume_relative_path(name.step, name.field, name.block, name.blocks, ".mask"),
+            encoded.mask));
+    }
+    return placed;
+}
 
 namespace {
 
@@ -116,7 +131,8 @@ nlohmann::json file_keys(const WrittenFile& written) {
 }
 
 /// Compresses and places the blocks of `volume` (the field at position `field_number` of the
-/// configuration's "fields"), appended to `written`; returns its entry.
+/// configuration's "fields"; blocks a rank placed itself are indexed as they are), appended to
+/// `written`; returns its entry.
 nlohmann::json write_volume(const fs::path& archive, std::int64_t step, int field_number,
                             const VolumeRecord& volume, std::vector<WrittenFile>& written) {
     const ZfpParameters parameters{volume.mode, volume.tolerance, volume.rate, volume.threads};
@@ -125,27 +141,28 @@ nlohmann::json write_volume(const fs::path& archive, std::int64_t step, int fiel
     std::int64_t nonfinite = 0;
     for (int b = 0; b < count; ++b) {
         const VolumeRecord::Block& block = volume.blocks[b];
-        if (static_cast<std::int64_t>(block.values.size()) !=
-            block.dims[0] * block.dims[1] * block.dims[2]) {
+        if (!block.placed && static_cast<std::int64_t>(block.values.size()) !=
+                                 block.dims[0] * block.dims[1] * block.dims[2]) {
             fail<InvalidArgument>("step ", step, ": compressed field of \"", volume.field,
                                   "\": block ", b, " holds ", block.values.size(), " values for ",
                                   triple(block.dims).dump(), " samples");
         }
-        const EncodedVolumeBlock encoded =
-            encode_volume_block(block.values.data(), block.dims, parameters);
-        written.push_back(place_file(
-            archive, volume_relative_path(step, field_number, b, count, ".zfp"), encoded.stream));
-        nlohmann::json entry = file_keys(written.back());
+        const VolumeRecord::Block::Placed placed =
+            block.placed ? *block.placed
+                         : place_volume_block(archive, {step, field_number, b, count},
+                                              block.values.data(), block.dims, parameters);
+        if (placed.files.size() != (placed.nonfinite > 0 ? 2u : 1u)) {
+            fail<InvalidArgument>("step ", step, ": compressed field of \"", volume.field,
+                                  "\": block ", b, " lists ", placed.files.size(), " files for ",
+                                  placed.nonfinite, " non-finite samples");
+        }
+        written.insert(written.end(), placed.files.begin(), placed.files.end());
+        nlohmann::json entry = file_keys(placed.files[0]);
         entry["offset"] = triple(block.offset);
         entry["dims"] = triple(block.dims);
-        entry["nonfinite"] = encoded.nonfinite;
-        if (encoded.nonfinite > 0) {
-            written.push_back(
-                place_file(archive, volume_relative_path(step, field_number, b, count, ".mask"),
-                           encoded.mask));
-            entry["mask"] = file_keys(written.back());
-        }
-        nonfinite += encoded.nonfinite;
+        entry["nonfinite"] = placed.nonfinite;
+        if (placed.nonfinite > 0) entry["mask"] = file_keys(placed.files[1]);
+        nonfinite += placed.nonfinite;
         blocks.push_back(std::move(entry));
     }
     return {{"field", volume.field},

@@ -16,8 +16,25 @@
 
 #include "archive/entry_list.hpp"
 #include "insitu/archive/archive_reader.hpp"
+#include "representation/volume/zfp_volume.hpp"
 
 namespace insitu::archive_format {
+
+/// Which block file: block `block` of `blocks` of the field at position `field` of the
+/// configuration's "fields", at `step` (volume_relative_path).
+struct VolumeBlockName {
+    std::int64_t step = 0;
+    int field = 0;
+    int block = 0;
+    int blocks = 1;
+};
+
+/// Compresses one block (`dims` samples, x fastest) and places its files crash-safely: the ZFP
+/// stream, then the mask where it has non-finite samples. The writer does this for one process's
+/// field on its thread; each rank of a distributed run for its own block.
+VolumeRecord::Block::Placed place_volume_block(const std::filesystem::path& archive,
+                                               const VolumeBlockName& name, const float* values,
+                                               const Index3& dims, const ZfpParameters& parameters);
 
 /// The compressed field's list (registered in representations.cpp).
 const EntryList& volume_entry_list();

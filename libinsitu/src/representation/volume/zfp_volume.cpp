@@ -87,6 +87,25 @@ void check_parameters(const ZfpParameters& parameters) {
     }
 }
 
+/// ZFP trusts a header's bits per block: a non-empty block spends 1 + 8 bits on its exponent
+/// before its budget is subtracted, so a header whose budget is smaller underflows that unsigned
+/// subtraction and ZFP reads far past any buffer (found by the fuzzer). Only the modes this
+/// writer uses are accepted, and a rate no smaller than its smallest (0.5 bits per value).
+void check_block_budget(const zfp_stream* zfp, const std::string& path) {
+    const zfp_mode mode = zfp_stream_compression_mode(zfp);
+    unsigned int min_bits = 0;
+    unsigned int max_bits = 0;
+    unsigned int max_precision = 0;
+    int min_exponent = 0;
+    zfp_stream_params(zfp, &min_bits, &max_bits, &max_precision, &min_exponent);
+    const unsigned int smallest_block = 32;  // 0.5 bits per value x 4^3 values
+    if ((mode != zfp_mode_fixed_accuracy && mode != zfp_mode_fixed_rate) || min_bits > max_bits ||
+        max_bits < smallest_block) {
+        fail<IoError>("\"", path, "\": the ZFP header asks for a mode this archive never writes (",
+                      min_bits, " to ", max_bits, " bits per block; corrupt)");
+    }
+}
+
 void check_dims(Index3 dims, const std::string& where) {
     for (const std::int64_t n : dims) {
         if (n < 1 || n > kMaxVolumeBlockSamples) {
@@ -215,6 +234,7 @@ std::vector<float> decode_volume_block(const std::vector<char>& stream,
         fail<IoError>("\"", path, "\": the ZFP header declares another grid than the manifest's ",
                       dims[0], "x", dims[1], "x", dims[2], " floats");
     }
+    check_block_budget(zfp.get(), path);
     const std::size_t largest = zfp_stream_maximum_size(zfp.get(), field.get());
     if (largest == 0 || stream.size() > largest) {
         fail<IoError>("\"", path, "\": ", stream.size(),

@@ -1,0 +1,13 @@
+#pragma once
+// What a distributed run refuses at construction, on every rank alike: what one process of it
+// cannot make (a budget's ground truth, light fields, the compressed field), each named by its
+// key. (The interleaving counts and entry depths, which a block cannot count either, are on in
+// every default selection, the C++ one included, so the Instrument drops them with a notice.)
+#include "insitu/config.hpp"
+
+namespace insitu {
+
+/// InvalidArgument naming the first key a distributed run cannot honour.
+void refuse_what_ranks_cannot_composite(const InstrumentConfig& config);
+
+}  // namespace insitu

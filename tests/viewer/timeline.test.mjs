@@ -1,0 +1,164 @@
+// The timestep follows the label (issue 42, 1): the page polls the archive's index every few
+// seconds and replaces its timeline; a step whose data arrives after such a refresh must still be
+// shown, and a reply for a step no longer asked for must not be shown under another step's label.
+// Also the times a user waits for (first frame, step change, opacity edit), printed.
+//
+//   INSITU_VIEW=build/viewer/insitu-view ARCHIVE=viewer.cdb WORK_DIR=dir node timeline.test.mjs
+import assert from 'node:assert/strict';
+import { test } from 'node:test';
+
+import { env, openViewerPage, serverAndBrowser, waitForSettledFrame } from './lib.mjs';
+
+const binary = env('INSITU_VIEW');
+const archive = env('ARCHIVE');
+const session = serverAndBrowser(binary, archive);
+
+const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+
+async function setStepIndex(page, index) {
+  await page.$eval('#step', (slider, i) => {
+    slider.value = String(i);
+    slider.dispatchEvent(new Event('input'));
+  }, index);
+}
+
+// What the page shows: the displayed frame's step, the step the label names, and whether a
+// frame is settled on the page's current options.
+function shown(page) {
+  return page.evaluate(() => {
+    const v = window.insituViewer;
+    return { frameStep: v.displayed && v.displayed.options.step,
+      label: document.getElementById('step-label').textContent,
+      settled: Boolean(v.displayed && !v.displayed.preview &&
+        JSON.stringify(v.displayed.options) === JSON.stringify(v.options())) };
+  });
+}
+
+async function timeline() {
+  return (await (await fetch(session.server.url + 'api/archive')).json()).timeline
+    .map((entry) => entry.step);
+}
+
+for (const gpu of ['on', 'off']) {
+  test(`a step whose data arrives after an index refresh is shown (gpu ${gpu})`, async () => {
+    const steps = await timeline();
+    assert.ok(steps.length >= 2, 'the fixture holds two steps');
+    const errors = [];
+    const page = await openViewerPage(session.browser, `${session.server.url}?gpu=${gpu}`, errors);
+    await waitForSettledFrame(page);
+    // The second step's description is held until the page has read the index again (it polls
+    // it every few seconds), so its reply comes after the timeline's objects were replaced.
+    let refreshed = 0;
+    page.on('response', (response) => {
+      if (response.url().endsWith('/api/archive')) ++refreshed;
+    });
+    let held = false;
+    const secondStep = (url) => url.pathname.endsWith('/api/step') &&
+      url.searchParams.get('step') === String(steps[1]);
+    await page.route(secondStep, async (route) => {
+      held = true;
+      const seen = refreshed;
+      while (refreshed === seen) await sleep(50);
+      await sleep(200);  // the refresh's reply taken in
+      await route.continue();
+    });
+    await setStepIndex(page, 1);
+    await page.waitForFunction((step) => {
+      const v = window.insituViewer;
+      return v.displayed && v.displayed.options.step === step && !v.displayed.preview;
+    }, String(steps[1]), { timeout: 20000 }).catch(() => {});
+    const now = await shown(page);
+    assert.ok(held, 'the step description was held past a refresh');
+    assert.equal(now.frameStep, String(steps[1]),
+      `the frame follows the label "${now.label}" after a refresh`);
+    assert.match(now.label, new RegExp(`step ${steps[1]} `));
+    assert.deepEqual(errors, []);
+    await page.close();
+  });
+}
+
+test('a reply for a step no longer asked for is not shown', async () => {
+  const steps = await timeline();
+  const errors = [];
+  const page = await openViewerPage(session.browser, `${session.server.url}?gpu=off`, errors);
+  await waitForSettledFrame(page);
+  // The second step's frame is held; meanwhile the user goes back to the first step.
+  let release;
+  const released = new Promise((resolve) => { release = resolve; });
+  let heldFrames = 0;
+  await page.route('**/api/frame', async (route) => {
+    if (new URLSearchParams(route.request().postData()).get('step') === String(steps[1])) {
+      ++heldFrames;
+      await released;
+    }
+    await route.continue();
+  });
+  await setStepIndex(page, 1);
+  for (let i = 0; i < 100 && !heldFrames; ++i) await sleep(50);
+  assert.ok(heldFrames > 0, 'the second step\'s frame was asked for and held');
+  const before = await page.evaluate(() => window.insituViewer.frameCount);
+  await setStepIndex(page, 0);
+  // From now on, at every animation frame: the step of the frame shown and the label.
+  await page.evaluate(() => {
+    const v = window.insituViewer;
+    v.shownLog = [];
+    const sample = () => {
+      if (v.displayed) {
+        v.shownLog.push([v.displayed.options.step, document.getElementById('step-label')
+          .textContent]);
+      }
+      if (v.shownLog.length < 100000) requestAnimationFrame(sample);
+    };
+    requestAnimationFrame(sample);
+  });
+  release();
+  await page.waitForFunction((n) => window.insituViewer.frameCount >= n, before, {
+    timeout: 20000 }).catch(() => {});
+  await sleep(1500);
+  const now = await shown(page);
+  assert.equal(now.frameStep, String(steps[0]), `the frame of step ${steps[0]}, as the label says`);
+  assert.match(now.label, new RegExp(`step ${steps[0]} `));
+  const log = await page.evaluate(() => window.insituViewer.shownLog);
+  for (const [step, label] of log) {
+    assert.ok(label.startsWith(`step ${step} `), `frame of step ${step} shown under "${label}"`);
+  }
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('a step change shows the stored view before the step\'s proxies have come', async () => {
+  const steps = await timeline();
+  const errors = [];
+  const page = await openViewerPage(session.browser, session.server.url, errors);
+  await waitForSettledFrame(page);
+  assert.equal(await page.evaluate(() => window.insituViewer.displayed.drawnFrom),
+    'stored view', 'the browser draws the stored view from its proxies');
+  // The second step's proxies are held until its frame is shown.
+  let release;
+  const released = new Promise((resolve) => { release = resolve; });
+  let held = false;
+  await page.route((url) => url.pathname.endsWith('/api/proxies') &&
+    url.searchParams.get('step') === String(steps[1]), async (route) => {
+    held = true;
+    await released;
+    await route.continue();
+  });
+  await setStepIndex(page, 1);
+  const shownWhileHeld = await page.waitForFunction((step) => {
+    const v = window.insituViewer;
+    return v.displayed.options.step === step;
+  }, String(steps[1]), { timeout: 15000 }).then(() => true, () => false);
+  const first = await page.evaluate(() => ({ gpu: Boolean(window.insituViewer.displayed.gpu),
+    provisional: window.insituViewer.displayed.provisional }));
+  release();
+  assert.ok(held, 'the proxies were asked for');
+  assert.ok(shownWhileHeld, 'the new step\'s frame came without its proxies');
+  assert.deepEqual(first, { gpu: false, provisional: true }, 'the server\'s exact stored view');
+  // Once they come, the browser draws the step from them (edits and drags start from there).
+  await waitForSettledFrame(page);
+  const settled = await page.evaluate(() => ({ step: window.insituViewer.displayed.options.step,
+    drawnFrom: window.insituViewer.displayed.drawnFrom }));
+  assert.deepEqual(settled, { step: String(steps[1]), drawnFrom: 'stored view' });
+  assert.deepEqual(errors, []);
+  await page.close();
+});
