@@ -8,7 +8,8 @@
 //   insitu_evaluate --out DIR [--smoke] [--sections a,b,...] [--raw PATH:NXxNYxNZ:TYPE ...]
 //   [--sizes N,N,...]
 // Sections: rotation, curvature, colour, configurations, storage, light_fields, budget, volume,
-// crossover (default: all); --sizes: the crossover's volume sizes (default 64,128,256,512).
+// crossover, light_field_cracks (default: all); --sizes: the crossover's volume sizes (default
+// 64,128,256,512).
 #include <unistd.h>
 
 #include <algorithm>
@@ -46,6 +47,7 @@
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/metrics.hpp"
+#include "light_field_quality.hpp"
 #include "median_time.hpp"
 #include "scenes.hpp"
 
@@ -66,9 +68,9 @@ struct RawInput {
 struct Options {
     std::string out;
     bool smoke = false;
-    std::set<std::string> sections{"rotation",       "curvature", "colour",
-                                   "configurations", "storage",   "light_fields",
-                                   "budget",         "volume",    "crossover"};
+    std::set<std::string> sections{"rotation",  "curvature",         "colour", "configurations",
+                                   "storage",   "light_fields",      "budget", "volume",
+                                   "crossover", "light_field_cracks"};
     std::vector<RawInput> raw;
     /// The crossover's volume sizes (--sizes); empty: 64, 128, 256, 512 (smoke: 24, 32).
     std::vector<int> sizes;
@@ -78,7 +80,7 @@ struct Options {
     std::fprintf(stderr,
                  "insitu_evaluate: %s\nusage: insitu_evaluate --out DIR [--smoke] "
                  "[--sections rotation,curvature,colour,configurations,storage,light_fields,"
-                 "budget,volume,crossover] [--sizes N,N,...] "
+                 "budget,volume,crossover,light_field_cracks] [--sizes N,N,...] "
                  "[--raw PATH:NXxNYxNZ:TYPE ...]\n",
                  message.c_str());
     std::exit(2);
@@ -1466,6 +1468,10 @@ int main(int argc, char** argv) {
         if (options.sections.count("light_fields")) {
             // The goal scenes: Gray-Scott and Marschner-Lobb.
             section_light_fields({&primary, &analytic[2]}, options, scratch, image);
+        }
+        if (options.sections.count("light_field_cracks")) {
+            section_light_field_cracks({&primary, &analytic[2]}, options.smoke, options.out,
+                                       scratch, image);
         }
         if (options.sections.count("volume")) {
             // The light-field section's scenes and views: the field beside the light fields.

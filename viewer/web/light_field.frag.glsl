@@ -4,19 +4,26 @@
 //  1. the target ray's line enters the camera sphere; the icosphere triangle of that point
 //     (LightFieldRig::cameras_around's cube-map look-up) gives three cameras and barycentric
 //     weights; cameras the light field lacks drop out and the weights renormalise;
-//  2. per camera and segment, depth correction: the ray is searched (search steps, then 16
-//     bisections) between where it enters and leaves the bounding sphere for the first point
-//     that passes from in front of the camera's stored surface to behind it and lies within
-//     4 map pixels' footprint (plus the depth's resolution) of it; RGBA is read bilinearly where
-//     the camera sees that point, or, without a hit, where it sees the ray's point nearest the
-//     centre unless it recorded a surface there (one the ray passes by: it holds nothing);
-//  3. per segment, the cameras that hold something of the ray blend with renormalised weights;
-//     segments composite front to back, segment s with its opacity scaled: A' = 1 - (1 - A)^k;
-//  4. (BASIS) the target camera's depth of the first hit, its t blended over the cameras that
+//  2. per camera, depth correction against its whole-ray depth: the ray between where it enters
+//     and leaves the bounding sphere is searched for the first point that passes from in front
+//     of the camera's stored surface (bilinear within one surface, else the nearest texel's) to
+//     behind it and lies within 4 map pixels' footprint (plus the depth's resolution) of it;
+//     each of the search steps is walked a map pixel's footprint at a time where the min/max
+//     depth pyramids (uBounds) allow a crossing, then 16 bisections;
+//  3. occlusion: where no camera around sees the hit and some recorded a surface in front of
+//     it, a neighbour further out on the icosphere that sees a hit no camera around contradicts
+//     is read instead, with their weight; cameras without a hit read the ray where the others
+//     found it (else at its point nearest the centre), and pass by (hold nothing of the ray)
+//     where they recorded a surface there;
+//  4. per segment (its own depth search where there are several), RGBA read bilinearly where
+//     each camera sees the hit; the cameras that hold something of the ray blend with
+//     renormalised weights; segments composite front to back, segment s with its opacity
+//     scaled: A' = 1 - (1 - A)^k;
+//  5. (BASIS) the target camera's depth of the first hit, its t blended over the cameras that
 //     recorded one (LightFieldReconstruction::depth): what lighting and occlusion read; with
-//     SAMPLES, per camera around the ray where it was read and its weight (0 for one the ray
-//     passes by), for
-//  5. (ATTENUATION, a pass of its own) attenuation light fields' a_j, read the same way at the
+//     SAMPLES, the cameras that see the ray (at most three), where each was read and its weight,
+//     for
+//  6. (ATTENUATION, a pass of its own) attenuation light fields' a_j, read the same way at the
 //     whole-ray first hit and blended over the cameras that see the ray, and the per-interval
 //     mean depth carried into the target camera (the point at that depth along the source
 //     camera's ray, seen from the target), blended with the weights w_k a_jk.
@@ -41,14 +48,22 @@ uniform usampler2DArray uDepth;  // seed 001's 8-bit codes, 255 = no hit
 #else
 uniform sampler2DArray uDepth;   // half secant fractions, +inf = no hit
 #endif
-uniform sampler2D uCameraFrames;    // texel (i, k): eye, right, up, forward of camera k
+// Layer as uDepth's, level L: the least (r) and greatest (g) distance from the eye of the
+// surfaces recorded in each 2^L x 2^L block of texels (+inf where none), the map padded to a
+// power of two with empty blocks (light_field_bounds.js; DepthBounds in the C++ code).
+uniform sampler2DArray uBounds;
+uniform int uBoundLevels;
 uniform isampler2D uTables;         // 1D integer tables in rows of TABLE_WIDTH (see below)
-uniform sampler2D uVertices;        // texel k: unit icosphere vertex k (1D, TABLE_WIDTH rows)
+// 1D float table in rows of TABLE_WIDTH: texel k the unit icosphere vertex k; texel
+// uFramesAt + 4 k + i: eye, right, up, forward of camera k.
+uniform sampler2D uVectors;
+uniform int uFramesAt;
 
 uniform int uSlotsAt;           // uTables offset: slot of camera k, -1 where missing
 uniform int uTrianglesAt;       // 3 entries per triangle
 uniform int uCellOffsetsAt;     // cells + 1 entries
 uniform int uCellTrianglesAt;   // the cells' candidate triangles
+uniform int uNeighboursAt;      // cameras + 1 offsets, then each camera's icosphere neighbours
 uniform int uCellsPerFace;
 uniform int uMapSize;
 uniform float uMapHalfExtent;   // tan 45 degrees as the C++ rig computes it
@@ -73,8 +88,8 @@ uniform vec2 uHalfExtent;  // half width, half height: world units, or tangents
 uniform vec2 uImageSize;
 
 #if defined(ATTENUATION)
-// Camera i around the target ray, layer i: (slot + 4096 camera, map x, map y, weight w_k
-// renormalised over the cameras present, 0 where the ray passes by what the camera saw).
+// Camera i that sees the target ray, layer i: (slot + 4096 camera, map x, map y, its weight w_k
+// renormalised over the cameras present; 0: none).
 uniform sampler2DArray uSamples;
 // Layer slot * uGroups + g: a_j (then mean depth) of intervals 4g .. 4g + 3 of that camera.
 uniform sampler2DArray uSourceAttenuation;
@@ -92,33 +107,33 @@ layout(location = 4) out vec4 outSample2;
 #else
 out vec4 outColour;
 #endif
-#if defined(BASIS) || defined(CONFIDENCE)
-const bool kWholeRayHits = true;
-#else
-const bool kWholeRayHits = false;  // only a single segment reads them
-#endif
 const float kInfinity = uintBitsToFloat(0x7f800000u);
 
 const int TABLE_WIDTH = 1024;
 const float NO_HIT = 1e30;  // +inf of the C++ code, kept finite for the arithmetic
 const int BISECTIONS = 16;
 const float SURFACE_FOOTPRINTS = 4.0;
+const int MAX_SEARCH_STEPS = 4096;  // of the fine walk within one coarse step (kMaxSearchSteps)
+// Relative widening of the depth bounds: more than float rounding of a distance, so a coarse
+// step is skipped only where the walk's own reads find no crossing either.
+const float BOUNDS_MARGIN = 1e-5;
 
 int tableAt(int index) {
   return texelFetch(uTables, ivec2(index % TABLE_WIDTH, index / TABLE_WIDTH), 0).r;
 }
+vec3 vectorAt(int index) {
+  return texelFetch(uVectors, ivec2(index % TABLE_WIDTH, index / TABLE_WIDTH), 0).xyz;
+}
 vec3 vertexAt(int k) {
-  return texelFetch(uVertices, ivec2(k % TABLE_WIDTH, k / TABLE_WIDTH), 0).xyz;
+  return vectorAt(k);
 }
 
 struct RigCamera {
   vec3 eye, right, up, forward;
 };
 RigCamera rigCamera(int k) {
-  return RigCamera(texelFetch(uCameraFrames, ivec2(0, k), 0).xyz,
-                   texelFetch(uCameraFrames, ivec2(1, k), 0).xyz,
-                   texelFetch(uCameraFrames, ivec2(2, k), 0).xyz,
-                   texelFetch(uCameraFrames, ivec2(3, k), 0).xyz);
+  int at = uFramesAt + 4 * k;
+  return RigCamera(vectorAt(at), vectorAt(at + 1), vectorAt(at + 2), vectorAt(at + 3));
 }
 
 // Camera::project for a rig camera (perspective, 90 degrees, N x N): map position in pixels.
@@ -135,10 +150,8 @@ float secantLength(vec2 map) {
   return 2.0 * uCameraRadius / sqrt(1.0 + dot(p, p));
 }
 
-// Eq. 3 at the nearest map pixel: the distance from the eye of the recorded surface, NO_HIT
-// where the camera recorded none.
-float storedDistance(int layer, vec2 map) {
-  ivec2 pixel = clamp(ivec2(floor(map)), ivec2(0), ivec2(uMapSize - 1));
+// Eq. 3 at one texel: the distance from the eye of the surface it recorded, NO_HIT where none.
+float texelDistance(int layer, ivec2 pixel) {
 #ifdef DEPTH_CODES
   uint code = texelFetch(uDepth, ivec3(pixel, layer), 0).r;
   if (code == 255u) return NO_HIT;
@@ -160,31 +173,107 @@ float depthTolerance(float distance, vec2 map, float footprints) {
   return footprints * 2.0 * distance / float(uMapSize) + quantum;
 }
 
+// Eq. 3 at a map position (stored_distance): bilinear where the four texels around it recorded
+// one surface (within SURFACE_FOOTPRINTS of each other), else the nearest texel's (bilinear
+// between a silhouette and the background would invent a surface); NO_HIT where none.
+float storedDistance(int layer, vec2 map) {
+  float last = float(uMapSize - 1);
+  ivec2 pixel = ivec2(clamp(floor(map), vec2(0.0), vec2(last)));
+  float nearest = texelDistance(layer, pixel);
+  if (!recorded(nearest)) return NO_HIT;
+  vec2 f = clamp(map - 0.5, vec2(0.0), vec2(last));
+  ivec2 p0 = ivec2(f);
+  ivec2 p1 = min(p0 + 1, ivec2(uMapSize - 1));
+  vec2 w = f - vec2(p0);
+  vec4 d = vec4(texelDistance(layer, p0), texelDistance(layer, ivec2(p1.x, p0.y)),
+                texelDistance(layer, ivec2(p0.x, p1.y)), texelDistance(layer, p1));
+  if (!(recorded(d.x) && recorded(d.y) && recorded(d.z) && recorded(d.w))) return nearest;
+  float low = min(min(d.x, d.y), min(d.z, d.w)), high = max(max(d.x, d.y), max(d.z, d.w));
+  float sum = (1.0 - w.x) * (1.0 - w.y) * d.x + w.x * (1.0 - w.y) * d.y +
+              (1.0 - w.x) * w.y * d.z + w.x * w.y * d.w;
+  return high - low <= depthTolerance(nearest, map, SURFACE_FOOTPRINTS) ? sum : nearest;
+}
+
+// The least and greatest stored distance (DepthBounds::between) over the map segment from a to
+// b: the blocks of the min/max pyramid (uBounds, level L: 2^L x 2^L texels) that cover the
+// texels any read along it may touch, at the level where they are at most 2 x 2.
+vec2 depthBounds(int layer, vec2 a, vec2 b) {
+  float last = float(uMapSize - 1);
+  ivec2 low = ivec2(0), high = ivec2(uMapSize - 1);
+  if (!(any(isnan(a)) || any(isinf(a)) || any(isnan(b)) || any(isinf(b)))) {
+    low = ivec2(clamp(floor(min(a, b) - 0.5), vec2(0.0), vec2(last)));
+    high = ivec2(clamp(floor(max(a, b) - 0.5) + 1.0, vec2(0.0), vec2(last)));
+  }
+  int level = 0;
+  while (level + 1 < uBoundLevels &&
+         any(greaterThan((high >> level) - (low >> level), ivec2(1)))) {
+    ++level;
+  }
+  vec2 range = vec2(kInfinity, -kInfinity);
+  for (int y = low.y >> level; y <= (high.y >> level); ++y) {
+    for (int x = low.x >> level; x <= (high.x >> level); ++x) {
+      vec2 block = texelFetch(uBounds, ivec3(x, y, layer), level).rg;
+      range = vec2(min(range.x, block.x), max(range.y, block.y));
+    }
+  }
+  return range;
+}
+
 float behindBy(RigCamera c, int layer, vec3 origin, vec3 direction, float t) {
   vec3 point = origin + t * direction;
   return length(point - c.eye) - storedDistance(layer, project(c, point));
 }
 
-// The first hit along [t0, t1] against a camera's stored depth (first_hit in the C++ code);
-// returns t, or -1 for none.
+// Where the step [t - step, t] crossed from in front of the stored surface to behind it: t of
+// the hit after BISECTIONS halvings, or -1 where the point behind lies too far behind (an
+// occluding edge, not a surface).
+float refinedHit(RigCamera c, int layer, vec3 origin, vec3 direction, float t, float step) {
+  float inFront = t - step, hidden = t;
+  for (int b = 0; b < BISECTIONS; ++b) {
+    float middle = 0.5 * (inFront + hidden);
+    if (behindBy(c, layer, origin, direction, middle) >= 0.0) hidden = middle;
+    else inFront = middle;
+  }
+  vec3 point = origin + hidden * direction;
+  float tolerance = depthTolerance(length(point - c.eye), project(c, point), SURFACE_FOOTPRINTS);
+  return behindBy(c, layer, origin, direction, hidden) <= tolerance ? 0.5 * (inFront + hidden)
+                                                                     : -1.0;
+}
+
+// The first hit along [t0, t1] against a camera's stored depth (first_hit in the C++ code):
+// each of the uSearchSteps coarse steps walked a map pixel's footprint at a time, unless the
+// depth bounds show the ray cannot pass from in front of a recorded surface to behind one in it
+// (BOUNDS_MARGIN keeps the float bounds on the safe side of the walk's own reads); returns t,
+// or -1 for none.
 float firstHit(RigCamera c, int layer, vec3 origin, vec3 direction, float t0, float t1) {
-  float step = (t1 - t0) / float(uSearchSteps - 1);
+  float coarseStep = (t1 - t0) / float(uSearchSteps - 1);
+  float footprint = 2.0 * uCameraRadius / float(uMapSize);
+  int fine = clamp(int(ceil(coarseStep / footprint)), 1, MAX_SEARCH_STEPS);
+  float step = coarseStep / float(fine);
   bool wasBehind = behindBy(c, layer, origin, direction, t0) >= 0.0;
-  for (int i = 1; i < uSearchSteps; ++i) {
-    float t = i == uSearchSteps - 1 ? t1 : t0 + float(i) * step;
-    bool isBehind = behindBy(c, layer, origin, direction, t) >= 0.0;
-    if (isBehind && !wasBehind) {
-      float inFront = t - step, hidden = t;
-      for (int b = 0; b < BISECTIONS; ++b) {
-        float middle = 0.5 * (inFront + hidden);
-        if (behindBy(c, layer, origin, direction, middle) >= 0.0) hidden = middle;
-        else inFront = middle;
-      }
-      vec3 point = origin + hidden * direction;
-      float tolerance = depthTolerance(length(point - c.eye), project(c, point), SURFACE_FOOTPRINTS);
-      if (behindBy(c, layer, origin, direction, hidden) <= tolerance) return 0.5 * (inFront + hidden);
+  for (int k = 1; k < uSearchSteps; ++k) {
+    float ta = t0 + float(k - 1) * coarseStep;
+    float tb = k == uSearchSteps - 1 ? t1 : t0 + float(k) * coarseStep;
+    vec3 a = origin + ta * direction, b = origin + tb * direction;
+    vec2 stored = depthBounds(layer, project(c, a), project(c, b));
+    if (max(length(a - c.eye), length(b - c.eye)) < stored.x * (1.0 - BOUNDS_MARGIN)) {
+      wasBehind = false;
+      continue;
     }
-    wasBehind = isBehind;
+    float tNear = clamp(dot(c.eye - origin, direction), ta, tb);
+    if (length(origin + tNear * direction - c.eye) > stored.y * (1.0 + BOUNDS_MARGIN)) {
+      wasBehind = true;
+      continue;
+    }
+    for (int i = 1; i <= fine; ++i) {
+      float t = i == fine ? tb : ta + float(i) * step;
+      bool isBehind = behindBy(c, layer, origin, direction, t) >= 0.0;
+      if (isBehind && !wasBehind) {
+        float hit = refinedHit(c, layer, origin, direction, t, step);
+        if (hit >= 0.0) return hit;
+      }
+      wasBehind = isBehind;
+    }
   }
   return -1.0;
 }
@@ -324,6 +413,200 @@ void main() {
   writeOutputs(outputs);
 }
 #else
+// The cameras read for this pixel's ray (CameraSample in the C++ code): the present ones of the
+// three around it, and where none of them sees the ray's hit, one further out (substitute()).
+const int MAX_READ = 4;
+int gCount;           // cameras read
+int gAround;          // of which the first gAround are those around the ray
+int gSlot[MAX_READ];
+int gIndex[MAX_READ];
+float gWeight[MAX_READ];  // renormalised over the cameras around; a substitute takes theirs
+RigCamera gCamera[MAX_READ];
+float gHit[MAX_READ];     // whole-ray first hit along the ray, -1 none
+float gReadT[MAX_READ];   // where it reads the ray: its hit, or the others' (tRead)
+bool gPassesBy[MAX_READ]; // no hit, yet a surface recorded where it reads: nothing of this ray
+vec3 gOrigin, gDirection;
+float gT0, gT1;
+
+vec3 rayAt(float t) {
+  return gOrigin + t * gDirection;
+}
+
+// The present cameras around the ray (LightFieldRig::cameras_around at the point where its line
+// enters the camera sphere; the missing drop out); returns their summed weight.
+float presentCameras(vec3 entry) {
+  ivec3 around;
+  vec3 aroundWeights;
+  camerasAround(entry - uCenter, around, aroundWeights);
+  float presentWeight = 0.0;
+  gCount = 0;
+  for (int i = 0; i < 3; ++i) {
+    if (!(aroundWeights[i] > 0.0)) continue;
+    int slot = tableAt(uSlotsAt + around[i]);
+    if (slot < 0) continue;  // missing: the others renormalise
+    gSlot[gCount] = slot;
+    gIndex[gCount] = around[i];
+    gWeight[gCount] = aroundWeights[i];
+    presentWeight += aroundWeights[i];
+    ++gCount;
+  }
+  gAround = gCount;
+  return presentWeight;
+}
+
+// Whether the stored depth of `layer` records a surface where camera i reads t.
+bool recordsAt(int i, int layer, float t) {
+  return recorded(storedDistance(layer, project(gCamera[i], rayAt(t))));
+}
+
+// Each camera's whole-ray first hit and where it reads the ray (place()).
+void placeCameras(float presentWeight, float tCentre) {
+  for (int i = 0; i < gCount; ++i) {
+    gWeight[i] /= presentWeight;
+    gCamera[i] = rigCamera(gIndex[i]);
+    gHit[i] = firstHit(gCamera[i], gSlot[i], gOrigin, gDirection, gT0, gT1);
+    gReadT[i] = gHit[i] >= 0.0 ? gHit[i] : tCentre;
+    gPassesBy[i] = gHit[i] < 0.0 && recordsAt(i, gSlot[i], gReadT[i]);
+  }
+}
+
+// Whether camera i around the ray records no surface at `point`, or one behind it.
+bool seesThrough(int i, vec3 point) {
+  vec2 map = project(gCamera[i], point);
+  float distance = length(point - gCamera[i].eye);
+  return !(storedDistance(gSlot[i], map) <=
+           distance + depthTolerance(distance, map, SURFACE_FOOTPRINTS));
+}
+
+// Whether camera k is one of those around the ray.
+bool isAround(int k) {
+  for (int i = 0; i < gAround; ++i) {
+    if (gIndex[i] == k) return true;
+  }
+  return false;
+}
+
+// Occlusion (substitute()): where no camera around the ray recorded its hit and some recorded a
+// surface in front of it, their icosphere neighbours, nearest the ray's direction first, are
+// searched; the first whose hit no camera around sees through is read with the weight of those
+// that pass by.
+void substitute() {
+  float hiddenWeight = 0.0;
+  for (int i = 0; i < gCount; ++i) {
+    if (gHit[i] >= 0.0) return;
+    if (gPassesBy[i]) hiddenWeight += gWeight[i];
+  }
+  if (!(hiddenWeight > 0.0)) return;
+  const int MAX_CANDIDATES = 24;
+  int candidates[MAX_CANDIDATES];
+  float nearness[MAX_CANDIDATES];
+  int count = 0;
+  for (int i = 0; i < gAround; ++i) {
+    int first = tableAt(uNeighboursAt + gIndex[i]), last = tableAt(uNeighboursAt + gIndex[i] + 1);
+    for (int e = first; e < last && count < MAX_CANDIDATES; ++e) {
+      int k = tableAt(e);
+      bool known = isAround(k) || tableAt(uSlotsAt + k) < 0;
+      for (int c = 0; c < count && !known; ++c) known = candidates[c] == k;
+      if (known) continue;
+      // Inserted in order of nearness to the ray's direction (std::sort's order).
+      float score = dot(vertexAt(k), -gDirection);
+      int at = count++;
+      while (at > 0 && nearness[at - 1] < score) {
+        candidates[at] = candidates[at - 1];
+        nearness[at] = nearness[at - 1];
+        --at;
+      }
+      candidates[at] = k;
+      nearness[at] = score;
+    }
+  }
+  for (int c = 0; c < count; ++c) {
+    int k = candidates[c];
+    int slot = tableAt(uSlotsAt + k);
+    RigCamera camera = rigCamera(k);
+    float hit = firstHit(camera, slot, gOrigin, gDirection, gT0, gT1);
+    if (hit < 0.0) continue;
+    bool contradicted = false;
+    for (int i = 0; i < gAround && !contradicted; ++i) contradicted = seesThrough(i, rayAt(hit));
+    if (contradicted) continue;
+    gSlot[gCount] = slot;
+    gIndex[gCount] = k;
+    gWeight[gCount] = hiddenWeight;
+    gCamera[gCount] = camera;
+    gHit[gCount] = hit;
+    gReadT[gCount] = hit;
+    gPassesBy[gCount] = false;
+    ++gCount;
+    return;
+  }
+}
+
+// Cameras without a hit read the ray where the others found its hit (read_without_hits); one
+// that recorded a surface there is occluded at the hit and passes by. Returns where they read.
+float readWithoutHits(float tCentre) {
+  float hitT = 0.0, weight = 0.0;
+  for (int i = 0; i < gCount; ++i) {
+    if (gHit[i] < 0.0) continue;
+    hitT += gWeight[i] * gHit[i];
+    weight += gWeight[i];
+  }
+  if (!(weight > 0.0)) return tCentre;
+  float tRead = hitT / weight;
+  for (int i = 0; i < gAround; ++i) {
+    if (gHit[i] >= 0.0) continue;
+    gReadT[i] = tRead;
+    gPassesBy[i] = recordsAt(i, gSlot[i], tRead);
+  }
+  return tRead;
+}
+
+// The cameras' first hits blended over those that recorded one: (their weight, t).
+vec2 blendedHit() {
+  float hitWeight = 0.0, hitT = 0.0;
+  for (int i = 0; i < gCount; ++i) {
+    if (gHit[i] < 0.0) continue;
+    hitWeight += gWeight[i];
+    hitT += gWeight[i] * gHit[i];
+  }
+  return vec2(hitWeight, hitWeight > 0.0 ? hitT / hitWeight : 0.0);
+}
+
+// The header's confidence: present weight x consensus x depth agreement x angular closeness
+// x colour agreement (light_field_reconstruction.cpp's confidence()), from each camera's own
+// colour of the ray.
+float confidence(float presentWeight, float unscaledTransmittance, vec4 cameraColour[MAX_READ]) {
+  vec2 hit = blendedHit();
+  float hitWeight = hit.x, hitT = hit.y;
+  float consensus = 1.0 - unscaledTransmittance >= uDepthThreshold ? hitWeight : 1.0;
+  float agreement = 1.0;
+  float angle = 0.0;
+  vec4 meanColour = vec4(0.0);
+  float spread2 = 0.0, tolerance = 0.0;
+  for (int i = 0; i < gCount; ++i) {
+    vec3 readPoint = rayAt(gReadT[i]);
+    vec3 seen = readPoint - gCamera[i].eye;
+    float distance = length(seen);
+    if (gHit[i] >= 0.0) {
+      float w = gWeight[i] / hitWeight;
+      spread2 += w * (gHit[i] - hitT) * (gHit[i] - hitT);
+      tolerance += w * depthTolerance(distance, project(gCamera[i], readPoint), 2.0);
+    }
+    angle += gWeight[i] * acos(clamp(dot(seen / distance, gDirection), -1.0, 1.0));
+    meanColour += gWeight[i] * cameraColour[i];
+  }
+  if (hitWeight > 0.0) agreement = exp(-spread2 / (tolerance * tolerance));
+  float relative = angle / uCameraSpacing;
+  float angular = exp(-0.5 * relative * relative);
+  float colourSpread2 = 0.0;
+  for (int i = 0; i < gCount; ++i) {
+    vec4 off = abs(cameraColour[i] - meanColour);
+    float worst = max(max(off.r, off.g), max(off.b, off.a));
+    colourSpread2 += gWeight[i] * worst * worst;
+  }
+  float colourAgreement = exp(-colourSpread2 / (0.2 * 0.2));  // kColourAgreement
+  return clamp(presentWeight * consensus * agreement * angular * colourAgreement, 0.0, 1.0);
+}
+
 void main() {
 #if defined(BASIS) || defined(CONFIDENCE)
   // Texel row y holds image row y (rows from the top), as the frame pass (and the confidence's
@@ -334,8 +617,8 @@ void main() {
   vec2 pixel = vec2(gl_FragCoord.x, uImageSize.y - gl_FragCoord.y);
 #endif
   vec2 plane = vec2(2.0 * pixel.x / uImageSize.x - 1.0, 1.0 - 2.0 * pixel.y / uImageSize.y) * uHalfExtent;
-  vec3 origin = uPerspective ? uEye : uEye + plane.x * uRight + plane.y * uUp;
-  vec3 direction = uPerspective ? normalize(uForward + plane.x * uRight + plane.y * uUp) : uForward;
+  gOrigin = uPerspective ? uEye : uEye + plane.x * uRight + plane.y * uUp;
+  gDirection = uPerspective ? normalize(uForward + plane.x * uRight + plane.y * uUp) : uForward;
   outColour = vec4(0.0);
 #ifdef BASIS
   outDepth = vec4(kInfinity);
@@ -349,62 +632,40 @@ void main() {
   outColour = vec4(1.0);  // nothing can be where the ray misses the bounding sphere
 #endif
 
-  vec2 chord = sphereChord(origin, direction, uBoundingRadius);
+  vec2 chord = sphereChord(gOrigin, gDirection, uBoundingRadius);
   if (!(chord.y > chord.x)) return;
-  float t0 = max(chord.x, 0.0), t1 = chord.y;
-  if (!(t1 > t0)) return;
-  float tCentre = clamp(dot(uCenter - origin, direction), t0, t1);
-  float tEntry = sphereChord(origin, direction, uCameraRadius).x;
-
-  ivec3 around;
-  vec3 aroundWeights;
-  camerasAround(origin + tEntry * direction - uCenter, around, aroundWeights);
-  int slots[3];
-  int indices[3];
-  float weights[3];
-  int present = 0;
-  float presentWeight = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    if (!(aroundWeights[i] > 0.0)) continue;
-    int slot = tableAt(uSlotsAt + around[i]);
-    if (slot < 0) continue;  // missing: the others renormalise
-    slots[present] = slot;
-    indices[present] = around[i];
-    weights[present] = aroundWeights[i];
-    presentWeight += aroundWeights[i];
-    ++present;
-  }
+  gT0 = max(chord.x, 0.0);
+  gT1 = chord.y;
+  if (!(gT1 > gT0)) return;
+  float tCentre = clamp(dot(uCenter - gOrigin, gDirection), gT0, gT1);
+  float tEntry = sphereChord(gOrigin, gDirection, uCameraRadius).x;
+  float presentWeight = presentCameras(rayAt(tEntry));
 #ifdef CONFIDENCE
   outColour = vec4(0.0, 0.0, 0.0, 1.0);  // nothing known of this ray
 #endif
-  if (present == 0) return;
-
-  RigCamera cameras[3];
-  float hits[3];  // whole-ray first hits: what a single segment is read at
-  for (int i = 0; i < present; ++i) {
-    weights[i] /= presentWeight;
-    cameras[i] = rigCamera(indices[i]);
-    hits[i] = uSegments == 1 || kWholeRayHits
-                  ? firstHit(cameras[i], slots[i], origin, direction, t0, t1) : -1.0;
-  }
+  if (gCount == 0) return;
+  placeCameras(presentWeight, tCentre);
+  substitute();
+  float tRead = readWithoutHits(tCentre);
 
   vec3 colour = vec3(0.0);
   float transmittance = 1.0;
   float unscaledTransmittance = 1.0;
   // Each camera's own colour of the ray: its segments read and composited, unscaled.
-  vec4 cameraColour[3] = vec4[3](vec4(0.0), vec4(0.0), vec4(0.0));
-  float cameraTransmittance[3] = float[3](1.0, 1.0, 1.0);
+  vec4 cameraColour[MAX_READ] = vec4[MAX_READ](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
+  float cameraTransmittance[MAX_READ] = float[MAX_READ](1.0, 1.0, 1.0, 1.0);
   for (int s = 0; s < uSegments; ++s) {
     vec4 blended = vec4(0.0);
     float segmentWeight = 0.0;
-    for (int i = 0; i < present; ++i) {
-      int layer = uSegments > 1 ? uSlotCount + slots[i] * uSegments + s : slots[i];
-      float hit = uSegments > 1 ? firstHit(cameras[i], layer, origin, direction, t0, t1) : hits[i];
-      vec2 map = project(cameras[i], origin + (hit >= 0.0 ? hit : tCentre) * direction);
+    for (int i = 0; i < gCount; ++i) {
+      int layer = uSegments > 1 ? uSlotCount + gSlot[i] * uSegments + s : gSlot[i];
+      float hit = uSegments > 1 ? firstHit(gCamera[i], layer, gOrigin, gDirection, gT0, gT1)
+                                : gHit[i];
+      vec2 map = project(gCamera[i], rayAt(hit >= 0.0 ? hit : tRead));
       if (hit < 0.0 && recorded(storedDistance(layer, map))) continue;  // passes it by
-      vec4 read = bilinear(slots[i] * uSegments + s, map);
-      blended += weights[i] * read;
-      segmentWeight += weights[i];
+      vec4 read = bilinear(gSlot[i] * uSegments + s, map);
+      blended += gWeight[i] * read;
+      segmentWeight += gWeight[i];
       cameraColour[i].rgb += cameraTransmittance[i] * read.rgb;
       cameraTransmittance[i] *= 1.0 - clamp(read.a, 0.0, 1.0);
     }
@@ -422,63 +683,25 @@ void main() {
   }
   float a = 1.0 - transmittance;
 #ifdef CONFIDENCE
-  // The header's confidence: present weight x consensus x depth agreement x angular closeness
-  // x colour agreement (light_field_reconstruction.cpp's confidence()).
-  float hitWeight = 0.0, hitT = 0.0;
-  for (int i = 0; i < present; ++i) {
-    if (hits[i] < 0.0) continue;
-    hitWeight += weights[i];
-    hitT += weights[i] * hits[i];
-  }
-  if (hitWeight > 0.0) hitT /= hitWeight;
-  float consensus = 1.0 - unscaledTransmittance >= uDepthThreshold ? hitWeight : 1.0;
-  float agreement = 1.0;
-  float angle = 0.0;
-  vec4 meanColour = vec4(0.0);
-  float spread2 = 0.0, tolerance = 0.0;
-  for (int i = 0; i < present; ++i) {
-    vec3 readPoint = origin + (hits[i] >= 0.0 ? hits[i] : tCentre) * direction;
-    vec3 seen = readPoint - cameras[i].eye;
-    float distance = length(seen);
-    if (hits[i] >= 0.0) {
-      float w = weights[i] / hitWeight;
-      spread2 += w * (hits[i] - hitT) * (hits[i] - hitT);
-      tolerance += w * depthTolerance(distance, project(cameras[i], readPoint), 2.0);
-    }
-    angle += weights[i] * acos(clamp(dot(seen / distance, direction), -1.0, 1.0));
-    cameraColour[i].a = 1.0 - cameraTransmittance[i];
-    meanColour += weights[i] * cameraColour[i];
-  }
-  if (hitWeight > 0.0) agreement = exp(-spread2 / (tolerance * tolerance));
-  float relative = angle / uCameraSpacing;
-  float angular = exp(-0.5 * relative * relative);
-  float colourSpread2 = 0.0;
-  for (int i = 0; i < present; ++i) {
-    vec4 off = abs(cameraColour[i] - meanColour);
-    float worst = max(max(off.r, off.g), max(off.b, off.a));
-    colourSpread2 += weights[i] * worst * worst;
-  }
-  float colourAgreement = exp(-colourSpread2 / (0.2 * 0.2));  // kColourAgreement
-  float confidence = presentWeight * consensus * agreement * angular * colourAgreement;
+  for (int i = 0; i < gCount; ++i) cameraColour[i].a = 1.0 - cameraTransmittance[i];
   // Encoded as the mask PNGs hold it (write_png's sRGB), so the overlay reads both alike.
-  outColour = vec4(linearToSrgb(vec3(confidence)).r, 0.0, 0.0, 1.0);
+  float c = confidence(presentWeight, unscaledTransmittance, cameraColour);
+  outColour = vec4(linearToSrgb(vec3(c)).r, 0.0, 0.0, 1.0);
   return;
 #endif
 #ifdef BASIS
   outColour = vec4(colour, a);
-  float hitWeight = 0.0, hitT = 0.0;
-  for (int i = 0; i < present; ++i) {
-    if (hits[i] < 0.0) continue;
-    hitWeight += weights[i];
-    hitT += weights[i] * hits[i];
-  }
-  if (hitWeight > 0.0) outDepth.r = dot(origin + (hitT / hitWeight) * direction - uEye, uForward);
+  vec2 hit = blendedHit();
+  if (hit.x > 0.0) outDepth.r = dot(rayAt(hit.y) - uEye, uForward);
 #ifdef SAMPLES
+  // The cameras that see the ray (those that pass by hold none of its attenuation): at most
+  // three, since a substitute takes the place of at least one that passes by.
   vec4 samples[3] = vec4[3](vec4(0.0), vec4(0.0), vec4(0.0));
-  for (int i = 0; i < present; ++i) {
-    vec2 map = project(cameras[i], origin + (hits[i] >= 0.0 ? hits[i] : tCentre) * direction);
-    bool passesBy = hits[i] < 0.0 && recorded(storedDistance(slots[i], map));
-    samples[i] = vec4(float(slots[i] + 4096 * indices[i]), map, passesBy ? 0.0 : weights[i]);
+  int seeing = 0;
+  for (int i = 0; i < gCount && seeing < 3; ++i) {
+    if (gPassesBy[i]) continue;
+    vec2 map = project(gCamera[i], rayAt(gReadT[i]));
+    samples[seeing++] = vec4(float(gSlot[i] + 4096 * gIndex[i]), map, gWeight[i]);
   }
   outSample0 = samples[0];
   outSample1 = samples[1];

@@ -10,6 +10,7 @@
 // stated PSNR.
 
 import { ColourModelTable, setEditTrustTerms, setFrameTerms } from './frame_terms.js';
+import { depthPyramids } from './light_field_bounds.js';
 import { drawOutputs, proxyProgram, proxySources } from './proxy_renderer.js';
 import {
   attachTargets, buildProgram, frameContext, gpuFinished, layerTargets, nearestTexture, readCanvas,
@@ -139,17 +140,15 @@ export class LightFieldRenderer {
     gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, codes ? gl.R8UI : gl.R16F, n, n, depthLayers, 0,
       codes ? gl.RED_INTEGER : gl.RED, codes ? gl.UNSIGNED_BYTE : gl.HALF_FLOAT, depth);
 
-    const frames = new Float32Array(header.cameras * 4 * 4);
-    header.camera_frames.forEach((frame, k) => {
-      ['eye', 'right', 'up', 'forward'].forEach((key, i) => frames.set([...frame[key], 0], (k * 4 + i) * 4));
-    });
-    this.texture(2, gl.TEXTURE_2D);
-    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, 4, header.cameras, 0, gl.RGBA, gl.FLOAT, frames);
+    this.loadBounds(lightField, depth, depthLayers);
 
-    // One integer table: slots by camera, triangles, cell offsets, cell candidates.
+    // One integer table: slots by camera, triangles, cell offsets, cell candidates, each
+    // camera's icosphere neighbours (offsets, then the lists).
     const slotOf = new Int32Array(header.cameras).fill(-1);
     header.present.forEach((camera, slot) => { slotOf[camera] = slot; });
-    const parts = [slotOf, header.triangles.flat(), header.cell_offsets, header.cell_triangles];
+    const neighbours = icosphereNeighbours(header);
+    const parts = [slotOf, header.triangles.flat(), header.cell_offsets, header.cell_triangles,
+      neighbours.offsets, neighbours.lists];
     const offsets = [];
     let total = 0;
     for (const part of parts) {
@@ -159,15 +158,23 @@ export class LightFieldRenderer {
     const rows = Math.ceil(total / TABLE_WIDTH);
     const table = new Int32Array(rows * TABLE_WIDTH);
     parts.forEach((part, i) => table.set(part, offsets[i]));
+    // The neighbour offsets count from the table's start.
+    for (let k = 0; k < neighbours.offsets.length; ++k) table[offsets[4] + k] += offsets[5];
     this.texture(3, gl.TEXTURE_2D);
     gl.texImage2D(gl.TEXTURE_2D, 0, gl.R32I, TABLE_WIDTH, rows, 0, gl.RED_INTEGER, gl.INT, table);
 
-    const vertexRows = Math.ceil(header.vertices.length / TABLE_WIDTH);
-    const vertices = new Float32Array(vertexRows * TABLE_WIDTH * 4);
-    header.vertices.forEach((v, k) => vertices.set([...v, 0], 4 * k));
+    // One float table: the icosphere's vertices, then each camera's eye, right, up, forward.
+    const framesAt = header.vertices.length;
+    const vectorRows = Math.ceil((framesAt + 4 * header.cameras) / TABLE_WIDTH);
+    const vectors = new Float32Array(vectorRows * TABLE_WIDTH * 4);
+    header.vertices.forEach((v, k) => vectors.set([...v, 0], 4 * k));
+    header.camera_frames.forEach((frame, k) => {
+      ['eye', 'right', 'up', 'forward'].forEach((key, i) =>
+        vectors.set([...frame[key], 0], 4 * (framesAt + 4 * k + i)));
+    });
     this.texture(4, gl.TEXTURE_2D);
-    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, TABLE_WIDTH, vertexRows, 0, gl.RGBA, gl.FLOAT,
-      vertices);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, TABLE_WIDTH, vectorRows, 0, gl.RGBA, gl.FLOAT,
+      vectors);
 
     // An attenuation light field's a_j and mean depths, four intervals to a texel, layer
     // slot * groups + g (where this GPU has the layers; else its edits stay the server's).
@@ -197,9 +204,12 @@ export class LightFieldRenderer {
       gl.uniform1i(uniform('uGroups'), groups);
       gl.uniform1i(uniform('uRgba'), 0);
       gl.uniform1i(uniform('uDepth'), 1);
-      gl.uniform1i(uniform('uCameraFrames'), 2);
+      gl.uniform1i(uniform('uBounds'), 2);
+      gl.uniform1i(uniform('uBoundLevels'), this.boundLevels);
       gl.uniform1i(uniform('uTables'), 3);
-      gl.uniform1i(uniform('uVertices'), 4);
+      gl.uniform1i(uniform('uVectors'), 4);
+      gl.uniform1i(uniform('uFramesAt'), framesAt);
+      gl.uniform1i(uniform('uNeighboursAt'), offsets[4]);
       gl.uniform1i(uniform('uSlotsAt'), offsets[0]);
       gl.uniform1i(uniform('uTrianglesAt'), offsets[1]);
       gl.uniform1i(uniform('uCellOffsetsAt'), offsets[2]);
@@ -218,6 +228,29 @@ export class LightFieldRenderer {
     };
     this.loaded = { header, maxSegments, groups, hasAttenuation, setUp, prepared: new Map() };
     this.prepared('canvas');
+  }
+
+  /// The depth search's min/max pyramids (light_field_bounds.js) of the `layers` depth maps in
+  /// `depth` (as the depth texture holds them), into unit 2's mipmapped RG32F texture array.
+  loadBounds(lightField, depth, layers) {
+    const gl = this.gl;
+    const { header } = lightField;
+    const n = header.map_size;
+    const secant = (x, y) => {
+      const px = 2 * x / n - 1;
+      const py = 1 - 2 * y / n;
+      return 2 * header.camera_radius / Math.sqrt(1 + px * px + py * py);
+    };
+    const { side, levels } = depthPyramids(depth, header.depth_bits === 8, n, layers, secant);
+    this.texture(2, gl.TEXTURE_2D_ARRAY);
+    gl.texParameteri(gl.TEXTURE_2D_ARRAY, gl.TEXTURE_MIN_FILTER, gl.NEAREST_MIPMAP_NEAREST);
+    gl.texStorage3D(gl.TEXTURE_2D_ARRAY, levels.length, gl.RG32F, side, side, layers);
+    levels.forEach((values, level) => {
+      const size = side >> level;
+      gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, level, 0, 0, 0, size, size, layers, gl.RG, gl.FLOAT,
+        values);
+    });
+    this.boundLevels = levels.length;
   }
 
   /// Draws the reconstruction for `camera` (camera.js) with per-segment opacity scales
@@ -507,6 +540,23 @@ export class LightFieldRenderer {
   finish() {
     return gpuFinished(this.gl);
   }
+}
+
+/// Each camera's neighbours on the icosphere (those it shares a triangle edge with), in the
+/// order icosphere_neighbours lists them: {offsets (cameras + 1, into lists), lists}.
+function icosphereNeighbours(header) {
+  const neighbours = Array.from({ length: header.cameras }, () => []);
+  for (const triangle of header.triangles) {
+    for (let e = 0; e < 3; ++e) {
+      const a = triangle[e];
+      const b = triangle[(e + 1) % 3];
+      if (!neighbours[a].includes(b)) neighbours[a].push(b);
+      if (!neighbours[b].includes(a)) neighbours[b].push(a);
+    }
+  }
+  const offsets = [0];
+  for (const list of neighbours) offsets.push(offsets[offsets.length - 1] + list.length);
+  return { offsets, lists: neighbours.flat() };
 }
 
 /// The mean angle between neighbouring icosphere vertices (radians), as the reconstruction's

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
+#include <vector>
+
+#include "insitu/explore/light_field_reconstruction.hpp"
 
 namespace insitu::detail {
 
@@ -52,4 +55,44 @@ double camera_spacing_rad(const Icosphere& icosphere) {
     return sum / (3.0 * static_cast<double>(icosphere.triangles.size()));
 }
 
+std::vector<std::vector<int>> icosphere_neighbours(const LightFieldRig& rig) {
+    std::vector<std::vector<int>> neighbours(static_cast<std::size_t>(rig.camera_count()));
+    for (const auto& triangle : rig.icosphere().triangles) {
+        for (int e = 0; e < 3; ++e) {
+            const int a = triangle[static_cast<std::size_t>(e)];
+            const int b = triangle[static_cast<std::size_t>((e + 1) % 3)];
+            auto& list = neighbours[static_cast<std::size_t>(a)];
+            if (std::find(list.begin(), list.end(), b) == list.end()) list.push_back(b);
+            auto& back = neighbours[static_cast<std::size_t>(b)];
+            if (std::find(back.begin(), back.end(), a) == back.end()) back.push_back(a);
+        }
+    }
+    return neighbours;
+}
+
 }  // namespace insitu::detail
+
+namespace insitu {
+
+std::vector<int> light_field_cameras_seen(const LightFieldRig& rig, const Camera& target) {
+    std::vector<char> seen(static_cast<std::size_t>(rig.camera_count()), 0);
+    for (int y = 0; y < target.height(); ++y) {
+        for (int x = 0; x < target.width(); ++x) {
+            const auto crossing = detail::ray_neighbourhood(rig, target.ray(x + 0.5, y + 0.5));
+            if (!crossing) continue;
+            for (int i = 0; i < 3; ++i) {
+                const auto n = static_cast<std::size_t>(i);
+                if (crossing->around.weights[n] > 0.0) {
+                    seen[static_cast<std::size_t>(crossing->around.cameras[n])] = 1;
+                }
+            }
+        }
+    }
+    std::vector<int> cameras;
+    for (int k = 0; k < rig.camera_count(); ++k) {
+        if (seen[static_cast<std::size_t>(k)]) cameras.push_back(k);
+    }
+    return cameras;
+}
+
+}  // namespace insitu

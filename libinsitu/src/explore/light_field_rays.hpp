@@ -8,6 +8,7 @@
 #include <glm/vec3.hpp>
 #include <optional>
 #include <utility>
+#include <vector>
 
 #include "insitu/core/camera.hpp"
 #include "insitu/core/light_field.hpp"
@@ -36,6 +37,9 @@ struct Taps {
     std::array<double, 4> weight{};
 };
 Taps bilinear_taps(int size, const glm::dvec2& map_position);
+
+// Each camera's neighbours on the icosphere (the cameras it shares a triangle edge with).
+std::vector<std::vector<int>> icosphere_neighbours(const LightFieldRig& rig);
 
 // Mean angle between neighbouring cameras, seen from the centre: the scale of the angular term.
 double camera_spacing_rad(const Icosphere& icosphere);

@@ -2,18 +2,18 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <cstddef>
-#include <exception>
 #include <glm/geometric.hpp>
 #include <limits>
 #include <optional>
-#include <thread>
 #include <utility>
 #include <vector>
 
+#include "explore/light_field_depth_bounds.hpp"
+#include "explore/light_field_inputs.hpp"
 #include "explore/light_field_rays.hpp"
+#include "explore/light_field_samples.hpp"
 #include "insitu/error.hpp"
 
 namespace insitu {
@@ -21,13 +21,20 @@ namespace {
 
 using detail::bilinear_taps;
 using detail::camera_spacing_rad;
+using detail::camera_table;
+using detail::CameraSample;
+using detail::check_settings;
+using detail::DepthBounds;
+using detail::icosphere_neighbours;
+using detail::kMaxSearchSteps;
 using detail::ray_neighbourhood;
 using detail::RayNeighbourhood;
+using detail::RaySpan;
+using detail::Samples;
+using detail::Scratch;
 using detail::Taps;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr int kMinSearchSteps = 4;
-constexpr int kMaxSearchSteps = 4096;
 // Halvings of the coarse bracket: 2^-16 of a coarse step is far below a map pixel's footprint
 // for any search_steps allowed, so the hit is as exact as the stored depth.
 constexpr int kBisections = 16;
@@ -43,107 +50,6 @@ constexpr double kAgreementFootprints = 2.0;
 // term many wrong pixels go unflagged; 0.2 keeps the overlay usable (bench/RESULTS.md,
 // "Light-field colour agreement").
 constexpr double kColourAgreement = 0.2;
-
-// A target ray's chord through the bounding sphere, [t0, t1], and its point nearest the
-// centre (t_centre): where a camera without a hit reads the ray.
-struct RaySpan {
-    Ray ray;
-    double t0 = 0.0, t1 = 0.0, t_centre = 0.0;
-    glm::dvec3 at(double t) const { return ray.origin + t * ray.direction; }
-};
-
-// One present camera around a pixel's ray.
-struct CameraSample {
-    int camera = 0;
-    const LightFieldImages* images = nullptr;
-    double weight = 0.0;          ///< renormalised over the cameras present
-    std::optional<double> hit_t;  ///< whole-ray first hit along the target ray
-    glm::dvec3 read_point{0.0};   ///< the hit, or the ray's point nearest the centre
-    glm::dvec2 read_map{0.0};     ///< read_point in this camera's map (pixels)
-    /// This camera's own colour of the ray: its segments read and composited, unscaled.
-    std::array<double, 4> rgba{0.0, 0.0, 0.0, 0.0};
-    /// No hit, yet a first hit recorded at read_map: a surface the ray passes by, none of whose
-    /// colour or attenuation is on this ray.
-    bool passes_by = false;
-};
-
-// Per-thread buffers, so that rows allocate nothing.
-struct Scratch {
-    std::vector<std::array<double, 4>> segment_rgba;
-    std::vector<double> segment_weight;  ///< of the cameras that contributed to segment s
-    std::vector<char> missing;           ///< by camera index
-};
-
-void check_settings(const LightFieldReconstructionSettings& settings, int segments) {
-    if (settings.search_steps < kMinSearchSteps || settings.search_steps > kMaxSearchSteps) {
-        fail<InvalidArgument>("search_steps = ", settings.search_steps, " (must be in [",
-                              kMinSearchSteps, ", ", kMaxSearchSteps, "])");
-    }
-    const auto& scales = settings.segment_opacity_scales;
-    for (std::size_t s = 0; s < scales.size(); ++s) {
-        if (!(std::isfinite(scales[s]) && scales[s] >= 0.0)) {
-            fail<InvalidArgument>("segment_opacity_scales[", s, "] = ", scales[s],
-                                  " (must be finite and >= 0)");
-        }
-    }
-    if (scales.size() > static_cast<std::size_t>(segments)) {
-        fail<InvalidArgument>("segment_opacity_scales has ", scales.size(),
-                              " entries for a light field of ", segments, " segment(s)");
-    }
-}
-
-void check_image(const Image& image, int size, int channels, int camera, const char* what) {
-    if (image.width != size || image.height != size || image.channels != channels) {
-        fail<InvalidArgument>("light field camera ", camera, ": ", what, " is ", image.width, "x",
-                              image.height, "x", image.channels, ", expected ", size, "x", size,
-                              "x", channels);
-    }
-}
-
-// The images of each rig camera (null where the light field lacks it), after checking that
-// every image has the rig's map size and the light field's segment and interval counts.
-std::vector<const LightFieldImages*> camera_table(const LightField& light_field, int segments,
-                                                  int intervals) {
-    const LightFieldRig& rig = light_field.rig;
-    if (light_field.cameras.empty()) {
-        fail<InvalidArgument>("light field holds no camera images (rig of ", rig.camera_count(),
-                              " cameras)");
-    }
-    std::vector<const LightFieldImages*> table(static_cast<std::size_t>(rig.camera_count()),
-                                               nullptr);
-    const int n = rig.map_size();
-    for (const LightFieldImages& images : light_field.cameras) {
-        const int k = images.camera;
-        if (k < 0 || k >= rig.camera_count()) {
-            fail<InvalidArgument>("light field camera ", k, " is out of range for a rig of ",
-                                  rig.camera_count(), " cameras");
-        }
-        if (table[static_cast<std::size_t>(k)] != nullptr) {
-            fail<InvalidArgument>("light field holds camera ", k, " twice");
-        }
-        table[static_cast<std::size_t>(k)] = &images;
-        if (images.segment_rgba.size() != static_cast<std::size_t>(segments)) {
-            fail<InvalidArgument>("light field camera ", k, ": ", images.segment_rgba.size(),
-                                  " segment images, expected ", segments);
-        }
-        for (const Image& rgba : images.segment_rgba) check_image(rgba, n, 4, k, "segment_rgba");
-        check_image(images.depth, n, 1, k, "depth");
-        if (segments > 1) {
-            if (images.segment_depth.size() != static_cast<std::size_t>(segments)) {
-                fail<InvalidArgument>("light field camera ", k, ": ", images.segment_depth.size(),
-                                      " segment depth images, expected ", segments);
-            }
-            for (const Image& depth : images.segment_depth) {
-                check_image(depth, n, 1, k, "segment_depth");
-            }
-        }
-        if (intervals > 0) {
-            check_image(images.attenuation, n, intervals, k, "attenuation");
-            check_image(images.mean_depth, n, intervals, k, "mean_depth");
-        }
-    }
-    return table;
-}
 
 class Reconstructor {
 public:
@@ -163,6 +69,8 @@ public:
         std::copy(settings.segment_opacity_scales.begin(), settings.segment_opacity_scales.end(),
                   scales_.begin());
         spacing_rad_ = camera_spacing_rad(rig_.icosphere());
+        neighbours_ = icosphere_neighbours(rig_);
+        bounds_ = detail::depth_bounds(rig_, table_);
 
         const int w = target.width(), h = target.height();
         result_.rgba = Image(w, h, 4, 0.0f);
@@ -175,34 +83,15 @@ public:
     }
 
     LightFieldReconstruction run() {
-        const int height = target_.height();
-        const unsigned threads =
-            std::clamp(std::thread::hardware_concurrency(), 1u, static_cast<unsigned>(height));
-        std::atomic<int> next_row{0};
-        std::vector<Scratch> scratch(threads);
-        std::vector<std::exception_ptr> errors(threads);
-        std::vector<std::thread> workers;
-        workers.reserve(threads);
-        for (unsigned i = 0; i < threads; ++i) {
-            workers.emplace_back([&, i] {
-                try {
-                    Scratch& own = scratch[i];
-                    own.segment_rgba.resize(static_cast<std::size_t>(segments_));
-                    own.segment_weight.resize(static_cast<std::size_t>(segments_));
-                    own.missing.assign(static_cast<std::size_t>(rig_.camera_count()), 0);
-                    for (int y = next_row++; y < height; y = next_row++) {
-                        for (int x = 0; x < target_.width(); ++x) pixel(x, y, own);
-                    }
-                } catch (...) {
-                    errors[i] = std::current_exception();
-                    next_row = height;  // the others stop after their row
-                }
-            });
+        std::vector<Scratch> scratch(detail::row_workers(target_.height()));
+        for (Scratch& own : scratch) {
+            own.segment_rgba.resize(static_cast<std::size_t>(segments_));
+            own.segment_weight.resize(static_cast<std::size_t>(segments_));
+            own.missing.assign(static_cast<std::size_t>(rig_.camera_count()), 0);
         }
-        for (std::thread& worker : workers) worker.join();
-        for (const std::exception_ptr& error : errors) {
-            if (error) std::rethrow_exception(error);
-        }
+        detail::parallel_rows(target_.height(), [&](unsigned worker, int y) {
+            for (int x = 0; x < target_.width(); ++x) pixel(x, y, scratch[worker]);
+        });
         for (int k = 0; k < rig_.camera_count(); ++k) {
             const bool missing = std::any_of(scratch.begin(), scratch.end(), [k](const Scratch& s) {
                 return s.missing[static_cast<std::size_t>(k)] != 0;
@@ -213,14 +102,31 @@ public:
     }
 
 private:
-    // Eq. 3: the distance from camera k's eye of the surface it recorded at a map position,
-    // from the nearest map pixel: bilinear depth between a silhouette and the background (+inf)
-    // would be +inf or invent a surface between the two. +inf where it recorded none.
+    // Eq. 3: the distance from camera k's eye of the surface it recorded at a map position, +inf
+    // where it recorded none. Bilinear where the four texels around the position recorded one
+    // surface (within a few footprints of each other): nearest-pixel depth puts the hit on a
+    // staircase that moves from camera to camera (blocky silhouettes, seams where the blend
+    // changes). Else the nearest texel's: bilinear between a silhouette and the background
+    // (+inf) would be +inf or invent a surface between the two.
     double stored_distance(const Image& depth, const glm::dvec2& map) const {
         const int n = rig_.map_size();
         const int px = static_cast<int>(std::clamp(std::floor(map.x), 0.0, n - 1.0));
         const int py = static_cast<int>(std::clamp(std::floor(map.y), 0.0, n - 1.0));
-        return depth.at(px, py, 0) * rig_.secant_length(px + 0.5, py + 0.5);
+        const double nearest = depth.at(px, py, 0) * rig_.secant_length(px + 0.5, py + 0.5);
+        if (!std::isfinite(nearest)) return nearest;
+        const Taps taps = bilinear_taps(n, map);
+        double sum = 0.0, low = kInf, high = -kInf;
+        for (int i = 0; i < 4; ++i) {
+            const std::size_t texel = taps.pixel[static_cast<std::size_t>(i)];
+            const double x = static_cast<double>(texel % static_cast<std::size_t>(n)) + 0.5;
+            const double y = static_cast<double>(texel / static_cast<std::size_t>(n)) + 0.5;
+            const double distance = depth.pixels[texel] * rig_.secant_length(x, y);
+            if (!std::isfinite(distance)) return nearest;
+            sum += taps.weight[static_cast<std::size_t>(i)] * distance;
+            low = std::min(low, distance);
+            high = std::max(high, distance);
+        }
+        return high - low <= depth_tolerance(nearest, map, kSurfaceFootprints) ? sum : nearest;
     }
 
     // How far a point may lie behind camera k's recorded surface and still be on it: `footprints`
@@ -248,24 +154,55 @@ private:
             const double stored = stored_distance(depth, camera.project(point));
             return glm::length(point - camera.position()) - stored;  // -inf, NaN: never behind
         };
-        const int steps = settings_.search_steps;
-        const double step = (t1 - t0) / (steps - 1);
+        // The graze: a step coarser than a map pixel's footprint (at the camera sphere's radius)
+        // jumps over a surface the ray passes behind and comes out of within the step, and the
+        // graze is a crack. So each of the coarse steps the settings ask for is walked a
+        // footprint at a time, unless the ray cannot pass from in front of a recorded surface to
+        // behind one in it (its farthest point from the eye nearer than every surface recorded
+        // where it projects, or its nearest point farther than all of them):
+        // as accurate as walking the whole ray so, in less time (bench/RESULTS.md, "Light-field
+        // cracks (issue 41)").
+        const DepthBounds& bounds = bounds_.at(&depth);
+        const double coarse_step = (t1 - t0) / (settings_.search_steps - 1);
+        const double footprint = 2.0 * rig_.camera_radius() / rig_.map_size();
+        const int fine =
+            std::clamp(static_cast<int>(std::ceil(coarse_step / footprint)), 1, kMaxSearchSteps);
+        const double step = coarse_step / fine;
         bool was_behind = behind_by(t0) >= 0.0;
-        for (int i = 1; i < steps; ++i) {
-            const double t = i == steps - 1 ? t1 : t0 + i * step;
-            const bool is_behind = behind_by(t) >= 0.0;
-            if (is_behind && !was_behind) {
-                double in_front = t - step, hidden = t;
-                for (int b = 0; b < kBisections; ++b) {
-                    const double middle = 0.5 * (in_front + hidden);
-                    (behind_by(middle) >= 0.0 ? hidden : in_front) = middle;
-                }
-                const glm::dvec3 point = ray.origin + hidden * ray.direction;
-                const double tolerance = depth_tolerance(glm::length(point - camera.position()),
-                                                         camera.project(point), kSurfaceFootprints);
-                if (behind_by(hidden) <= tolerance) return 0.5 * (in_front + hidden);
+        for (int c = 1; c < settings_.search_steps; ++c) {
+            const double ta = t0 + (c - 1) * coarse_step;
+            const double tb = c == settings_.search_steps - 1 ? t1 : t0 + c * coarse_step;
+            const glm::dvec3 a = ray.origin + ta * ray.direction,
+                             b = ray.origin + tb * ray.direction;
+            const DepthBounds::Range stored = bounds.between(camera.project(a), camera.project(b));
+            const glm::dvec3 eye = camera.position();
+            if (std::max(glm::length(a - eye), glm::length(b - eye)) < stored.nearest) {
+                was_behind = false;
+                continue;
             }
-            was_behind = is_behind;
+            // The point of the step nearest the eye (the distance is convex along the ray).
+            const double t_near = std::clamp(glm::dot(eye - ray.origin, ray.direction), ta, tb);
+            if (glm::length(ray.origin + t_near * ray.direction - eye) > stored.farthest) {
+                was_behind = true;
+                continue;
+            }
+            for (int i = 1; i <= fine; ++i) {
+                const double t = i == fine ? tb : ta + i * step;
+                const bool is_behind = behind_by(t) >= 0.0;
+                if (is_behind && !was_behind) {
+                    double in_front = t - step, hidden = t;
+                    for (int k = 0; k < kBisections; ++k) {
+                        const double middle = 0.5 * (in_front + hidden);
+                        (behind_by(middle) >= 0.0 ? hidden : in_front) = middle;
+                    }
+                    const glm::dvec3 point = ray.origin + hidden * ray.direction;
+                    const double tolerance =
+                        depth_tolerance(glm::length(point - camera.position()),
+                                        camera.project(point), kSurfaceFootprints);
+                    if (behind_by(hidden) <= tolerance) return 0.5 * (in_front + hidden);
+                }
+                was_behind = is_behind;
+            }
         }
         return std::nullopt;
     }
@@ -287,10 +224,10 @@ private:
         const double t0 = crossing->t0, t1 = crossing->t1;
         const double t_centre =
             std::clamp(glm::dot(rig_.center() - ray.origin, ray.direction), t0, t1);
-        const RaySpan span{ray, t0, t1, t_centre};
-        std::array<CameraSample, 3> samples;
+        RaySpan span{ray, t0, t1, t_centre, t_centre};
+        Samples samples;
         double present_weight = 0.0;
-        const int present = present_cameras(crossing->around, scratch, samples, present_weight);
+        int present = present_cameras(crossing->around, scratch, samples, present_weight);
         const std::size_t p = static_cast<std::size_t>(y) * target_.width() + x;
         if (present == 0) {  // nothing known about this ray
             result_.confidence.pixels[p] = 0.0f;
@@ -299,6 +236,9 @@ private:
         for (int i = 0; i < present; ++i) {
             place(samples[static_cast<std::size_t>(i)], present_weight, span);
         }
+        const int around = present;
+        present = substitute(samples, present, span);
+        read_without_hits(samples, around, span);
         blend_segments(samples, present, span, scratch);
         const double unscaled_transmittance = composite_segments(scratch, p);
         double hit_t = 0.0;
@@ -311,8 +251,8 @@ private:
 
     // The cameras around the ray that the light field holds, into `samples` (the others are
     // marked missing), with their summed weight; returns how many.
-    int present_cameras(const CameraNeighbourhood& around, Scratch& scratch,
-                        std::array<CameraSample, 3>& samples, double& present_weight) const {
+    int present_cameras(const CameraNeighbourhood& around, Scratch& scratch, Samples& samples,
+                        double& present_weight) const {
         int present = 0;
         for (int i = 0; i < 3; ++i) {
             const int k = around.cameras[static_cast<std::size_t>(i)];
@@ -343,9 +283,94 @@ private:
             !sample.hit_t && std::isfinite(stored_distance(sample.images->depth, sample.read_map));
     }
 
+    // Whether camera k records no surface at `point`, or one behind it: it sees through it.
+    bool sees_through(int k, const Image& depth, const glm::dvec3& point) const {
+        const Camera& camera = rig_.camera(k);
+        const glm::dvec2 map = camera.project(point);
+        const double distance = glm::length(point - camera.position());
+        return !(stored_distance(depth, map) <=
+                 distance + depth_tolerance(distance, map, kSurfaceFootprints));
+    }
+
+    // Occlusion: where no camera around the ray recorded its hit and some recorded a surface in
+    // front of it, a camera further out may see the ray's surface: their icosphere neighbours,
+    // nearest the ray's direction first. Its hit counts where no camera around sees through it;
+    // it takes the weight of those that passed by (the blend's weights stay the barycentric
+    // ones). Returns the samples now present.
+    int substitute(Samples& samples, int present, const RaySpan& span) const {
+        double hidden_weight = 0.0;
+        for (int i = 0; i < present; ++i) {
+            const CameraSample& sample = samples[static_cast<std::size_t>(i)];
+            if (sample.hit_t) return present;
+            if (sample.passes_by) hidden_weight += sample.weight;
+        }
+        if (!(hidden_weight > 0.0)) return present;
+        std::vector<int> candidates;
+        for (int i = 0; i < present; ++i) {
+            for (const int k : neighbours_[static_cast<std::size_t>(samples[i].camera)]) {
+                const bool around =
+                    std::any_of(samples.begin(), samples.begin() + present,
+                                [k](const CameraSample& s) { return s.camera == k; });
+                if (!around && table_[static_cast<std::size_t>(k)] != nullptr &&
+                    std::find(candidates.begin(), candidates.end(), k) == candidates.end()) {
+                    candidates.push_back(k);
+                }
+            }
+        }
+        const glm::dvec3 towards_eye = -span.ray.direction;
+        const auto& vertices = rig_.icosphere().vertices;
+        std::sort(candidates.begin(), candidates.end(), [&](int a, int b) {
+            return glm::dot(vertices[static_cast<std::size_t>(a)], towards_eye) >
+                   glm::dot(vertices[static_cast<std::size_t>(b)], towards_eye);
+        });
+        for (const int k : candidates) {
+            const LightFieldImages* images = table_[static_cast<std::size_t>(k)];
+            const auto hit = first_hit(rig_.camera(k), images->depth, span.ray, span.t0, span.t1);
+            if (!hit) continue;
+            const glm::dvec3 point = span.at(*hit);
+            const bool contradicted =
+                std::any_of(samples.begin(), samples.begin() + present, [&](const CameraSample& s) {
+                    return sees_through(s.camera, s.images->depth, point);
+                });
+            if (contradicted) continue;
+            CameraSample& found = samples[static_cast<std::size_t>(present)];
+            found = CameraSample{};
+            found.camera = k;
+            found.images = images;
+            found.weight = hidden_weight;
+            found.hit_t = hit;
+            found.read_point = point;
+            found.read_map = rig_.camera(k).project(point);
+            return present + 1;
+        }
+        return present;
+    }
+
+    // Cameras without a hit read the ray where the others found its hit (t_read); one that
+    // recorded a surface there is occluded at the hit and passes by (read, it mixed the
+    // occluder's colour or nothing into the blend: cracks).
+    void read_without_hits(Samples& samples, int around, RaySpan& span) const {
+        double hit_t = 0.0, weight = 0.0;
+        for (const CameraSample& sample : samples) {  // those not present have no hit
+            if (!sample.hit_t) continue;
+            hit_t += sample.weight * *sample.hit_t;
+            weight += sample.weight;
+        }
+        if (!(weight > 0.0)) return;
+        span.t_read = hit_t / weight;
+        for (int i = 0; i < around; ++i) {
+            CameraSample& sample = samples[static_cast<std::size_t>(i)];
+            if (sample.hit_t) continue;
+            sample.read_point = span.at(span.t_read);
+            sample.read_map = rig_.camera(sample.camera).project(sample.read_point);
+            sample.passes_by =
+                std::isfinite(stored_distance(sample.images->depth, sample.read_map));
+        }
+    }
+
     // Segments: each camera depth-corrected against the segment's own depth, blended (into the
     // scratch's segment colours, and each camera's own composited colour of the ray).
-    void blend_segments(std::array<CameraSample, 3>& samples, int present, const RaySpan& span,
+    void blend_segments(Samples& samples, int present, const RaySpan& span,
                         Scratch& scratch) const {
         for (auto& rgba : scratch.segment_rgba) rgba = {0.0, 0.0, 0.0, 0.0};
         for (double& weight : scratch.segment_weight) weight = 0.0;
@@ -360,7 +385,7 @@ private:
                 const auto hit = segments_ > 1
                                      ? first_hit(camera, depth, span.ray, span.t0, span.t1)
                                      : sample.hit_t;
-                const glm::dvec2 map = camera.project(span.at(hit.value_or(span.t_centre)));
+                const glm::dvec2 map = camera.project(span.at(hit.value_or(span.t_read)));
                 // No hit: what the camera saw there is either faint (no first hit recorded:
                 // read it, it lies somewhere along the ray) or a surface the ray passes by
                 // (recorded, yet the ray never reached it): nothing of it is on this ray.
@@ -414,8 +439,8 @@ private:
 
     // The first hit blended over the cameras that recorded one, into pixel p's depth: returns
     // their weight, and the hit in `hit_t`.
-    double blended_first_hit(const std::array<CameraSample, 3>& samples, int present,
-                             const RaySpan& span, std::size_t p, double& hit_t) {
+    double blended_first_hit(const Samples& samples, int present, const RaySpan& span,
+                             std::size_t p, double& hit_t) {
         double hit_weight = 0.0;
         hit_t = 0.0;
         for (int i = 0; i < present; ++i) {
@@ -436,7 +461,7 @@ private:
     // is); the mean depth carried into the target camera (the point at the
     // stored mean depth along the source camera's ray, seen from the target) and blended with
     // the weights w_k a_jk.
-    void attenuation(const std::array<CameraSample, 3>& samples, int present, std::size_t p) {
+    void attenuation(const Samples& samples, int present, std::size_t p) {
         const int n = rig_.map_size();
         double seeing_weight = 0.0;
         for (int i = 0; i < present; ++i) {
@@ -484,9 +509,8 @@ private:
     }
 
     // The header's confidence: present weight x consensus x depth agreement x angular closeness.
-    double confidence(const std::array<CameraSample, 3>& samples, int present,
-                      double present_weight, double hit_weight, double hit_t, double alpha,
-                      const glm::dvec3& direction) const {
+    double confidence(const Samples& samples, int present, double present_weight, double hit_weight,
+                      double hit_t, double alpha, const glm::dvec3& direction) const {
         // Consensus: where the blend shows something (alpha at least the light field's first-hit
         // opacity), the weight of the cameras that recorded a hit; none -> 0.
         const double consensus = alpha >= light_field_.settings.depth_threshold ? hit_weight : 1.0;
@@ -544,34 +568,15 @@ private:
     int segments_ = 1;
     int intervals_ = 0;
     std::vector<const LightFieldImages*> table_;
+    detail::DepthBoundsTable bounds_;  ///< of each depth map first_hit reads
     std::vector<double> scales_;
+    std::vector<std::vector<int>> neighbours_;  ///< by camera: its neighbours on the icosphere
     double spacing_rad_ = 1.0;
     // Rows are disjoint, so the workers write their pixels without locks.
     LightFieldReconstruction result_;
 };
 
 }  // namespace
-
-std::vector<int> light_field_cameras_seen(const LightFieldRig& rig, const Camera& target) {
-    std::vector<char> seen(static_cast<std::size_t>(rig.camera_count()), 0);
-    for (int y = 0; y < target.height(); ++y) {
-        for (int x = 0; x < target.width(); ++x) {
-            const auto crossing = ray_neighbourhood(rig, target.ray(x + 0.5, y + 0.5));
-            if (!crossing) continue;
-            for (int i = 0; i < 3; ++i) {
-                const auto n = static_cast<std::size_t>(i);
-                if (crossing->around.weights[n] > 0.0) {
-                    seen[static_cast<std::size_t>(crossing->around.cameras[n])] = 1;
-                }
-            }
-        }
-    }
-    std::vector<int> cameras;
-    for (int k = 0; k < rig.camera_count(); ++k) {
-        if (seen[static_cast<std::size_t>(k)]) cameras.push_back(k);
-    }
-    return cameras;
-}
 
 LightFieldReconstruction reconstruct_light_field(const LightField& light_field,
                                                  const Camera& target,

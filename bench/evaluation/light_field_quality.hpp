@@ -1,0 +1,19 @@
+#pragma once
+// Light fields that hold (issue 41): 42-camera light fields at 256^2 maps through the
+// archive and the Explorer, from the light-field section's 30 random views against the ground
+// truth: mean error, mean and worst PSNR (and which view), and cracks, the issue's measure (the
+// truth's alpha > 0.1 where the frame's < 0.02) as a share of the view's pixels, mean and worst.
+// Writes light_field_cracks.csv and, besides, the stored view turned 20 degrees as PNGs (frame
+// and truth) to look at.
+#include <filesystem>
+#include <vector>
+
+#include "scenes.hpp"
+
+namespace insitu::evaluation {
+
+void section_light_field_cracks(const std::vector<const Scene*>& scenes, bool smoke,
+                                const std::filesystem::path& out,
+                                const std::filesystem::path& scratch, int image);
+
+}  // namespace insitu::evaluation
