@@ -17,6 +17,7 @@
 
 #include "arguments.hpp"
 #include "insitu/archive/archive.hpp"
+#include "machine.hpp"
 #include "median_time.hpp"
 
 namespace {
@@ -74,6 +75,7 @@ StepRecord tiny_step(std::int64_t step) {
 int main(int argc, char** argv) {
     const Options options =
         cli::parse_or_exit("bench_archive_index", [&] { return parse(argc, argv); });
+    insitu::bench::print_machine("start");
     try {
         const fs::path root = fs::absolute(options.dir);
         fs::remove_all(root);

@@ -31,6 +31,7 @@
 #include "insitu/render/volume_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/reference_renderer.hpp"
+#include "machine.hpp"
 #include "sample_count.hpp"
 
 namespace {
@@ -154,6 +155,7 @@ double max_abs_difference(const insitu::Image& a, const insitu::Image& b) {
 }
 
 int run(const BenchOptions& options) {
+    insitu::bench::print_machine("start");
     using Clock = std::chrono::steady_clock;
     const auto make_start = Clock::now();
     const insitu::SampledVolume volume = insitu::make_marschner_lobb(options.volume_side);

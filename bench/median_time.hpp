@@ -43,6 +43,7 @@ struct Timing {
     double worst = 0.0;
     double warmup = 0.0;
     bool skipped = false;
+    std::vector<double> rounds;  // every timed run in order: round r of interleaved_timings
 };
 
 /// Times each of `runs` `repeats` (>= 1) times after one untimed warm-up each, interleaved round
@@ -69,6 +70,7 @@ inline std::vector<Timing> interleaved_timings(
     }
     for (std::size_t i = 0; i < runs.size(); ++i) {
         if (timings[i].skipped) continue;
+        timings[i].rounds = times[i];
         std::sort(times[i].begin(), times[i].end());
         timings[i].best = times[i].front();
         timings[i].median = times[i][times[i].size() / 2];
