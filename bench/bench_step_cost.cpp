@@ -77,8 +77,11 @@ Run make_run(const std::string& name, const fs::path& archive, bool with_field) 
     config.every = 1;  // every executed step is archived (the mini-app's default is every 50th)
     config.on_existing = OnExisting::replace;
     config.no_volume = !with_field;
-    Run run{name, std::make_unique<Instrument>(config, InstrumentOptions{false, false, nullptr}),
-            {}, {}, {}};
+    Run run{name,
+            std::make_unique<Instrument>(config, InstrumentOptions{false, false, nullptr}),
+            {},
+            {},
+            {}};
     return run;
 }
 
@@ -178,7 +181,8 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    const Options options = cli::parse_or_exit("bench_step_cost", [&] { return parse(argc, argv); });
+    const Options options =
+        cli::parse_or_exit("bench_step_cost", [&] { return parse(argc, argv); });
     try {
         return run(options);
     } catch (const std::exception& error) {
