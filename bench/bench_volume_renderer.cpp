@@ -33,6 +33,7 @@
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/reference_renderer.hpp"
 #include "machine.hpp"
+#include "median_time.hpp"
 #include "sample_count.hpp"
 
 namespace {
@@ -113,13 +114,6 @@ struct Timing {
     double min_cpu_ms = 0.0;
 };
 
-/// CPU time of every thread of this process (the device's worker threads included), ms.
-double process_cpu_ms() {
-    timespec now{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
-    return 1e3 * static_cast<double>(now.tv_sec) + 1e-6 * static_cast<double>(now.tv_nsec);
-}
-
 /// Wall time of `repeats` calls after `warmup` untimed ones. The median is the figure; the
 /// minimum is printed beside it because on a shared machine it shows what an idle one does, and
 /// so is the least CPU time a call took (all cores together): other processes' load lengthens
@@ -129,13 +123,13 @@ Timing time_runs(int warmup, int repeats, const std::function<void()>& run) {
     std::vector<double> times_ms;
     double min_cpu_ms = std::numeric_limits<double>::infinity();
     for (int i = 0; i < repeats; ++i) {
-        const double cpu_start = process_cpu_ms();
+        const double cpu_start = insitu::bench::process_cpu_ms();
         const auto start = std::chrono::steady_clock::now();
         run();
         times_ms.push_back(
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count());
-        min_cpu_ms = std::min(min_cpu_ms, process_cpu_ms() - cpu_start);
+        min_cpu_ms = std::min(min_cpu_ms, insitu::bench::process_cpu_ms() - cpu_start);
     }
     std::sort(times_ms.begin(), times_ms.end());
     const std::size_t n = times_ms.size();

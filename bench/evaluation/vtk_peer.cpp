@@ -93,21 +93,29 @@ Options parse(int argc, char** argv) {
 
 // Every round's times and their ratios to VTK's frame of the same round (issue 45, item 3): the
 // best of the rounds hides a round where VTK (or we) met a burst of load, the ratios show it.
-// timings: VTK, ground truth, shaded, single, multi (interleaved_timings' order).
+// Also the ratios of the CPU time each spent (both run on every core), which other processes'
+// load moves less than wall time. timings: VTK, ground truth, shaded, single, multi
+// (interleaved_timings' order).
 void print_rounds(const std::vector<Timing>& timings, std::ofstream& csv) {
     csv << "round,vtk_ms,ground_truth_ms,shaded_ms,single_ms,multi_ms,ground_truth_x,single_x,"
-           "all_x\n";
+           "all_x,vtk_cpu_ms,ground_truth_cpu_x,single_cpu_x,all_cpu_x\n";
     for (std::size_t r = 0; r < timings[0].rounds.size(); ++r) {
-        const double vtk = timings[0].rounds[r], truth = timings[1].rounds[r];
-        const double shaded = timings[2].rounds[r], single = timings[3].rounds[r];
-        const double multi = timings[4].rounds[r];
+        double ms[5], cpu[5];
+        for (int i = 0; i < 5; ++i) {
+            ms[i] = timings[i].rounds[r];
+            cpu[i] = timings[i].cpu_rounds[r];
+        }
         std::printf(
             "peer round %zu: VTK %.1f ms; ground truth %.1f (%.2fx VTK), shaded %.1f (%.2fx "
-            "unshaded), single %.1f (%.2fx VTK), multi %.1f, all proxies %.1f (%.2fx VTK)\n",
-            r + 1, vtk, truth, truth / vtk, shaded, shaded / truth, single, single / vtk, multi,
-            single + multi, (single + multi) / vtk);
-        csv << r + 1 << ',' << vtk << ',' << truth << ',' << shaded << ',' << single << ',' << multi
-            << ',' << truth / vtk << ',' << single / vtk << ',' << (single + multi) / vtk << '\n';
+            "unshaded), single %.1f (%.2fx VTK), multi %.1f, all proxies %.1f (%.2fx VTK); CPU "
+            "time: VTK %.1f ms, ground truth %.2fx, single %.2fx, all %.2fx\n",
+            r + 1, ms[0], ms[1], ms[1] / ms[0], ms[2], ms[2] / ms[1], ms[3], ms[3] / ms[0], ms[4],
+            ms[3] + ms[4], (ms[3] + ms[4]) / ms[0], cpu[0], cpu[1] / cpu[0], cpu[3] / cpu[0],
+            (cpu[3] + cpu[4]) / cpu[0]);
+        csv << r + 1 << ',' << ms[0] << ',' << ms[1] << ',' << ms[2] << ',' << ms[3] << ',' << ms[4]
+            << ',' << ms[1] / ms[0] << ',' << ms[3] / ms[0] << ',' << (ms[3] + ms[4]) / ms[0] << ','
+            << cpu[0] << ',' << cpu[1] / cpu[0] << ',' << cpu[3] / cpu[0] << ','
+            << (cpu[3] + cpu[4]) / cpu[0] << '\n';
     }
 }
 
