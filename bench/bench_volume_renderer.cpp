@@ -205,6 +205,14 @@ int run(const BenchOptions& options) {
         "warm-up\n",
         options.image_width, options.image_height, static_cast<unsigned long long>(samples),
         options.repeats, options.warmup);
+    // What the 4 x 4 ray packets march for those samples: lanes idle past their own ray's end.
+    const std::uint64_t lane_samples = insitu::bench::packet_lane_samples(
+        camera, camera.width(), camera.height(), field.bounds(), step_world);
+    std::printf(
+        "packets:   %llu lane-samples per frame, %.1f %% of them samples (early "
+        "termination off)\n",
+        static_cast<unsigned long long>(lane_samples),
+        100.0 * static_cast<double>(samples) / static_cast<double>(lane_samples));
     if (options.reference_repeats > 0) {
         std::printf("reference: %dx%d, %llu samples per frame (counted), median of %d\n",
                     options.reference_width, options.reference_height,
