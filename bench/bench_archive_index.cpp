@@ -23,6 +23,7 @@
 #include "arguments.hpp"
 #include "insitu/archive/archive.hpp"
 #include "insitu/archive/archive_description.hpp"
+#include "machine.hpp"
 #include "median_time.hpp"
 
 namespace {
@@ -155,6 +156,7 @@ void print_opening(const std::string& long_run, const std::string& short_run, in
 int main(int argc, char** argv) {
     const Options options =
         cli::parse_or_exit("bench_archive_index", [&] { return parse(argc, argv); });
+    insitu::bench::print_machine("start");
     try {
         const fs::path root = fs::absolute(options.dir);
         fs::remove_all(root);

@@ -43,6 +43,7 @@
 #include "insitu/core/camera.hpp"
 #include "insitu/instrument.hpp"
 #include "insitu/render/proxy_renderer.hpp"
+#include "machine.hpp"
 
 namespace {
 
@@ -257,6 +258,7 @@ int main(int argc, char** argv) {
             keep.empty() ? fs::temp_directory_path() / ("bench_capture_" + std::to_string(getpid()))
                          : fs::path(keep);
         fs::create_directories(dir);
+        insitu::bench::print_machine("start");
         const std::string self = argv[0];
         const auto child = [&](const char* mode) {
             return insitu::bench::run_self_as_child(

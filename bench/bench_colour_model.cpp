@@ -17,6 +17,7 @@
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/metrics.hpp"
+#include "machine.hpp"
 #include "median_time.hpp"
 
 namespace {
@@ -67,6 +68,7 @@ TransferFunction blob_function(float low, float middle, float high) {
 int main(int argc, char** argv) {
     const Options options =
         cli::parse_or_exit("bench_colour_model", [&] { return parse(argc, argv); });
+    insitu::bench::print_machine("start");
     const std::int64_t n = options.volume;
     const SampledVolume volume = make_gaussian_blobs({n, n, n}, 12, /*seed=*/3);
     ProxyRenderer renderer;

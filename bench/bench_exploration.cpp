@@ -23,6 +23,7 @@
 #include "insitu/instrument.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
+#include "machine.hpp"
 #include "median_time.hpp"
 
 namespace {
@@ -82,6 +83,7 @@ TransferFunction ramp(double peak_opacity) {
 int main(int argc, char** argv) {
     const Options options =
         cli::parse_or_exit("bench_exploration", [&] { return parse(argc, argv); });
+    insitu::bench::print_machine("start");
     const fs::path scratch =
         fs::temp_directory_path() / ("insitu_bench_exploration_" + std::to_string(::getpid()));
     std::printf(

@@ -19,6 +19,7 @@
 #include "insitu/archive/archive.hpp"
 #include "insitu/instrument.hpp"
 #include "insitu/testing/analytic_fields.hpp"
+#include "machine.hpp"
 
 namespace {
 
@@ -171,6 +172,7 @@ int main(int argc, char** argv) {
         std::error_code ignored;
         fs::create_directories(options.disk, ignored);
         fs::create_directories(options.fast, ignored);
+        insitu::bench::print_machine("start");
         std::printf("device: %s\n", ComputeDevice::shared()->description().c_str());
         const std::int64_t n = options.sizes.front();
         blocking(options, make_gaussian_blobs({n, n, n}, 12, 3));

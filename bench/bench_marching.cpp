@@ -40,6 +40,7 @@
 #include "insitu/device/compute_device.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
+#include "machine.hpp"
 #include "median_time.hpp"
 #include "sample_count.hpp"
 
@@ -689,6 +690,7 @@ void write_csv(const std::string& path, const std::vector<Point>& points) {
 int run(const Options& options) {
     const auto start = Clock::now();
     const Machine machine = measure_machine();
+    insitu::bench::print_machine("start");
     print_machine(machine, ComputeDevice::shared()->description());
     std::printf(
         "\nscene: Marschner-Lobb on [-1, 1]^3, orthographic orbit view (azimuth 30, "

@@ -62,6 +62,7 @@
 #include "insitu/field.hpp"
 #include "insitu/instrument.hpp"
 #include "insitu/mpi.hpp"
+#include "machine.hpp"
 #include "median_time.hpp"
 
 namespace {
@@ -453,6 +454,7 @@ int main(int argc, char** argv) {
         return insitu::cli::kExitBadInput;
     }
     try {
+        if (rank == 0) insitu::bench::print_machine("start");
         status = run(options);
     } catch (const std::exception& error) {
         std::fprintf(stderr, "bench_mpi: rank %d: %s\n", rank, error.what());

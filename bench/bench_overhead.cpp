@@ -53,6 +53,7 @@
 #include "insitu/device/compute_device.hpp"
 #include "insitu/field.hpp"
 #include "insitu/instrument.hpp"
+#include "machine.hpp"
 
 namespace {
 
@@ -377,6 +378,7 @@ void print_table(const std::vector<Configuration>& configurations) {
 }
 
 int run_parent(Options options) {
+    insitu::bench::print_machine("start");
     const int cpu = choose_cpu(options.cpu);
     const bool temporary = options.archive.empty();
     if (temporary) {

@@ -16,6 +16,7 @@
 #include "gray_scott_volume.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
+#include "machine.hpp"
 #include "sample_count.hpp"
 
 namespace {
@@ -171,6 +172,7 @@ SampledVolume gray_scott_field(int size, int steps) {
 int main(int argc, char** argv) {
     const Options options = cli::parse_or_exit("bench_proxies", [&] { return parse(argc, argv); });
     try {
+        insitu::bench::print_machine("start");
         std::printf("device: %s\n", ComputeDevice::shared()->description().c_str());
         const SampledVolume blobs =
             make_gaussian_blobs({options.size, options.size, options.size}, 12, 3);

@@ -31,6 +31,7 @@
 #include "evaluation/scenes.hpp"
 #include "insitu/render/volume_renderer.hpp"
 #include "insitu/testing/metrics.hpp"
+#include "machine.hpp"
 #include "median_time.hpp"
 #include "representation/volume/zfp_volume.hpp"
 
@@ -67,14 +68,6 @@ Options parse(int argc, char** argv) {
             throw cli::UsageError("unknown flag " + flag);
     }
     return options;
-}
-
-std::string cpu_model() {
-    std::ifstream in("/proc/cpuinfo");
-    for (std::string line; std::getline(in, line);) {
-        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-    }
-    return "unknown";
 }
 
 /// The sharp function's peak width as a share of the value range (the 2 %).
@@ -362,9 +355,8 @@ void time_first_frame(const Scene& scene, double k, const Options& options) {
 int main(int argc, char** argv) {
     const Options options = cli::parse_or_exit("bench_volume", [&] { return parse(argc, argv); });
     try {
-        std::printf("cpu: %s, %u threads; device: %s\n", cpu_model().c_str(),
-                    std::thread::hardware_concurrency(),
-                    ComputeDevice::shared()->description().c_str());
+        insitu::bench::print_machine("start");
+        std::printf("device: %s\n", ComputeDevice::shared()->description().c_str());
         std::printf(
             "\n== 1. accuracy per byte: tolerance = k x the sharp peak's width (%.0f %% of"
             " the range)\n",

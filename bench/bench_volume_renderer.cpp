@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <ctime>
 #include <functional>
 #include <iostream>
 #include <limits>
@@ -31,6 +32,8 @@
 #include "insitu/render/volume_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/reference_renderer.hpp"
+#include "machine.hpp"
+#include "median_time.hpp"
 #include "sample_count.hpp"
 
 namespace {
@@ -108,24 +111,30 @@ BenchOptions parse_options(int argc, char** argv) {
 struct Timing {
     double median_ms = 0.0;
     double min_ms = 0.0;
+    double min_cpu_ms = 0.0;
 };
 
 /// Wall time of `repeats` calls after `warmup` untimed ones. The median is the figure; the
-/// minimum is printed beside it because on a shared machine it shows what an idle one does.
+/// minimum is printed beside it because on a shared machine it shows what an idle one does, and
+/// so is the least CPU time a call took (all cores together): other processes' load lengthens
+/// the wall time of a frame more than the CPU time its own threads spend on it.
 Timing time_runs(int warmup, int repeats, const std::function<void()>& run) {
     for (int i = 0; i < warmup; ++i) run();
     std::vector<double> times_ms;
+    double min_cpu_ms = std::numeric_limits<double>::infinity();
     for (int i = 0; i < repeats; ++i) {
+        const double cpu_start = insitu::bench::process_cpu_ms();
         const auto start = std::chrono::steady_clock::now();
         run();
         times_ms.push_back(
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count());
+        min_cpu_ms = std::min(min_cpu_ms, insitu::bench::process_cpu_ms() - cpu_start);
     }
     std::sort(times_ms.begin(), times_ms.end());
     const std::size_t n = times_ms.size();
     const double median = n % 2 ? times_ms[n / 2] : 0.5 * (times_ms[n / 2 - 1] + times_ms[n / 2]);
-    return {median, times_ms.front()};
+    return {median, times_ms.front(), min_cpu_ms};
 }
 
 /// Semi-transparent low values, denser high values: rays cross several layers of the
@@ -154,6 +163,7 @@ double max_abs_difference(const insitu::Image& a, const insitu::Image& b) {
 }
 
 int run(const BenchOptions& options) {
+    insitu::bench::print_machine("start");
     using Clock = std::chrono::steady_clock;
     const auto make_start = Clock::now();
     const insitu::SampledVolume volume = insitu::make_marschner_lobb(options.volume_side);
@@ -195,14 +205,22 @@ int run(const BenchOptions& options) {
         "warm-up\n",
         options.image_width, options.image_height, static_cast<unsigned long long>(samples),
         options.repeats, options.warmup);
+    // What the 4 x 4 ray packets march for those samples: lanes idle past their own ray's end.
+    const std::uint64_t lane_samples = insitu::bench::packet_lane_samples(
+        camera, camera.width(), camera.height(), field.bounds(), step_world);
+    std::printf(
+        "packets:   %llu lane-samples per frame, %.1f %% of them samples (early "
+        "termination off)\n",
+        static_cast<unsigned long long>(lane_samples),
+        100.0 * static_cast<double>(samples) / static_cast<double>(lane_samples));
     if (options.reference_repeats > 0) {
         std::printf("reference: %dx%d, %llu samples per frame (counted), median of %d\n",
                     options.reference_width, options.reference_height,
                     static_cast<unsigned long long>(reference_samples), options.reference_repeats);
     }
     std::printf("early termination on: Msamples/s is span-equivalent (full-span samples / time)\n");
-    std::printf("\n%-34s %10s %9s %12s %10s %12s %9s %12s\n", "mode", "OpenCL ms", "(min)",
-                "OpenCL Ms/s", "ref ms", "ref Ms/s", "CL/ref", "max |dRGBA|");
+    std::printf("\n%-34s %10s %9s %9s %12s %10s %12s %9s %12s\n", "mode", "OpenCL ms", "(min)",
+                "CPU ms", "OpenCL Ms/s", "ref ms", "ref Ms/s", "CL/ref", "max |dRGBA|");
 
     const Mode modes[] = {
         {"unshaded, early termination off", false, 2.0},
@@ -220,8 +238,8 @@ int run(const BenchOptions& options) {
                                         [&] { renderer.render(camera, tf, settings); });
         const double opencl_rate =
             static_cast<double>(samples) / (opencl.median_ms * 1e3);  // Msamples/s
-        std::printf("%-34s %10.1f %9.1f %12.1f", mode.name, opencl.median_ms, opencl.min_ms,
-                    opencl_rate);
+        std::printf("%-34s %10.1f %9.1f %9.1f %12.1f", mode.name, opencl.median_ms, opencl.min_ms,
+                    opencl.min_cpu_ms, opencl_rate);
 
         if (options.reference_repeats > 0) {
             insitu::Rendering reference_image;

@@ -3,6 +3,7 @@
 // kernel builds and buffer allocation, which a steady state does not).
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <functional>
 #include <limits>
 #include <utility>
@@ -20,6 +21,13 @@ inline double ms_since(std::chrono::steady_clock::time_point start) {
 inline double median(std::vector<double> values) {
     std::sort(values.begin(), values.end());
     return values[values.size() / 2];
+}
+
+/// CPU time of every thread of this process so far (a device's worker threads included), ms.
+inline double process_cpu_ms() {
+    timespec now{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
+    return 1e3 * static_cast<double>(now.tv_sec) + 1e-6 * static_cast<double>(now.tv_nsec);
 }
 
 /// Median wall time (ms) of `repeats` (>= 1) runs of `run`, after one warm-up run.
@@ -43,6 +51,10 @@ struct Timing {
     double worst = 0.0;
     double warmup = 0.0;
     bool skipped = false;
+    std::vector<double> rounds;  // every timed run in order: round r of interleaved_timings
+    // CPU time of this process's threads in each of those runs: on a loaded machine other
+    // processes lengthen a run's wall time far more than the CPU time its threads spend.
+    std::vector<double> cpu_rounds;
 };
 
 /// Times each of `runs` `repeats` (>= 1) times after one untimed warm-up each, interleaved round
@@ -62,13 +74,16 @@ inline std::vector<Timing> interleaved_timings(
     for (int r = 0; r < std::max(1, repeats); ++r) {
         for (std::size_t i = 0; i < runs.size(); ++i) {
             if (timings[i].skipped) continue;
+            const double cpu_start = process_cpu_ms();
             const auto start = std::chrono::steady_clock::now();
             runs[i]();
             times[i].push_back(ms_since(start));
+            timings[i].cpu_rounds.push_back(process_cpu_ms() - cpu_start);
         }
     }
     for (std::size_t i = 0; i < runs.size(); ++i) {
         if (timings[i].skipped) continue;
+        timings[i].rounds = times[i];
         std::sort(times[i].begin(), times[i].end());
         timings[i].best = times[i].front();
         timings[i].median = times[i][times[i].size() / 2];

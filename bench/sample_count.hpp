@@ -43,4 +43,28 @@ std::uint64_t samples_per_frame(const AnyCamera& camera, int width, int height, 
     return total;
 }
 
+/// Lane-samples the ray packets of a frame march (kernels/render/ray_march.cl: 4 x 4 rays a
+/// packet, marched in lockstep until its longest ray ends, lanes past their own end idle):
+/// 16 x the most samples of any ray of each packet, summed. samples_per_frame() over this is the
+/// share of lanes that do work, without early termination.
+template <typename AnyCamera>
+std::uint64_t packet_lane_samples(const AnyCamera& camera, int width, int height, const Bounds& box,
+                                  double step_world) {
+    constexpr int kSide = 4;
+    std::uint64_t total = 0;
+    for (int y0 = 0; y0 < height; y0 += kSide) {
+        for (int x0 = 0; x0 < width; x0 += kSide) {
+            std::uint64_t longest = 0;
+            for (int y = y0; y < std::min(height, y0 + kSide); ++y) {
+                for (int x = x0; x < std::min(width, x0 + kSide); ++x) {
+                    longest = std::max(
+                        longest, samples_along(camera.ray(x + 0.5, y + 0.5), box, step_world));
+                }
+            }
+            total += kSide * kSide * longest;
+        }
+    }
+    return total;
+}
+
 }  // namespace insitu::bench

@@ -536,6 +536,7 @@ def write_markdown(d, path, prefix, elapsed):
     storage = read(d, "storage")
     peer = read(d, "peer")
     peer_acc = read(d, "peer_accuracy")
+    peer_rounds = read(d, "peer_rounds")
     primary = edits[0]["scene"] if edits else "?"
     rot_scene = rotation[0]["scene"] if rotation else "?"
 
@@ -789,6 +790,17 @@ def write_markdown(d, path, prefix, elapsed):
                  "%.2f×" % (num(r, "ms_per_frame") / num(vtk, "ms_per_frame"))] for r in peer]
         lines += [table(["renderer", "volume", "image", "ms per frame (best)", "median", "slowest",
                          "M samples", "ns per sample", "vs VTK"], body), ""]
+        if peer_rounds:
+            # Each round's ratios (issue 45): a round where VTK met a burst of load shows here.
+            body = [[r["round"], "%.1f" % num(r, "vtk_ms"), "%.1f" % num(r, "ground_truth_ms"),
+                     "%.2f×" % num(r, "ground_truth_x"), "%.1f" % num(r, "single_ms"),
+                     "%.2f×" % num(r, "single_x"), "%.2f×" % num(r, "all_x"),
+                     "%.2f× / %.2f× / %.2f×" % (num(r, "ground_truth_cpu_x"), num(r, "single_cpu_x"),
+                                              num(r, "all_cpu_x"))] for r in peer_rounds]
+            lines += ["Every round (ms; ratios to VTK's frame of the same round; CPU time: the "
+                      "ratios of the CPU time each spent, which other processes' load moves less):",
+                      "", table(["round", "VTK", "ground truth", "vs VTK", "single", "vs VTK",
+                                 "all proxies vs VTK", "CPU time: truth / single / all"], body), ""]
         if peer_acc:
             lines += ["PSNR between VTK's image and our ground truth: %.2f dB (SSIM %.4f)." % (
                 num(peer_acc[0], "psnr_ours_vs_vtk"), num(peer_acc[0], "ssim_ours_vs_vtk")), ""]

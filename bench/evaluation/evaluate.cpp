@@ -48,6 +48,7 @@
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/metrics.hpp"
 #include "light_field_quality.hpp"
+#include "machine.hpp"
 #include "median_time.hpp"
 #include "scenes.hpp"
 
@@ -1384,15 +1385,6 @@ void section_light_fields(const std::vector<const Scene*>& scenes, const Options
     }
 }
 
-std::string cpu_model() {
-    std::ifstream in("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(in, line)) {
-        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-    }
-    return "unknown";
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -1406,12 +1398,14 @@ int main(int argc, char** argv) {
         const auto start = std::chrono::steady_clock::now();
         {
             Csv machine(fs::path(options.out) / "machine.csv", "key,value");
-            machine.row("cpu", "\"" + cpu_model() + "\"");
+            machine.row("cpu", "\"" + bench::cpu_model() + "\"");
+            machine.row("load_average_start", "\"" + bench::load_average() + "\"");
             machine.row("hardware_threads", static_cast<int>(std::thread::hardware_concurrency()));
             machine.row("opencl_device", "\"" + ComputeDevice::shared()->description() + "\"");
             machine.row("mode", options.smoke ? "smoke" : "full");
         }
         std::printf("device: %s\n", ComputeDevice::shared()->description().c_str());
+        bench::print_machine("start");
 
         // Most sweeps: 128^3 fields, 256^2 images (smoke: 40^3, 64^2).
         const int size = options.smoke ? 40 : 128;

@@ -359,13 +359,15 @@ typedef struct {
 // Adds one sample's contribution to the interleaved per-interval outputs of the lanes in
 // `contributes`, one lane at a time (a lane's interval is data-dependent, and its pixel's
 // intervals share one or two cache lines, as in render_proxies).
-inline void accumulate_lanes(intp contributes, floatp value, floatp weight, floatp depth,
-                             floatp alpha, int gx, int gy, int2 size, int interval_count,
-                             float uniform_interval_scale, __global const float* interval_edges,
-                             bool want_mean_depth, bool want_optical_depth, bool want_entry_depth,
-                             __global float* attenuation_out, __global float* mean_depth_out,
-                             __global float* optical_depth_out, __global float* entry_depth_out,
-                             PacketInterleaving* interleaving) {
+PACKET_INLINE void accumulate_lanes(intp contributes, floatp value, floatp weight, floatp depth,
+                                    floatp alpha, int gx, int gy, int2 size, int interval_count,
+                                    float uniform_interval_scale,
+                                    __global const float* interval_edges, bool want_mean_depth,
+                                    bool want_optical_depth, bool want_entry_depth,
+                                    __global float* attenuation_out, __global float* mean_depth_out,
+                                    __global float* optical_depth_out,
+                                    __global float* entry_depth_out,
+                                    PacketInterleaving* interleaving) {
     for (int lane = 0; lane < PACKET_LANES; ++lane) {
         if (!LANE_INT(contributes, lane)) continue;
         const int2 pixel_xy = packet_pixel(gx, gy, lane);
@@ -406,10 +408,11 @@ inline void accumulate_lanes(intp contributes, floatp value, floatp weight, floa
 // argument list.
 // absorb() for the lanes of `composites`: premultiplied colour and T front to back, the depth
 // where the opacity first reaches `depth_threshold`, and compositing stopped at `stop_opacity`.
-inline void composite_lanes(intp composites, floatp alpha, floatp sample_red, floatp sample_green,
-                            floatp sample_blue, floatp depth, float depth_threshold,
-                            float stop_opacity, floatp* transmittance, floatp* red, floatp* green,
-                            floatp* blue, floatp* hit_depth, intp* compositing) {
+PACKET_INLINE void composite_lanes(intp composites, floatp alpha, floatp sample_red,
+                                   floatp sample_green, floatp sample_blue, floatp depth,
+                                   float depth_threshold, float stop_opacity, floatp* transmittance,
+                                   floatp* red, floatp* green, floatp* blue, floatp* hit_depth,
+                                   intp* compositing) {
     if (!any(composites)) return;
     const floatp a = select((floatp)0.0f, alpha, composites);
     const floatp weight = *transmittance * a;

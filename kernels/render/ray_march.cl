@@ -216,6 +216,10 @@ inline float absorb(float* transmittance, float alpha) {
 // 16 lanes ran faster than 8, both well ahead of one ray per work-item (bench/RESULTS.md, "Ray
 // packets on CPU devices, 16 lanes").
 #define PACKET_LANES 16
+// The packet helpers are inlined by force: PoCL (3.1, LLVM 15) otherwise compiled packet_cell,
+// packet_cell_gradient and packet_lookup_transfer as calls, each packet of 16 lanes passed and
+// returned through the stack (bench/RESULTS.md, "Where a sample's cycles go on AMD EPYC").
+#define PACKET_INLINE inline __attribute__((always_inline))
 #define PACKET_W 4
 #define PACKET_H 4
 typedef float16 floatp;
@@ -228,12 +232,30 @@ typedef int16 intp;
               buf[(index).s5], buf[(index).s6], buf[(index).s7], buf[(index).s8], buf[(index).s9], \
               buf[(index).sa], buf[(index).sb], buf[(index).sc], buf[(index).sd], buf[(index).se], \
               buf[(index).sf]))
+// Lanes k of two packets read as pairs: first.sk = buf[index.sk], second.sk = buf[index.sk + 1],
+// with one 8-byte element per lane where GATHER takes two 4-byte ones (index even, buf 8-byte
+// aligned). The same floats, half the gathered elements: AMD's Zen cores gather an element at a
+// time (bench/RESULTS.md, "Where a sample's cycles go on AMD EPYC").
+PACKET_INLINE void gather_pairs(__global const float* buf, intp index, floatp* first,
+                                floatp* second) {
+    __global const ulong* pairs = (__global const ulong*)buf;
+    const intp q = index >> 1;
+    const ulong8 low = (ulong8)(pairs[q.s0], pairs[q.s1], pairs[q.s2], pairs[q.s3], pairs[q.s4],
+                                pairs[q.s5], pairs[q.s6], pairs[q.s7]);
+    const ulong8 high = (ulong8)(pairs[q.s8], pairs[q.s9], pairs[q.sa], pairs[q.sb], pairs[q.sc],
+                                 pairs[q.sd], pairs[q.se], pairs[q.sf]);
+    // Little-endian: the float at the lower address is the low half of its ulong.
+    const float16 a = as_float16(low), b = as_float16(high);
+    *first = shuffle2(a, b, (uint16)(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30));
+    *second = shuffle2(a, b, (uint16)(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31));
+}
+
 // Lane access to a packet held in private memory (set-up and stores only, not the inner loop).
 #define LANE(packet, lane) (((float*)&(packet))[lane])
 #define LANE_INT(packet, lane) (((int*)&(packet))[lane])
 
 // Pixel of lane `lane` in the packet of work-item (gx, gy).
-inline int2 packet_pixel(int gx, int gy, int lane) {
+PACKET_INLINE int2 packet_pixel(int gx, int gy, int lane) {
     return (int2)(gx * PACKET_W + lane % PACKET_W, gy * PACKET_H + lane / PACKET_W);
 }
 
@@ -249,11 +271,11 @@ typedef struct {
     intp hits;
 } MarchPacket;
 
-inline MarchPacket march_packet(int gx, int gy, int2 size, float4 cam_position, float4 cam_forward,
-                                float4 cam_right, float4 cam_up, float4 cam_half_extent,
-                                float sin_tilt, float cos_tilt, float4 origin_world,
-                                float4 inv_spacing, float4 box_lower, float4 box_upper,
-                                float4 data_offset) {
+PACKET_INLINE MarchPacket march_packet(int gx, int gy, int2 size, float4 cam_position,
+                                       float4 cam_forward, float4 cam_right, float4 cam_up,
+                                       float4 cam_half_extent, float sin_tilt, float cos_tilt,
+                                       float4 origin_world, float4 inv_spacing, float4 box_lower,
+                                       float4 box_upper, float4 data_offset) {
     MarchPacket packet;
     for (int lane = 0; lane < PACKET_LANES; ++lane) {
         const int2 pixel = packet_pixel(gx, gy, lane);
@@ -283,7 +305,8 @@ inline MarchPacket march_packet(int gx, int gy, int2 size, float4 cam_position, 
 }
 
 // sample_position_voxels() for a packet: the lanes' positions at their t, in the buffer's voxels.
-inline void packet_position(const MarchPacket* rays, floatp t, floatp* x, floatp* y, floatp* z) {
+PACKET_INLINE void packet_position(const MarchPacket* rays, floatp t, floatp* x, floatp* y,
+                                   floatp* z) {
     *x = rays->start_x + t * rays->direction_x;
     *y = rays->start_y + t * rays->direction_y;
     *z = rays->start_z + t * rays->direction_z;
@@ -302,8 +325,8 @@ typedef struct {
 // Lanes of a gather at the stencil offsets (x, y, z) of a cell: whole offsets into the buffer.
 #define AT(xo, yo, zo) GATHER(volume, (xo) + (yo) + (zo))
 
-inline PacketCell packet_cell(__global const float* volume, int4 dims, floatp x, floatp y, floatp z,
-                              intp active) {
+PACKET_INLINE PacketCell packet_cell(__global const float* volume, int4 dims, floatp x, floatp y,
+                                     floatp z, intp active) {
     PacketCell cell;
     const floatp px = clamp(select((floatp)0.0f, x, active), 0.0f, (float)(dims.x - 1));
     const floatp py = clamp(select((floatp)0.0f, y, active), 0.0f, (float)(dims.y - 1));
@@ -332,9 +355,9 @@ inline PacketCell packet_cell(__global const float* volume, int4 dims, floatp x,
 }
 
 // Trilinear interpolation of one cell's corners in sample_trilinear's order of operations.
-inline floatp packet_cell_trilinear(floatp c000, floatp c100, floatp c010, floatp c110, floatp c001,
-                                    floatp c101, floatp c011, floatp c111, floatp fx, floatp fy,
-                                    floatp fz) {
+PACKET_INLINE floatp packet_cell_trilinear(floatp c000, floatp c100, floatp c010, floatp c110,
+                                           floatp c001, floatp c101, floatp c011, floatp c111,
+                                           floatp fx, floatp fy, floatp fz) {
     const floatp c00 = mix(c000, c100, fx);
     const floatp c10 = mix(c010, c110, fx);
     const floatp c01 = mix(c001, c101, fx);
@@ -342,14 +365,14 @@ inline floatp packet_cell_trilinear(floatp c000, floatp c100, floatp c010, float
     return mix(mix(c00, c10, fy), mix(c01, c11, fy), fz);
 }
 
-inline floatp packet_cell_value(const PacketCell* c) {
+PACKET_INLINE floatp packet_cell_value(const PacketCell* c) {
     return packet_cell_trilinear(c->c000, c->c100, c->c010, c->c110, c->c001, c->c101, c->c011,
                                  c->c111, c->fx, c->fy, c->fz);
 }
 
 // sample_trilinear() for a packet of positions.
-inline floatp packet_trilinear(__global const float* volume, int4 dims, floatp x, floatp y,
-                               floatp z, intp active) {
+PACKET_INLINE floatp packet_trilinear(__global const float* volume, int4 dims, floatp x, floatp y,
+                                      floatp z, intp active) {
     const PacketCell cell = packet_cell(volume, dims, x, y, z, active);
     return packet_cell_value(&cell);
 }
@@ -360,8 +383,9 @@ inline floatp packet_trilinear(__global const float* volume, int4 dims, floatp x
 // six full trilinear samples' 48. Clamping the neighbour's index to the grid gives what clamping
 // its position gives (a face value), so this is gradient_central's definition, to rounding of
 // the fractions.
-inline void packet_cell_gradient(__global const float* volume, int4 dims, const PacketCell* c,
-                                 float4 inv_spacing, floatp* gx, floatp* gy, floatp* gz) {
+PACKET_INLINE void packet_cell_gradient(__global const float* volume, int4 dims,
+                                        const PacketCell* c, float4 inv_spacing, floatp* gx,
+                                        floatp* gy, floatp* gz) {
     const int2 b = volume_bricks(dims);
     // Row, column and slice offsets of the stencil: -1, 0, 1, 2 around the cell, clamped.
     const intp x_m = volume_offset_x(max(c->ix - 1, 0)), x_0 = volume_offset_x(c->ix),
@@ -408,32 +432,44 @@ inline void packet_cell_gradient(__global const float* volume, int4 dims, const 
 
 // lookup_transfer() for a packet: colour and step-corrected opacity, bilinear in (value, gradient
 // magnitude). Values must not be NaN (callers replace them and mask their opacity).
-inline void packet_lookup_transfer(__global const float4* table4, int2 bins, float4 domain,
-                                   floatp value, floatp gradient_magnitude, floatp* r, floatp* g,
-                                   floatp* b, floatp* a) {
+PACKET_INLINE void packet_lookup_transfer(__global const float4* table4, int2 bins, float4 domain,
+                                          floatp value, floatp gradient_magnitude, floatp* r,
+                                          floatp* g, floatp* b, floatp* a) {
     __global const float* table = (__global const float*)table4;
     const floatp x = clamp((value - domain.x) * domain.y, 0.0f, 1.0f) * (float)(bins.x - 1);
     const intp ix = min(convert_intp(x), bins.x - 2);
     const floatp fx = x - convert_floatp(ix);
     const intp e0 = 4 * ix;
+    // An entry's (r, g) and (b, a) are 8-byte pairs (the table is float4): four paired gathers
+    // per row instead of eight.
+    floatp r0, g0, b0, a0, r1, g1, b1, a1;
     if (bins.y == 1) {
-        *r = mix(GATHER(table, e0), GATHER(table, e0 + 4), fx);
-        *g = mix(GATHER(table, e0 + 1), GATHER(table, e0 + 5), fx);
-        *b = mix(GATHER(table, e0 + 2), GATHER(table, e0 + 6), fx);
-        *a = mix(GATHER(table, e0 + 3), GATHER(table, e0 + 7), fx);
+        gather_pairs(table, e0, &r0, &g0);
+        gather_pairs(table, e0 + 2, &b0, &a0);
+        gather_pairs(table, e0 + 4, &r1, &g1);
+        gather_pairs(table, e0 + 6, &b1, &a1);
+        *r = mix(r0, r1, fx);
+        *g = mix(g0, g1, fx);
+        *b = mix(b0, b1, fx);
+        *a = mix(a0, a1, fx);
         return;
     }
     const floatp y = clamp(gradient_magnitude * domain.z, 0.0f, 1.0f) * (float)(bins.y - 1);
     const intp iy = min(convert_intp(y), bins.y - 2);
     const floatp fy = y - convert_floatp(iy);
-    const intp r0 = e0 + 4 * iy * bins.x;  // row iy, entry ix
-    const intp r1 = r0 + 4 * bins.x;
-    *r = mix(mix(GATHER(table, r0), GATHER(table, r0 + 4), fx),
-             mix(GATHER(table, r1), GATHER(table, r1 + 4), fx), fy);
-    *g = mix(mix(GATHER(table, r0 + 1), GATHER(table, r0 + 5), fx),
-             mix(GATHER(table, r1 + 1), GATHER(table, r1 + 5), fx), fy);
-    *b = mix(mix(GATHER(table, r0 + 2), GATHER(table, r0 + 6), fx),
-             mix(GATHER(table, r1 + 2), GATHER(table, r1 + 6), fx), fy);
-    *a = mix(mix(GATHER(table, r0 + 3), GATHER(table, r0 + 7), fx),
-             mix(GATHER(table, r1 + 3), GATHER(table, r1 + 7), fx), fy);
+    const intp row0 = e0 + 4 * iy * bins.x;  // row iy, entry ix
+    const intp row1 = row0 + 4 * bins.x;
+    floatp r2, g2, b2, a2, r3, g3, b3, a3;
+    gather_pairs(table, row0, &r0, &g0);
+    gather_pairs(table, row0 + 2, &b0, &a0);
+    gather_pairs(table, row0 + 4, &r1, &g1);
+    gather_pairs(table, row0 + 6, &b1, &a1);
+    gather_pairs(table, row1, &r2, &g2);
+    gather_pairs(table, row1 + 2, &b2, &a2);
+    gather_pairs(table, row1 + 4, &r3, &g3);
+    gather_pairs(table, row1 + 6, &b3, &a3);
+    *r = mix(mix(r0, r1, fx), mix(r2, r3, fx), fy);
+    *g = mix(mix(g0, g1, fx), mix(g2, g3, fx), fy);
+    *b = mix(mix(b0, b1, fx), mix(b2, b3, fx), fy);
+    *a = mix(mix(a0, a1, fx), mix(a2, a3, fx), fy);
 }

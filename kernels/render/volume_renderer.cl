@@ -86,7 +86,7 @@ __kernel void render_volume(__global const float* volume, int4 dims, float4 orig
 // (bench/RESULTS.md, "pow as exp2 and log2 in shaded packets"). It differs from pow by a few ulp
 // times w |log2 x|, checked against render_volume's pow by the packet tests. pow(x, 0) is 1, also
 // at x = 0.
-inline floatp packet_pow_unit(floatp x, float w) {
+PACKET_INLINE floatp packet_pow_unit(floatp x, float w) {
     if (w == 0.0f) return (floatp)(1.0f);
     return exp2(w * log2(x));  // log2(0) = -inf gives 0
 }
