@@ -174,14 +174,17 @@ bool step_before(const nlohmann::json& a, const nlohmann::json& b) {
 /// Steps in ascending order, as find_step's binary search needs them (stable: a repeated step's
 /// entries keep their order for the checks that report it).
 void sort_steps(nlohmann::json& steps) {
-    if (!std::is_sorted(steps.begin(), steps.end(), step_before)) {
-        std::stable_sort(steps.begin(), steps.end(), step_before);
+    auto& entries = steps.get_ref<nlohmann::json::array_t&>();
+    if (!std::is_sorted(entries.begin(), entries.end(), step_before)) {
+        std::stable_sort(entries.begin(), entries.end(), step_before);
     }
 }
 
 /// The entry of `step` in the sorted "steps" of a validated manifest; nullptr when none.
 const nlohmann::json* step_entry_of(const nlohmann::json& manifest, std::int64_t step) {
-    const nlohmann::json& steps = manifest.at("steps");
+    // The array itself: nlohmann's iterators call themselves bidirectional, so a search over
+    // them walks every entry to find the middle.
+    const auto& steps = manifest.at("steps").get_ref<const nlohmann::json::array_t&>();
     const auto found = std::lower_bound(steps.begin(), steps.end(), step,
                                         [](const nlohmann::json& entry, std::int64_t number) {
                                             return entry.at("step").get<std::int64_t>() < number;

@@ -185,8 +185,9 @@ private:
     ArchiveReader(std::string path, std::vector<std::string> diagnostics,
                   std::shared_ptr<const nlohmann::json> manifest, bool manifest_readable);
 
+    /// data.csv's checks; `checked`: the manifest's files, which check() has looked at.
     void verify_cinema_csv(const std::filesystem::path& root,
-                           const std::set<std::filesystem::path>& reported,
+                           const std::set<std::filesystem::path>& checked,
                            std::vector<std::string>& problems) const;
 
     std::string path_;
