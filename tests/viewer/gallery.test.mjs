@@ -234,6 +234,18 @@ test('a damaged step is left out and listed; the rest is exported', () => {
   assert.equal(index.exported.left_out[0].step, 600);
   assert.match(readFileSync(path.join(out, 'README.txt'), 'utf8'), /Left out: step 600/);
   assert.ok(!readFileSync(path.join(out, 'data.csv'), 'utf8').includes('600'));
+
+  // The first step's proxies damaged: the index describes the views from the next step.
+  const first = path.join(workDir, 'damaged-first.cdb');
+  cpSync(archive, first, { recursive: true });
+  truncateSync(path.join(first, 'proxies', 'step000300_view0.exr'), 1000);
+  const firstOut = path.join(workDir, 'damaged-first-gallery');
+  const firstResult = exportGallery(first, firstOut);
+  assert.equal(firstResult.status, 3, `exit 3 for damage: ${firstResult.stderr}`);
+  assert.match(firstResult.stdout, /left out: step 300: damaged: .*step000300_view0\.exr/);
+  const firstIndex = JSON.parse(readFileSync(path.join(firstOut, 'api', 'archive')));
+  assert.deepEqual(firstIndex.timeline.map((t) => t.step), [600]);
+  assert.ok(firstIndex.views[0].single, 'the view described from step 600');
 });
 
 test('the recipes the gallery\'s page makes are serve\'s (Explorer::recipe)', async () => {
