@@ -208,7 +208,8 @@ viewer_browser_test(trust volume
 # the page's recipes are serve's, that the same archive exports to the same bytes and that a
 # damaged step is left out and listed.
 viewer_browser_test(gallery lf ENVIRONMENT ARCHIVE_VOLUME=${viewer_work}/viewer_volume.cdb
-                    FIXTURES viewer_volume_archive)
+                                          ARCHIVE_MODEL=${viewer_archive}
+                    FIXTURES viewer_volume_archive viewer_archive)
 
 # export's command line and bad input: exit 2 and one line on stderr naming the value.
 function(viewer_export_case name text)

@@ -1,6 +1,7 @@
 #include "static_site.hpp"
 
 #include <algorithm>
+#include <array>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -86,11 +87,13 @@ std::string fixed2(double value) {
     return text.str();
 }
 
-/// The recipes of the stored function (no edits) for each combination of the page's toggles
-/// that changes what the recipe is (lights, occlusion, enhancement: their parameters the page
-/// sets itself) and of colour source, at the stored view and at another; keyed as
-/// viewer/web/source.js asks ("stored|other" "/" colour "/" L A E), with serve's refusal where it
-/// refuses. Plus, where the step holds a compressed field, the recipe of a frame made from it.
+/// The recipes of the stored function for each combination of the page's toggles that changes
+/// what the recipe is (lights, occlusion, enhancement: their parameters the page sets itself),
+/// of colour source, at the stored view and at another, unedited and with an opacity edit (whose
+/// scales the page sets itself: the recipe's source and colour model do not depend on them);
+/// keyed as viewer/web/source.js asks ("edited/"? "stored|other" "/" colour "/" L A E), with
+/// serve's refusal where it refuses. Plus, where the step holds a compressed field, the recipe of
+/// a frame made from it.
 json step_recipes(Routes& routes, const Params& key, const json& info) {
     const auto recipe = [&](const Params& options) {
         const Answer answer =
@@ -100,24 +103,25 @@ json step_recipes(Routes& routes, const Params& key, const json& info) {
                     {"status", answer.status}};
     };
     json recipes = json::object();
-    for (const bool other : {false, true}) {
-        for (const char* colour : {"auto", "model", "recompose"}) {
-            for (int toggles = 0; toggles < 8; ++toggles) {
-                Params options = key;
-                if (other) {
-                    options["azimuth"] = fixed2(info.at("azimuth").get<double>() + 30.0);
-                    options["elevation"] = fixed2(info.at("elevation").get<double>());
-                }
-                if (std::string(colour) != "auto") options["colour"] = colour;
-                if (toggles & 1) options["light"] = "camera";
-                if (toggles & 2) options["ao"] = "8";
-                if (toggles & 4) options["enhance"] = "1,1";
-                const std::string name = std::string(other ? "other" : "stored") + "/" + colour +
-                                         "/" + (toggles & 1 ? "L" : "") + (toggles & 2 ? "A" : "") +
-                                         (toggles & 4 ? "E" : "");
-                recipes[name] = recipe(options);
-            }
+    for (int variant = 0; variant < 4 * 3 * 8; ++variant) {
+        const bool edited = variant / 48 == 1;
+        const bool other = variant / 24 % 2 == 1;
+        const std::string colour = std::array{"auto", "model", "recompose"}[variant / 8 % 3];
+        const int toggles = variant % 8;
+        Params options = key;
+        if (edited) options["opacity-scale"] = "0=0.5";
+        if (other) {
+            options["azimuth"] = fixed2(info.at("azimuth").get<double>() + 30.0);
+            options["elevation"] = fixed2(info.at("elevation").get<double>());
         }
+        if (colour != "auto") options["colour"] = colour;
+        if (toggles & 1) options["light"] = "camera";
+        if (toggles & 2) options["ao"] = "8";
+        if (toggles & 4) options["enhance"] = "1,1";
+        const std::string name =
+            std::string(edited ? "edited/" : "") + (other ? "other/" : "stored/") + colour + "/" +
+            (toggles & 1 ? "L" : "") + (toggles & 2 ? "A" : "") + (toggles & 4 ? "E" : "");
+        recipes[name] = recipe(options);
     }
     if (info.contains("volume")) {
         Params options = key;
@@ -207,9 +211,10 @@ std::string readme_text(const std::string& name, const ExportReport& report) {
     for (const auto& [step, why] : report.left_out) {
         text << "Left out: step " << step << ": " << why << "\n";
     }
-    text << "\nWhat needs `insitu-view serve` instead: transfer-function and opacity edits of\n"
-         << "frames made from proxies or light fields (the compressed field takes any edit here),\n"
-         << "and frames a browser without WebGL2 would ask the server for.\n\n"
+    text << "\nWhat needs `insitu-view serve` instead: an edited or loaded transfer function on\n"
+         << "frames made from proxies or light fields (opacity edits per interval work here, and\n"
+         << "the compressed field takes any function), and the frames a browser without WebGL2\n"
+         << "would ask the server for.\n\n"
          << "data.csv and previews/ are the run's Cinema database (Spec D): Cinema viewers open\n"
          << "this folder too.\n";
     return text.str();

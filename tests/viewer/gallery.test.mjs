@@ -4,7 +4,8 @@
 // field and the stored view's proxies (ARCHIVE: orbit views, lights and occlusion whose terms the
 // page computes itself, the next step) and on a run with a compressed field (ARCHIVE_VOLUME:
 // orbit views and an edited transfer function). No request may leave the gallery's folder. Also:
-// the same archive exports to the same bytes; a damaged step is left out and listed.
+// the page's recipes are serve's (also on ARCHIVE_MODEL, a run with a colour model), the same
+// archive exports to the same bytes, a damaged step is left out and listed.
 //
 //   INSITU_VIEW=build/viewer/insitu-view ARCHIVE=viewer_lf.cdb ARCHIVE_VOLUME=viewer_volume.cdb \
 //     WORK_DIR=dir node gallery.test.mjs
@@ -24,6 +25,7 @@ import {
 const binary = env('INSITU_VIEW');
 const archive = env('ARCHIVE');
 const volumeArchive = env('ARCHIVE_VOLUME');
+const modelArchive = env('ARCHIVE_MODEL');
 const workDir = makeWorkDir('gallery-');
 // The served page's bar (webgl, proxies and volume tests): the issue's.
 const MIN_PSNR_DB = 40;
@@ -119,6 +121,28 @@ test('a gallery of a light-field run draws the served page\'s frames from static
       MIN_PSNR_DB, 'stored view');
     results.push(`stored view ${stored.psnr.toFixed(1)} dB`);
     const info = JSON.parse(readFileSync(path.join(workDir, 'lf', 'data', '300_0', 'step.json')));
+    // An opacity edit: the heaviest interval's handle dragged down (scales set by the page).
+    const heaviest = info.mean_attenuation.indexOf(Math.max(...info.mean_attenuation));
+    const handle = await page.locator(`circle[data-interval="${heaviest}"]`).boundingBox();
+    const editedOptions = await settle(page, async () => {
+      await page.mouse.move(handle.x + handle.width / 2, handle.y + handle.height / 2);
+      await page.mouse.down();
+      await page.mouse.move(handle.x + handle.width / 2, handle.y + handle.height / 2 + 25,
+        { steps: 3 });
+      await page.mouse.up();
+    });
+    assert.ok(editedOptions['opacity-scale'], 'an opacity edit sends a scale');
+    const edited = await browserFrameMatches(page, binary, archive, workDir, 'opacity edit',
+      MIN_PSNR_DB, 'stored view');
+    assert.ok(differingSamples(edited.image, stored.image) > 0, 'the edit shows');
+    results.push(`opacity edit ${edited.psnr.toFixed(1)} dB`);
+    // A recolouring needs the engine's estimate: the gallery says so, naming serve.
+    await page.locator(`#tf-colours input[data-interval="${heaviest}"]`).fill('#ff2000');
+    await page.waitForFunction(() => document.getElementById('error').textContent
+      .includes('insitu-view serve'));
+    await settle(page, async () => {
+      await page.click('#tf-reset');
+    });
     await orbitTo(page, Math.round(info.azimuth + 25), Math.round(info.elevation - 10));
     const orbit = await lightFieldFrameMatches(page, binary, archive, workDir, 'orbit', MIN_PSNR_DB);
     results.push(`orbit ${orbit.psnr.toFixed(1)} dB`);
@@ -248,20 +272,25 @@ test('a damaged step is left out and listed; the rest is exported', () => {
   assert.ok(firstIndex.views[0].single, 'the view described from step 600');
 });
 
-test('the recipes the gallery\'s page makes are serve\'s (Explorer::recipe)', async () => {
-  const out = path.join(workDir, 'recipes');
-  assert.equal(exportGallery(archive, out).status, 0);
-  const recipes = JSON.parse(readFileSync(path.join(out, 'data', '300_0', 'recipes.json')));
-  const server = await startServer(binary, archive);
+/// The recipes the gallery of `from` makes at its first step against serve's.
+async function recipesMatch(from, name) {
+  const out = path.join(workDir, name);
+  assert.equal(exportGallery(from, out).status, 0);
+  const index = JSON.parse(readFileSync(path.join(out, 'api', 'archive')));
+  const step = String(index.timeline[0].step);
+  const recipes = JSON.parse(readFileSync(path.join(out, 'data', `${step}_0`, 'recipes.json')));
+  const server = await startServer(binary, from);
   try {
-    const info = await (await fetch(`${server.url}api/step?step=300&view=0`)).json();
+    const info = await (await fetch(`${server.url}api/step?step=${step}&view=0`)).json();
     const other = { azimuth: (info.azimuth - 50).toFixed(2), elevation: '5.00' };
     const cases = [{}, other, { light: 'camera', ambient: '0.35' },
       { ...other, light: '-40,60,1.2,0.1;camera', ambient: '0', ao: '3,2.5' },
       { ...other, enhance: '0.7,1.6' }, { light: '10,-20', ao: '17', enhance: '2,0.5' },
-      { colour: 'recompose', ao: '1,0' }, { ...other, colour: 'recompose', light: '90,0,0,2' }];
+      { colour: 'recompose', ao: '1,0' }, { ...other, colour: 'recompose', light: '90,0,0,2' },
+      { 'opacity-scale': '2=0.25,5=1.7' }, { ...other, 'opacity-scale': '3=0', light: '20,10' },
+      { 'opacity-scale': '1=2,1=0.5,4=0.3', colour: 'recompose', ao: '4,1', enhance: '1,2' }];
     for (const extra of cases) {
-      const options = { step: '300', view: '0', ...extra };
+      const options = { step, view: '0', ...extra };
       const served = await (await fetch(`${server.url}api/recipe`,
         { method: 'POST', body: new URLSearchParams(options) })).json();
       const made = galleryRecipe(recipes, options, extra.azimuth !== undefined);
@@ -271,10 +300,16 @@ test('the recipes the gallery\'s page makes are serve\'s (Explorer::recipe)', as
       assert.deepEqual(rounded(made), rounded(served), JSON.stringify(extra));
     }
     // What only the engine estimates: the gallery says it cannot, rather than drawing it.
-    assert.equal(galleryRecipe(recipes, { step: '300', view: '0', 'opacity-scale': '2=0.5' },
-      false), null);
-    assert.equal(galleryRecipe(recipes, { step: '300', view: '0', tf: '{}' }, false), null);
+    assert.equal(galleryRecipe(recipes, { step, view: '0', tf: '{}' }, false), null);
+    assert.throws(() => galleryRecipe(recipes, { step, view: '0', 'opacity-scale': '99=0.5' },
+      false), /opacity-scale interval 99/);
   } finally {
     await stopServer(server);
   }
+}
+
+test('the recipes the gallery\'s page makes are serve\'s (Explorer::recipe)', async () => {
+  await recipesMatch(archive, 'recipes-lf');
+  // A run with a colour model, which opacity edits colour by.
+  await recipesMatch(modelArchive, 'recipes-model');
 });

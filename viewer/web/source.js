@@ -4,9 +4,10 @@
 // the stored view's frame and mask) and the recipes of the stored function for each
 // combination of lights, occlusion, enhancement and colour source; the parameters of those
 // (light directions and strengths, the occlusion's radius and strength, the enhancement's
-// lambda and gamma) the page sets here itself, as Explorer::recipe does. A compressed field takes
-// any transfer function (the page ray-marches it); opacity edits of proxies and light fields are
-// estimated by the engine only, and a gallery says so instead of drawing them.
+// lambda and gamma, the opacity scales of an edit) the page sets here itself, as
+// Explorer::recipe does. A compressed field takes any transfer function (the page ray-marches
+// it); the per-interval estimate of an edited function for proxies and light fields only the
+// engine makes, and a gallery says so instead of drawing it.
 
 let exported = null;  // api/archive's "exported" (the gallery's steps, views, what it left out)
 
@@ -137,21 +138,46 @@ export function enhancementTerms(enhance) {
   return { lambda, gamma };
 }
 
+/// `opacity-scale` ("J=S,...") as one scale per interval (frame_plan.cpp checked_scales).
+export function opacityScales(text, count) {
+  const scales = new Array(count).fill(1);
+  for (const item of text.split(',')) {
+    const [index, factor] = item.split('=');
+    const j = Number(index);
+    if (!Number.isInteger(j) || j < 0 || j >= count) {
+      throw new Error(`opacity-scale interval ${index} (the archive has ${count} intervals: ` +
+        `0..${count - 1})`);
+    }
+    const value = finite(factor, 'opacity-scale');
+    if (!(value >= 0)) throw new Error(`opacity-scale of interval ${j} = ${value} (must be >= 0)`);
+    scales[j] *= value;
+  }
+  return scales;
+}
+
 /// The recipe of `options` from the gallery's recipes of the stored function (null: the gallery
 /// cannot make it), with the options' own light, occlusion and enhancement terms.
 export function galleryRecipe(recipes, options, synthesised) {
   const { step, view, azimuth, elevation, session, ...rest } = options;
   if (rest['segment-opacity'] || rest.source || rest.fill) return null;
-  if (rest.tf || rest['opacity-scale']) {
-    // The compressed field takes the edited function itself; opacity scales only the engine.
+  if (rest.tf) {
+    // The compressed field takes the edited function itself; the estimate of a function's
+    // per-interval scales and colours for proxies and light fields only the engine makes.
     if (rest['opacity-scale'] || !recipes.volume || recipes.volume.error) return null;
     return { ...recipes.volume, synthesised, shading: Boolean(rest.light) };
   }
-  const key = `${synthesised ? 'other' : 'stored'}/${rest.colour || 'auto'}/` +
-    `${rest.light ? 'L' : ''}${rest.ao ? 'A' : ''}${rest.enhance ? 'E' : ''}`;
+  const edited = Boolean(rest['opacity-scale']);
+  const key = `${edited ? 'edited/' : ''}${synthesised ? 'other' : 'stored'}/` +
+    `${rest.colour || 'auto'}/${rest.light ? 'L' : ''}${rest.ao ? 'A' : ''}${rest.enhance ? 'E' : ''}`;
   const stored = recipes[key];
   if (!stored || stored.error) return stored || null;
   const recipe = structuredClone(stored);
+  if (edited) {
+    // The gallery's recipe of an opacity edit (its source, colours, colour model and trust
+    // terms are those of any edit of opacity alone); the scales are this edit's.
+    recipe.opacity_scales = opacityScales(rest['opacity-scale'], recipe.opacity_scales.length);
+    recipe.opacity_edited = recipe.opacity_scales.some((s) => s !== 1);
+  }
   if (recipe.lighting) recipe.lighting = lightingTerms(rest.light, rest.ambient);
   if (recipe.ambient_occlusion) {
     recipe.ambient_occlusion = occlusionTerms(rest.ao,
