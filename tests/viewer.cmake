@@ -219,7 +219,7 @@ function(viewer_export_case name text)
                    "-DCOMMAND=${command}" -P ${CMAKE_CURRENT_LIST_DIR}/cli/expect_exit.cmake)
   set_tests_properties(viewer.export_${name} PROPERTIES TIMEOUT 60 FIXTURES_REQUIRED viewer_archive)
 endfunction()
-viewer_export_case(missing_out "expected ARCHIVE and OUT" ${viewer_archive})
+viewer_export_case(missing_out "expected ARCHIVE... and OUT" ${viewer_archive})
 viewer_export_case(existing_out "exists (--replace to replace it)" ${viewer_archive} ${viewer_work})
 viewer_export_case(replace_foreign "is neither empty nor a gallery" ${viewer_archive}
                    ${viewer_work} --replace)

@@ -83,14 +83,17 @@ const cli::CommandHelp& export_help() {
     static const cli::CommandHelp help = [] {
         cli::CommandHelp h;
         h.usage =
-            "insitu-view export ARCHIVE OUT [--steps S,...] [--views V,...] [--max-bytes N] "
+            "insitu-view export ARCHIVE... OUT [--steps S,...] [--views V,...] [--max-bytes N] "
             "[--replace]";
         h.description =
             "Writes ARCHIVE as a static web gallery in the folder OUT: the web viewer's page and, "
             "per step, the data it draws from (light field, proxies, compressed field, the "
             "stored frame, recipes, trusted range), an index, README.txt (how to host it) and the "
             "run's Cinema database (data.csv, previews). Any static web server shows it (python3 "
-            "-m http.server); nothing runs server-side. Damaged steps are left out and listed.";
+            "-m http.server); nothing runs server-side. Damaged steps are left out and listed. "
+            "With several archives, OUT is a gallery of the runs: OUT/NAME/ each run's site "
+            "(NAME: its folder's name), OUT/index.html their thumbnails, steps and sizes, each "
+            "--max-bytes an equal share.";
         h.options = cli::help_rows(option_table());
         h.notes =
             "Exit status: 0 written, 3 written with damaged steps left out (listed on stdout), 2 "
@@ -109,20 +112,34 @@ int export_main(const std::vector<std::string>& args) {
     Arguments arguments;
     cli::parse_table(static_cast<int>(argv.size()), argv.data(), option_table(), arguments,
                      &arguments.positional);
-    if (arguments.positional.size() != 2) {
-        throw UsageError("export: expected ARCHIVE and OUT, got " +
+    if (arguments.positional.size() < 2) {
+        throw UsageError("export: expected ARCHIVE... and OUT, got " +
                          std::to_string(arguments.positional.size()) + " argument(s)");
     }
-    arguments.options.archive = arguments.positional[0];
-    arguments.options.out = arguments.positional[1];
-    const ExportReport report = export_site(arguments.options);
-    std::cout << arguments.options.out.string() << ": " << report.steps.size() << " step"
-              << (report.steps.size() == 1 ? "" : "s") << ", " << report.files << " files, "
-              << report.bytes << " bytes\n";
+    std::vector<std::string> archives = arguments.positional;
+    arguments.options.out = archives.back();
+    archives.pop_back();
+    std::vector<ExportReport> reports;
+    if (archives.size() == 1) {
+        arguments.options.archive = archives.front();
+        reports.push_back(export_site(arguments.options));
+    } else {
+        reports = export_gallery(archives, arguments.options);
+    }
     bool damaged = false;
-    for (const auto& [step, why] : report.left_out) {
-        std::cout << "left out: step " << step << ": " << why << "\n";
-        damaged = damaged || why.rfind("damaged", 0) == 0;
+    for (std::size_t r = 0; r < reports.size(); ++r) {
+        const ExportReport& report = reports[r];
+        const fs::path site =
+            archives.size() == 1
+                ? arguments.options.out
+                : arguments.options.out / fs::absolute(archives[r]).lexically_normal().filename();
+        std::cout << site.string() << ": " << report.steps.size() << " step"
+                  << (report.steps.size() == 1 ? "" : "s") << ", " << report.files << " files, "
+                  << report.bytes << " bytes\n";
+        for (const auto& [step, why] : report.left_out) {
+            std::cout << "left out: step " << step << ": " << why << "\n";
+            damaged = damaged || why.rfind("damaged", 0) == 0;
+        }
     }
     return damaged ? cli::kExitDamagedInput : 0;
 }

@@ -10,7 +10,7 @@
 //   insitu-view verify ARCHIVE
 //   insitu-view compare ONE.cdb OTHER.cdb [--attenuation-tolerance A] [--depth-tolerance R] ...
 //   insitu-view serve ARCHIVE [--port P] [--bind ADDR]
-//   insitu-view export ARCHIVE OUT [--steps S,...] [--views V,...] [--max-bytes N] [--replace]
+//   insitu-view export ARCHIVE... OUT [--steps S,...] [--views V,...] [--max-bytes N] [--replace]
 //   insitu-view COMMAND --help      (or -h, anywhere among the arguments; or: help COMMAND)
 //
 // info and verify read damaged archives too: info shows what can be read and lists the damage

@@ -183,16 +183,6 @@ std::uintmax_t size_of(const SiteFiles& files) {
     return bytes;
 }
 
-void write_files(const fs::path& root, const SiteFiles& files) {
-    for (const auto& [path, content] : files) {
-        const fs::path target = root / path;
-        fs::create_directories(target.parent_path());
-        std::ofstream out(target, std::ios::binary | std::ios::trunc);
-        out.write(content.data(), static_cast<std::streamsize>(content.size()));
-        if (!out) fail<IoError>("cannot write \"", target.string(), "\"");
-    }
-}
-
 std::string readme_text(const std::string& name, const ExportReport& report) {
     std::ostringstream text;
     text
@@ -267,28 +257,6 @@ std::pair<std::vector<std::int64_t>, std::vector<int>> chosen(const ExportOption
     return {steps, views};
 }
 
-/// Whether `folder` is a site export wrote (its api/archive says so) or empty: only such a
-/// folder is replaced, never one that merely shares the name.
-bool replaceable(const fs::path& folder) {
-    if (fs::is_directory(folder) && fs::is_empty(folder)) return true;
-    std::ifstream in(folder / "api" / "archive");
-    const json index = json::parse(in, nullptr, false);
-    return index.is_object() && index.contains("exported");
-}
-
-void check_output(const ExportOptions& options) {
-    if (!fs::exists(options.out)) return;
-    if (!options.replace) {
-        fail<InvalidArgument>("output folder \"", options.out.string(),
-                              "\" exists (--replace to replace it)");
-    }
-    if (!replaceable(options.out)) {
-        fail<InvalidArgument>("--replace: \"", options.out.string(),
-                              "\" is neither empty nor a gallery insitu-view export wrote; "
-                              "not replaced");
-    }
-}
-
 /// serve's /api/archive of the exported steps, marked as an export (the page then reads files).
 std::string site_index(Routes& routes, const ExportReport& report, const std::vector<int>& views) {
     json index = json::parse(
@@ -360,6 +328,43 @@ void export_steps(Routes& routes, const ExportOptions& options, const fs::path& 
 
 }  // namespace
 
+void write_files(const fs::path& root, const SiteFiles& files) {
+    for (const auto& [path, content] : files) {
+        const fs::path target = root / path;
+        fs::create_directories(target.parent_path());
+        std::ofstream out(target, std::ios::binary | std::ios::trunc);
+        out.write(content.data(), static_cast<std::streamsize>(content.size()));
+        if (!out) fail<IoError>("cannot write \"", target.string(), "\"");
+    }
+}
+
+/// Whether `folder` is a site export wrote (its api/archive or gallery.json says so) or empty: only
+/// such a folder is replaced, never one that merely shares the name.
+static bool replaceable(const fs::path& folder) {
+    if (fs::is_directory(folder) && fs::is_empty(folder)) return true;
+    for (const char* marker : {"api/archive", "gallery.json"}) {  // a run's site, a gallery's
+        std::ifstream in(folder / marker);
+        const json index = json::parse(in, nullptr, false);
+        if (index.is_object() && (index.contains("exported") || index.contains("runs"))) {
+            return true;
+        }
+    }
+    return false;
+}
+
+void check_output(const ExportOptions& options) {
+    if (!fs::exists(options.out)) return;
+    if (!options.replace) {
+        fail<InvalidArgument>("output folder \"", options.out.string(),
+                              "\" exists (--replace to replace it)");
+    }
+    if (!replaceable(options.out)) {
+        fail<InvalidArgument>("--replace: \"", options.out.string(),
+                              "\" is neither empty nor a gallery insitu-view export wrote; "
+                              "not replaced");
+    }
+}
+
 ExportReport export_site(const ExportOptions& options) {
     check_output(options);
     Routes routes(options.archive);
@@ -385,6 +390,8 @@ ExportReport export_site(const ExportOptions& options) {
             fail<InvalidArgument>("--max-bytes ", *options.max_bytes, ": the index and README ",
                                   "took more than the ", kIndexReserve, " bytes kept for them");
         }
+        report.thumbnail =
+            preview_file(routes.archive, report.steps.front(), choice.second.front()).first;
         if (fs::exists(out)) fs::remove_all(out);
         fs::rename(temporary, out);
     } catch (...) {

@@ -40,6 +40,7 @@ struct ExportReport {
     std::vector<std::pair<std::int64_t, std::string>> left_out;
     std::uintmax_t bytes = 0;  ///< the site's files together
     std::size_t files = 0;
+    std::string thumbnail;  ///< the first exported step's preview (first view), in the site
 };
 
 /// Writes the site. InvalidArgument names a step or view the archive lacks, an existing output
@@ -47,6 +48,21 @@ struct ExportReport {
 /// steps reads. The site is built beside `out` and renamed into place: a failure leaves
 /// nothing behind.
 ExportReport export_site(const ExportOptions& options);
+
+/// Refuses (InvalidArgument) an existing `options.out` unless `options.replace`, and then any but
+/// an empty folder or one export wrote.
+void check_output(const ExportOptions& options);
+
+/// Writes each file under `root`, making folders; IoError names a file that cannot be written.
+void write_files(const std::filesystem::path& root, const SiteFiles& files);
+
+/// Several runs as one gallery in `out`: each run's site (export_site with `options`' steps,
+/// views and an equal share of its --max-bytes) in out/NAME/ (NAME: the archive folder's name),
+/// and out/index.html listing them with their thumbnails (previews), steps and sizes, linking
+/// each run's explorer; gallery.json and README.txt beside. InvalidArgument for two runs of one
+/// name; the whole gallery is built beside `out` and renamed into place.
+std::vector<ExportReport> export_gallery(const std::vector<std::string>& archives,
+                                         const ExportOptions& options);
 
 /// The archive's Cinema database for the site: data.csv with the rows of `steps` only, and
 /// without the columns that name archive files the site does not carry (proxies, volumes), and

@@ -5,7 +5,8 @@
 // page computes itself, the next step) and on a run with a compressed field (ARCHIVE_VOLUME:
 // orbit views and an edited transfer function). No request may leave the gallery's folder. Also:
 // the page's recipes are serve's (also on ARCHIVE_MODEL, a run with a colour model), the same
-// archive exports to the same bytes, a damaged step is left out and listed.
+// archive exports to the same bytes, a damaged step is left out and listed, and a gallery of
+// several runs lists them with thumbnails and sizes and opens each run's explorer.
 //
 //   INSITU_VIEW=build/viewer/insitu-view ARCHIVE=viewer_lf.cdb ARCHIVE_VOLUME=viewer_volume.cdb \
 //     WORK_DIR=dir node gallery.test.mjs
@@ -313,3 +314,35 @@ test('the recipes the gallery\'s page makes are serve\'s (Explorer::recipe)', as
   // A run with a colour model, which opacity edits colour by.
   await recipesMatch(modelArchive, 'recipes-model');
 });
+
+test('a gallery of several runs lists each with its thumbnail and size, opening its explorer',
+  async () => {
+    const out = path.join(workDir, 'runs');
+    const result = spawnSync(binary, ['export', archive, volumeArchive, out], { encoding: 'utf8' });
+    assert.equal(result.status, 0, `export: ${result.stderr}`);
+    const listed = JSON.parse(readFileSync(path.join(out, 'gallery.json'))).runs;
+    assert.deepEqual(listed.map((r) => r.name), [path.basename(archive), path.basename(volumeArchive)]);
+    const server = await staticServer(out);
+    servers.push(server);
+    const page = await browser.newPage({ viewport: { width: 1280, height: 900 } });
+    const requests = [];
+    page.on('request', (request) => requests.push(request.url()));
+    await page.goto(server.url);
+    const runs = await page.evaluate(() => Array.from(document.querySelectorAll('.run'), (run) => ({
+      name: run.dataset.run, size: run.querySelector('.size').textContent,
+      thumbnail: run.querySelector('img').complete && run.querySelector('img').naturalWidth })));
+    assert.equal(runs.length, 2);
+    runs.forEach((run, r) => {
+      assert.ok(run.thumbnail > 0, `${run.name}: its thumbnail shows`);
+      assert.equal(run.size, `${(listed[r].bytes / 1e6).toFixed(1)} MB`, `${run.name}: its size`);
+    });
+    // The first run's explorer opens from its thumbnail and draws.
+    await page.click(`.run[data-run="${runs[0].name}"] img`);
+    await page.waitForFunction(() => window.insituViewer && window.insituViewer.frameCount > 0,
+      null, { timeout: 30000 });
+    assert.equal(new URL(page.url()).pathname, `/${runs[0].name}/index.html`);
+    const outside = requests.filter((r) => !r.startsWith(server.url) && !r.startsWith('blob:') &&
+      !r.startsWith('data:'));
+    assert.deepEqual(outside, [], 'no request leaves the gallery\'s folder');
+    await page.close();
+  });
