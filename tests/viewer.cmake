@@ -210,6 +210,9 @@ viewer_browser_test(trust volume
 viewer_browser_test(gallery lf ENVIRONMENT ARCHIVE_VOLUME=${viewer_work}/viewer_volume.cdb
                                           ARCHIVE_MODEL=${viewer_archive}
                     FIXTURES viewer_volume_archive viewer_archive)
+# Three galleries, a dozen frames held to render and serve's recipes: about 2 minutes on 2 loaded
+# cores.
+set_tests_properties(viewer.gallery PROPERTIES TIMEOUT 480)
 
 # export's command line and bad input: exit 2 and one line on stderr naming the value.
 function(viewer_export_case name text)

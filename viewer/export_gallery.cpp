@@ -17,11 +17,20 @@ std::string escaped(const std::string& text) {
     std::string out;
     for (const char c : text) {
         switch (c) {
-            case '&': out += "&amp;"; break;
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '"': out += "&quot;"; break;
-            default: out += c;
+            case '&':
+                out += "&amp;";
+                break;
+            case '<':
+                out += "&lt;";
+                break;
+            case '>':
+                out += "&gt;";
+                break;
+            case '"':
+                out += "&quot;";
+                break;
+            default:
+                out += c;
         }
     }
     return out;
@@ -46,7 +55,8 @@ std::string index_html(const std::vector<Run>& runs) {
          << "<title>libinsitu gallery</title>\n<style>\n"
          << "body{font-family:sans-serif;margin:2em;background:#fafafa;color:#222}\n"
          << ".runs{display:flex;flex-wrap:wrap;gap:1.5em}\n"
-         << ".run{background:#fff;border:1px solid #ccc;border-radius:6px;padding:.8em;width:260px}\n"
+         << ".run{background:#fff;border:1px solid "
+            "#ccc;border-radius:6px;padding:.8em;width:260px}\n"
          << ".run img{width:256px;height:256px;object-fit:contain;background:#000}\n"
          << ".run h2{font-size:1.05em;margin:.4em 0}.run p{margin:.2em 0;font-size:.9em}\n"
          << "</style>\n</head>\n<body>\n<h1>Gallery</h1>\n"

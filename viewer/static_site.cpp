@@ -201,10 +201,9 @@ std::string readme_text(const std::string& name, const ExportReport& report) {
     for (const auto& [step, why] : report.left_out) {
         text << "Left out: step " << step << ": " << why << "\n";
     }
-    text << "\nWhat needs `insitu-view serve` instead: an edited or loaded transfer function on\n"
-         << "frames made from proxies or light fields (opacity edits per interval work here, and\n"
-         << "the compressed field takes any function), and the frames a browser without WebGL2\n"
-         << "would ask the server for.\n\n"
+    text << "\nWhat needs `insitu-view serve` instead: a 2D transfer function, an edit over an\n"
+         << "attenuation light field's own intervals, segment fades with lights or occlusion, and\n"
+         << "the frames a browser without WebGL2 would ask the server for.\n\n"
          << "data.csv and previews/ are the run's Cinema database (Spec D): Cinema viewers open\n"
          << "this folder too.\n";
     return text.str();

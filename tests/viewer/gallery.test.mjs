@@ -137,13 +137,20 @@ test('a gallery of a light-field run draws the served page\'s frames from static
       MIN_PSNR_DB, 'stored view');
     assert.ok(differingSamples(edited.image, stored.image) > 0, 'the edit shows');
     results.push(`opacity edit ${edited.psnr.toFixed(1)} dB`);
-    // A recolouring needs the engine's estimate: the gallery says so, naming serve.
-    await page.locator(`#tf-colours input[data-interval="${heaviest}"]`).fill('#ff2000');
-    await page.waitForFunction(() => document.getElementById('error').textContent
-      .includes('insitu-view serve'));
-    await settle(page, async () => {
-      await page.click('#tf-reset');
-    });
+    // A recolouring on top: its per-interval colours and scales estimated by the page.
+    const recolouredOptions = await settle(page, () =>
+      page.locator(`#tf-colours input[data-interval="${heaviest}"]`).fill('#ff2000'));
+    assert.ok(recolouredOptions.tf, 'a colour edit sends an edited transfer function');
+    const recoloured = await browserFrameMatches(page, binary, archive, workDir, 'recolour',
+      MIN_PSNR_DB, 'stored view');
+    assert.ok(differingSamples(recoloured.image, edited.image) > 0, 'the recolouring shows');
+    results.push(`recolour ${recoloured.psnr.toFixed(1)} dB`);
+    // 20 degrees around with the edits: the view's proxies synthesised, then edited.
+    await orbitTo(page, Math.round(info.azimuth + 20), Math.round(info.elevation));
+    const editedOrbit = await browserFrameMatches(page, binary, archive, workDir, 'edited orbit',
+      MIN_PSNR_DB, 'synthesised view');
+    results.push(`edited orbit ${editedOrbit.psnr.toFixed(1)} dB`);
+    await settle(page, () => page.click('#tf-reset'));
     await orbitTo(page, Math.round(info.azimuth + 25), Math.round(info.elevation - 10));
     const orbit = await lightFieldFrameMatches(page, binary, archive, workDir, 'orbit', MIN_PSNR_DB);
     results.push(`orbit ${orbit.psnr.toFixed(1)} dB`);
@@ -178,6 +185,15 @@ test('a gallery of a light-field run draws the served page\'s frames from static
     const later = await browserFrameMatches(page, binary, archive, workDir, 'step 600',
       MIN_PSNR_DB, 'stored view');
     results.push(`step 600 ${later.psnr.toFixed(1)} dB`);
+    // A 2D function's terms only the engine makes: the gallery says so, naming serve (last:
+    // the editor is off for such a function).
+    const tf2d = path.join(workDir, 'tf2d.json');
+    writeFileSync(tf2d, JSON.stringify({ unit_length: 1, gradient_rows: [
+      { gradient_magnitude: 0, points: [[0, 0.1, 0.2, 0.9, 0], [0.45, 0.9, 0.3, 0.1, 0.4]] },
+      { gradient_magnitude: 1, points: [[0, 0.9, 0.2, 0.1, 0], [0.45, 0.1, 0.3, 0.9, 0.4]] }] }));
+    await page.setInputFiles('#tf-file', tf2d);
+    await page.waitForFunction(() => document.getElementById('error').textContent
+      .includes('insitu-view serve'));
     console.log(`gallery (light field) vs insitu-view render: ${results.join(', ')}`);
     assertContained(requests, url);
     assert.deepEqual(errors, []);
@@ -273,6 +289,19 @@ test('a damaged step is left out and listed; the rest is exported', () => {
   assert.ok(firstIndex.views[0].single, 'the view described from step 600');
 });
 
+/// `tf` with its colours changed (red up, blue down): a recolouring.
+function recoloured(tf) {
+  return { ...tf, points: tf.points.map(([v, r, g, b, a]) => [v, Math.min(1, r + 0.3), g, b * 0.5, a]) };
+}
+
+/// `tf` with its opacity sharpened (squared, one point more): an opacity edit of the function.
+function sharper(tf) {
+  const points = tf.points.map(([v, r, g, b, a]) => [v, r, g, b, a * a * 2]);
+  const [first, second] = points;
+  points.splice(1, 0, [(first[0] + second[0]) / 2, 0.9, 0.9, 0.1, 0.3]);
+  return { ...tf, points };
+}
+
 /// The recipes the gallery of `from` makes at its first step against serve's.
 async function recipesMatch(from, name) {
   const out = path.join(workDir, name);
@@ -289,21 +318,25 @@ async function recipesMatch(from, name) {
       { ...other, enhance: '0.7,1.6' }, { light: '10,-20', ao: '17', enhance: '2,0.5' },
       { colour: 'recompose', ao: '1,0' }, { ...other, colour: 'recompose', light: '90,0,0,2' },
       { 'opacity-scale': '2=0.25,5=1.7' }, { ...other, 'opacity-scale': '3=0', light: '20,10' },
-      { 'opacity-scale': '1=2,1=0.5,4=0.3', colour: 'recompose', ao: '4,1', enhance: '1,2' }];
+      { 'opacity-scale': '1=2,1=0.5,4=0.3', colour: 'recompose', ao: '4,1', enhance: '1,2' },
+      { tf: JSON.stringify(recoloured(info.transfer_function)) },
+      { ...other, tf: JSON.stringify(sharper(info.transfer_function)), light: 'camera' },
+      { tf: JSON.stringify(sharper(info.transfer_function)), 'opacity-scale': '0=3' }];
     for (const extra of cases) {
       const options = { step, view: '0', ...extra };
       const served = await (await fetch(`${server.url}api/recipe`,
         { method: 'POST', body: new URLSearchParams(options) })).json();
-      const made = galleryRecipe(recipes, options, extra.azimuth !== undefined);
+      const made = galleryRecipe(recipes, options, extra.azimuth !== undefined, info);
       // Numbers to 12 digits: the engine's doubles against JavaScript's own arithmetic.
       const rounded = (x) => JSON.parse(JSON.stringify(x, (k, v) => (typeof v === 'number'
         ? Number(v.toPrecision(12)) : v)));
       assert.deepEqual(rounded(made), rounded(served), JSON.stringify(extra));
     }
     // What only the engine estimates: the gallery says it cannot, rather than drawing it.
-    assert.equal(galleryRecipe(recipes, { step, view: '0', tf: '{}' }, false), null);
+    assert.equal(galleryRecipe(recipes, { step, view: '0', tf: '{"gradient_rows": []}' }, false,
+      info), null);
     assert.throws(() => galleryRecipe(recipes, { step, view: '0', 'opacity-scale': '99=0.5' },
-      false), /opacity-scale interval 99/);
+      false, info), /opacity-scale interval 99/);
   } finally {
     await stopServer(server);
   }

@@ -4,10 +4,15 @@
 // the stored view's frame and mask) and the recipes of the stored function for each
 // combination of lights, occlusion, enhancement and colour source; the parameters of those
 // (light directions and strengths, the occlusion's radius and strength, the enhancement's
-// lambda and gamma, the opacity scales of an edit) the page sets here itself, as
-// Explorer::recipe does. A compressed field takes any transfer function (the page ray-marches
-// it); the per-interval estimate of an edited function for proxies and light fields only the
-// engine makes, and a gallery says so instead of drawing it.
+// lambda and gamma, an edit's per-interval scales and colours: tf_estimate.js) the page sets
+// here itself, as Explorer::recipe does. A compressed field takes any transfer function (the
+// page ray-marches it). Only the engine makes an edited function's terms over a light field's
+// own intervals and a 2D function's, and frames with segment fades and lights; a gallery says
+// so instead of drawing them.
+
+import {
+  intervalColours, intervalColourSpread, opacityScalesOf, parseTf, sameColours,
+} from './tf_estimate.js';
 
 let exported = null;  // api/archive's "exported" (the gallery's steps, views, what it left out)
 
@@ -52,21 +57,23 @@ function refused(status, error) {
 
 const SERVE_ONLY = 'not in this gallery: only `insitu-view serve` makes this frame';
 
-const recipeFiles = new Map();  // "step_view" -> Promise of recipes.json
+const galleryJson = new Map();  // "step_view/name" -> Promise of the gallery's JSON file
 
-function stepRecipes(step, view) {
-  const key = `${step}_${view}`;
-  if (!recipeFiles.has(key)) {
-    recipeFiles.set(key, fetch(`data/${key}/recipes.json`).then((response) => {
-      if (!response.ok) throw new Error(`data/${key}/recipes.json: ${response.status}`);
+function galleryFile(step, view, name) {
+  const key = `${step}_${view}/${name}`;
+  if (!galleryJson.has(key)) {
+    galleryJson.set(key, fetch(`data/${key}`).then((response) => {
+      if (!response.ok) throw new Error(`data/${key}: ${response.status}`);
       return response.json();
     }).catch((error) => {
-      recipeFiles.delete(key);
+      galleryJson.delete(key);
       throw error;
     }));
   }
-  return recipeFiles.get(key);
+  return galleryJson.get(key);
 }
+
+const stepRecipes = (step, view) => galleryFile(step, view, 'recipes.json');
 
 const DEFAULT_LIGHT = { diffuse: 0.8, specular: 0.3, shininess: 32 };  // relighting.hpp's Light
 const DEFAULT_AMBIENT = 0.2;
@@ -155,29 +162,59 @@ export function opacityScales(text, count) {
   return scales;
 }
 
-/// The recipe of `options` from the gallery's recipes of the stored function (null: the gallery
-/// cannot make it), with the options' own light, occlusion and enhancement terms.
-export function galleryRecipe(recipes, options, synthesised) {
+/// An edit's per-interval terms on the recipe of an edit of the same kind: the scales (of the
+/// edited function, times the explicit ones), the colours, their spread and the colour source
+/// (Explorer::recipe's add_edit, frame_plan.cpp plan_edit); null where only the engine can (a 2D
+/// function, a light field's own intervals).
+function applyEdit(recipe, rest, info, model) {
+  const count = recipe.opacity_scales.length;
+  let scales = new Array(count).fill(1);
+  let coloursChanged = false;
+  if (rest.tf) {
+    const shown = parseTf(JSON.parse(rest.tf));
+    const stored = parseTf(info.transfer_function);
+    const edges = info.intervals;
+    if (recipe.light_field || !shown || !stored || !edges || edges.length !== count + 1) return null;
+    scales = opacityScalesOf(stored, shown, edges);
+    recipe.colours = intervalColours(shown, edges);
+    if (recipe.trust) recipe.trust.colour_spread = intervalColourSpread(shown, edges);
+    coloursChanged = !sameColours(stored, shown, edges);
+  }
+  if (rest['opacity-scale']) {
+    const explicit = opacityScales(rest['opacity-scale'], count);
+    scales = scales.map((s, j) => s * explicit[j]);
+  }
+  recipe.opacity_scales = scales;
+  recipe.opacity_edited = scales.some((s) => s !== 1);
+  const colour = rest.colour || 'auto';
+  const useModel = colour === 'model' || (colour === 'auto' && Boolean(model && !model.error) &&
+    recipe.opacity_edited && !coloursChanged);
+  recipe.colour_source = useModel ? 'model' : 'recompose';
+  if (useModel) recipe.colour_model = model.colour_model;
+  else delete recipe.colour_model;
+  return recipe;
+}
+
+/// The recipe of `options` from the gallery's recipes of the stored function and its
+/// description `info` (null: the gallery cannot make it), with the options' own edit, light,
+/// occlusion and enhancement terms.
+export function galleryRecipe(recipes, options, synthesised, info) {
   const { step, view, azimuth, elevation, session, ...rest } = options;
   if (rest['segment-opacity'] || rest.source || rest.fill) return null;
-  if (rest.tf) {
-    // The compressed field takes the edited function itself; the estimate of a function's
-    // per-interval scales and colours for proxies and light fields only the engine makes.
-    if (rest['opacity-scale'] || !recipes.volume || recipes.volume.error) return null;
+  // The compressed field takes an edited function itself (opacity scales are edits of proxies).
+  if (rest.tf && !rest['opacity-scale'] && recipes.volume && !recipes.volume.error) {
     return { ...recipes.volume, synthesised, shading: Boolean(rest.light) };
   }
-  const edited = Boolean(rest['opacity-scale']);
-  const key = `${edited ? 'edited/' : ''}${synthesised ? 'other' : 'stored'}/` +
-    `${rest.colour || 'auto'}/${rest.light ? 'L' : ''}${rest.ao ? 'A' : ''}${rest.enhance ? 'E' : ''}`;
-  const stored = recipes[key];
+  const edited = Boolean(rest.tf || rest['opacity-scale']);
+  const toggles = `${rest.light ? 'L' : ''}${rest.ao ? 'A' : ''}${rest.enhance ? 'E' : ''}`;
+  const prefix = `${edited ? 'edited/' : ''}${synthesised ? 'other' : 'stored'}/`;
+  const stored = recipes[`${prefix}${rest.colour || 'auto'}/${toggles}`];
   if (!stored || stored.error) return stored || null;
-  const recipe = structuredClone(stored);
-  if (edited) {
-    // The gallery's recipe of an opacity edit (its source, colours, colour model and trust
-    // terms are those of any edit of opacity alone); the scales are this edit's.
-    recipe.opacity_scales = opacityScales(rest['opacity-scale'], recipe.opacity_scales.length);
-    recipe.opacity_edited = recipe.opacity_scales.some((s) => s !== 1);
-  }
+  let recipe = structuredClone(stored);
+  // The gallery's recipe of an edit has its source, trust terms and colour model; the scales,
+  // colours and colour source are this edit's.
+  if (edited) recipe = applyEdit(recipe, rest, info, recipes[`${prefix}model/${toggles}`]);
+  if (!recipe) return null;
   if (recipe.lighting) recipe.lighting = lightingTerms(rest.light, rest.ambient);
   if (recipe.ambient_occlusion) {
     recipe.ambient_occlusion = occlusionTerms(rest.ao,
@@ -198,8 +235,9 @@ export async function fetchRecipe(options, synthesised) {
     return fetch('api/recipe', { method: 'POST', body: new URLSearchParams(options) });
   }
   try {
-    const recipe = galleryRecipe(await stepRecipes(options.step, options.view), options,
-      synthesised);
+    const [recipes, info] = await Promise.all([stepRecipes(options.step, options.view),
+      galleryFile(options.step, options.view, 'step.json')]);
+    const recipe = galleryRecipe(recipes, options, synthesised, info);
     if (!recipe) return refused(501, SERVE_ONLY);
     if (recipe.error) return refused(recipe.status || 400, recipe.error);
     return jsonResponse(recipe);
