@@ -382,8 +382,8 @@ ExportReport export_site(const ExportOptions& options) {
         const SiteFiles cinema = cinema_files(routes.archive.root(), report.steps, choice.second);
         page.insert(cinema.begin(), cinema.end());
         write_files(temporary, page);
+        // The steps' bytes and the site's other files (the page's reserve given back).
         report.bytes += size_of(page) - kIndexReserve - size_of(embedded_web_files());
-        report.bytes += size_of(page);
         report.files += page.size();
         if (options.max_bytes && report.bytes > *options.max_bytes) {
             fail<InvalidArgument>("--max-bytes ", *options.max_bytes, ": the index and README ",

@@ -250,8 +250,16 @@ function filesOf(folder) {
 
 test('the same archive exports to the same bytes', () => {
   const [one, two] = ['same-1', 'same-2'].map((name) => path.join(workDir, name));
-  for (const out of [one, two]) assert.equal(exportGallery(archive, out).status, 0);
+  const printed = [one, two].map((out) => {
+    const result = exportGallery(archive, out);
+    assert.equal(result.status, 0);
+    return result.stdout;
+  });
   const [a, b] = [filesOf(one), filesOf(two)];
+  // The size export prints is the site's.
+  let total = 0;
+  for (const bytes of a.values()) total += bytes.length;
+  assert.match(printed[0], new RegExp(`, ${a.size} files, ${total} bytes`));
   assert.deepEqual([...a.keys()].sort(), [...b.keys()].sort());
   for (const [name, bytes] of a) assert.ok(bytes.equals(b.get(name)), `${name} is the same`);
   assert.ok(a.has('README.txt') && a.has('data.csv') && a.has('index.html'));
@@ -355,6 +363,11 @@ test('a gallery of several runs lists each with its thumbnail and size, opening 
     assert.equal(result.status, 0, `export: ${result.stderr}`);
     const listed = JSON.parse(readFileSync(path.join(out, 'gallery.json'))).runs;
     assert.deepEqual(listed.map((r) => r.name), [path.basename(archive), path.basename(volumeArchive)]);
+    for (const run of listed) {
+      let total = 0;
+      for (const bytes of filesOf(path.join(out, run.name)).values()) total += bytes.length;
+      assert.equal(run.bytes, total, `${run.name}: its size is its folder's`);
+    }
     const server = await staticServer(out);
     servers.push(server);
     const page = await browser.newPage({ viewport: { width: 1280, height: 900 } });
