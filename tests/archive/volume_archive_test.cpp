@@ -215,8 +215,11 @@ TEST_F(ZfpVolumeDecoding, RefusesAHeaderWhoseBlockBudgetZfpWouldUnderflow) {
     // a block's exponent bits from that budget unsigned and reads gigabytes past the stream.
     const std::vector<char> header = {0x7a, 0x66, 0x70, 0x05, 0x7a, 0x00, 0x50, 0x00,
                                       0x40, 0x00, 0x00, 0x00, 0x7f, 0x29, 0x30, 0x48};
-    expect_error_naming<IoError>([&] { decode(header, {}, {8, 6, 5}, 0); },
-                                 "1 to 1 bits per block");
+    expect_error_naming<IoError>(
+        [&] {
+            decode(header, {}, {8, 6, 5}, 0);
+        },
+        "1 to 1 bits per block");
 }
 
 TEST_F(ZfpVolumeDecoding, RefusesAMaskThatDisagrees) {
