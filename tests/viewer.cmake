@@ -204,3 +204,37 @@ viewer_browser_test(trust volume
                     ENVIRONMENT ARCHIVE_LIGHT_FIELD=${viewer_lf_archive}
                                 ARCHIVE_ONE_VIEW=${viewer_archive}
                     FIXTURES viewer_archive viewer_lf_archive)
+
+# Galleries (issue 46): `insitu-view export` of the light-field run served by Python's
+# http.server; gallery.test.mjs holds the page's frames there (stored view, orbit, lights and
+# occlusion whose terms the page computes, the next step) and of the compressed-field run (orbit,
+# an edited function) to `insitu-view render`, checks that no request leaves the gallery, that
+# the page's recipes are serve's, that the same archive exports to the same bytes and that a
+# damaged step is left out and listed.
+viewer_browser_test(gallery lf ENVIRONMENT ARCHIVE_VOLUME=${viewer_work}/viewer_volume.cdb
+                                          ARCHIVE_MODEL=${viewer_archive}
+                    FIXTURES viewer_volume_archive viewer_archive)
+# Three galleries, a dozen frames held to render and serve's recipes: about 2 minutes on 2 loaded
+# cores.
+set_tests_properties(viewer.gallery PROPERTIES TIMEOUT 480)
+
+# export's command line and bad input: exit 2 and one line on stderr naming the value.
+function(viewer_export_case name text)
+  string(JOIN "|" command $<TARGET_FILE:insitu-view> export ${ARGN})
+  add_test(NAME viewer.export_${name}
+           COMMAND ${CMAKE_COMMAND} -DEXPECTED_EXIT=2 "-DEXPECTED_STDERR_SUBSTRING=${text}"
+                   "-DCOMMAND=${command}" -P ${CMAKE_CURRENT_LIST_DIR}/cli/expect_exit.cmake)
+  set_tests_properties(viewer.export_${name} PROPERTIES TIMEOUT 60 FIXTURES_REQUIRED viewer_archive)
+endfunction()
+viewer_export_case(missing_out "expected ARCHIVE... and OUT" ${viewer_archive})
+viewer_export_case(existing_out "exists (--replace to replace it)" ${viewer_archive} ${viewer_work})
+viewer_export_case(replace_foreign "is neither empty nor a gallery" ${viewer_archive}
+                   ${viewer_work} --replace)
+viewer_export_case(max_bytes_small "--max-bytes 1000: smaller than one step" ${viewer_archive}
+                   ${viewer_work}/never_written --max-bytes 1000)
+viewer_export_case(max_bytes_bad "--max-bytes 12x" ${viewer_archive} ${viewer_work}/never_written
+                   --max-bytes 12x)
+viewer_export_case(unknown_step "--steps 35: the archive has no step 35" ${viewer_archive}
+                   ${viewer_work}/never_written --steps 35)
+viewer_export_case(unknown_view "--views 4" ${viewer_archive} ${viewer_work}/never_written
+                   --views 4)

@@ -10,6 +10,7 @@
 //   insitu-view verify ARCHIVE
 //   insitu-view compare ONE.cdb OTHER.cdb [--attenuation-tolerance A] [--depth-tolerance R] ...
 //   insitu-view serve ARCHIVE [--port P] [--bind ADDR]
+//   insitu-view export ARCHIVE... OUT [--steps S,...] [--views V,...] [--max-bytes N] [--replace]
 //   insitu-view COMMAND --help      (or -h, anywhere among the arguments; or: help COMMAND)
 //
 // info and verify read damaged archives too: info shows what can be read and lists the damage
@@ -43,6 +44,7 @@
 #include "cli.hpp"
 #include "compare_command.hpp"
 #include "explore_options.hpp"
+#include "export_command.hpp"
 #include "insitu/archive/archive_reader.hpp"
 #include "insitu/core/image.hpp"
 #include "insitu/error.hpp"
@@ -480,7 +482,8 @@ const std::vector<Command>& commands() {
         {"render", render_help, run_render},
         {"verify", verify_help, run_verify},
         {"compare", insitu::viewer::compare_help, insitu::viewer::compare_main},
-        {"serve", insitu::viewer::serve_help, insitu::viewer::serve_main}};
+        {"serve", insitu::viewer::serve_help, insitu::viewer::serve_main},
+        {"export", insitu::viewer::export_help, insitu::viewer::export_main}};
     return table;
 }
 
@@ -493,7 +496,7 @@ const Command* find_command(const std::string& name) {
 
 UsageError unknown_command(const std::string& name) {
     return UsageError("unknown command \"" + name +
-                      "\" (expected info, render, verify, compare or serve)");
+                      "\" (expected info, render, verify, compare, serve or export)");
 }
 
 void print_help(std::ostream& out) {
@@ -513,7 +516,8 @@ int main(int argc, char** argv) {
     const std::vector<std::string> all = insitu::cli::program_arguments(argc, argv);
     if (all.empty()) {
         return insitu::cli::report(
-            kProgram, "missing command (info, render, verify, compare or serve; --help for usage)",
+            kProgram,
+            "missing command (info, render, verify, compare, serve or export; --help for usage)",
             insitu::cli::kExitBadInput);
     }
     // "help [COMMAND]", "--help [COMMAND]": the overview, or the command's own help.

@@ -7,6 +7,7 @@
 import { $, errorText, session, short, state, viewer } from './page.js';
 import { currentOptions, sameOptions } from './explore_options.js';
 import { fieldLabel } from './annotations.js';
+import { fetchFrame } from './source.js';
 
 let inFlight = false;
 let shownUrl = null;
@@ -45,8 +46,7 @@ export function requestCompare() {
   document.body.classList.toggle('side-by-side', Boolean(options));
   if (!options || inFlight || sameOptions(viewer.compare.options, options)) return;
   inFlight = true;
-  const body = new URLSearchParams({ ...options, session: `${session}-compare` });
-  fetch('api/frame', { method: 'POST', body })
+  fetchFrame('frame', { ...options, session: `${session}-compare` })
     .then(async (response) => {
       if (response.status === 409) return;
       if (!response.ok) throw new Error(await errorText(response));

@@ -13,6 +13,7 @@ import { drawAnnotations } from './annotations.js';
 import { writeViewQuery } from './view_state.js';
 import { requestCompare } from './compare.js';
 import { askedStep, schedulePlay } from './timeline.js';
+import { fetchFrame, fetchRecipe } from './source.js';
 
 let inFlight = false;
 const READOUT_EVERY_MS = 250;
@@ -58,7 +59,7 @@ function recipeFor(options) {
   const { azimuth, elevation, ...rest } = options;
   const key = JSON.stringify({ ...rest, synthesised: !atStoredView(options) });
   if (!recipes.has(key)) {
-    recipes.set(key, fetch('api/recipe', { method: 'POST', body: new URLSearchParams(options) })
+    recipes.set(key, fetchRecipe(options, !atStoredView(options))
       .then(async (response) => {
         if (!response.ok) throw new Error(await errorText(response));
         return response.json();
@@ -132,8 +133,7 @@ function upgradable() {
 
 function serverFrame(options, provisional = false) {
   const sent = performance.now();
-  const body = new URLSearchParams({ ...options, session });
-  fetch('api/frame', { method: 'POST', body })
+  fetchFrame('frame', { ...options, session })
     .then(async (response) => {
       if (response.status === 409) return;  // a newer request of ours replaced it
       if (!response.ok) {
@@ -393,8 +393,7 @@ export async function updateMask() {
     // Else (a GPU that could not) the engine's mask of the frame shown; a frame drawn here from
     // the light field has the light field's confidence.
     const source = displayed.drawnFrom === 'light field' ? { source: 'lightfield' } : {};
-    const response = await fetch('api/mask',
-      { method: 'POST', body: new URLSearchParams({ ...options, ...source, session }) });
+    const response = await fetchFrame('mask', { ...options, ...source, session });
     if (!response.ok) return;
     const bitmap = await createImageBitmap(await response.blob());
     ({ width, height } = bitmap);

@@ -5,6 +5,7 @@
 // float32.
 
 import { fetchPayload, readPayloadHeader } from './page.js';
+import { stepUrl } from './source.js';
 
 const MAGIC = 'insituLF';
 const VERSION = 2;
@@ -38,7 +39,7 @@ export function parseLightField(buffer) {
 
 /// Fetches and parses the light field of (step, view); null when the step has none (404).
 export async function fetchLightField(step, view) {
-  const buffer = await fetchPayload(`api/lightfield?step=${step}&view=${view}`,
+  const buffer = await fetchPayload(stepUrl('lightfield', step, view),
     `light field of step ${step}`);
   return buffer && parseLightField(buffer);
 }

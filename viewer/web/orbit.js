@@ -2,6 +2,7 @@
 // (/api/trust), drawn as a map of offsets.
 import { $, DEGREES_PER_PIXEL, REST_MS, getJson, short, state, svg } from './page.js';
 import { requestFrame } from './frames.js';
+import { stepUrl } from './source.js';
 
 let trust = null;
 let trustKey = null;
@@ -52,7 +53,7 @@ export async function requestTrust() {
   $('trust-label').textContent = 'trusted range: measuring…';
   drawTrustMap();
   try {
-    const result = await getJson(`api/trust?step=${entry.step}&view=${state.view}`);
+    const result = await getJson(stepUrl('trust', entry.step, state.view));
     if (trustKey !== key) return;
     trust = result;
     $('trust-label').textContent = trustWords(trust);

@@ -2,6 +2,8 @@
 // request's parts), the object tests read (window.insituViewer), the constants of its controls,
 // and small DOM and fetch helpers.
 
+import { inflated } from './source.js';
+
 export const DEGREES_PER_PIXEL = 0.4;  // orbit drag: degrees of azimuth/elevation per CSS pixel
 export const MAX_OPACITY_SCALE = 4;    // top of the opacity-handle axis
 export const ARCHIVE_POLL_MS = 3000;   // how often new timesteps of a running simulation are looked for
@@ -79,14 +81,14 @@ export function svg(tag, attributes, parent) {
 }
 
 
-/// A binary payload of the data server (light fields, proxies) as an ArrayBuffer; null where the
-/// step has none (404). Revalidated with the server's ETag (`no-cache`), so a revisited step is a
+/// A binary payload of the data server (light fields, proxies) or a gallery's file as an
+/// ArrayBuffer; null where the step has none (404). Revalidated with the server's ETag (`no-cache`), so a revisited step is a
 /// 304. Other failures throw, naming `what` and the server's error.
 export async function fetchPayload(url, what) {
   const response = await fetch(url, { cache: 'no-cache' });
   if (response.status === 404) return null;
   if (!response.ok) throw new Error(`${what}: ${await errorText(response)}`);
-  return response.arrayBuffer();
+  return inflated(await response.arrayBuffer());
 }
 
 /// The opening every payload shares (viewer/payload_header.hpp): checks magic and version and

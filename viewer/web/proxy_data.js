@@ -4,6 +4,7 @@
 // stores it.
 
 import { fetchPayload, readPayloadHeader } from './page.js';
+import { stepUrl } from './source.js';
 
 const MAGIC = 'insituPX';
 const VERSION = 1;
@@ -36,7 +37,7 @@ export function parseProxies(buffer) {
 /// Fetches and parses the proxies of (step, view); null when the view has no attenuation
 /// proxies to draw from (404).
 export async function fetchProxies(step, view) {
-  const buffer = await fetchPayload(`api/proxies?step=${step}&view=${view}`,
+  const buffer = await fetchPayload(stepUrl('proxies', step, view),
     `proxies of step ${step} view ${view}`);
   return buffer && parseProxies(buffer);
 }

@@ -6,9 +6,11 @@ import { requestFrame } from './frames.js';
 import { drawTfEditor } from './tf_editor.js';
 import { requestTrust, syncOrbitInputs } from './orbit.js';
 import { applyValueEdits } from './value_edits.js';
+import { exportedViews, noteIndex, stepUrl } from './source.js';
 
 export async function loadArchive() {
   const archive = await getJson('api/archive');
+  noteIndex(archive);
   const grew = state.archive && archive.timeline.length !== state.timeline.length;
   state.archive = archive;
   state.timeline = archive.timeline;
@@ -23,8 +25,10 @@ export async function loadArchive() {
     await stepChanged();
   }
   const select = $('view-select');
-  if (select.options.length !== archive.view_count) {
-    select.replaceChildren(...Array.from({ length: archive.view_count }, (_, v) => {
+  // A gallery holds the views it was exported with.
+  const views = exportedViews() || Array.from({ length: archive.view_count }, (_, v) => v);
+  if (select.options.length !== views.length) {
+    select.replaceChildren(...views.map((v) => {
       const option = document.createElement('option');
       option.value = option.textContent = String(v);
       return option;
@@ -61,7 +65,7 @@ export async function stepChanged() {
   // Until the step's description comes, the picture is still the step before: said so.
   $('step-label').classList.toggle('loading', !state.info || state.info.step !== step ||
     state.info.view !== view);
-  const info = await getJson(`api/step?step=${step}&view=${view}`);
+  const info = await getJson(stepUrl('step', step, view));
   let lightField = false;
   // A compressed field of the view's field (/api/step lists it): the recipe may draw from it.
   const volume = Boolean(info.volume);

@@ -3,6 +3,7 @@
 // as a fraction of the decoded field's finite range, and which samples were non-finite.
 
 import { fetchPayload, readPayloadHeader } from './page.js';
+import { stepUrl } from './source.js';
 
 const MAGIC = 'insituVF';
 const VERSION = 1;
@@ -77,7 +78,7 @@ export function parseVolume(buffer) {
 /// Fetches and parses the compressed field that (step, view) shows; null when the step has
 /// none (404).
 export async function fetchVolume(step, view) {
-  const buffer = await fetchPayload(`api/volume?step=${step}&view=${view}`,
+  const buffer = await fetchPayload(stepUrl('volume', step, view),
     `volume of step ${step}`);
   return buffer && parseVolume(buffer);
 }

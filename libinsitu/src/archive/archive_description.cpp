@@ -1,5 +1,6 @@
 #include "insitu/archive/archive_description.hpp"
 
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -52,6 +53,56 @@ nlohmann::json volume_descriptions(const ArchiveReader& archive,
     return volumes;
 }
 
+/// A view's proxies (single- or multi-perspective) of the first step that holds them and reads:
+/// a damaged step is for info and verify to list, and the description (serve's index, a
+/// gallery's) takes the next; none where the first step holds no such proxies.
+std::optional<ProxyFrame> first_readable(const ArchiveReader& archive,
+                                         const std::vector<std::int64_t>& steps, int v,
+                                         bool multi) {
+    for (const std::int64_t step : steps) {
+        if (!has_perspective(archive.manifest(), step, v, multi)) return std::nullopt;
+        try {
+            return archive.load(step, v, multi);
+        } catch (const Error&) {
+        }
+    }
+    return std::nullopt;
+}
+
+/// Per view, what the first step that reads holds: image size, layers, intervals, colour model.
+nlohmann::json view_descriptions(const ArchiveReader& archive,
+                                 const std::vector<std::int64_t>& steps) {
+    nlohmann::json views = nlohmann::json::array();
+    if (!steps.empty()) {
+        for (int v = 0; v < archive.view_count(); ++v) {
+            nlohmann::json view{{"view", v}};
+            for (const bool multi : {false, true}) {
+                const std::optional<ProxyFrame> first = first_readable(archive, steps, v, multi);
+                if (!first) continue;
+                const ProxyFrame& frame = *first;
+                nlohmann::json entry{{"size", {frame.camera.width(), frame.camera.height()}},
+                                     {"projection", to_string(frame.camera.projection())},
+                                     {"azimuth", frame.camera.azimuth_deg()},
+                                     {"elevation", frame.camera.elevation_deg()},
+                                     {"isovalues", frame.isovalues},
+                                     {"depth_layers", frame.depth_layers.size()},
+                                     {"attenuation", frame.attenuation.channels > 0},
+                                     {"optical_depth", frame.optical_depth.channels > 0},
+                                     {"training_images", frame.training.size()}};
+                if (frame.intervals) entry["intervals"] = frame.intervals->to_json();
+                if (multi) entry["distortion_tilt"] = frame.distortion_tilt_deg;
+                if (frame.colour_model) {
+                    entry["colour_model"] = {{"intervals", frame.colour_model->intervals()},
+                                             {"clusters", frame.colour_model->clusters()}};
+                }
+                view[multi ? "multi" : "single"] = entry;
+            }
+            views.push_back(view);
+        }
+    }
+    return views;
+}
+
 }  // namespace
 
 nlohmann::json describe_archive(const ArchiveReader& archive) {
@@ -86,45 +137,24 @@ nlohmann::json describe_archive(const ArchiveReader& archive) {
     for (const auto& item : parts.items()) part_names.push_back(item.key());
     description["parts"] = part_names;
 
-    // Per view, what the first step holds: image size, layers, intervals, colour model.
-    nlohmann::json views = nlohmann::json::array();
     const std::vector<std::int64_t> steps = archive.steps();
-    if (!steps.empty()) {
-        for (int v = 0; v < archive.view_count(); ++v) {
-            nlohmann::json view{{"view", v}};
-            for (const bool multi : {false, true}) {
-                if (!has_perspective(manifest, steps.front(), v, multi)) continue;
-                const ProxyFrame frame = archive.load(steps.front(), v, multi);
-                nlohmann::json entry{{"size", {frame.camera.width(), frame.camera.height()}},
-                                     {"projection", to_string(frame.camera.projection())},
-                                     {"azimuth", frame.camera.azimuth_deg()},
-                                     {"elevation", frame.camera.elevation_deg()},
-                                     {"isovalues", frame.isovalues},
-                                     {"depth_layers", frame.depth_layers.size()},
-                                     {"attenuation", frame.attenuation.channels > 0},
-                                     {"optical_depth", frame.optical_depth.channels > 0},
-                                     {"training_images", frame.training.size()}};
-                if (frame.intervals) entry["intervals"] = frame.intervals->to_json();
-                if (multi) entry["distortion_tilt"] = frame.distortion_tilt_deg;
-                if (frame.colour_model) {
-                    entry["colour_model"] = {{"intervals", frame.colour_model->intervals()},
-                                             {"clusters", frame.colour_model->clusters()}};
-                }
-                view[multi ? "multi" : "single"] = entry;
-            }
-            views.push_back(view);
-        }
-    }
-    description["views"] = views;
+    description["views"] = view_descriptions(archive, steps);
 
     // Per field, the light field of the first step that has one: its rig and what it holds.
     nlohmann::json light_fields = nlohmann::json::array();
     std::set<std::string> described;
     for (const std::int64_t step : steps) {
         for (const ArchivedLightField& stored : archive.light_fields(step)) {
-            if (!described.insert(stored.field).second) continue;
-            // Camera 0 only: the headers say what every part holds.
-            const LightField light_field = archive.load_light_field(step, stored.field, {0});
+            if (described.count(stored.field)) continue;
+            // Camera 0 only: the headers say what every part holds (a damaged step's light
+            // field is for info and verify to list: the next step's describes the field).
+            LightField light_field;
+            try {
+                light_field = archive.load_light_field(step, stored.field, {0});
+            } catch (const Error&) {
+                continue;
+            }
+            described.insert(stored.field);
             light_fields.push_back({{"field", stored.field},
                                     {"first_step", step},
                                     {"cameras", stored.cameras},
