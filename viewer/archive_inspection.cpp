@@ -45,20 +45,18 @@ ArchiveInspection inspect_archive(const std::string& path) {
     inspection.damage = std::move(check.problems);
     inspection.unreadable = std::move(check.unreadable_proxies);
     inspection.manifest_readable = reader.manifest_readable();
-    // describe_archive decodes the first step's proxies of every view. A file whose size and
-    // checksum match and that still does not decode (something else wrote it) is damage as well:
-    // it is left out in turn, until the rest describes; each round leaves out one entry more.
+    // The sizes are checked, not the bytes; the first step's proxies, which describe the archive,
+    // are read whole: a file of the recorded size that fails its CRC-32 or does not decode is
+    // damage as well, and is left out in turn until the first step reads.
     for (;;) {
         const ArchiveReader readable = reader.without_views(inspection.unreadable);
-        try {
+        const std::optional<Undecodable> culprit = first_undecodable(readable);
+        if (!culprit) {
             inspection.description = describe_archive(readable);
             return inspection;
-        } catch (const IoError&) {
-            const std::optional<Undecodable> culprit = first_undecodable(readable);
-            if (!culprit) throw;
-            inspection.damage.push_back(culprit->problem);
-            inspection.unreadable.insert(culprit->entry);
         }
+        inspection.damage.push_back(culprit->problem);
+        inspection.unreadable.insert(culprit->entry);
     }
 }
 
