@@ -58,10 +58,13 @@ async function oneRun(browser, url) {
   waits['step change'] = await page.evaluate(() => performance.now()) - start;
   await settledAfter(page, count);
   count = await page.evaluate(() => window.insituViewer.frameCount);
-  // The middle interval's opacity x 0.25, as the handle's drag sets it.
-  start = await page.evaluate(() => window.insituViewer.setOpacityScale(
-    Math.floor(window.insituViewer.intervalCount() / 2), 0.25));
-  waits['opacity edit'] = await settledAfter(page, count) - start;
+  // The middle interval's opacity x 0.25, as the handle's drag sets it (an archive without
+  // attenuation, e.g. a long run of depth only, has no interval to edit).
+  if (await page.evaluate(() => window.insituViewer.intervalCount()) > 0) {
+    start = await page.evaluate(() => window.insituViewer.setOpacityScale(
+      Math.floor(window.insituViewer.intervalCount() / 2), 0.25));
+    waits['opacity edit'] = await settledAfter(page, count) - start;
+  }
   const drawn = await page.evaluate(() => window.insituViewer.displayed.drawnFrom || 'server');
   await page.close();
   return { waits, drawn };
