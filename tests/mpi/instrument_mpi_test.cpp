@@ -24,6 +24,7 @@
 #include "insitu/parallel/communicator.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/archive_comparison.hpp"
+#include "insitu_mpi.h"
 #include "mpi_test_main.hpp"
 
 namespace insitu {
@@ -293,6 +294,80 @@ TEST(InstrumentMpi, AFailureOnOneRankFailsTheStepOnEveryRank) {
     EXPECT_EQ(instrument->execute(4, 4.0, views_of(blocks)), Status::ok);
     EXPECT_EQ(instrument->finalize(), Status::ok);
     EXPECT_EQ(instrument->statistics().errors, world_size() > 1 ? 4 : 2);
+}
+
+// This rank's block through insitu_add_block (node-centred; its samples, or `data` of
+// `scalar_type` in their place), then insitu_execute; what the C API returned, with
+// insitu_last_error() after a failure.
+struct CStep {
+    int status = INSITU_OK;
+    std::string error;
+};
+CStep c_step(insitu_instrument* instrument, const VolumeBlock* block, std::int64_t step,
+             glm::dvec3 spacing, const void* data = nullptr, int scalar_type = INSITU_FLOAT32) {
+    CStep result;
+    if (block != nullptr) {
+        const std::int64_t dims[3] = {block->allocated[0], block->allocated[1],
+                                      block->allocated[2]};
+        const std::int64_t low[3] = {block->ghost_low[0], block->ghost_low[1], block->ghost_low[2]};
+        const std::int64_t high[3] = {block->ghost_high[0], block->ghost_high[1],
+                                      block->ghost_high[2]};
+        const double origin[3] = {block->origin.x, block->origin.y, block->origin.z};
+        const double cell[3] = {spacing.x, spacing.y, spacing.z};
+        if (data == nullptr) data = block->values.data();
+        result.status = insitu_add_block(instrument, "f", data, scalar_type, dims, origin, cell,
+                                         low, high, nullptr, INSITU_NODE);
+        EXPECT_EQ(result.status, INSITU_OK) << insitu_last_error();
+    }
+    result.status = insitu_execute(instrument, step, static_cast<double>(step));
+    if (result.status < 0) result.error = insitu_last_error();
+    return result;
+}
+
+// Through the C API, as a C or Fortran code meets it: a rank whose block is on another grid
+// (its spacing differs) makes insitu_execute fail on every rank, with the same code and a
+// message naming that rank; nothing hangs (ctest's TIMEOUT would say so), and the next step,
+// with every block right, is stored on every rank.
+TEST(InstrumentMpiCApi, AWrongBlockOnOneRankIsEveryRanksErrorNamingIt) {
+    const std::string directory = shared_directory("c_wrong_block");
+    insitu_instrument* instrument = nullptr;
+    ASSERT_EQ(insitu_create_mpi_from_json(
+                  configuration(directory + "/wrong.cdb", "[0.35]", "uniform").c_str(),
+                  MPI_COMM_WORLD, &instrument),
+              INSITU_OK)
+        << insitu_last_error();
+    const SampledVolume volume = field_at(0);
+    const std::vector<VolumeBlock> blocks = my_blocks(volume, {world_size(), 1, 1});
+    const VolumeBlock* mine = blocks.empty() ? nullptr : &blocks.front();
+    // At 1 rank no other block can disagree: the wrong one then holds a value beyond float32's
+    // range (float64 data), which fails the step the same way.
+    const int wrong = world_size() - 1;
+    glm::dvec3 spacing = volume.spacing;
+    std::string expected = "rank " + std::to_string(wrong) + "'s block has spacing";
+    if (world_size() > 1 && world_rank() == wrong) spacing *= 2.0;
+    std::vector<double> doubles;
+    if (world_size() == 1) {
+        doubles.assign(mine->values.begin(), mine->values.end());
+        doubles[doubles.size() / 2] = 1e300;
+        expected = "beyond the float32 range";
+    }
+    const CStep failed =
+        c_step(instrument, mine, 0, spacing, doubles.empty() ? nullptr : doubles.data(),
+               doubles.empty() ? INSITU_FLOAT32 : INSITU_FLOAT64);
+    const int codes[2] = {failed.status, -failed.status};
+    int extremes[2] = {0, 0};
+    MPI_Allreduce(codes, extremes, 2, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    EXPECT_LT(failed.status, 0);
+    EXPECT_EQ(extremes[0], -extremes[1]) << "not the same code on every rank";
+    EXPECT_NE(failed.error.find(expected), std::string::npos) << failed.error;
+
+    // The run goes on: the next step, every block right, is stored everywhere.
+    const CStep next =
+        c_step(instrument, blocks.empty() ? nullptr : &blocks.front(), 1, volume.spacing);
+    EXPECT_EQ(next.status, INSITU_OK) << next.error;
+    EXPECT_TRUE(on_every_rank(next.status == INSITU_OK));
+    EXPECT_EQ(insitu_finalize(instrument), INSITU_OK) << insitu_last_error();
+    insitu_destroy(instrument);
 }
 
 // Rank 0's writer fails (its proxies folder replaced by a file, as a full or failing disk would
