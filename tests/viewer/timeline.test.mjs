@@ -5,9 +5,15 @@
 //
 //   INSITU_VIEW=build/viewer/insitu-view ARCHIVE=viewer.cdb WORK_DIR=dir node timeline.test.mjs
 import assert from 'node:assert/strict';
+import { spawnSync } from 'node:child_process';
+import { writeFileSync } from 'node:fs';
+import path from 'node:path';
 import { test } from 'node:test';
 
-import { env, openViewerPage, serverAndBrowser, waitForSettledFrame } from './lib.mjs';
+import {
+  env, makeWorkDir, openViewerPage, serverAndBrowser, startServer, stopServer,
+  waitForSettledFrame,
+} from './lib.mjs';
 
 const binary = env('INSITU_VIEW');
 const archive = env('ARCHIVE');
@@ -161,4 +167,38 @@ test('a step change shows the stored view before the step\'s proxies have come',
   assert.deepEqual(settled, { step: String(steps[1]), drawnFrom: 'stored view' });
   assert.deepEqual(errors, []);
   await page.close();
+});
+
+test('a run of depth only: steps change without a request the archive cannot answer', async () => {
+  // No attenuation to draw from: every frame is the server's, and the page must not ask for
+  // proxies (/api/proxies would answer 404, an error in the console of every such page).
+  const workDir = makeWorkDir('timeline-depth-');
+  const config = path.join(workDir, 'depth.json');
+  writeFileSync(config, JSON.stringify({ fields: ['v'], proxies: ['depth'], volume: false,
+    views: [{ azimuth: 30, elevation: 20, size: [64, 64] }], every: 10 }));
+  const depthOnly = path.join(workDir, 'depth.cdb');
+  const run = spawnSync(env('GRAY_SCOTT'), ['--size', '16', '--steps', '20', '--config', config,
+    '--out', depthOnly], { encoding: 'utf8' });
+  assert.equal(run.status, 0, run.stderr);
+  const server = await startServer(binary, depthOnly);
+  const context = await session.browser.newContext();
+  const refused = [];
+  context.on('response', (response) => {
+    if (response.status() >= 400) refused.push(`${response.status()} ${response.url()}`);
+  });
+  try {
+    const errors = [];
+    const page = await openViewerPage(context, server.url, errors);
+    await waitForSettledFrame(page);
+    assert.ok(await page.evaluate(() => window.insituViewer.gpu !== null), 'WebGL2 is there');
+    const count = await page.evaluate(() => window.insituViewer.frameCount);
+    await setStepIndex(page, 1);
+    await waitForSettledFrame(page, count);
+    assert.equal(await page.evaluate(() => window.insituViewer.displayed.options.step), '20');
+    assert.deepEqual(refused, []);
+    assert.deepEqual(errors, []);
+  } finally {
+    await context.close();
+    assert.equal(await stopServer(server), 0);
+  }
 });

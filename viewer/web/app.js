@@ -7,7 +7,7 @@
 // segment_faders.js, annotations.js (caption, colour bar, box & axes), zoom.js, view_state.js
 // (the view in the address), export_png.js, compare.js (side by side); the WebGL2 side: gpu_frames.js,
 // light_field_data.js, light_field_renderer.js, camera.js and the shaders beside them.
-import { $, ARCHIVE_POLL_MS, showError, state, viewer } from './page.js';
+import { $, ARCHIVE_POLL_MS, showError, state, viewer, viewHasAttenuation } from './page.js';
 import { currentOptions } from './explore_options.js';
 import { requestFrame, updateMask } from './frames.js';
 import { forgetTrust, installOrbitDrag, resetView } from './orbit.js';
@@ -127,8 +127,8 @@ async function start() {
     await stepChanged().catch((error) => showError(error.message));
     const asked = askedStep();
     if (asked) {
-      viewer.gpu.prefetch(asked.step, asked.view,
-        { lightField: state.lightField, volume: state.volume });
+      viewer.gpu.prefetch(asked.step, asked.view, { lightField: state.lightField,
+        volume: state.volume, proxies: viewHasAttenuation(asked.view) });
     }
   }
   viewer.readyAt = performance.now();  // the page draws in the browser from here (tests wait)

@@ -231,11 +231,11 @@ export class GpuFrames {
 
   /// Starts downloading what the next step draws from ahead of need: its light field and its
   /// compressed field where this step has them (steps of one run hold the same), and its stored
-  /// view's proxies where they are drawn here.
-  prefetch(step, view, { lightField = false, volume = false } = {}) {
+  /// view's proxies where they are drawn here and hold attenuation.
+  prefetch(step, view, { lightField = false, volume = false, proxies = false } = {}) {
     if (volume && this.volumeRenderer) this.volume(step, view).catch(() => {});
     if (lightField) this.lightField(step, view).catch(() => {});
-    if (this.proxyRenderer) this.proxies(step, view).catch(() => {});
+    if (proxies && this.proxyRenderer) this.proxies(step, view).catch(() => {});
   }
 
   /// Whether (step, view) has a light field (downloads it if needed).

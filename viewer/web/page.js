@@ -50,6 +50,14 @@ export const viewer = {
 };
 window.insituViewer = viewer;
 
+/// Whether `view`'s stored proxies hold attenuation, the proxies the browser draws from (the
+/// archive's description says; /api/proxies would answer 404 for the others, an error in the
+/// console of every page that asked).
+export function viewHasAttenuation(view) {
+  const described = state.archive && state.archive.views && state.archive.views[view];
+  return Boolean(described && described.single && described.single.attenuation);
+}
+
 export function short(x) {
   return Number(x.toPrecision(6)).toString();
 }

@@ -1,6 +1,8 @@
 // Timesteps: the archive's index (polled, so a running simulation's new steps appear), the
 // step shown and its intervals, light field and faders, and playing through the steps.
-import { $, PLAY_INTERVAL_MS, getJson, short, showError, state, viewer } from './page.js';
+import {
+  $, PLAY_INTERVAL_MS, getJson, short, showError, state, viewer, viewHasAttenuation,
+} from './page.js';
 import { showSegmentFaders } from './segment_faders.js';
 import { requestFrame } from './frames.js';
 import { drawTfEditor } from './tf_editor.js';
@@ -75,7 +77,10 @@ export async function stepChanged() {
     lightField = info.light_field_segments > 0 &&
       await viewer.gpu.has(step, view).catch(() => false);
     const next = state.timeline[state.stepIndex + 1];
-    if ((lightField || volume) && next) viewer.gpu.prefetch(next.step, view, { lightField, volume });
+    if ((lightField || volume) && next) {
+      viewer.gpu.prefetch(next.step, view,
+        { lightField, volume, proxies: viewHasAttenuation(view) });
+    }
   }
   if (request !== stepRequests) return;  // another step or view was asked for meanwhile
   $('step-label').classList.remove('loading');
