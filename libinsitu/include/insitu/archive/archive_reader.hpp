@@ -69,7 +69,7 @@ struct VolumeGrid {
 };
 
 /// How much of each listed file ArchiveReader::check() reads: every byte (its CRC-32, verify's
-/// depth) or only its size (what the viewer and `info` check when they open an archive).
+/// depth) or only its size (what `info` checks when it opens an archive).
 enum class CheckDepth { bytes, sizes };
 
 /// What ArchiveReader::check() found.
