@@ -207,14 +207,16 @@ viewer_browser_test(trust volume
 
 # Galleries (issue 46): `insitu-view export` of the light-field run served by Python's
 # http.server; gallery.test.mjs holds the page's frames there (stored view, orbit, lights and
-# occlusion whose terms the page computes, the next step) and of the compressed-field run (orbit,
-# an edited function) to `insitu-view render`, checks that no request leaves the gallery, that
-# the page's recipes are serve's, that the same archive exports to the same bytes and that a
-# damaged step is left out and listed.
+# occlusion whose terms the page computes, the next step), of the compressed-field run (orbit, an
+# edited function) and of the attenuation light-field run (an orbit view recoloured and edited on
+# the light field's intervals) to `insitu-view render`, checks that no request leaves the
+# gallery, that the page's recipes are serve's, that the same archive exports to the same bytes
+# and that a damaged step is left out and listed.
 viewer_browser_test(gallery lf ENVIRONMENT ARCHIVE_VOLUME=${viewer_work}/viewer_volume.cdb
                                           ARCHIVE_MODEL=${viewer_archive}
-                    FIXTURES viewer_volume_archive viewer_archive)
-# Three galleries, a dozen frames held to render and serve's recipes: about 2 minutes on 2 loaded
+                         ARCHIVE_LF_ATTENUATION=${viewer_work}/viewer_lf_attenuation.cdb
+                    FIXTURES viewer_volume_archive viewer_archive viewer_lf_attenuation_archive)
+# Four galleries, a dozen frames held to render and serve's recipes: about 2 minutes on 2 loaded
 # cores.
 set_tests_properties(viewer.gallery PROPERTIES TIMEOUT 480)
 

@@ -4,6 +4,7 @@
 #include <array>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -131,15 +132,39 @@ json step_recipes(Routes& routes, const Params& key, const json& info) {
     return recipes;
 }
 
+/// The edges of the intervals of the view's field's attenuation light field at `step` (none
+/// where the step has no such light field): an edit over the light field is made on its own
+/// intervals (Explorer::recipe), which serve's recipe route alone knows; the gallery's page
+/// makes that edit's terms from these (source.js).
+std::optional<std::vector<double>> light_field_intervals(const ServedArchive& archive,
+                                                         std::int64_t step, int view) {
+    const ArchiveReader& reader = archive.reader_locked();
+    const std::string field = reader.entry(step, view).field;
+    for (const ArchivedLightField& stored : reader.light_fields(step)) {
+        if (stored.field != field) continue;
+        archive.require_inside(stored.exr_path);
+        const LightField light_field = reader.load_light_field(step, field, {0});
+        if (light_field.settings.attenuation && light_field.intervals) {
+            return light_field.intervals->edges();
+        }
+    }
+    return std::nullopt;
+}
+
 /// What the page reads of one (step, view), under data/S_V/; throws (naming the part) where the
 /// archive cannot give it.
 SiteFiles step_files(Routes& routes, std::int64_t step, int view) {
     const Params key{{"step", std::to_string(step)}, {"view", std::to_string(view)}};
     const std::string dir = "data/" + key.at("step") + "_" + key.at("view") + "/";
     SiteFiles files;
-    files[dir + "step.json"] =
+    json info = json::parse(
         required(call([&](const auto& r, auto& s) { routes.archive_routes.step_info(r, s); }, key),
-                 "description");
+                 "description"));
+    if (const std::optional<std::vector<double>> edges =
+            light_field_intervals(routes.archive, step, view)) {
+        info["light_field_intervals"] = *edges;
+    }
+    files[dir + "step.json"] = info.dump();
     files[dir + "trust.json"] = required(
         call([&](const auto& r, auto& s) { routes.frames.trust(r, s); }, key), "trusted range");
     const std::pair<const char*,
@@ -170,7 +195,7 @@ SiteFiles step_files(Routes& routes, std::int64_t step, int view) {
                 headers[name] = value;
             }
         }
-        json recipes = step_recipes(routes, key, json::parse(files[dir + "step.json"]));
+        json recipes = step_recipes(routes, key, info);
         recipes["frame_headers"] = headers;
         files[dir + "recipes.json"] = recipes.dump();
     }
@@ -201,9 +226,9 @@ std::string readme_text(const std::string& name, const ExportReport& report) {
     for (const auto& [step, why] : report.left_out) {
         text << "Left out: step " << step << ": " << why << "\n";
     }
-    text << "\nWhat needs `insitu-view serve` instead: a 2D transfer function, an edit over an\n"
-         << "attenuation light field's own intervals, segment fades with lights or occlusion, and\n"
-         << "the frames a browser without WebGL2 would ask the server for.\n\n"
+    text << "\nWhat needs `insitu-view serve` instead: a 2D transfer function, segment fades with\n"
+         << "lights or occlusion, and the frames a browser without WebGL2 would ask the server "
+            "for.\n\n"
          << "data.csv and previews/ are the run's Cinema database (Spec D): Cinema viewers open\n"
          << "this folder too.\n";
     return text.str();

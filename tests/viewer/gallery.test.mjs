@@ -3,13 +3,15 @@
 // match `insitu-view render` as the served page's do (the same helpers), on a run with a light
 // field and the stored view's proxies (ARCHIVE: orbit views, lights and occlusion whose terms the
 // page computes itself, the next step) and on a run with a compressed field (ARCHIVE_VOLUME:
-// orbit views and an edited transfer function). No request may leave the gallery's folder. Also:
+// orbit views and an edited transfer function), and an orbit view of a run with an attenuation
+// light field (ARCHIVE_LF_ATTENUATION) recoloured and edited. No request may leave the gallery's folder. Also:
 // the page's recipes are serve's (also on ARCHIVE_MODEL, a run with a colour model), the same
 // archive exports to the same bytes, a damaged step is left out and listed, and a gallery of
 // several runs lists them with thumbnails and sizes and opens each run's explorer.
 //
 //   INSITU_VIEW=build/viewer/insitu-view ARCHIVE=viewer_lf.cdb ARCHIVE_VOLUME=viewer_volume.cdb \
-//     WORK_DIR=dir node gallery.test.mjs
+//     ARCHIVE_MODEL=viewer.cdb ARCHIVE_LF_ATTENUATION=viewer_lf_attenuation.cdb WORK_DIR=dir \
+//     node gallery.test.mjs
 import assert from 'node:assert/strict';
 import { spawn, spawnSync } from 'node:child_process';
 import { cpSync, readdirSync, readFileSync, truncateSync, writeFileSync } from 'node:fs';
@@ -27,6 +29,7 @@ const binary = env('INSITU_VIEW');
 const archive = env('ARCHIVE');
 const volumeArchive = env('ARCHIVE_VOLUME');
 const modelArchive = env('ARCHIVE_MODEL');
+const lfAttenuationArchive = env('ARCHIVE_LF_ATTENUATION');
 const workDir = makeWorkDir('gallery-');
 // The served page's bar (webgl, proxies and volume tests): the issue's.
 const MIN_PSNR_DB = 40;
@@ -200,6 +203,46 @@ test('a gallery of a light-field run draws the served page\'s frames from static
     await page.close();
   });
 
+test('a gallery of an attenuation light field edits an orbit view on the light field\'s intervals',
+  async () => {
+    const { page, requests, errors, url } = await openGallery(lfAttenuationArchive, 'lf-att');
+    const info = JSON.parse(readFileSync(path.join(workDir, 'lf-att', 'data', '300_0',
+      'step.json')));
+    assert.equal(info.light_field_intervals.length, info.intervals.length,
+      'the export gives the light field\'s intervals');
+    const results = [];
+    const matches = async (what) => {
+      const { psnr, image } = await lightFieldFrameMatches(page, binary, lfAttenuationArchive,
+        workDir, what, MIN_PSNR_DB);
+      results.push(`${what} ${psnr.toFixed(1)} dB`);
+      return image;
+    };
+    await orbitTo(page, Math.round(info.azimuth + 20), Math.round(info.elevation));
+    const plain = await matches('orbit');
+    // A recolouring: the edited function's colours and scales over the light field's intervals,
+    // which only serve made before the export carried them.
+    const heaviest = info.mean_attenuation.indexOf(Math.max(...info.mean_attenuation));
+    const options = await settle(page, () =>
+      page.locator(`#tf-colours input[data-interval="${heaviest}"]`).fill('#ff2000'));
+    assert.ok(options.tf, 'a colour edit sends an edited transfer function');
+    const recoloured = await matches('recolour');
+    assert.ok(differingSamples(recoloured, plain) > 0, 'the recolouring shows');
+    const handle = await page.locator(`circle[data-interval="${heaviest}"]`).boundingBox();
+    await settle(page, async () => {
+      await page.mouse.move(handle.x + handle.width / 2, handle.y + handle.height / 2);
+      await page.mouse.down();
+      await page.mouse.move(handle.x + handle.width / 2, handle.y + handle.height / 2 + 25,
+        { steps: 3 });
+      await page.mouse.up();
+    });
+    const edited = await matches('recolour + opacity edit');
+    assert.ok(differingSamples(edited, recoloured) > 0, 'the opacity edit shows');
+    console.log(`gallery (attenuation light field) vs insitu-view render: ${results.join(', ')}`);
+    assertContained(requests, url);
+    assert.deepEqual(errors, []);
+    await page.close();
+  });
+
 test('a gallery of a compressed field orbits and takes any transfer function', async () => {
   const { page, requests, errors, url } = await openGallery(volumeArchive, 'volume');
   const info = JSON.parse(readFileSync(path.join(workDir, 'volume', 'data', '300_0', 'step.json')));
@@ -319,7 +362,8 @@ async function recipesMatch(from, name) {
   const recipes = JSON.parse(readFileSync(path.join(out, 'data', `${step}_0`, 'recipes.json')));
   const server = await startServer(binary, from);
   try {
-    const info = await (await fetch(`${server.url}api/step?step=${step}&view=0`)).json();
+    // The page's description of the step is the gallery's (serve's, with what the export adds).
+    const info = JSON.parse(readFileSync(path.join(out, 'data', `${step}_0`, 'step.json')));
     const other = { azimuth: (info.azimuth - 50).toFixed(2), elevation: '5.00' };
     const cases = [{}, other, { light: 'camera', ambient: '0.35' },
       { ...other, light: '-40,60,1.2,0.1;camera', ambient: '0', ao: '3,2.5' },
@@ -354,6 +398,8 @@ test('the recipes the gallery\'s page makes are serve\'s (Explorer::recipe)', as
   await recipesMatch(archive, 'recipes-lf');
   // A run with a colour model, which opacity edits colour by.
   await recipesMatch(modelArchive, 'recipes-model');
+  // An attenuation light field, whose edits at other views are made on its own intervals.
+  await recipesMatch(lfAttenuationArchive, 'recipes-lf-attenuation');
 });
 
 test('a gallery of several runs lists each with its thumbnail and size, opening its explorer',

@@ -5,10 +5,10 @@
 // combination of lights, occlusion, enhancement and colour source; the parameters of those
 // (light directions and strengths, the occlusion's radius and strength, the enhancement's
 // lambda and gamma, an edit's per-interval scales and colours: tf_estimate.js) the page sets
-// here itself, as Explorer::recipe does. A compressed field takes any transfer function (the
-// page ray-marches it). Only the engine makes an edited function's terms over a light field's
-// own intervals and a 2D function's, and frames with segment fades and lights; a gallery says
-// so instead of drawing them.
+// here itself, as Explorer::recipe does, an edit over a light field on the light field's own
+// intervals (step.json's light_field_intervals). A compressed field takes any transfer function
+// (the page ray-marches it). Only the engine makes a 2D function's terms and frames with segment
+// fades and lights; a gallery says so instead of drawing them.
 
 import {
   intervalColours, intervalColourSpread, opacityScalesOf, parseTf, sameColours,
@@ -165,7 +165,7 @@ export function opacityScales(text, count) {
 /// An edit's per-interval terms on the recipe of an edit of the same kind: the scales (of the
 /// edited function, times the explicit ones), the colours, their spread and the colour source
 /// (Explorer::recipe's add_edit, frame_plan.cpp plan_edit); null where only the engine can (a 2D
-/// function, a light field's own intervals).
+/// function; a light field's intervals where the gallery's step.json lacks them).
 function applyEdit(recipe, rest, info, model) {
   const count = recipe.opacity_scales.length;
   let scales = new Array(count).fill(1);
@@ -173,8 +173,9 @@ function applyEdit(recipe, rest, info, model) {
   if (rest.tf) {
     const shown = parseTf(JSON.parse(rest.tf));
     const stored = parseTf(info.transfer_function);
-    const edges = info.intervals;
-    if (recipe.light_field || !shown || !stored || !edges || edges.length !== count + 1) return null;
+    // Over a light field, its own intervals (the gallery's step.json has them).
+    const edges = recipe.light_field ? info.light_field_intervals : info.intervals;
+    if (!shown || !stored || !edges || edges.length !== count + 1) return null;
     scales = opacityScalesOf(stored, shown, edges);
     recipe.colours = intervalColours(shown, edges);
     if (recipe.trust) recipe.trust.colour_spread = intervalColourSpread(shown, edges);

@@ -6,19 +6,19 @@
 #include <vector>
 
 #include "archive/archive_format.hpp"
+#include "archive/manifest.hpp"
 
 namespace insitu {
 
 namespace af = archive_format;
 
 bool has_perspective(const nlohmann::json& manifest, std::int64_t step, int view, bool multi) {
-    for (const nlohmann::json& step_entry : manifest.at("steps")) {
-        if (step_entry.at("step").get<std::int64_t>() != step) continue;
-        for (const nlohmann::json& view_entry : step_entry.at("views")) {
-            if (view_entry.at("view").get<int>() != view) continue;
-            for (const nlohmann::json& part : view_entry.at("parts")) {
-                if (af::is_multi_part(part.get<std::string>()) == multi) return true;
-            }
+    const nlohmann::json* step_entry = af::step_entry_of(manifest, step);
+    if (step_entry == nullptr) return false;
+    for (const nlohmann::json& view_entry : step_entry->at("views")) {
+        if (view_entry.at("view").get<int>() != view) continue;
+        for (const nlohmann::json& part : view_entry.at("parts")) {
+            if (af::is_multi_part(part.get<std::string>()) == multi) return true;
         }
     }
     return false;

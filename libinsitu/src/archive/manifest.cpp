@@ -180,19 +180,6 @@ void sort_steps(nlohmann::json& steps) {
     }
 }
 
-/// The entry of `step` in the sorted "steps" of a validated manifest; nullptr when none.
-const nlohmann::json* step_entry_of(const nlohmann::json& manifest, std::int64_t step) {
-    // The array itself: nlohmann's iterators call themselves bidirectional, so a search over
-    // them walks every entry to find the middle.
-    const auto& steps = manifest.at("steps").get_ref<const nlohmann::json::array_t&>();
-    const auto found = std::lower_bound(steps.begin(), steps.end(), step,
-                                        [](const nlohmann::json& entry, std::int64_t number) {
-                                            return entry.at("step").get<std::int64_t>() < number;
-                                        });
-    return found != steps.end() && found->at("step").get<std::int64_t>() == step ? &*found
-                                                                                 : nullptr;
-}
-
 }  // namespace
 
 nlohmann::json read_manifest(const std::string& archive_path, nlohmann::json* skipped) {
@@ -396,6 +383,18 @@ std::vector<ListedFile> listed_files(const std::string& archive, const nlohmann:
 ListedFile listed_entry_file(const std::string& archive, const nlohmann::json& entry) {
     return {(fs::path(archive) / entry.at("file").get<std::string>()).string(),
             entry.at("bytes").get<std::uint64_t>(), entry.at("crc32").get<std::uint32_t>()};
+}
+
+const nlohmann::json* step_entry_of(const nlohmann::json& manifest, std::int64_t step) {
+    // The array itself: nlohmann's iterators call themselves bidirectional, so a search over
+    // them walks every entry to find the middle.
+    const auto& steps = manifest.at("steps").get_ref<const nlohmann::json::array_t&>();
+    const auto found = std::lower_bound(steps.begin(), steps.end(), step,
+                                        [](const nlohmann::json& entry, std::int64_t number) {
+                                            return entry.at("step").get<std::int64_t>() < number;
+                                        });
+    return found != steps.end() && found->at("step").get<std::int64_t>() == step ? &*found
+                                                                                 : nullptr;
 }
 
 const nlohmann::json& find_step(const nlohmann::json& manifest, const std::string& archive,

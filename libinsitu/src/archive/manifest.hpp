@@ -135,6 +135,9 @@ void check_listed_file_size(const ListedFile& file);
 /// The file an object of a validated manifest names with "file", "bytes" and "crc32" (a light
 /// field's entry, a compressed field's block or mask).
 ListedFile listed_entry_file(const std::string& archive, const nlohmann::json& entry);
+/// The entry of `step` in the sorted "steps" of a manifest read here (a binary search);
+/// nullptr when none.
+const nlohmann::json* step_entry_of(const nlohmann::json& manifest, std::int64_t step);
 /// The step entry of `step` (a binary search: a manifest read here keeps its steps sorted);
 /// InvalidArgument when the manifest has none.
 const nlohmann::json& find_step(const nlohmann::json& manifest, const std::string& archive,

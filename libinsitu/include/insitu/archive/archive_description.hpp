@@ -11,7 +11,8 @@ namespace insitu {
 /// A summary of an archive for `insitu-view info` and the viewer's API.
 nlohmann::json describe_archive(const ArchiveReader& archive);
 
-/// Whether the manifest lists single- or multi-perspective parts for (step, view).
+/// Whether the manifest lists single- or multi-perspective parts for (step, view); the
+/// manifest is one ArchiveReader read (its steps sorted, found by a binary search).
 bool has_perspective(const nlohmann::json& manifest, std::int64_t step, int view, bool multi);
 
 }  // namespace insitu
