@@ -67,8 +67,9 @@ const std::vector<cli::TableOption<Arguments>>& option_table() {
         {"--views", "V,V,...", false, "the views to export", "every view",
          [](Arguments& a, V f, V v) { a.options.views = parse_list<int>(f, v, 0); }},
         {"--max-bytes", "N", false,
-         "the site at most N bytes (k, M, G: powers of 1000): steps that do not fit, in order, "
-         "are left out and listed; an error when none fits",
+         "the site at most N bytes (k, M, G: powers of 1000): where the run does not fit, its "
+         "light fields are left out (the largest, least accurate per byte), then steps, evenly "
+         "over the run; each listed; an error when no step fits",
          "no limit", [](Arguments& a, V f, V v) { a.options.max_bytes = parse_bytes(f, v); }},
         {"--replace", nullptr, false,
          "replace OUT where it exists (only an empty folder or a gallery export wrote)",
@@ -140,6 +141,7 @@ int export_main(const std::vector<std::string>& args) {
             std::cout << "left out: step " << step << ": " << why << "\n";
             damaged = damaged || why.rfind("damaged", 0) == 0;
         }
+        for (const std::string& what : report.omitted) std::cout << "left out: " << what << "\n";
     }
     return damaged ? cli::kExitDamagedInput : 0;
 }

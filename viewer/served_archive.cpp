@@ -19,10 +19,10 @@ std::pair<std::int64_t, std::uintmax_t> file_stamp(const fs::path& path) {
             static_cast<std::uintmax_t>(info.st_size)};
 }
 
-ServedArchive::ServedArchive(const std::string& archive_path)
+ServedArchive::ServedArchive(const std::string& archive_path, ArchiveOmissions omitted)
     : root_(fs::weakly_canonical(fs::absolute(archive_path))) {
     require_inside(root_ / "manifest.json");
-    explorer_ = std::make_unique<Explorer>(root_.string());
+    explorer_ = std::make_unique<Explorer>(root_.string(), ComputeDevice::shared(), omitted);
     manifest_stamp_ = index_stamp();
 }
 

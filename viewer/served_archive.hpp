@@ -38,7 +38,8 @@ std::pair<std::int64_t, std::uintmax_t> file_stamp(const std::filesystem::path& 
 class ServedArchive {
 public:
     /// Opens the archive; 403 (HttpError) where its manifest resolves outside its directory.
-    explicit ServedArchive(const std::string& archive_path);
+    /// `omitted`: representations served as absent (a gallery exported without them).
+    explicit ServedArchive(const std::string& archive_path, ArchiveOmissions omitted = {});
 
     const std::filesystem::path& root() const { return root_; }
     std::mutex& mutex() { return mutex_; }

@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <array>
 #include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
 
 #include "archive_routes.hpp"
+#include "export_fit.hpp"
 #include "frame_routes.hpp"
 #include "http_boundary.hpp"
 #include "insitu/error.hpp"
@@ -31,8 +33,11 @@ constexpr int kExportFormat = 1;
 
 /// serve's routes over the archive, called in-process: the site holds what serve would send.
 struct Routes {
-    explicit Routes(const std::string& path)
-        : archive(path), archive_routes(archive), payloads(archive), frames(archive, refusals) {}
+    explicit Routes(const std::string& path, ArchiveOmissions omitted = {})
+        : archive(path, omitted),
+          archive_routes(archive),
+          payloads(archive),
+          frames(archive, refusals) {}
     ServedArchive archive;
     RefusalLog refusals;
     ArchiveRoutes archive_routes;
@@ -226,6 +231,7 @@ std::string readme_text(const std::string& name, const ExportReport& report) {
     for (const auto& [step, why] : report.left_out) {
         text << "Left out: step " << step << ": " << why << "\n";
     }
+    for (const std::string& what : report.omitted) text << "Left out: " << what << "\n";
     text << "\nWhat needs `insitu-view serve` instead: a 2D transfer function, segment fades with\n"
          << "lights or occlusion, and the frames a browser without WebGL2 would ask the server "
             "for.\n\n"
@@ -304,29 +310,92 @@ std::string site_index(Routes& routes, const ExportReport& report, const std::ve
     index["exported"] = {{"format", kExportFormat},
                          {"steps", report.steps},
                          {"views", views},
-                         {"left_out", left_out}};
+                         {"left_out", left_out},
+                         {"omitted", report.omitted}};
     return index.dump();
+}
+
+using Choice = std::pair<std::vector<std::int64_t>, std::vector<int>>;
+
+/// The files of `step` for each of `views`, its previews too; nullopt (the step listed in
+/// `report` as damaged, naming what failed) where the archive cannot give them.
+std::optional<SiteFiles> step_site_files(Routes& routes, std::int64_t step,
+                                         const std::vector<int>& views, ExportReport& report) {
+    SiteFiles files;
+    try {
+        for (const int view : views) {
+            const SiteFiles more = step_files(routes, step, view);
+            files.insert(more.begin(), more.end());
+            files.insert(preview_file(routes.archive, step, view));
+        }
+    } catch (const std::exception& error) {
+        report.left_out.emplace_back(
+            step, "damaged: " + published(routes.archive, one_line(error.what())));
+        return std::nullopt;
+    }
+    return files;
+}
+
+/// Fits the chosen steps into --max-bytes (export_fit.hpp): each step measured as exported
+/// whole, then the light fields and steps that do not fit left out (and said so in `report`,
+/// with the damaged steps found). Returns the routes to export with: those given, or new ones
+/// over the archive without what was left out.
+std::unique_ptr<Routes> fit_to_budget(std::unique_ptr<Routes> routes, const ExportOptions& options,
+                                      std::uintmax_t fixed_bytes, Choice& choice,
+                                      ExportReport& report) {
+    std::vector<StepBytes> measured;
+    for (const std::int64_t step : choice.first) {
+        const std::optional<SiteFiles> files =
+            step_site_files(*routes, step, choice.second, report);
+        if (!files) continue;
+        StepBytes bytes{step, size_of(*files), 0};
+        for (const auto& [path, content] : *files) {
+            if (path.size() >= 14 && path.compare(path.size() - 14, 14, "lightfield.bin") == 0) {
+                bytes.light_field_bytes += content.size();
+            }
+        }
+        measured.push_back(bytes);
+    }
+    const std::uintmax_t budget =
+        *options.max_bytes > fixed_bytes ? *options.max_bytes - fixed_bytes : 0;
+    const SiteFit fit = fit_site(measured, budget);
+    const std::string over = "over --max-bytes " + std::to_string(*options.max_bytes);
+    if (fit.steps.empty() && !measured.empty()) {
+        std::uintmax_t smallest = UINTMAX_MAX;
+        for (const StepBytes& step : measured) {
+            smallest = std::min(smallest, step.bytes - step.light_field_bytes);
+        }
+        fail<InvalidArgument>("--max-bytes ", *options.max_bytes, ": smaller than one step (the ",
+                              "smallest takes ", smallest, " bytes without its light field, the ",
+                              "page ", fixed_bytes, ")");
+    }
+    for (const StepBytes& step : measured) {
+        if (!std::binary_search(fit.steps.begin(), fit.steps.end(), step.step)) {
+            const std::uintmax_t bytes =
+                step.bytes - (fit.omitted.light_fields ? step.light_field_bytes : 0);
+            report.left_out.emplace_back(step.step, over + " (" + std::to_string(bytes) +
+                                                        " bytes; the steps kept spread evenly "
+                                                        "over the run)");
+        }
+    }
+    choice.first = fit.steps;
+    if (!fit.omitted.any()) return routes;
+    std::uintmax_t light_field_bytes = 0;
+    for (const StepBytes& step : measured) light_field_bytes += step.light_field_bytes;
+    report.omitted.push_back("light fields of every step (" + std::to_string(light_field_bytes) +
+                             " bytes): " + over);
+    return std::make_unique<Routes>(options.archive, fit.omitted);
 }
 
 /// Exports each chosen step that reads and fits into `temporary`; fills the report.
 void export_steps(Routes& routes, const ExportOptions& options, const fs::path& temporary,
-                  const std::pair<std::vector<std::int64_t>, std::vector<int>>& choice,
-                  std::uintmax_t fixed_bytes, ExportReport& report) {
+                  const Choice& choice, std::uintmax_t fixed_bytes, ExportReport& report) {
     std::uintmax_t smallest = 0;
     report.bytes = fixed_bytes;
     for (const std::int64_t step : choice.first) {
-        SiteFiles files;
-        try {
-            for (const int view : choice.second) {
-                const SiteFiles more = step_files(routes, step, view);
-                files.insert(more.begin(), more.end());
-                files.insert(preview_file(routes.archive, step, view));
-            }
-        } catch (const std::exception& error) {
-            report.left_out.emplace_back(
-                step, "damaged: " + published(routes.archive, one_line(error.what())));
-            continue;
-        }
+        const std::optional<SiteFiles> read = step_site_files(routes, step, choice.second, report);
+        if (!read) continue;
+        const SiteFiles& files = *read;
         const std::uintmax_t bytes = size_of(files);
         smallest = smallest == 0 ? bytes : std::min(smallest, bytes);
         if (options.max_bytes && report.bytes + bytes > *options.max_bytes) {
@@ -391,8 +460,8 @@ void check_output(const ExportOptions& options) {
 
 ExportReport export_site(const ExportOptions& options) {
     check_output(options);
-    Routes routes(options.archive);
-    const auto choice = chosen(options, routes.archive.reader_locked());
+    auto whole = std::make_unique<Routes>(options.archive);
+    Choice choice = chosen(options, whole->archive.reader_locked());
     const fs::path out = fs::absolute(options.out).lexically_normal();
     const fs::path temporary = out.parent_path() / ("." + out.filename().string() + ".export");
     fs::remove_all(temporary);
@@ -401,7 +470,13 @@ ExportReport export_site(const ExportOptions& options) {
         SiteFiles page(embedded_web_files().begin(), embedded_web_files().end());
         // The page, the index, README and the Cinema database: what the steps' share leaves.
         constexpr std::uintmax_t kIndexReserve = 64 << 10;
-        export_steps(routes, options, temporary, choice, size_of(page) + kIndexReserve, report);
+        const std::uintmax_t fixed_bytes = size_of(page) + kIndexReserve;
+        const std::unique_ptr<Routes> fitted =
+            options.max_bytes
+                ? fit_to_budget(std::move(whole), options, fixed_bytes, choice, report)
+                : std::move(whole);
+        Routes& routes = *fitted;
+        export_steps(routes, options, temporary, choice, fixed_bytes, report);
         page["api/archive"] = site_index(routes, report, choice.second);
         page["README.txt"] = readme_text(routes.archive.root().filename().string(), report);
         const SiteFiles cinema = cinema_files(routes.archive.root(), report.steps, choice.second);

@@ -25,10 +25,12 @@ namespace insitu::viewer {
 struct ExportOptions {
     std::string archive;
     std::filesystem::path out;
-    std::vector<std::int64_t> steps;          ///< empty: every step the archive lists
-    std::vector<int> views;                   ///< empty: every view
-    std::optional<std::uintmax_t> max_bytes;  ///< the whole site at most this many bytes
-    bool replace = false;                     ///< an existing `out` is replaced, else refused
+    std::vector<std::int64_t> steps;  ///< empty: every step the archive lists
+    std::vector<int> views;           ///< empty: every view
+    /// The whole site at most this many bytes: light fields, then steps (evenly over the run)
+    /// left out where all does not fit (export_fit.hpp).
+    std::optional<std::uintmax_t> max_bytes;
+    bool replace = false;  ///< an existing `out` is replaced, else refused
 };
 
 /// A file of the site: its path under the site's root and its bytes.
@@ -38,6 +40,8 @@ struct ExportReport {
     std::vector<std::int64_t> steps;  ///< exported
     /// Steps left out and why: damaged (what failed to read), or over --max-bytes.
     std::vector<std::pair<std::int64_t, std::string>> left_out;
+    /// Representations left out of every step to fit --max-bytes, and why (export_fit.hpp).
+    std::vector<std::string> omitted;
     std::uintmax_t bytes = 0;  ///< the site's files together
     std::size_t files = 0;
     std::string thumbnail;  ///< the first exported step's preview (first view), in the site

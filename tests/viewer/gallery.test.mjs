@@ -72,9 +72,9 @@ after(async () => {
 
 /// Exports `from`, serves the gallery and opens it: {page, requests, errors, url}, once the
 /// page draws in the browser.
-async function openGallery(from, name) {
+async function openGallery(from, name, args = []) {
   const out = path.join(workDir, name);
-  const result = exportGallery(from, out);
+  const result = exportGallery(from, out, args);
   assert.equal(result.status, 0, `export: ${result.stderr}`);
   const server = await staticServer(out);
   servers.push(server);
@@ -89,7 +89,7 @@ async function openGallery(from, name) {
   // From navigation to the first frame shown, on the page's clock.
   const firstFrameMs = await page.evaluate(() => window.insituViewer.firstFrameAt);
   await waitForSettledFrame(page);
-  return { page, requests, errors, url: server.url, firstFrameMs };
+  return { page, requests, errors, url: server.url, firstFrameMs, stdout: result.stdout };
 }
 
 /// Every request the page made stayed inside the gallery (its own blob: URLs aside).
@@ -241,6 +241,38 @@ test('a gallery of an attenuation light field edits an orbit view on the light f
     assertContained(requests, url);
     assert.deepEqual(errors, []);
     await page.close();
+  });
+
+test('--max-bytes leaves the light fields out before any step; the page orbits without them',
+  async () => {
+    // Both steps with their light fields take about 5 MB, without them about 1.5 MB.
+    const { page, requests, errors, url, stdout } =
+      await openGallery(archive, 'no-light-field', ['--max-bytes', '3M']);
+    assert.match(stdout, /left out: light fields of every step \(\d+ bytes\): over --max-bytes/);
+    const index = JSON.parse(readFileSync(path.join(workDir, 'no-light-field', 'api', 'archive')));
+    assert.deepEqual(index.exported.steps, [300, 600], 'every step kept');
+    assert.equal(index.exported.omitted.length, 1);
+    const info = JSON.parse(readFileSync(path.join(workDir, 'no-light-field', 'data', '300_0',
+      'step.json')));
+    assert.equal(info.light_field_segments, 0, 'the step says it has no light field');
+    // Turned, the view is synthesised from its proxies, as render does without a light field.
+    await orbitTo(page, Math.round(info.azimuth + 20), Math.round(info.elevation));
+    const orbit = await browserFrameMatches(page, binary, archive, workDir, 'orbit', MIN_PSNR_DB,
+      'synthesised view', { source: 'single' });
+    const next = await settle(page, async () => {
+      await page.focus('#step');
+      await page.keyboard.press('ArrowRight');
+    });
+    assert.equal(next.step, '600');
+    console.log(`gallery without light fields: orbit ${orbit.psnr.toFixed(1)} dB`);
+    assert.ok(!requests.some((r) => r.includes('lightfield')), 'no light field asked for');
+    assertContained(requests, url);
+    assert.deepEqual(errors, []);
+    await page.close();
+    // Below both steps without their light fields: the first step alone.
+    const one = exportGallery(archive, path.join(workDir, 'one-step'), ['--max-bytes', '1200k']);
+    assert.equal(one.status, 0, one.stderr);
+    assert.match(one.stdout, /1 step,.*\nleft out: step 600: over --max-bytes 1200000/);
   });
 
 test('a gallery of a compressed field orbits and takes any transfer function', async () => {

@@ -473,6 +473,16 @@ ArchiveReader ArchiveReader::without_views(
     return ArchiveReader(path_, diagnostics_, std::move(manifest), manifest_readable_);
 }
 
+ArchiveReader ArchiveReader::without(const ArchiveOmissions& omitted) const {
+    if (!omitted.any()) return *this;
+    auto manifest = std::make_shared<nlohmann::json>(*manifest_);
+    for (nlohmann::json& step : (*manifest)["steps"]) {
+        if (omitted.light_fields) step.erase("light_fields");
+        if (omitted.volumes) step.erase("volumes");
+    }
+    return ArchiveReader(path_, diagnostics_, std::move(manifest), manifest_readable_);
+}
+
 void ArchiveReader::verify_cinema_csv(const fs::path& root, const std::set<fs::path>& checked,
                                       std::vector<std::string>& problems) const {
     // data.csv must have a row per manifest step x view naming the manifest's files, and every

@@ -77,8 +77,9 @@ ColourSource parse_colour_source(const std::string& text) {
     fail<InvalidArgument>("colour = \"", text, "\" (expected auto, model or recompose)");
 }
 
-Explorer::Explorer(const std::string& archive_path, std::shared_ptr<ComputeDevice> device)
-    : path_(archive_path), device_(std::move(device)), steps_(archive_path) {}
+Explorer::Explorer(const std::string& archive_path, std::shared_ptr<ComputeDevice> device,
+                   ArchiveOmissions omitted)
+    : path_(archive_path), device_(std::move(device)), steps_(archive_path, omitted) {}
 
 Explorer::~Explorer() = default;
 

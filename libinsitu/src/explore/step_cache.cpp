@@ -10,12 +10,14 @@
 
 namespace insitu {
 
-StepCache::StepCache(const std::string& archive_path)
-    : path_(archive_path), archive_(std::make_unique<ArchiveReader>(archive_path)) {}
+StepCache::StepCache(const std::string& archive_path, ArchiveOmissions omitted)
+    : path_(archive_path),
+      omitted_(omitted),
+      archive_(std::make_unique<ArchiveReader>(ArchiveReader(archive_path).without(omitted))) {}
 
 void StepCache::refresh() {
     // Steps are immutable once the manifest names them, so the cached frames stay valid.
-    archive_ = std::make_unique<ArchiveReader>(path_);
+    archive_ = std::make_unique<ArchiveReader>(ArchiveReader(path_).without(omitted_));
     attenuation_resolution_.reset();
 }
 

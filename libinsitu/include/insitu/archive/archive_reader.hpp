@@ -72,6 +72,14 @@ struct VolumeGrid {
 /// depth) or only its size (what `info` checks when it opens an archive).
 enum class CheckDepth { bytes, sizes };
 
+/// Representations a reader leaves out of the archive's index (ArchiveReader::without): a
+/// gallery that publishes a run without them reads it as if it had none.
+struct ArchiveOmissions {
+    bool light_fields = false;
+    bool volumes = false;  ///< compressed fields
+    bool any() const { return light_fields || volumes; }
+};
+
 /// What ArchiveReader::check() found.
 struct ArchiveCheck {
     /// One line per problem, each naming its file (verify()'s list).
@@ -180,6 +188,9 @@ public:
     /// left without views goes too): what stays readable of a damaged archive, for tools that
     /// show it (`views` from check()).
     ArchiveReader without_views(const std::set<std::pair<std::int64_t, int>>& views) const;
+    /// The same archive with the representations `omitted` names left out of every step's index
+    /// entry: what `insitu-view export --max-bytes` publishes when they do not fit.
+    ArchiveReader without(const ArchiveOmissions& omitted) const;
 
 private:
     ArchiveReader(std::string path, std::vector<std::string> diagnostics,

@@ -176,9 +176,11 @@ class VolumeFrames;
 
 class Explorer {
 public:
-    /// Opens the archive (IoError/ParseError name the file).
+    /// Opens the archive (IoError/ParseError name the file); `omitted`: representations it
+    /// reads as absent (a gallery published without them).
     explicit Explorer(const std::string& archive_path,
-                      std::shared_ptr<ComputeDevice> device = ComputeDevice::shared());
+                      std::shared_ptr<ComputeDevice> device = ComputeDevice::shared(),
+                      ArchiveOmissions omitted = {});
     ~Explorer();
 
     /// Re-reads the manifest so steps a running simulation wrote since appear.

@@ -27,7 +27,8 @@ struct CachedStep {
 class StepCache {
 public:
     /// Opens the archive (IoError/ParseError name the file).
-    explicit StepCache(const std::string& archive_path);
+    /// `omitted`: representations read as absent (ArchiveReader::without).
+    explicit StepCache(const std::string& archive_path, ArchiveOmissions omitted = {});
 
     /// Re-reads the manifest so steps a running simulation wrote since appear.
     void refresh();
@@ -55,6 +56,7 @@ private:
     };
 
     std::string path_;
+    ArchiveOmissions omitted_;
     std::unique_ptr<ArchiveReader> archive_;
     std::list<CachedStep> steps_;  ///< most recently used first
     std::optional<CachedLightField> light_field_;
