@@ -156,6 +156,26 @@ std::optional<std::vector<double>> light_field_intervals(const ServedArchive& ar
     return std::nullopt;
 }
 
+/// `recipes` (name -> recipe object) with each member value stored once: {"members": [values],
+/// "recipes": {name: {key: index into members}}}. The 96 variants share most of their members
+/// (the trust terms, the stored colours), so this is a fraction of the plain object;
+/// viewer/web/source.js expandRecipes undoes it.
+json shared_members(const json& recipes) {
+    json members = json::array();
+    std::map<std::string, std::size_t> index_of;  // a member's dump -> its index
+    json shared = json::object();
+    for (const auto& [name, recipe] : recipes.items()) {
+        json keys = json::object();
+        for (const auto& [key, value] : recipe.items()) {
+            const auto [found, added] = index_of.emplace(value.dump(), members.size());
+            if (added) members.push_back(value);
+            keys[key] = found->second;
+        }
+        shared[name] = keys;
+    }
+    return {{"members", members}, {"recipes", shared}};
+}
+
 /// What the page reads of one (step, view), under data/S_V/; throws (naming the part) where the
 /// archive cannot give it.
 SiteFiles step_files(Routes& routes, std::int64_t step, int view) {
@@ -200,7 +220,7 @@ SiteFiles step_files(Routes& routes, std::int64_t step, int view) {
                 headers[name] = value;
             }
         }
-        json recipes = step_recipes(routes, key, info);
+        json recipes = shared_members(step_recipes(routes, key, info));
         recipes["frame_headers"] = headers;
         files[dir + "recipes.json"] = recipes.dump();
     }
@@ -232,9 +252,9 @@ std::string readme_text(const std::string& name, const ExportReport& report) {
         text << "Left out: step " << step << ": " << why << "\n";
     }
     for (const std::string& what : report.omitted) text << "Left out: " << what << "\n";
-    text << "\nWhat needs `insitu-view serve` instead: a 2D transfer function, segment fades with\n"
-         << "lights or occlusion, and the frames a browser without WebGL2 would ask the server "
-            "for.\n\n"
+    text << "\nWhat needs `insitu-view serve` instead: light-field segment fades with lights or\n"
+         << "occlusion, and the frames a browser without WebGL2 would ask the server for. A 2D\n"
+         << "transfer function needs a step with a compressed field, here as in serve.\n\n"
          << "data.csv and previews/ are the run's Cinema database (Spec D): Cinema viewers open\n"
          << "this folder too.\n";
     return text.str();

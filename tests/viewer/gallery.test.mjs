@@ -18,7 +18,7 @@ import { cpSync, readdirSync, readFileSync, truncateSync, writeFileSync } from '
 import path from 'node:path';
 import { after, before, test } from 'node:test';
 
-import { galleryRecipe } from '../../viewer/web/source.js';
+import { expandRecipes, galleryRecipe } from '../../viewer/web/source.js';
 import {
   browserFrameMatches, CHROMIUM, decodePng, differingSamples, env, lightFieldFrameMatches,
   loadPlaywright, makeWorkDir, psnrPremultiplied, renderWithCli, startServer, stopServer,
@@ -188,15 +188,15 @@ test('a gallery of a light-field run draws the served page\'s frames from static
     const later = await browserFrameMatches(page, binary, archive, workDir, 'step 600',
       MIN_PSNR_DB, 'stored view');
     results.push(`step 600 ${later.psnr.toFixed(1)} dB`);
-    // A 2D function's terms only the engine makes: the gallery says so, naming serve (last:
-    // the editor is off for such a function).
+    // A 2D function over the view's proxies: refused as serve refuses it (last: the editor is
+    // off for such a function).
     const tf2d = path.join(workDir, 'tf2d.json');
     writeFileSync(tf2d, JSON.stringify({ unit_length: 1, gradient_rows: [
       { gradient_magnitude: 0, points: [[0, 0.1, 0.2, 0.9, 0], [0.45, 0.9, 0.3, 0.1, 0.4]] },
       { gradient_magnitude: 1, points: [[0, 0.9, 0.2, 0.1, 0], [0.45, 0.1, 0.3, 0.9, 0.4]] }] }));
     await page.setInputFiles('#tf-file', tf2d);
     await page.waitForFunction(() => document.getElementById('error').textContent
-      .includes('insitu-view serve'));
+      .includes('is 2D; per-interval summaries need a function of the value only'));
     console.log(`gallery (light field) vs insitu-view render: ${results.join(', ')}`);
     assertContained(requests, url);
     assert.deepEqual(errors, []);
@@ -391,7 +391,8 @@ async function recipesMatch(from, name) {
   assert.equal(exportGallery(from, out).status, 0);
   const index = JSON.parse(readFileSync(path.join(out, 'api', 'archive')));
   const step = String(index.timeline[0].step);
-  const recipes = JSON.parse(readFileSync(path.join(out, 'data', `${step}_0`, 'recipes.json')));
+  const recipes = expandRecipes(JSON.parse(readFileSync(path.join(out, 'data', `${step}_0`,
+    'recipes.json'))));
   const server = await startServer(binary, from);
   try {
     // The page's description of the step is the gallery's (serve's, with what the export adds).
@@ -416,8 +417,18 @@ async function recipesMatch(from, name) {
         ? Number(v.toPrecision(12)) : v)));
       assert.deepEqual(rounded(made), rounded(served), JSON.stringify(extra));
     }
-    // What only the engine estimates: the gallery says it cannot, rather than drawing it.
-    assert.equal(galleryRecipe(recipes, { step, view: '0', tf: '{"gradient_rows": []}' }, false,
+    // What serve refuses, the gallery refuses: a 2D function over proxies or a light field.
+    const tf2d = { step, view: '0', tf: JSON.stringify({ unit_length: 1, gradient_rows: [
+      { gradient_magnitude: 0, points: [[0, 0.1, 0.2, 0.9, 0], [0.45, 0.9, 0.3, 0.1, 0.4]] },
+      { gradient_magnitude: 1, points: [[0, 0.9, 0.2, 0.1, 0], [0.45, 0.1, 0.3, 0.9, 0.4]] }] }) };
+    const servedRefusal = await fetch(`${server.url}api/recipe`,
+      { method: 'POST', body: new URLSearchParams(tf2d) });
+    assert.equal(servedRefusal.status, 400);
+    assert.match((await servedRefusal.json()).error, /is 2D; per-interval summaries need/);
+    assert.throws(() => galleryRecipe(recipes, tf2d, false, info),
+      /is 2D; per-interval summaries need/);
+    // What only the engine makes: the gallery says it cannot, rather than drawing it.
+    assert.equal(galleryRecipe(recipes, { step, view: '0', 'segment-opacity': '0=0.5' }, false,
       info), null);
     assert.throws(() => galleryRecipe(recipes, { step, view: '0', 'opacity-scale': '99=0.5' },
       false, info), /opacity-scale interval 99/);

@@ -7,8 +7,8 @@
 // lambda and gamma, an edit's per-interval scales and colours: tf_estimate.js) the page sets
 // here itself, as Explorer::recipe does, an edit over a light field on the light field's own
 // intervals (step.json's light_field_intervals). A compressed field takes any transfer function
-// (the page ray-marches it). Only the engine makes a 2D function's terms and frames with segment
-// fades and lights; a gallery says so instead of drawing them.
+// (the page ray-marches it); proxies and light fields take 1D ones, in serve as here. Only the
+// engine makes frames with segment fades and lights; a gallery says so instead of drawing them.
 
 import {
   intervalColours, intervalColourSpread, opacityScalesOf, parseTf, sameColours,
@@ -73,7 +73,31 @@ function galleryFile(step, view, name) {
   return galleryJson.get(key);
 }
 
-const stepRecipes = (step, view) => galleryFile(step, view, 'recipes.json');
+/// A gallery's recipes.json as name -> recipe: the file stores each member value once
+/// ({members, recipes: {name: {key: index}}}, static_site.cpp shared_members); the frame's
+/// headers beside them.
+export function expandRecipes(file) {
+  const recipes = { frame_headers: file.frame_headers };
+  for (const [name, keys] of Object.entries(file.recipes)) {
+    recipes[name] = Object.fromEntries(Object.entries(keys).map(([key, i]) =>
+      [key, file.members[i]]));
+  }
+  return recipes;
+}
+
+const expandedRecipes = new Map();  // "step_view" -> Promise of expandRecipes' result
+
+function stepRecipes(step, view) {
+  const key = `${step}_${view}`;
+  if (!expandedRecipes.has(key)) {
+    expandedRecipes.set(key, galleryFile(step, view, 'recipes.json').then(expandRecipes)
+      .catch((error) => {
+        expandedRecipes.delete(key);
+        throw error;
+      }));
+  }
+  return expandedRecipes.get(key);
+}
 
 const DEFAULT_LIGHT = { diffuse: 0.8, specular: 0.3, shininess: 32 };  // relighting.hpp's Light
 const DEFAULT_AMBIENT = 0.2;
@@ -164,14 +188,21 @@ export function opacityScales(text, count) {
 
 /// An edit's per-interval terms on the recipe of an edit of the same kind: the scales (of the
 /// edited function, times the explicit ones), the colours, their spread and the colour source
-/// (Explorer::recipe's add_edit, frame_plan.cpp plan_edit); null where only the engine can (a 2D
-/// function; a light field's intervals where the gallery's step.json lacks them).
+/// (Explorer::recipe's add_edit, frame_plan.cpp plan_edit); null where only the engine can (a
+/// light field's intervals where the gallery's step.json lacks them). A 2D function is refused
+/// as serve refuses it.
 function applyEdit(recipe, rest, info, model) {
   const count = recipe.opacity_scales.length;
   let scales = new Array(count).fill(1);
   let coloursChanged = false;
   if (rest.tf) {
-    const shown = parseTf(JSON.parse(rest.tf));
+    const shownJson = JSON.parse(rest.tf);
+    // serve refuses it the same way: scales and colours per interval are a 1D function's.
+    if (shownJson && shownJson.gradient_rows) {
+      throw new Error('the edited transfer function is 2D; per-interval summaries need a ' +
+        'function of the value only (a step with a compressed field renders it)');
+    }
+    const shown = parseTf(shownJson);
     const stored = parseTf(info.transfer_function);
     // Over a light field, its own intervals (the gallery's step.json has them).
     const edges = recipe.light_field ? info.light_field_intervals : info.intervals;
@@ -254,7 +285,17 @@ export async function fetchFrame(what, options) {
     return fetch(`api/${what}`, { method: 'POST', body: new URLSearchParams(options) });
   }
   const { step, view, session, ...rest } = options;
-  if (Object.keys(rest).length) return refused(501, SERVE_ONLY);
+  if (Object.keys(rest).length) {
+    // Options serve would refuse (the recipe's error: a 2D function over proxies) are refused
+    // as serve refuses them; the rest only the engine draws.
+    try {
+      const info = await galleryFile(step, view, 'step.json');
+      galleryRecipe(await stepRecipes(step, view), options, false, info);
+    } catch (error) {
+      return refused(400, error.message);
+    }
+    return refused(501, SERVE_ONLY);
+  }
   const response = await fetch(`data/${step}_${view}/${what === 'mask' ? 'mask' : 'frame'}.png`);
   if (!response.ok) return response;
   const headers = (await stepRecipes(step, view)).frame_headers || {};
