@@ -3,6 +3,7 @@
 //
 //   mpirun -np N bench_mpi [--size 128] [--image 256] [--steps 5] [--layers 4] [--intervals 16]
 //                          [--archive DIR] [--latency-us A --bandwidth-gbs B] [--radix K]
+//                          [--light-field CAMERAS --light-field-size S --segments none|layers]
 //
 // Every rank steps its block of the Gray-Scott box (examples/gray_scott_mpi: a periodic process
 // grid, halo exchange) and hands it to one Instrument over insitu::mpi::communicator, every step
@@ -17,6 +18,9 @@
 //                 model below is the transfer alone;
 //   execute ms    execute_seconds: the time the simulation waited in execute();
 //   MB sent, MB received: payload bytes between ranks.
+// --light-field adds a light field of CAMERAS cameras and S^2 maps (segments split at the layers
+// or none) to every step: each rank then marches each camera up to three times, and the three
+// exchanges of insitu/parallel/light_field_compositing.hpp count as composite ms.
 // Rank 0 prints the steps (the slowest rank's times, the bytes of all ranks), then one row per
 // rank: best / median / spread (max - min) over the steps, the bench/median_time.hpp way.
 //
@@ -57,6 +61,7 @@
 #include "arguments.hpp"
 #include "gray_scott_mpi_simulation.hpp"
 #include "insitu/config.hpp"
+#include "insitu/core/light_field.hpp"
 #include "insitu/core/transfer_function.hpp"
 #include "insitu/device/compute_device.hpp"
 #include "insitu/field.hpp"
@@ -77,8 +82,11 @@ struct Options {
     int intervals = 16;
     int radix = 8;
     std::string archive = "/dev/shm/bench-mpi.cdb";
-    double latency_us = 0.0;     ///< 0: measure
-    double bandwidth_gbs = 0.0;  ///< 0: measure
+    double latency_us = 0.0;      ///< 0: measure
+    double bandwidth_gbs = 0.0;   ///< 0: measure
+    int light_field_cameras = 0;  ///< 0: no light field
+    int light_field_size = 64;
+    std::string segments = "none";
 };
 
 Options parse(int argc, char** argv) {
@@ -101,6 +109,15 @@ Options parse(int argc, char** argv) {
             options.radix = cli::parse_integer<int>(flag, value, 2, 64);
         } else if (flag == "--archive") {
             options.archive = value;
+        } else if (flag == "--light-field") {
+            options.light_field_cameras = cli::parse_integer<int>(flag, value, 12, 642);
+        } else if (flag == "--light-field-size") {
+            options.light_field_size = cli::parse_integer<int>(flag, value, 8, 4096);
+        } else if (flag == "--segments") {
+            if (value != "none" && value != "layers") {
+                throw cli::UsageError(flag + " " + value + ": must be none or layers");
+            }
+            options.segments = value;
         } else if (flag == "--latency-us" || flag == "--bandwidth-gbs") {
             const double parsed = cli::parse_finite(flag, value);
             if (!(parsed > 0.0)) throw cli::UsageError(flag + " " + value + ": must be > 0");
@@ -148,6 +165,15 @@ insitu::InstrumentConfig make_config(const Options& options) {
     config.every = 1;
     config.precision = insitu::StoragePrecision::single;
     config.archive = options.archive;
+    if (options.light_field_cameras > 0) {
+        insitu::LightFieldSettings light_field;
+        light_field.cameras = options.light_field_cameras;
+        light_field.size = options.light_field_size;
+        light_field.segments = options.segments == "layers" ? insitu::SegmentRule::layers
+                                                            : insitu::SegmentRule::whole_ray;
+        light_field.validate();
+        config.light_field = light_field;
+    }
     return config;
 }
 
@@ -310,6 +336,11 @@ int run(const Options& options) {
             ranks, grid[0], grid[1], grid[2], options.size, block[0], block[1], block[2],
             options.image, options.image, options.layers, options.intervals, options.steps,
             insitu::ComputeDevice::shared()->description().c_str());
+        if (options.light_field_cameras > 0) {
+            std::printf("light field: %d cameras, %d^2 maps, segments %s\n",
+                        options.light_field_cameras, options.light_field_size,
+                        options.segments.c_str());
+        }
     }
 
     simulation.step();

@@ -64,7 +64,7 @@ __kernel void render_proxies(
     int segment_count, __global const float* segment_thresholds, float depth_threshold,
     __global float4* segment_rgba_out, __global float* segment_depth_out,
     __global float* first_hit_out, __global const uchar* skippable_blocks, int4 block_counts,
-    int block_size, __global float* fragment_out) {
+    int block_size, __global float* fragment_out, __global const float* front_in) {
     const int x = get_global_id(0);
     const int y = get_global_id(1);
     if (x >= size.x || y >= size.y) return;
@@ -141,6 +141,34 @@ __kernel void render_proxies(
     float ray_transmittance = 1.0f;
     float first_hit = INFINITY;
 
+    // A block's light-field pass (WANT_FRONT) continues the march where the blocks in front of
+    // it left it (insitu/parallel/light_field_compositing.hpp): the ray's transmittance, the
+    // isovalues crossed, the sample just in front, and the transmittance in front of the segment
+    // the ray enters in, which its depth threshold reads (its colour starts here from T = 1 and
+    // composites over the front's).
+    float previous_value = NAN;
+    int entry_segment = 0;
+    float entry_segment_front = 1.0f;
+    if ((wanted & WANT_FRONT) != 0) {
+        const float4 front = vload4(pixel, front_in);
+        ray_transmittance = front.x;
+        entry_segment_front = front.y;
+        const int crossed = (int)front.z;
+        for (int l = 0; l < layer_count; ++l) {
+            if (((crossed >> l) & 1) != 0) {
+                layer_t[l] = 0.0f;
+                ++layers_found;
+            }
+        }
+        previous_value = front.w;
+        if (segment_rule == SEGMENTS_LAYERS) entry_segment = layers_found;
+        while (segment_rule == SEGMENTS_OPACITY && entry_segment + 1 < segment_count &&
+               1.0f - ray_transmittance >= segment_thresholds[entry_segment]) {
+            ++entry_segment;
+        }
+    }
+    float segment_front = entry_segment == 0 ? entry_segment_front : 1.0f;
+
     float transmittance = 1.0f;
     float owned_t_exit;
     const int first_sample =
@@ -151,7 +179,6 @@ __kernel void render_proxies(
         // and the whole ray's (which only opacity thresholds and the first hit read).
         bool compositing_segment = want_segments;
         bool compositing_ray = want_segments;
-        float previous_value = NAN;
         float previous_t = 0.0f;
         float next_block_t = -INFINITY;  // t where the ray leaves the block looked up last
         for (int i = first_sample;; ++i) {
@@ -216,6 +243,7 @@ __kernel void render_proxies(
                     segment = sample_segment;
                     segment_colour = (float3)(0.0f);
                     segment_transmittance = 1.0f;
+                    segment_front = segment == entry_segment ? entry_segment_front : 1.0f;
                     segment_depth = INFINITY;
                     compositing_segment = true;
                 }
@@ -255,7 +283,8 @@ __kernel void render_proxies(
                 }
                 if (alpha > 0.0f && compositing_segment) {
                     segment_colour += absorb(&segment_transmittance, alpha) * classified.xyz;
-                    if (isinf(segment_depth) && 1.0f - segment_transmittance >= depth_threshold) {
+                    if (isinf(segment_depth) &&
+                        1.0f - segment_front * segment_transmittance >= depth_threshold) {
                         segment_depth = sample_depth(&ray, t);
                     }
                     if (1.0f - segment_transmittance >= stop_opacity) compositing_segment = false;
@@ -344,7 +373,8 @@ __kernel void render_proxies(
         fragment[5] = fragment_depth_last;
         fragment[6] = fragment_t_first;
         fragment[7] = fragment_t_last;
-        fragment[8] = transmittance;
+        // The ray's, where only segments composite (a light field's passes).
+        fragment[8] = accumulate ? transmittance : ray_transmittance;
     }
 }
 
@@ -439,7 +469,7 @@ __kernel void render_proxies_packets(
     __global const float* segment_thresholds, float depth_threshold,
     __global float4* segment_rgba_out, __global float* segment_depth_out,
     __global float* first_hit_out, __global const uchar* skippable_blocks, int4 block_counts,
-    int block_size, __global float* fragment_out) {
+    int block_size, __global float* fragment_out, __global const float* front_in) {
     const int gx = get_global_id(0);
     const int gy = get_global_id(1);
     if (gx * PACKET_W >= size.x || gy * PACKET_H >= size.y) return;

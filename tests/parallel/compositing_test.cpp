@@ -313,7 +313,8 @@ TEST(Compositing, BlocksThatSeeNothingAddNothing) {
     for (float d : nothing.depth_layers.at(0).pixels) ASSERT_TRUE(std::isinf(d));
 }
 
-TEST(Compositing, RefusesLightFieldSegmentsForABlock) {
+// A block's segments need the state in front of it (composite_light_field_pass finds it).
+TEST(Compositing, RefusesLightFieldSegmentsForABlockWithoutTheStateInFront) {
     const SampledVolume volume = make_gaussian_blobs({16, 16, 16}, 3, 1);
     const std::vector<Block> blocks = cut_blocks(volume, {8}, {}, {}, false);
     const Decomposition grid = decompose_blocks(blocks);
@@ -327,7 +328,8 @@ TEST(Compositing, RefusesLightFieldSegmentsForABlock) {
                         request);
         FAIL() << "segments of a block were rendered";
     } catch (const InvalidArgument& error) {
-        EXPECT_NE(std::string(error.what()).find("not composited across blocks"), std::string::npos)
+        EXPECT_NE(std::string(error.what()).find("need the state in front of the block"),
+                  std::string::npos)
             << error.what();
     }
 }

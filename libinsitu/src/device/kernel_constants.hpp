@@ -32,6 +32,12 @@ constexpr int kWantInterleaving = 512;
 /// "entry_depth" proxy: where its first run begins; the edit trust compares the intervals in
 /// that order with the mean-depth order, transfer_function_edit.hpp).
 constexpr int kWantEntryDepth = 1024;
+/// A block's light-field pass reads, per pixel, the march's state where the ray enters the
+/// block (kFrontChannels floats, insitu/parallel/light_field_compositing.hpp).
+constexpr int kWantFront = 2048;
+/// Transmittance in front, the entry segment's transmittance in front, the isovalues crossed in
+/// front (bits), the value of the sample just in front (NaN when none adjoins).
+constexpr int kFrontChannels = 4;
 /// Floats per pixel of that record (kernels/render/proxy_renderer.cl writes them).
 constexpr int kFragmentChannels = 9;
 
@@ -55,7 +61,7 @@ struct KernelConstant {
 
 /// Every constant passed to the kernels. Private arrays are sized by the MAX_* limits, so they
 /// bound each work-item's private memory.
-inline constexpr std::array<KernelConstant, 19> kKernelConstants{{
+inline constexpr std::array<KernelConstant, 20> kKernelConstants{{
     {"MAX_LAYERS", kMaxLayers},        // depth layers per pass (layer_t[] in the proxy kernel)
     {"MAX_INTERVALS", kMaxIntervals},  // intensity intervals (a[] in colour model, edits)
     {"MAX_LIGHTS", kMaxLights},        // lights per relighting call (half_vectors[])
@@ -70,6 +76,7 @@ inline constexpr std::array<KernelConstant, 19> kKernelConstants{{
     {"WANT_FRAGMENT", kWantFragment},
     {"WANT_INTERLEAVING", kWantInterleaving},
     {"WANT_ENTRY_DEPTH", kWantEntryDepth},
+    {"WANT_FRONT", kWantFront},
     {"FRAGMENT_CHANNELS", kFragmentChannels},
     {"SEGMENTS_WHOLE_RAY", kSegmentsWholeRay},
     {"SEGMENTS_LAYERS", kSegmentsLayers},
@@ -84,8 +91,8 @@ static_assert(kMaxLights >= 1 && kMaxLights <= 64, "half_vectors[] is a private 
 // The wanted bits must be distinct powers of two.
 static_assert((kWantDepth | kWantDistortion | kWantAttenuation | kWantMeanDepth |
                kWantOpticalDepth | kWantSegmentRgba | kWantSegmentDepth | kWantFirstHitDepth |
-               kWantFragment | kWantInterleaving | kWantEntryDepth) == 2047,
-              "wanted bits are the eleven distinct low bits");
+               kWantFragment | kWantInterleaving | kWantEntryDepth | kWantFront) == 4095,
+              "wanted bits are the twelve distinct low bits");
 static_assert(kSegmentsWholeRay != kSegmentsLayers && kSegmentsLayers != kSegmentsOpacity &&
                   kSegmentsWholeRay != kSegmentsOpacity,
               "the kernel tells the segment rules apart by these values");

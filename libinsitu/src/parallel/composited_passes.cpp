@@ -4,6 +4,7 @@
 
 #include "core/elapsed.hpp"
 #include "insitu/parallel/compositing.hpp"
+#include "insitu/parallel/light_field_compositing.hpp"
 #include "insitu/render/distortion_camera.hpp"
 
 namespace insitu {
@@ -69,6 +70,19 @@ ProxyFrame CompositedPasses::proxies(const OrbitView& orbit, const Bounds& bound
     for (const TransferFunction& tf : request.training_transfer_functions) {
         frame.training.push_back(truth(camera, tf, request.march));
     }
+    return frame;
+}
+
+ProxyFrame CompositedPasses::light_field_pass(const Camera& camera, const ProxyRequest& request) {
+    BlockPass march;
+    if (has_block_ && !failure_.failed()) {
+        march = [&](const ProxyRequest& pass) { return renderer_.render(camera, pass); };
+    }
+    // The marches in between are not compositing: only the exchanges' time counts as that.
+    ProxyFrame frame = frame_shell(camera, 0.0, false, request);
+    failure_.always([&] {
+        frame = composite_light_field_pass(ranks_, camera, request, march, 0, &composite_seconds_);
+    });
     return frame;
 }
 

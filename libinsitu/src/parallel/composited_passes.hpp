@@ -20,6 +20,7 @@ public:
                 const RenderSettings& settings) override;
     ProxyFrame proxies(const OrbitView& orbit, const Bounds& bounds, double tilt_deg,
                        bool multi_perspective, const ProxyRequest& request) override;
+    ProxyFrame light_field_pass(const Camera& camera, const ProxyRequest& request) override;
     bool holds_results() const override { return ranks_.rank() == 0; }
     bool holds_whole_field() const override { return false; }
     void finish() override;

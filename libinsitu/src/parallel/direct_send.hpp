@@ -16,6 +16,24 @@ inline std::int64_t tile_begin(std::int64_t pixels, int tiles, int tile) {
     return pixels * tile / tiles;
 }
 
+// Runs local work and keeps the first failure: a rank whose own work fails (packing, folding,
+// unpacking) still takes part in every exchange, with nothing to send, and throws once they are
+// done: the others must not wait for it. (Its caller then agrees on the failure with them.)
+struct FirstFailure {
+    std::exception_ptr failure;
+    template <typename Work>
+    void operator()(Work&& work) {
+        try {
+            work();
+        } catch (...) {
+            if (!failure) failure = std::current_exception();
+        }
+    }
+    void rethrow() const {
+        if (failure) std::rethrow_exception(failure);
+    }
+};
+
 // Direct send: tile k of every rank's records to rank k, fold, gather the tiles at the root,
 // which hands each folded tile to unpack(begin, end, values). A rank's share of its own tile
 // and the root's own folded tile never go through the communicator (no copy of them).
@@ -26,17 +44,7 @@ void direct_send(Communicator& communicator, std::int64_t pixels, int outputs, i
     if (pixels >= std::int64_t{1} << 32) {
         fail<InvalidArgument>("compositing: ", pixels, " pixels exceed 2^32");
     }
-    // A rank whose own work fails (packing, folding, unpacking) still takes part in both
-    // exchanges, with nothing to send, and throws once they are done: the others must not wait
-    // for it. (Its caller then agrees on the failure with them.)
-    std::exception_ptr failure;
-    const auto local = [&](auto&& work) {
-        try {
-            work();
-        } catch (...) {
-            if (!failure) failure = std::current_exception();
-        }
-    };
+    FirstFailure local;  // see FirstFailure
     const int me = communicator.rank();
     std::vector<Bytes> to_each(static_cast<std::size_t>(ranks));
     Bytes own;
@@ -50,7 +58,7 @@ void direct_send(Communicator& communicator, std::int64_t pixels, int outputs, i
         }
         own = pack(begin, end);
     });
-    if (failure) to_each.assign(static_cast<std::size_t>(ranks), Bytes{});
+    if (local.failure) to_each.assign(static_cast<std::size_t>(ranks), Bytes{});
     std::vector<Bytes> received = communicator.all_to_all(to_each);
     received[me] = std::move(own);
     std::vector<float> tile;
@@ -84,7 +92,7 @@ void direct_send(Communicator& communicator, std::int64_t pixels, int outputs, i
             }
         });
     }
-    if (failure) std::rethrow_exception(failure);
+    local.rethrow();
 }
 
 }  // namespace insitu::detail

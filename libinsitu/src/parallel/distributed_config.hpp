@@ -1,8 +1,9 @@
 #pragma once
 // What a distributed run refuses at construction, on every rank alike: what one process of it
-// cannot make (a budget's ground truth, light fields, the compressed field), each named by its
-// key. (The interleaving counts and entry depths, which a block cannot count either, are on in
-// every default selection, the C++ one included, so the Instrument drops them with a notice.)
+// cannot make (a budget's ground truth), named by its key. (Light fields composite across the
+// ranks: insitu/parallel/light_field_compositing.hpp.) The interleaving counts and entry depths,
+// which a block cannot count, are on in every default selection, the C++ one included, so the
+// Instrument drops them with a notice.
 #include "insitu/config.hpp"
 
 namespace insitu {

@@ -37,6 +37,7 @@ ProxyRequest proxy_request(const LightFieldRequest& request, int segment_count) 
 
 // Camera depth (world units along forward) -> secant fraction (seed 001 Eq. 3), in place.
 void to_secant_fractions(const LightFieldRig& rig, Image& depth) {
+    if (depth.pixels.empty()) return;  // a rank of a distributed run that holds no results
     for (int y = 0; y < depth.height; ++y) {
         for (int x = 0; x < depth.width; ++x) {
             float& value = depth.at(x, y, 0);
@@ -68,6 +69,16 @@ const LightFieldImages* LightField::find(int camera) const {
 
 LightField capture_light_field(ProxyRenderer& renderer, const LightFieldRig& rig,
                                const LightFieldRequest& request) {
+    if (renderer.volume().empty()) fail<Error>("capture_light_field called before upload()");
+    return capture_light_field(
+        [&](const Camera& camera, const ProxyRequest& proxies) {
+            return renderer.render(camera, proxies);
+        },
+        rig, request);
+}
+
+LightField capture_light_field(const CameraPass& pass, const LightFieldRig& rig,
+                               const LightFieldRequest& request) {
     const LightFieldSettings& settings = request.settings;
     settings.validate();
     if (rig.camera_count() != settings.cameras || rig.map_size() != settings.size) {
@@ -81,7 +92,6 @@ LightField capture_light_field(ProxyRenderer& renderer, const LightFieldRig& rig
             "light_field.attenuation = true, but no intervals are given for "
             "the attenuation light field");
     }
-    if (renderer.volume().empty()) fail<Error>("capture_light_field called before upload()");
 
     LightField light_field;
     light_field.rig = rig;
@@ -107,7 +117,7 @@ LightField capture_light_field(ProxyRenderer& renderer, const LightFieldRig& rig
     }
     light_field.cameras.reserve(cameras.size());
     for (const int k : cameras) {
-        ProxyFrame frame = renderer.render(rig.camera(k), proxies);
+        ProxyFrame frame = pass(rig.camera(k), proxies);
         LightFieldImages images;
         images.camera = k;
         images.segment_rgba = std::move(frame.segment_rgba);

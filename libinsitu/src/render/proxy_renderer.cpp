@@ -83,11 +83,11 @@ void check_partial_request(const ProxyRequest& request, bool want_segments) {
             "cannot know which intervals the ray met in front of it");
     }
     // A segment's and the first hit's opacity thresholds depend on the opacity in front of
-    // the block, which a block does not know.
-    if (want_segments) {
+    // the block: the caller finds it (parallel/light_field_compositing.cpp).
+    if (want_segments && request.front.pixels.empty()) {
         fail<InvalidArgument>(
-            "segment and first-hit outputs (light fields) are not composited across blocks: "
-            "a block of a distributed run cannot know the opacity in front of it");
+            "segment and first-hit outputs of a block of a distributed run need the state in "
+            "front of the block (ProxyRequest::front; composite_light_field_pass finds it)");
     }
     if (request.march.early_termination_opacity < 1.0) {
         fail<InvalidArgument>(
@@ -126,6 +126,7 @@ PassPlan plan_pass(const ProxyRequest& request, bool multi_perspective, bool par
     if (request.first_hit_depth) wanted |= detail::kWantFirstHitDepth;
     if (request.interleaving) wanted |= detail::kWantInterleaving;
     if (request.entry_depth) wanted |= detail::kWantEntryDepth;
+    if (!request.front.pixels.empty()) wanted |= detail::kWantFront;
     plan.partial = partial;
     if (partial) {
         check_partial_request(request, plan.want_segments);
@@ -143,7 +144,7 @@ struct PassOutputs {
 /// The pass's inputs on the device (null buffers for those it does not read).
 struct PassInputs {
     TransferTable table;
-    cl::Buffer table_buffer, isovalues, thresholds, edges;
+    cl::Buffer table_buffer, isovalues, thresholds, edges, front;
     /// Equal-width intervals let the kernel compute the index instead of searching for it.
     double uniform_scale = 0.0;
 };
@@ -217,7 +218,7 @@ struct ProxyRenderer::DeviceState {
     detail::DeviceMemory table, isovalues, edges, thresholds, depth_out, distortion_out,
         attenuation_out, mean_depth_out, optical_depth_out, interleaving_out, entry_depth_out,
         segment_rgba_out, segment_depth_out, first_hit_out, skippable, fragment_out,
-        block_ranges_out;
+        block_ranges_out, front;
     cl::Kernel block_ranges;  ///< kernels/render/empty_space.cl
     /// Block ranges of the uploaded volume, rescanned when its generation changes.
     detail::BlockRanges blocks;
@@ -361,6 +362,7 @@ PassInputs ProxyRenderer::DeviceState::upload_inputs(detail::OpenClDevice& openc
         interval_edges.assign(request.intervals->edges().begin(), request.intervals->edges().end());
     }
     in.edges = upload_floats(opencl, edges, interval_edges, "interval edges");
+    in.front = upload_floats(opencl, front, request.front.pixels, "state in front of the block");
     if (plan.want_accumulation && request.intervals->is_uniform()) {
         in.uniform_scale = plan.interval_count / (interval_edges.back() - interval_edges.front());
     }
@@ -471,6 +473,13 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     frame.distortion_tilt_deg = tilt_deg;
     const bool partial = volume.region.has_value();
     const PassPlan plan = plan_pass(request, multi_perspective, partial);
+    const Image& front = request.front;
+    if (!front.pixels.empty() &&
+        (front.width != camera.width() || front.height != camera.height() ||
+         front.channels != detail::kFrontChannels || !partial)) {
+        fail<InvalidArgument>("ProxyRequest::front ", front, " for a ", camera.width(), "x",
+                              camera.height(), " camera", partial ? "" : " of a whole volume");
+    }
     if (plan.want_layers) frame.isovalues = request.isovalues;
     if (plan.want_accumulation) frame.intervals = request.intervals;
 
@@ -511,7 +520,7 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
         static_cast<cl_int>(request.segments), static_cast<cl_int>(plan.segments),
         inputs.thresholds, static_cast<cl_float>(request.first_hit_threshold), outputs.segment_rgba,
         outputs.segment_depth, outputs.first_hit, skipped.skippable, skipped.block_counts,
-        skipped.block_voxels, outputs.fragment);
+        skipped.block_voxels, outputs.fragment, inputs.front);
 
     download_outputs(opencl, request, plan, outputs, frame);
     return frame;

@@ -18,6 +18,9 @@ public:
     /// A view's single-perspective pass (tilt 0) or its volume distortion camera's.
     virtual ProxyFrame proxies(const OrbitView& orbit, const Bounds& bounds, double tilt_deg,
                                bool multi_perspective, const ProxyRequest& request) = 0;
+    /// A light-field camera's pass (segments, first hit, attenuation): this process's pass, or
+    /// every rank's block composited (insitu/parallel/light_field_compositing.hpp).
+    virtual ProxyFrame light_field_pass(const Camera& camera, const ProxyRequest& request) = 0;
     /// Whether this process holds the passes' results (the only process, or rank 0).
     virtual bool holds_results() const = 0;
     /// Whether renderer() holds the whole field (one process), not a rank's block of it.
@@ -51,6 +54,9 @@ public:
     }
     ProxyFrame proxies(const OrbitView& orbit, const Bounds& bounds, double tilt_deg,
                        bool multi_perspective, const ProxyRequest& request) override;
+    ProxyFrame light_field_pass(const Camera& camera, const ProxyRequest& request) override {
+        return renderer_.render(camera, request);
+    }
     bool holds_results() const override { return true; }
     bool holds_whole_field() const override { return true; }
     void finish() override { failure_.raise(); }

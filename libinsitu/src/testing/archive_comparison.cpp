@@ -158,6 +158,71 @@ std::vector<ProxyMeasurement> compare_perspective(const ArchiveReader& one,
     return compare_frames(frames[0], frames[1], tolerances);
 }
 
+/// One camera of a light field from both archives: segment colours and the attenuation as
+/// fractions, the depths (secant fractions) and mean depths relative, each with its stored step.
+std::vector<ProxyMeasurement> compare_light_field_camera(const LightFieldImages& a,
+                                                         const LightFieldImages& b, int depth_bits,
+                                                         const ArchiveTolerances& tolerances) {
+    const double stored =
+        std::max(tolerances.stored_step_absolute, tolerances.stored_step_relative);
+    ProxyFrame one;
+    ProxyFrame other;
+    one.attenuation = a.attenuation;
+    one.mean_depth = a.mean_depth;
+    other.attenuation = b.attenuation;
+    other.mean_depth = b.mean_depth;
+    mask_unseen(one, other);
+    // Depths are stored as 8-bit codes of 1/254 or as half floats (light_field.depth_bits).
+    const double depth_step =
+        depth_bits == 8 ? 1.0 / kLightFieldDepthCodeSteps : std::ldexp(1.0, -11);
+    return {
+        compare_images("segment_rgba", a.segment_rgba, b.segment_rgba, false,
+                       tolerances.attenuation + tolerances.stored_step_absolute),
+        compare_images("segment_depth", a.segment_depth, b.segment_depth, true,
+                       tolerances.depth + depth_step),
+        compare_images("first_hit", {a.depth}, {b.depth}, true, tolerances.depth + depth_step),
+        compare_images("attenuation", {one.attenuation}, {other.attenuation}, false,
+                       tolerances.attenuation + tolerances.stored_step_absolute),
+        compare_images("mean_depth", {one.mean_depth}, {other.mean_depth}, true,
+                       tolerances.depth + stored),
+    };
+}
+
+/// Every light field of `step` in both archives, camera by camera.
+std::vector<FrameComparison> compare_light_fields(const ArchiveReader& one,
+                                                  const ArchiveReader& other, std::int64_t step,
+                                                  const ArchiveTolerances& tolerances) {
+    std::vector<FrameComparison> frames;
+    const std::vector<ArchivedLightField> listed[2] = {one.light_fields(step),
+                                                       other.light_fields(step)};
+    if (listed[0].size() != listed[1].size()) {
+        ProxyMeasurement missing{"light_field", kInfinity, 0.0, {}, {}};
+        missing.mismatch = std::to_string(listed[0].size()) + " against " +
+                           std::to_string(listed[1].size()) + " light fields";
+        frames.push_back({step, 0, "light fields", {missing}});
+        return frames;
+    }
+    for (const ArchivedLightField& archived : listed[0]) {
+        const LightField a = one.load_light_field(step, archived.field);
+        const LightField b = other.load_light_field(step, archived.field);
+        for (const LightFieldImages& camera : a.cameras) {
+            const std::string name =
+                "light field \"" + archived.field + "\" camera " + std::to_string(camera.camera);
+            const LightFieldImages* theirs = b.find(camera.camera);
+            if (theirs == nullptr) {
+                ProxyMeasurement missing{"light_field", kInfinity, 0.0, {}, {}};
+                missing.mismatch = "the second archive lacks the camera";
+                frames.push_back({step, 0, name, {missing}});
+                continue;
+            }
+            frames.push_back(
+                {step, 0, name,
+                 compare_light_field_camera(camera, *theirs, a.settings.depth_bits, tolerances)});
+        }
+    }
+    return frames;
+}
+
 void keep_largest(std::vector<ProxyMeasurement>& largest, ProxyMeasurement measurement,
                   const std::string& name) {
     measurement.quantity = name;
@@ -270,6 +335,13 @@ ArchiveComparison compare_archives(const std::string& expected, const std::strin
                                 {other.load_preview(step, view)}, false, tolerances.preview)}};
             keep_largest(comparison.largest, preview.measurements.front(), "preview");
             comparison.frames.push_back(std::move(preview));
+        }
+        for (FrameComparison& frame : compare_light_fields(one, other, step, tolerances)) {
+            for (const ProxyMeasurement& measurement : frame.measurements) {
+                keep_largest(comparison.largest, measurement,
+                             "light_field." + measurement.quantity);
+            }
+            comparison.frames.push_back(std::move(frame));
         }
     }
     return comparison;

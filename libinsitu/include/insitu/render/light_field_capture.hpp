@@ -19,6 +19,7 @@
 //  * attenuation light field (settings.attenuation): a_j and mean depth per interval, exactly
 //    the single-perspective proxies of proxy_renderer.hpp for that camera (mean depth in world
 //    units along the camera's forward, +inf where a_j = 0).
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -74,6 +75,12 @@ struct LightFieldRequest {
 /// Captures every camera of `rig` from the field uploaded to `renderer`. InvalidArgument names
 /// a bad setting or a missing isovalue/interval set; Error when nothing is uploaded.
 LightField capture_light_field(ProxyRenderer& renderer, const LightFieldRig& rig,
+                               const LightFieldRequest& request);
+/// The same with each camera's proxy pass made by `pass`: a distributed run's composite of every
+/// rank's block (insitu/parallel/light_field_compositing.hpp), whose images are empty on the
+/// ranks that do not hold the results (their light field then has empty images too).
+using CameraPass = std::function<ProxyFrame(const Camera& camera, const ProxyRequest& request)>;
+LightField capture_light_field(const CameraPass& pass, const LightFieldRig& rig,
                                const LightFieldRequest& request);
 
 }  // namespace insitu

@@ -74,6 +74,12 @@ struct ProxyRequest {
     std::optional<TransferFunction> transfer_function;
     /// Ground-truth renderings from the single-perspective camera.
     std::vector<TransferFunction> training_transfer_functions;
+    /// A block of a distributed run only, for its segment and first-hit outputs: per pixel the
+    /// march's state where the ray enters the block (4 channels: transmittance in front, the
+    /// entry segment's transmittance in front, the isovalues crossed in front as bits, the value
+    /// of the sample just in front or NaN), which insitu/parallel/light_field_compositing.hpp
+    /// finds. Empty: nothing in front.
+    Image front;
     /// Skip blocks of 8^3 voxels where the transfer function is transparent and no isovalue
     /// lies within the values: exact (the same proxies), only faster.
     bool skip_empty_space = true;

@@ -59,7 +59,8 @@ std::ostream& operator<<(std::ostream& out, const ProxyMeasurement& measurement)
 struct FrameComparison {
     std::int64_t step = 0;
     int view = 0;
-    std::string perspective;  ///< "single", "multi" or "preview"
+    /// "single", "multi", "preview", or "light field "<field>" camera <k>" (view 0)
+    std::string perspective;
     std::vector<ProxyMeasurement> measurements;
 };
 
@@ -77,7 +78,9 @@ struct ArchiveComparison {
 /// The largest difference of every quantity, one line.
 std::ostream& operator<<(std::ostream& out, const ArchiveComparison& comparison);
 
-/// Compares every step and view of the archives at `expected` and `actual` (paths); throws what
+/// Compares every step and view of the archives at `expected` and `actual` (paths), and every
+/// camera of their light fields (segment colours, segment and first-hit depths, attenuation and
+/// mean depth; a step's light fields listed in one archive only are a mismatch); throws what
 /// ArchiveReader throws for an archive that cannot be read.
 ArchiveComparison compare_archives(const std::string& expected, const std::string& actual,
                                    const ArchiveTolerances& tolerances = {});

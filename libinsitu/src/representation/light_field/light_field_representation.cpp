@@ -109,13 +109,16 @@ void LightFieldRepresentation::capture(const InstrumentConfig&, const FieldPlan&
                                        const FieldRecipe& recipe, StepPasses& passes,
                                        StepRecord& record) const {
     if (!recipe.light_field) return;
-    // Refused with a communicator at construction: segments have no exact composite.
-    INSITU_CHECK(passes.holds_whole_field());
     const LightFieldRequest& request = *recipe.light_field;
     const LightFieldRig rig =
         LightFieldRig::around(plan.bounds, request.settings.cameras, request.settings.size);
-    record.light_fields.push_back(
-        {plan.name, capture_light_field(passes.renderer(), rig, request)});
+    // Each camera's pass through `passes`: a distributed run composites every rank's block.
+    LightField light_field = capture_light_field(
+        [&](const Camera& camera, const ProxyRequest& proxies) {
+            return passes.light_field_pass(camera, proxies);
+        },
+        rig, request);
+    if (passes.holds_results()) record.light_fields.push_back({plan.name, std::move(light_field)});
 }
 
 void LightFieldRepresentation::choose(const FieldBudgetCheck& check, BudgetRecord& choice) const {
