@@ -124,11 +124,20 @@ export function requestFrame() {
   }
 }
 
-// A provisional frame: the server's, shown while the data the browser draws it from downloads.
+// A provisional frame: the server's, shown while the data the browser draws it from downloads,
+// or one drawn from the light field's cameras around the view while the rest download.
 function upgradable() {
   const d = viewer.displayed;
-  return Boolean(d && d.provisional && viewer.gpu &&
-    viewer.gpu.proxiesArrived(d.options.step, d.options.view));
+  if (!d || !viewer.gpu) return false;
+  const [step, view] = [Number(d.options.step), Number(d.options.view)];
+  return Boolean((d.provisional && viewer.gpu.proxiesArrived(step, view)) ||
+    (d.partial && viewer.gpu.lightFieldArrived(step, view)));
+}
+
+/// Redraws a provisional frame once what it waited for has come (unless a frame is being made:
+/// frameDone then redraws it).
+export function redrawUpgradable() {
+  if (!inFlight && upgradable()) requestFrame();
 }
 
 function serverFrame(options, provisional = false) {
@@ -305,7 +314,8 @@ function showGpuFrame(options, timing, what, colourSource) {
   if (viewer.displayed && viewer.displayed.url) URL.revokeObjectURL(viewer.displayed.url);
   viewer.displayed = { options, gpu: true, drawnFrom: what, preview, size: timing.size,
     toggle: requestedToggle, milliseconds: timing.milliseconds,
-    synthesised: what !== 'stored view', colourSource };
+    synthesised: what !== 'stored view', colourSource, partial: Boolean(timing.partial),
+    cameras: timing.cameras };
   const fps = countFrame();
   const open = viewer.gpu.lastOpen;
   // While dragging, the readout changes a few times a second (it is re-rastered each time).
@@ -314,7 +324,8 @@ function showGpuFrame(options, timing, what, colourSource) {
   readoutShownAt = now;
   $('readout').textContent =
     `frame ${timing.milliseconds.toFixed(1)} ms (WebGL2, ${what}` +
-    `${preview ? `, preview ${timing.size[0]}x${timing.size[1]}` : ''})` +
+    `${preview ? `, preview ${timing.size[0]}x${timing.size[1]}` : ''}` +
+    `${timing.partial ? `, ${timing.cameras} of ${timing.rigCameras} cameras, the rest coming` : ''})` +
     ` · ${fps.toFixed(1)} fps · step opened in ${(open.downloadMs + open.uploadMs).toFixed(0)} ms` +
     ` (${(open.bytes / 1e6).toFixed(1)} MB)` + ` · ${colourWords(what, colourSource)}`;
   showError('');

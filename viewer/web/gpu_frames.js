@@ -14,7 +14,7 @@
 
 import { reorbit, storedCamera } from './camera.js';
 import { DRAG_FRAME_MS, FrameCost } from './frame_cost.js';
-import { fetchLightField } from './light_field_data.js';
+import { fetchLightField, streamsLightField } from './light_field_data.js';
 import { LightFieldRenderer, webgl2Available } from './light_field_renderer.js';
 import { coarserProxies, fetchProxies } from './proxy_data.js';
 import { ProxyRenderer } from './proxy_renderer.js';
@@ -70,6 +70,8 @@ export class GpuFrames {
     this.proxyRenderer = proxyRenderer;  // null: frames from the view's proxies are the server's
     this.previewRenderer = previewRenderer;  // the same for previews (coarser proxies)
     this.cache = new Map();  // "step/view" -> Promise of {lightField, downloadMs} (or null)
+    // The same for the cameras around a view, sent ahead of the whole rig (streaming).
+    this.nearCache = new Map();
     this.proxyCache = new Map();  // "step/view" -> Promise of {proxies, downloadMs} (or null)
     this.uploaded = null;    // key of the light field on the GPU
     this.uploadedProxies = null;  // key of the proxies on the GPU
@@ -83,6 +85,9 @@ export class GpuFrames {
     // Whether (step, view) is still wanted once its data has come: a draw of one no longer
     // wanted resolves to {dropped: true} without touching the canvas (the page sets it).
     this.wanted = () => true;
+    // Called when the whole light field of (step, view) has come after its nearest cameras (the
+    // page redraws the frame drawn from those).
+    this.onLightField = () => {};
   }
 
   cost(kind, fullFactor = 1) {
@@ -229,18 +234,43 @@ export class GpuFrames {
       .then(({ value, downloadMs }) => ({ lightField: value, downloadMs }));
   }
 
-  /// Starts downloading what the next step draws from ahead of need: its light field and its
-  /// compressed field where this step has them (steps of one run hold the same), and its stored
-  /// view's proxies where they are drawn here and hold attenuation.
+  /// Whether the whole light field of (step, view) has arrived.
+  lightFieldArrived(step, view) {
+    return arrived(this.cache).has(`${step}/${view}`);
+  }
+
+  /// What a frame of (step, view) seen from `toward` (from the rig's centre toward the eye) draws
+  /// from now: the whole light field once it has come; before that the cameras around `toward`
+  /// (a fraction of the bytes, so the first orbit frame comes in a fraction of the time), the
+  /// whole requested once they have come (so it never delays them), to replace them. Resolves to
+  /// {lightField, downloadMs, partial, key}.
+  async streamedLightField(step, view, toward) {
+    const key = `${step}/${view}`;
+    // The whole one where it has come, or was asked for before any part.
+    if (!toward || !streamsLightField() || this.lightFieldArrived(step, view) ||
+      (this.cache.has(key) && !this.nearCache.has(key))) {
+      return { ...await this.lightField(step, view), partial: false, key };
+    }
+    const near = await cached(this.nearCache, key, () => fetchLightField(step, view, toward));
+    // A step without a light field has no whole one either.
+    if (near.value) this.lightField(step, view).then(() => this.onLightField(step, view), () => {});
+    return { lightField: near.value, downloadMs: near.downloadMs, partial: true, key: `${key}/near` };
+  }
+
+  /// Starts downloading the cameras around `toward` of (step, view) ahead of an orbit's first
+  /// frame (a drag starting), unless the whole light field is here or on its way.
+  prefetchNear(step, view, toward) {
+    this.streamedLightField(step, view, toward).catch(() => {});
+  }
+
+  /// Starts downloading what the next step draws from ahead of need: its light field (where the
+  /// user orbits: the stored view and its edits draw from the proxies) and its compressed field
+  /// where this step has them (steps of one run hold the same), and its stored view's proxies
+  /// where they are drawn here and hold attenuation.
   prefetch(step, view, { lightField = false, volume = false, proxies = false } = {}) {
     if (volume && this.volumeRenderer) this.volume(step, view).catch(() => {});
     if (lightField) this.lightField(step, view).catch(() => {});
     if (proxies && this.proxyRenderer) this.proxies(step, view).catch(() => {});
-  }
-
-  /// Whether (step, view) has a light field (downloads it if needed).
-  async has(step, view) {
-    return (await this.lightField(step, view)).lightField !== null;
   }
 
   /// Draws (step, view) from `storedCamera` (Camera::to_json) reorbited to the angles, with
@@ -251,8 +281,9 @@ export class GpuFrames {
   /// field.
   async draw(step, view, storedCamera, azimuthDeg, elevationDeg, segmentScales, dragging = false,
     recipe = null, withTrust = false) {
-    const key = `${step}/${view}`;
-    const { lightField, downloadMs } = await this.lightField(step, view);
+    const target = reorbit(storedCamera, azimuthDeg, elevationDeg);
+    const { lightField, downloadMs, partial, key } = await this.streamedLightField(step, view,
+      target.forward.map((c) => -c));
     if (!this.wanted(step, view)) return DROPPED;
     if (!lightField) return null;
     let uploadMs = 0;
@@ -285,7 +316,8 @@ export class GpuFrames {
     await this.renderer.finish();
     const milliseconds = performance.now() - started;
     cost.record(preview, milliseconds, size[0] * size[1]);
-    return { milliseconds, uploadMs, preview, size };
+    return { milliseconds, uploadMs, preview, size, partial,
+      cameras: lightField.header.present.length, rigCameras: lightField.header.cameras };
   }
 }
 
