@@ -24,16 +24,20 @@ import { VolumeRenderer } from './volume_renderer.js';
 const KEPT_STEPS = 3;  // light fields kept parsed: the shown step and the ones around it
 // While the user drags, each frame is drawn at the largest size that keeps the GPU's time for it
 // within a budget (frame_cost.js): the full frame where the GPU draws it that fast, else a
-// preview (the image scaled down by a whole factor; light fields with PREVIEW_SEARCH_STEPS
-// search steps instead of the reference's 64), and the full frame once the pointer rests. A
+// preview (the image scaled down by a whole factor, with fewer samples per ray: light fields
+// with fewer search steps than the reference's 64, volumes a longer step), and the full frame
+// once the pointer rests. A
 // software renderer such as SwiftShader takes seconds for a full light-field frame and a small
 // fraction of that for a preview; a GPU draws both quickly (bench/RESULTS.md, "Preview frames
 // while dragging in the web viewer").
-const PREVIEW_SEARCH_STEPS = 16;
 const FULL_SEARCH_STEPS = 64;  // LightFieldReconstructionSettings::search_steps' default
+// A light field's preview searches 64 / factor steps (16 or 8): previews keep 128 pixels a side
+// where fewer steps fit the budget (frame_cost.js dragPlan).
+const PREVIEW_SEARCH_FACTORS = [4, 8];
 // A volume's preview marches this many times the recipe's step (its table corrected for that
-// step, so the picture keeps its opacity), on the preview's fewer pixels.
-const PREVIEW_STEP_FACTOR = 2;
+// step, so the picture keeps its opacity), as few as the budget allows at 128 pixels a side.
+const PREVIEW_STEP_FACTORS = [2, 3, 4, 6, 8, 12, 16];
+const FULL_FRAME = Object.freeze({ divisor: 1, factor: 1 });
 const DROPPED = Object.freeze({ dropped: true });  // a draw's answer for data no longer wanted
 
 export class GpuFrames {
@@ -185,20 +189,21 @@ export class GpuFrames {
       this.lastOpen = { key, downloadMs, uploadMs, bytes: volume.bytes };
     }
     const [width, height] = stored.size;
-    const cost = this.cost(`volume/${Boolean(recipe.shading)}`, PREVIEW_STEP_FACTOR);
-    const divisor = dragging ? cost.dragDivisor(width, height, this.dragFrameMs) : 1;
+    const cost = this.cost(`volume/${Boolean(recipe.shading)}`);
+    const { divisor, factor } = dragging
+      ? cost.dragPlan(width, height, this.dragFrameMs, PREVIEW_STEP_FACTORS) : FULL_FRAME;
     const preview = divisor > 1;
     const size = [Math.max(1, Math.round(width / divisor)),
       Math.max(1, Math.round(height / divisor))];
     const camera = orbit ? reorbit({ ...stored, size }, azimuthDeg, elevationDeg)
       : { ...storedCamera(stored), width: size[0], height: size[1] };
     const settings = volumeSettings(recipe);
-    if (preview) settings.stepVoxels *= PREVIEW_STEP_FACTOR;
+    settings.stepVoxels *= factor;
     const started = performance.now();
     renderer.render(camera, tf, settings);
     await renderer.finish();
     const milliseconds = performance.now() - started;
-    cost.record(preview, milliseconds, size[0] * size[1]);
+    cost.record(preview, milliseconds, size[0] * size[1], factor);
     return { milliseconds, uploadMs, preview, size };
   }
 
@@ -303,19 +308,20 @@ export class GpuFrames {
     if (finished && !this.renderer.finishes(attenuation)) return null;
     const cost = this.cost(finished ? ['light field', attenuation, recipe.opacity_edited,
       Boolean(recipe.lighting), Boolean(recipe.ambient_occlusion), Boolean(recipe.enhancement)]
-      .join('/') : 'light field', FULL_SEARCH_STEPS / PREVIEW_SEARCH_STEPS);
-    const divisor = dragging ? cost.dragDivisor(width, height, this.dragFrameMs) : 1;
+      .join('/') : 'light field');
+    const { divisor, factor } = dragging
+      ? cost.dragPlan(width, height, this.dragFrameMs, PREVIEW_SEARCH_FACTORS) : FULL_FRAME;
     const preview = divisor > 1;
     const size = [Math.max(1, Math.round(width / divisor)),
       Math.max(1, Math.round(height / divisor))];
     const started = performance.now();
     this.renderer.render(reorbit({ ...storedCamera, size }, azimuthDeg, elevationDeg),
-      segmentScales, preview ? PREVIEW_SEARCH_STEPS : FULL_SEARCH_STEPS,
+      segmentScales, FULL_SEARCH_STEPS / factor,
       finished ? (preview ? previewRecipe(recipe, divisor) : recipe) : null,
       withTrust && !preview);
     await this.renderer.finish();
     const milliseconds = performance.now() - started;
-    cost.record(preview, milliseconds, size[0] * size[1]);
+    cost.record(preview, milliseconds, size[0] * size[1], factor);
     return { milliseconds, uploadMs, preview, size, partial,
       cameras: lightField.header.present.length, rigCameras: lightField.header.cameras };
   }
