@@ -206,12 +206,35 @@ async function drawProxies(options, dragging) {
         return null;
       }
       const what = recipe.synthesised ? 'synthesised view' : 'stored view';
-      return showGpuFrame(options, timing, what, recipe.colour_source).then(frameDone);
+      return showGpuFrame(options, timing, what, recipe.colour_source)
+        .then(() => (recipe.synthesised || timing.preview ? null : warmEdits(options, recipe)))
+        .then(frameDone);
     })
     .catch((error) => {
       showError(String(error));
       frameDone();
     });
+}
+
+let editsWarmed = false;
+
+// Once per page, after its first stored view drawn here without an edit: an opacity edit of it
+// drawn unseen (GpuFrames.warmEdits), within the frame in flight, so that the user's first edit
+// finds its passes built. A failure costs only the warm-up.
+async function warmEdits(options, recipe) {
+  if (editsWarmed || !unedited(options) || !state.scales.length) return;
+  editsWarmed = true;
+  const interval = Math.floor(state.scales.length / 2);
+  try {
+    const edited = await recipeFor({ ...options, 'opacity-scale': `${interval}=0.500` });
+    if (!edited.drawable || edited.light_field || edited.volume || edited.synthesised) return;
+    const entry = state.timeline[state.stepIndex];
+    if (await viewer.gpu.warmEdits(entry.step, state.view, edited, recipe)) {
+      viewer.editsWarmedAt = performance.now();  // for tests
+    }
+  } catch (error) {
+    console.warn(`edits not warmed up: ${error.message}`);
+  }
 }
 
 // The transfer function a volume frame classifies with, as the engine's shown function: the

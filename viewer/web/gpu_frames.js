@@ -154,6 +154,20 @@ export class GpuFrames {
     return { milliseconds, uploadMs, preview: coarse, size: camera.size };
   }
 
+  /// Draws the loaded stored view of (step, view) edited with `editRecipe` (/api/recipe of an
+  /// opacity edit), unseen: `recipe`'s frame (the one shown) is drawn over it before the canvas
+  /// is shown again. SwiftShader builds a program's code at its first draw, and the edit's trust
+  /// pass is first drawn by the first edit: without this, that edit waits about 2 s for it
+  /// (bench/RESULTS.md, "The web viewer's waits"). Resolves to whether it drew.
+  async warmEdits(step, view, editRecipe, recipe) {
+    const renderer = this.proxyRenderer;
+    if (!renderer || this.uploadedProxies !== `${step}/${view}`) return false;
+    renderer.render(editRecipe, null, true, true);
+    renderer.render(recipe, null, true, false);
+    await renderer.finish();
+    return true;
+  }
+
   /// The parsed compressed field of (step, view) with its download (and decoding) time; null
   /// where the step has none.
   volume(step, view) {
