@@ -111,7 +111,7 @@ export function requestFrame() {
   // The same options drawn the same way (toggling "draw in the browser", or the browser's
   // WebGL2 becoming ready after the first frame, redraws them).
   if (viewer.displayed && sameOptions(viewer.displayed.options, options) &&
-    !(viewer.displayed.preview && !dragging) && !upgradable() &&
+    !(viewer.displayed.preview && !dragging) && !upgradable() && !lacksConfidence() &&
     viewer.displayed.toggle === drawingToggle()) return;
   inFlight = true;
   requestedToggle = drawingToggle();
@@ -122,6 +122,12 @@ export function requestFrame() {
   } else {
     serverFrame(options);
   }
+}
+
+// A frame drawn here without its confidence while the overlay shows it: drawn again with it.
+function lacksConfidence() {
+  const d = viewer.displayed;
+  return Boolean(state.mask && d && d.gpu && !d.preview && !d.withConfidence);
 }
 
 // A provisional frame: the server's, shown while the data the browser draws it from downloads,
@@ -197,8 +203,10 @@ async function drawProxies(options, dragging) {
     serverFrame(options, viewer.gpu.proxyRenderer !== null);
     return;
   }
+  // The frame's confidence (the edit's trust pass) only where the overlay shows it: turning
+  // the overlay on draws the frame again with it (lacksConfidence).
   viewer.gpu.drawProxies(entry.step, state.view, recipe, Number(options.azimuth),
-    Number(options.elevation), dragging, true, !unedited(options))
+    Number(options.elevation), dragging, state.mask, !unedited(options))
     .then((timing) => {
       if (timing && timing.dropped) return frameDone();
       if (!timing) {
@@ -271,7 +279,7 @@ function frameDone() {
   // Also redrawn: a preview once the pointer rests, and a frame drawn before the browser's
   // WebGL2 was ready (or before "draw in the browser" was toggled).
   if (!viewer.displayed || !sameOptions(viewer.displayed.options, next) ||
-    (viewer.displayed.preview && !state.dragging) || upgradable() ||
+    (viewer.displayed.preview && !state.dragging) || upgradable() || lacksConfidence() ||
     viewer.displayed.toggle !== drawingToggle()) requestFrame();
   else if (state.playing) schedulePlay();
 }
@@ -338,7 +346,7 @@ function showGpuFrame(options, timing, what, colourSource) {
   viewer.displayed = { options, gpu: true, drawnFrom: what, preview, size: timing.size,
     toggle: requestedToggle, milliseconds: timing.milliseconds,
     synthesised: what !== 'stored view', colourSource, partial: Boolean(timing.partial),
-    cameras: timing.cameras };
+    cameras: timing.cameras, withConfidence: timing.withConfidence !== false };
   const fps = countFrame();
   const open = viewer.gpu.lastOpen;
   // While dragging, the readout changes a few times a second (it is re-rastered each time).
@@ -403,6 +411,10 @@ export async function updateMask() {
   const displayed = viewer.displayed;
   // A preview keeps the overlay it has: the full frame follows once the pointer rests.
   if (displayed.preview) return;
+  if (lacksConfidence()) {
+    requestFrame();  // drawn again with its confidence, whose overlay this call paints then
+    return;
+  }
   const options = displayed.options;
   let confidence = null;  // per pixel as the mask PNG holds it (sRGB-encoded), rows from the top
   let [width, height] = state.info ? state.info.camera.size : [0, 0];

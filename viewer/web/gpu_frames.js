@@ -38,6 +38,8 @@ const PREVIEW_SEARCH_FACTORS = [4, 8];
 // step, so the picture keeps its opacity), as few as the budget allows at 128 pixels a side.
 const PREVIEW_STEP_FACTORS = [2, 3, 4, 6, 8, 12, 16];
 const FULL_FRAME = Object.freeze({ divisor: 1, factor: 1 });
+const WHOLE_TRIES = 3;  // downloads of a whole light field after its nearest cameras
+const RETRY_MS = 500;
 const DROPPED = Object.freeze({ dropped: true });  // a draw's answer for data no longer wanted
 
 export class GpuFrames {
@@ -151,7 +153,8 @@ export class GpuFrames {
     await renderer.finish();
     const milliseconds = performance.now() - started;
     cost.record(coarse, milliseconds, camera.size[0] * camera.size[1]);
-    return { milliseconds, uploadMs, preview: coarse, size: camera.size };
+    return { milliseconds, uploadMs, preview: coarse, size: camera.size,
+      withConfidence: withConfidence && !coarse };
   }
 
   /// Draws the loaded stored view of (step, view) edited with `editRecipe` (/api/recipe of an
@@ -272,8 +275,21 @@ export class GpuFrames {
     }
     const near = await cached(this.nearCache, key, () => fetchLightField(step, view, toward));
     // A step without a light field has no whole one either.
-    if (near.value) this.lightField(step, view).then(() => this.onLightField(step, view), () => {});
+    if (near.value && !this.cache.has(key)) this.wholeLightField(step, view);
     return { lightField: near.value, downloadMs: near.downloadMs, partial: true, key: `${key}/near` };
+  }
+
+  /// Downloads the whole light field of (step, view) after its nearest cameras, and says when it
+  /// has come (onLightField); a download cut short (a page busy drawing for long stops reading,
+  /// and the server gives up on it) is tried again, WHOLE_TRIES times in all.
+  wholeLightField(step, view, tries = WHOLE_TRIES) {
+    this.lightField(step, view).then(() => this.onLightField(step, view), (error) => {
+      if (tries > 1 && this.wanted(step, view)) {
+        setTimeout(() => this.wholeLightField(step, view, tries - 1), RETRY_MS);
+      } else {
+        console.warn(`the whole light field of step ${step} did not come: ${error.message}`);
+      }
+    });
   }
 
   /// Starts downloading the cameras around `toward` of (step, view) ahead of an orbit's first
