@@ -85,3 +85,41 @@ test('the light field is fetched by need and streamed from the cameras around th
       `${psnr.toFixed(1)} dB against render`);
     assert.deepEqual(pageErrors, []);
   });
+
+test('/api/lightfield sends the cameras within an angle of a direction, and refuses bad ones',
+  async () => {
+    const { server } = session;
+    const url = `${server.url}api/lightfield?step=300&view=0`;
+    const header = async (query) => {
+      const response = await fetch(url + query);
+      assert.equal(response.status, 200, query);
+      const bytes = new Uint8Array(await response.arrayBuffer());
+      const length = new DataView(bytes.buffer).getUint32(12, true);
+      return JSON.parse(new TextDecoder().decode(bytes.subarray(16, 16 + length)));
+    };
+    const whole = await header('');
+    assert.equal(whole.present.length, whole.cameras);
+    const toward = [0.6, 0.3, -0.74];
+    const norm = Math.hypot(...toward);
+    for (const within of [30, 60, 90]) {
+      const near = await header(`&toward=${toward.join(',')}&within=${within}`);
+      // Camera k's eye lies at centre + Rc * vertex k: the angle from the centre.
+      const angle = (k) => {
+        const eye = whole.camera_frames[k].eye.map((e, i) => e - whole.center[i]);
+        const cosine = eye.reduce((sum, e, i) => sum + e * toward[i], 0) / Math.hypot(...eye) /
+          norm;
+        return Math.acos(Math.min(1, cosine)) * 180 / Math.PI;
+      };
+      const expected = whole.present.filter((k) => angle(k) <= within);
+      assert.deepEqual(near.present, expected, `the cameras within ${within} degrees`);
+      assert.ok(near.present.length > 0 && near.present.length < whole.cameras);
+    }
+    for (const [query, words] of [['&toward=0,0,0', 'toward = "0,0,0"'],
+      ['&toward=1,2', 'toward = "1,2"'], ['&toward=1,0,0&within=0', 'within = "0"'],
+      ['&toward=1,0,0&within=181', 'within = "181"'], ['&within=30', 'within: given without']]) {
+      const response = await fetch(url + query);
+      assert.equal(response.status, 400, query);
+      assert.match((await response.json()).error, new RegExp(words.replace(/[.*+?^${}()|[\]\\]/g,
+        '\\$&')), query);
+    }
+  });
