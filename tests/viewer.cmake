@@ -135,10 +135,13 @@ viewer_browser_test(proxies lf)
 # `insitu-view render --source lightfield` each time.
 viewer_light_field_archive(lf_attenuation [=[{"cameras": 42, "size": 128, "attenuation": true}]=])
 viewer_browser_test(light_field_edits lf_attenuation)
+# The light field fetched by need and streamed (issues 41, 42): streaming.test.mjs edits the
+# stored view of a new step without it, then orbits: the cameras around the view first.
+viewer_browser_test(streaming lf_attenuation)
 # The light field's depth search walks a map pixel at a time where a crossing may lie (issue 41):
 # in SwiftShader this suite took 79 s alone and 147 s beside the other viewer tests on the shared
 # 2-core machine, so the light-field suites get more than the default's 180 s.
-set_tests_properties(viewer.webgl viewer.light_field_edits PROPERTIES TIMEOUT 300)
+set_tests_properties(viewer.webgl viewer.light_field_edits viewer.streaming PROPERTIES TIMEOUT 300)
 
 # Per-segment fades (issue 15): the same run with its light field split at opacity 0.5 into two
 # segments, depth in half floats; segments.test.mjs moves the page's faders and compares the

@@ -54,7 +54,7 @@ std::string payload_etag(const char* kind, std::uint32_t version, const StepKey&
 }  // namespace
 
 void PayloadRoutes::light_field(const httplib::Request& request, httplib::Response& response) {
-    const StepKey key = step_key(request, archive_);
+    const StepKey key = step_key(request, archive_, {"toward", "within"});
     std::lock_guard<std::mutex> lock(archive_.mutex());
     const ArchiveReader& reader = archive_.reader_locked();
     const std::string field = reader.entry(key.step, key.view).field;
@@ -67,11 +67,17 @@ void PayloadRoutes::light_field(const httplib::Request& request, httplib::Respon
                                  " has no light field of field \"" + field + "\"");
     }
     archive_.require_inside(stored->exr_path);
-    send_payload(request, response,
-                 payload_etag("lf", kLightFieldPayloadVersion, key, stored->exr_path), [&] {
-                     return light_field_payload(reader.load_light_field(key.step, field), key.step,
-                                                field);
-                 });
+    // A page streams the light field: the cameras around its view first (only their parts are
+    // decoded), the whole rig after.
+    const std::vector<int> cameras = light_field_cameras(request, stored->cameras);
+    std::string subset;
+    for (const int camera : cameras) subset += "c" + std::to_string(camera);
+    const std::string etag = payload_etag(("lf" + subset + "-").c_str(), kLightFieldPayloadVersion,
+                                          key, stored->exr_path);
+    send_payload(request, response, etag, [&] {
+        return light_field_payload(reader.load_light_field(key.step, field, cameras), key.step,
+                                   field);
+    });
 }
 
 void PayloadRoutes::proxies(const httplib::Request& request, httplib::Response& response) {

@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 #include <mutex>
 
 #include "arguments.hpp"
 #include "http_boundary.hpp"
+#include "insitu/core/light_field.hpp"
 
 namespace insitu::viewer {
 namespace {
@@ -14,6 +17,7 @@ namespace {
 constexpr std::size_t kMaxLights = 8;
 constexpr double kMaxAbsAzimuthDeg = 720.0;
 constexpr std::size_t kMaxSessionLength = 64;
+constexpr double kDefaultWithinDeg = 60.0;
 
 bool is_session_character(char c) {
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' ||
@@ -35,12 +39,65 @@ std::string single_param(const httplib::Request& request, const std::string& key
     return request.get_param_value(key);
 }
 
+/// "x,y,z": three finite numbers, not all 0.
+glm::dvec3 parse_direction(const std::string& key, const std::string& text) {
+    glm::dvec3 direction{0.0};
+    std::size_t at = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+        const std::size_t comma = axis < 2 ? text.find(',', at) : text.size();
+        double value = 0.0;
+        if (comma == std::string::npos ||
+            cli::convert_finite(text.substr(at, comma - at), value) != std::errc() ||
+            !std::isfinite(value)) {
+            throw HttpError(400, key + " = \"" + text.substr(0, 64) +
+                                     "\" (expected three finite numbers x,y,z)");
+        }
+        direction[axis] = value;
+        at = comma + 1;
+    }
+    if (glm::length(direction) == 0.0) {
+        throw HttpError(400, key + " = \"" + text + "\" (a direction: not all 0)");
+    }
+    return glm::normalize(direction);
+}
+
 }  // namespace
 
-StepKey step_key(const httplib::Request& request, ServedArchive& archive) {
+std::vector<int> light_field_cameras(const httplib::Request& request, int rig_cameras) {
+    if (!request.has_param("toward")) {
+        if (request.has_param("within")) throw HttpError(400, "within: given without toward");
+        return {};
+    }
+    const glm::dvec3 toward = parse_direction("toward", single_param(request, "toward"));
+    double within_deg = kDefaultWithinDeg;
+    if (request.has_param("within")) {
+        const std::string text = single_param(request, "within");
+        if (cli::convert_finite(text, within_deg) != std::errc() || !(within_deg > 0.0) ||
+            !(within_deg <= 180.0)) {
+            throw HttpError(400, "within = \"" + text.substr(0, 64) + "\" (degrees, in (0, 180])");
+        }
+    }
+    const std::vector<glm::dvec3>& positions = Icosphere::with_vertices(rig_cameras).vertices;
+    const double least = std::cos(glm::radians(within_deg));
+    std::vector<int> cameras;
+    int nearest = 0;
+    for (int k = 0; k < static_cast<int>(positions.size()); ++k) {
+        const double cosine = glm::dot(positions[k], toward);
+        if (cosine >= least) cameras.push_back(k);
+        if (cosine > glm::dot(positions[nearest], toward)) nearest = k;
+    }
+    if (cameras.empty()) cameras.push_back(nearest);
+    return cameras;
+}
+
+StepKey step_key(const httplib::Request& request, ServedArchive& archive,
+                 const std::vector<std::string>& also) {
     for (const auto& [key, value] : request.params) {
-        if (key != "step" && key != "view") {
-            throw HttpError(400, "unknown parameter \"" + key + "\" (expected step, view)");
+        if (key != "step" && key != "view" &&
+            std::find(also.begin(), also.end(), key) == also.end()) {
+            std::string expected = "step, view";
+            for (const std::string& name : also) expected += ", " + name;
+            throw HttpError(400, "unknown parameter \"" + key + "\" (expected " + expected + ")");
         }
     }
     const std::int64_t step = parse_step_or_view("step", single_param(request, "step"));

@@ -45,3 +45,26 @@ test('a GPU that draws the full frame within the budget draws full frames while 
   lightField.record(true, 1.5, 128 * 128);
   assert.ok(lightField.dragDivisor(512, 512, BUDGET_MS) > 1, 'at 1 ms a preview, it does not');
 });
+
+test('frames that march samples thin them before their previews drop under 128 pixels', () => {
+  const factors = [2, 3, 4, 6, 8];
+  const cost = new FrameCost();
+  // Before anything is known: a 128-pixel preview with the least thinning.
+  assert.deepEqual(cost.dragPlan(512, 512, BUDGET_MS, factors), { divisor: 4, factor: 2 });
+  // SwiftShader's volume: 100 ms for a 128^2 preview at twice the step.
+  cost.record(true, 100, 128 * 128, 2);
+  const plan = cost.dragPlan(512, 512, BUDGET_MS, factors);
+  assert.ok(512 / plan.divisor >= 128, `previews stay at 128 pixels a side or more: ${plan.divisor}`);
+  const at = (p) => cost.preview * (512 / p.divisor) ** 2 / p.factor;
+  assert.ok(at(plan) <= BUDGET_MS, 'within the budget');
+  // The largest preview that fits, and at that size the least thinning that fits.
+  assert.deepEqual(plan, { divisor: 3, factor: 8 });
+  assert.ok(at({ divisor: 2, factor: 8 }) > BUDGET_MS && at({ divisor: 3, factor: 6 }) > BUDGET_MS);
+  // Slower still: below 128 pixels only with the most thinning.
+  cost.record(true, 1e4, 128 * 128, 8);
+  cost.record(true, 1e4, 128 * 128, 8);
+  const slow = cost.dragPlan(512, 512, BUDGET_MS, factors);
+  assert.deepEqual(slow, { divisor: Math.floor(512 / 48), factor: 8 });
+  // Frames without samples to thin (proxies) keep dragDivisor's sizes.
+  assert.equal(new FrameCost().dragPlan(512, 512, BUDGET_MS, [1], 48).factor, 1);
+});

@@ -180,13 +180,15 @@ export async function openViewerPage(context, url, errors) {
 
 /// Waits until `page` shows a whole frame (not a drag's preview) newer than frame number `count`
 /// whose options are the page's current ones: nothing is left to request or redraw, and the page
-/// is ready (it draws in the browser where it can; its first frame may come before, and the
-/// server's provisional frame while the step's proxies download).
+/// is ready (it draws in the browser where it can; its first frame may come before, the
+/// server's provisional frame while the step's proxies download, and a light field's frame from
+/// the cameras around the view while the rest download).
 export function waitForSettledFrame(page, count = 0, timeout = 60000) {
   return page.waitForFunction((n) => {
     const v = window.insituViewer;
     return v.readyAt !== undefined && !v.busy() &&
       v.frameCount > n && v.displayed && !v.displayed.preview && !v.displayed.provisional &&
+      !v.displayed.partial &&
       JSON.stringify(v.displayed.options) === JSON.stringify(v.options());
   }, count, { timeout });
 }

@@ -5,7 +5,10 @@
 //  * page ready: from navigation until the page draws in the browser (its shaders built);
 //  * step change: from moving the slider to the next step to its first frame shown (the step's
 //    data not downloaded before: each run opens a new page);
-//  * opacity edit: from setting an interval's opacity scale to the edited frame shown.
+//  * opacity edit: from setting an interval's opacity scale to the edited frame shown, and of
+//    that the frame's drawing (the GPU's, or the server's engine);
+//  * orbit: from turning the view 20 degrees to its first frame (of a light field: drawn from
+//    the cameras around the view), and to its settled frame (from the whole rig).
 //
 //   node tests/viewer/page_waits.mjs INSITU_VIEW ARCHIVE [RUNS] [--gpu=off]
 import { cpus } from 'node:os';
@@ -64,7 +67,30 @@ async function oneRun(browser, url) {
     start = await page.evaluate(() => window.insituViewer.setOpacityScale(
       Math.floor(window.insituViewer.intervalCount() / 2), 0.25));
     waits['opacity edit'] = await settledAfter(page, count) - start;
+    waits['  of it drawing'] = await page.evaluate(() => window.insituViewer.displayed.milliseconds);
   }
+  // The orbit without the edit (an edited orbit frame of an attenuation light field is another
+  // measure: bench/RESULTS.md).
+  if (waits['opacity edit'] !== undefined) {
+    count = await page.evaluate(() => window.insituViewer.frameCount);
+    await page.evaluate(() => window.insituViewer.setOpacityScale(
+      Math.floor(window.insituViewer.intervalCount() / 2), 1));
+    await settledAfter(page, count);
+  }
+  count = await page.evaluate(() => window.insituViewer.frameCount);
+  start = await page.evaluate(() => {
+    const azimuth = document.getElementById('azimuth');
+    azimuth.value = String(Number(window.insituViewer.state().info.azimuth) + 20);
+    const t = performance.now();
+    azimuth.dispatchEvent(new Event('change'));
+    return t;
+  });
+  await page.waitForFunction((n) => {
+    const v = window.insituViewer;
+    return v.frameCount > n && v.displayed.options.azimuth !== undefined;
+  }, count, { timeout: 120000 });
+  waits['orbit frame'] = await page.evaluate(() => performance.now()) - start;
+  waits['orbit settled'] = await settledAfter(page, count) - start;
   const drawn = await page.evaluate(() => window.insituViewer.displayed.drawnFrom || 'server');
   await page.close();
   return { waits, drawn };

@@ -76,6 +76,10 @@ function assertDrawnAndMatching(frame, what, drawnFrom = 'stored view') {
 test('the stored view and its edits drawn with WebGL2 match insitu-view render', async () => {
   await page.goto(server.url);
   let frame = await settledFrame(0);
+  // Before the user's first edit the page drew one unseen, so that the edit finds its passes
+  // built (frames.js warmEdits); the canvas still shows the stored view (compared below).
+  assert.ok(await page.evaluate(() => window.insituViewer.editsWarmedAt !== undefined),
+    'the edit passes are built before the first edit');
   assert.deepEqual(frame.options, { step: '300', view: '0' });
   assert.equal(frame.colourSource, 'stored', 'unedited: the rendering the run stored');
   const stored = assertDrawnAndMatching(frame, 'stored view');
@@ -104,6 +108,17 @@ test('the stored view and its edits drawn with WebGL2 match insitu-view render',
   assert.ok(scale > 0 && scale < 1, `scale ${scale} lowers the opacity`);
   const edited = assertDrawnAndMatching(frame, `opacity x${scale}`);
   assert.ok(differingSamples(edited, recoloured) > 0, 'the opacity edit shows');
+  // With the overlay off the edit took no trust pass; turned on, the frame is drawn again with
+  // its confidence, here in the browser.
+  assert.equal(await page.evaluate(() => window.insituViewer.gpu.proxyRenderer.loaded.confidenceOf),
+    null, 'no confidence drawn for an overlay not shown');
+  const masks = await page.evaluate(() => window.insituViewer.maskCount || 0);
+  await page.check('#mask-toggle');
+  await page.waitForFunction((n) => (window.insituViewer.maskCount || 0) > n, masks);
+  assert.deepEqual(await page.evaluate(() => [window.insituViewer.maskFrom,
+    window.insituViewer.gpu.proxyRenderer.loaded.confidenceOf]), ['browser', 'edited']);
+  await page.uncheck('#mask-toggle');
+  frame = await settledFrame(await page.evaluate(() => window.insituViewer.frameCount - 1));
 
   // 20 degrees around, with the edits: the light field (no attenuation) cannot make edited
   // views, so the view's proxies are synthesised in the new camera (Explorer's step 3), then

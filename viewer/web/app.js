@@ -9,7 +9,7 @@
 // light_field_data.js, light_field_renderer.js, camera.js and the shaders beside them.
 import { $, ARCHIVE_POLL_MS, showError, state, viewer, viewHasAttenuation } from './page.js';
 import { currentOptions } from './explore_options.js';
-import { requestFrame, updateMask } from './frames.js';
+import { redrawUpgradable, requestFrame, updateMask } from './frames.js';
 import { forgetTrust, installOrbitDrag, resetView } from './orbit.js';
 import { drawTfEditor, loadTf, resetTf, saveTf } from './tf_editor.js';
 import { askedStep, loadArchive, setPlaying, stepChanged } from './timeline.js';
@@ -122,13 +122,15 @@ async function start() {
       const now = askedStep();
       return Boolean(now && now.step === step && now.view === view);
     };
+    viewer.gpu.onLightField = redrawUpgradable;
     // The step again, now that the browser may draw from its light field or compressed field,
-    // and what its next frames draw from, fetched ahead of the first edit or drag.
+    // and what its next frames draw from, fetched ahead of the first edit (the light field by
+    // need: an orbit's first frame streams it).
     await stepChanged().catch((error) => showError(error.message));
     const asked = askedStep();
     if (asked) {
-      viewer.gpu.prefetch(asked.step, asked.view, { lightField: state.lightField,
-        volume: state.volume, proxies: viewHasAttenuation(asked.view) });
+      viewer.gpu.prefetch(asked.step, asked.view, { volume: state.volume,
+        proxies: viewHasAttenuation(asked.view) });
     }
   }
   viewer.readyAt = performance.now();  // the page draws in the browser from here (tests wait)

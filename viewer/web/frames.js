@@ -111,7 +111,7 @@ export function requestFrame() {
   // The same options drawn the same way (toggling "draw in the browser", or the browser's
   // WebGL2 becoming ready after the first frame, redraws them).
   if (viewer.displayed && sameOptions(viewer.displayed.options, options) &&
-    !(viewer.displayed.preview && !dragging) && !upgradable() &&
+    !(viewer.displayed.preview && !dragging) && !upgradable() && !lacksConfidence() &&
     viewer.displayed.toggle === drawingToggle()) return;
   inFlight = true;
   requestedToggle = drawingToggle();
@@ -124,11 +124,26 @@ export function requestFrame() {
   }
 }
 
-// A provisional frame: the server's, shown while the data the browser draws it from downloads.
+// A frame drawn here without its confidence while the overlay shows it: drawn again with it.
+function lacksConfidence() {
+  const d = viewer.displayed;
+  return Boolean(state.mask && d && d.gpu && !d.preview && !d.withConfidence);
+}
+
+// A provisional frame: the server's, shown while the data the browser draws it from downloads,
+// or one drawn from the light field's cameras around the view while the rest download.
 function upgradable() {
   const d = viewer.displayed;
-  return Boolean(d && d.provisional && viewer.gpu &&
-    viewer.gpu.proxiesArrived(d.options.step, d.options.view));
+  if (!d || !viewer.gpu) return false;
+  const [step, view] = [Number(d.options.step), Number(d.options.view)];
+  return Boolean((d.provisional && viewer.gpu.proxiesArrived(step, view)) ||
+    (d.partial && viewer.gpu.lightFieldArrived(step, view)));
+}
+
+/// Redraws a provisional frame once what it waited for has come (unless a frame is being made:
+/// frameDone then redraws it).
+export function redrawUpgradable() {
+  if (!inFlight && upgradable()) requestFrame();
 }
 
 function serverFrame(options, provisional = false) {
@@ -188,8 +203,10 @@ async function drawProxies(options, dragging) {
     serverFrame(options, viewer.gpu.proxyRenderer !== null);
     return;
   }
+  // The frame's confidence (the edit's trust pass) only where the overlay shows it: turning
+  // the overlay on draws the frame again with it (lacksConfidence).
   viewer.gpu.drawProxies(entry.step, state.view, recipe, Number(options.azimuth),
-    Number(options.elevation), dragging, true, !unedited(options))
+    Number(options.elevation), dragging, state.mask, !unedited(options))
     .then((timing) => {
       if (timing && timing.dropped) return frameDone();
       if (!timing) {
@@ -197,12 +214,35 @@ async function drawProxies(options, dragging) {
         return null;
       }
       const what = recipe.synthesised ? 'synthesised view' : 'stored view';
-      return showGpuFrame(options, timing, what, recipe.colour_source).then(frameDone);
+      return showGpuFrame(options, timing, what, recipe.colour_source)
+        .then(() => (recipe.synthesised || timing.preview ? null : warmEdits(options, recipe)))
+        .then(frameDone);
     })
     .catch((error) => {
       showError(String(error));
       frameDone();
     });
+}
+
+let editsWarmed = false;
+
+// Once per page, after its first stored view drawn here without an edit: an opacity edit of it
+// drawn unseen (GpuFrames.warmEdits), within the frame in flight, so that the user's first edit
+// finds its passes built. A failure costs only the warm-up.
+async function warmEdits(options, recipe) {
+  if (editsWarmed || !unedited(options) || !state.scales.length) return;
+  editsWarmed = true;
+  const interval = Math.floor(state.scales.length / 2);
+  try {
+    const edited = await recipeFor({ ...options, 'opacity-scale': `${interval}=0.500` });
+    if (!edited.drawable || edited.light_field || edited.volume || edited.synthesised) return;
+    const entry = state.timeline[state.stepIndex];
+    if (await viewer.gpu.warmEdits(entry.step, state.view, edited, recipe)) {
+      viewer.editsWarmedAt = performance.now();  // for tests
+    }
+  } catch (error) {
+    console.warn(`edits not warmed up: ${error.message}`);
+  }
 }
 
 // The transfer function a volume frame classifies with, as the engine's shown function: the
@@ -239,7 +279,7 @@ function frameDone() {
   // Also redrawn: a preview once the pointer rests, and a frame drawn before the browser's
   // WebGL2 was ready (or before "draw in the browser" was toggled).
   if (!viewer.displayed || !sameOptions(viewer.displayed.options, next) ||
-    (viewer.displayed.preview && !state.dragging) || upgradable() ||
+    (viewer.displayed.preview && !state.dragging) || upgradable() || lacksConfidence() ||
     viewer.displayed.toggle !== drawingToggle()) requestFrame();
   else if (state.playing) schedulePlay();
 }
@@ -305,7 +345,8 @@ function showGpuFrame(options, timing, what, colourSource) {
   if (viewer.displayed && viewer.displayed.url) URL.revokeObjectURL(viewer.displayed.url);
   viewer.displayed = { options, gpu: true, drawnFrom: what, preview, size: timing.size,
     toggle: requestedToggle, milliseconds: timing.milliseconds,
-    synthesised: what !== 'stored view', colourSource };
+    synthesised: what !== 'stored view', colourSource, partial: Boolean(timing.partial),
+    cameras: timing.cameras, withConfidence: timing.withConfidence !== false };
   const fps = countFrame();
   const open = viewer.gpu.lastOpen;
   // While dragging, the readout changes a few times a second (it is re-rastered each time).
@@ -314,7 +355,8 @@ function showGpuFrame(options, timing, what, colourSource) {
   readoutShownAt = now;
   $('readout').textContent =
     `frame ${timing.milliseconds.toFixed(1)} ms (WebGL2, ${what}` +
-    `${preview ? `, preview ${timing.size[0]}x${timing.size[1]}` : ''})` +
+    `${preview ? `, preview ${timing.size[0]}x${timing.size[1]}` : ''}` +
+    `${timing.partial ? `, ${timing.cameras} of ${timing.rigCameras} cameras, the rest coming` : ''})` +
     ` · ${fps.toFixed(1)} fps · step opened in ${(open.downloadMs + open.uploadMs).toFixed(0)} ms` +
     ` (${(open.bytes / 1e6).toFixed(1)} MB)` + ` · ${colourWords(what, colourSource)}`;
   showError('');
@@ -369,6 +411,10 @@ export async function updateMask() {
   const displayed = viewer.displayed;
   // A preview keeps the overlay it has: the full frame follows once the pointer rests.
   if (displayed.preview) return;
+  if (lacksConfidence()) {
+    requestFrame();  // drawn again with its confidence, whose overlay this call paints then
+    return;
+  }
   const options = displayed.options;
   let confidence = null;  // per pixel as the mask PNG holds it (sRGB-encoded), rows from the top
   let [width, height] = state.info ? state.info.camera.size : [0, 0];

@@ -14,7 +14,7 @@
 
 import { reorbit, storedCamera } from './camera.js';
 import { DRAG_FRAME_MS, FrameCost } from './frame_cost.js';
-import { fetchLightField } from './light_field_data.js';
+import { fetchLightField, streamsLightField } from './light_field_data.js';
 import { LightFieldRenderer, webgl2Available } from './light_field_renderer.js';
 import { coarserProxies, fetchProxies } from './proxy_data.js';
 import { ProxyRenderer } from './proxy_renderer.js';
@@ -24,16 +24,22 @@ import { VolumeRenderer } from './volume_renderer.js';
 const KEPT_STEPS = 3;  // light fields kept parsed: the shown step and the ones around it
 // While the user drags, each frame is drawn at the largest size that keeps the GPU's time for it
 // within a budget (frame_cost.js): the full frame where the GPU draws it that fast, else a
-// preview (the image scaled down by a whole factor; light fields with PREVIEW_SEARCH_STEPS
-// search steps instead of the reference's 64), and the full frame once the pointer rests. A
+// preview (the image scaled down by a whole factor, with fewer samples per ray: light fields
+// with fewer search steps than the reference's 64, volumes a longer step), and the full frame
+// once the pointer rests. A
 // software renderer such as SwiftShader takes seconds for a full light-field frame and a small
 // fraction of that for a preview; a GPU draws both quickly (bench/RESULTS.md, "Preview frames
 // while dragging in the web viewer").
-const PREVIEW_SEARCH_STEPS = 16;
 const FULL_SEARCH_STEPS = 64;  // LightFieldReconstructionSettings::search_steps' default
+// A light field's preview searches 64 / factor steps (16 or 8): previews keep 128 pixels a side
+// where fewer steps fit the budget (frame_cost.js dragPlan).
+const PREVIEW_SEARCH_FACTORS = [4, 8];
 // A volume's preview marches this many times the recipe's step (its table corrected for that
-// step, so the picture keeps its opacity), on the preview's fewer pixels.
-const PREVIEW_STEP_FACTOR = 2;
+// step, so the picture keeps its opacity), as few as the budget allows at 128 pixels a side.
+const PREVIEW_STEP_FACTORS = [2, 3, 4, 6, 8, 12, 16];
+const FULL_FRAME = Object.freeze({ divisor: 1, factor: 1 });
+const WHOLE_TRIES = 3;  // downloads of a whole light field after its nearest cameras
+const RETRY_MS = 500;
 const DROPPED = Object.freeze({ dropped: true });  // a draw's answer for data no longer wanted
 
 export class GpuFrames {
@@ -70,6 +76,8 @@ export class GpuFrames {
     this.proxyRenderer = proxyRenderer;  // null: frames from the view's proxies are the server's
     this.previewRenderer = previewRenderer;  // the same for previews (coarser proxies)
     this.cache = new Map();  // "step/view" -> Promise of {lightField, downloadMs} (or null)
+    // The same for the cameras around a view, sent ahead of the whole rig (streaming).
+    this.nearCache = new Map();
     this.proxyCache = new Map();  // "step/view" -> Promise of {proxies, downloadMs} (or null)
     this.uploaded = null;    // key of the light field on the GPU
     this.uploadedProxies = null;  // key of the proxies on the GPU
@@ -83,6 +91,9 @@ export class GpuFrames {
     // Whether (step, view) is still wanted once its data has come: a draw of one no longer
     // wanted resolves to {dropped: true} without touching the canvas (the page sets it).
     this.wanted = () => true;
+    // Called when the whole light field of (step, view) has come after its nearest cameras (the
+    // page redraws the frame drawn from those).
+    this.onLightField = () => {};
   }
 
   cost(kind, fullFactor = 1) {
@@ -142,7 +153,22 @@ export class GpuFrames {
     await renderer.finish();
     const milliseconds = performance.now() - started;
     cost.record(coarse, milliseconds, camera.size[0] * camera.size[1]);
-    return { milliseconds, uploadMs, preview: coarse, size: camera.size };
+    return { milliseconds, uploadMs, preview: coarse, size: camera.size,
+      withConfidence: withConfidence && !coarse };
+  }
+
+  /// Draws the loaded stored view of (step, view) edited with `editRecipe` (/api/recipe of an
+  /// opacity edit), unseen: `recipe`'s frame (the one shown) is drawn over it before the canvas
+  /// is shown again. SwiftShader builds a program's code at its first draw, and the edit's trust
+  /// pass is first drawn by the first edit: without this, that edit waits about 2 s for it
+  /// (bench/RESULTS.md, "The web viewer's waits"). Resolves to whether it drew.
+  async warmEdits(step, view, editRecipe, recipe) {
+    const renderer = this.proxyRenderer;
+    if (!renderer || this.uploadedProxies !== `${step}/${view}`) return false;
+    renderer.render(editRecipe, null, true, true);
+    renderer.render(recipe, null, true, false);
+    await renderer.finish();
+    return true;
   }
 
   /// The parsed compressed field of (step, view) with its download (and decoding) time; null
@@ -180,20 +206,21 @@ export class GpuFrames {
       this.lastOpen = { key, downloadMs, uploadMs, bytes: volume.bytes };
     }
     const [width, height] = stored.size;
-    const cost = this.cost(`volume/${Boolean(recipe.shading)}`, PREVIEW_STEP_FACTOR);
-    const divisor = dragging ? cost.dragDivisor(width, height, this.dragFrameMs) : 1;
+    const cost = this.cost(`volume/${Boolean(recipe.shading)}`);
+    const { divisor, factor } = dragging
+      ? cost.dragPlan(width, height, this.dragFrameMs, PREVIEW_STEP_FACTORS) : FULL_FRAME;
     const preview = divisor > 1;
     const size = [Math.max(1, Math.round(width / divisor)),
       Math.max(1, Math.round(height / divisor))];
     const camera = orbit ? reorbit({ ...stored, size }, azimuthDeg, elevationDeg)
       : { ...storedCamera(stored), width: size[0], height: size[1] };
     const settings = volumeSettings(recipe);
-    if (preview) settings.stepVoxels *= PREVIEW_STEP_FACTOR;
+    settings.stepVoxels *= factor;
     const started = performance.now();
     renderer.render(camera, tf, settings);
     await renderer.finish();
     const milliseconds = performance.now() - started;
-    cost.record(preview, milliseconds, size[0] * size[1]);
+    cost.record(preview, milliseconds, size[0] * size[1], factor);
     return { milliseconds, uploadMs, preview, size };
   }
 
@@ -229,18 +256,56 @@ export class GpuFrames {
       .then(({ value, downloadMs }) => ({ lightField: value, downloadMs }));
   }
 
-  /// Starts downloading what the next step draws from ahead of need: its light field and its
-  /// compressed field where this step has them (steps of one run hold the same), and its stored
-  /// view's proxies where they are drawn here and hold attenuation.
+  /// Whether the whole light field of (step, view) has arrived.
+  lightFieldArrived(step, view) {
+    return arrived(this.cache).has(`${step}/${view}`);
+  }
+
+  /// What a frame of (step, view) seen from `toward` (from the rig's centre toward the eye) draws
+  /// from now: the whole light field once it has come; before that the cameras around `toward`
+  /// (a fraction of the bytes, so the first orbit frame comes in a fraction of the time), the
+  /// whole requested once they have come (so it never delays them), to replace them. Resolves to
+  /// {lightField, downloadMs, partial, key}.
+  async streamedLightField(step, view, toward) {
+    const key = `${step}/${view}`;
+    // The whole one where it has come, or was asked for before any part.
+    if (!toward || !streamsLightField() || this.lightFieldArrived(step, view) ||
+      (this.cache.has(key) && !this.nearCache.has(key))) {
+      return { ...await this.lightField(step, view), partial: false, key };
+    }
+    const near = await cached(this.nearCache, key, () => fetchLightField(step, view, toward));
+    // A step without a light field has no whole one either.
+    if (near.value && !this.cache.has(key)) this.wholeLightField(step, view);
+    return { lightField: near.value, downloadMs: near.downloadMs, partial: true, key: `${key}/near` };
+  }
+
+  /// Downloads the whole light field of (step, view) after its nearest cameras, and says when it
+  /// has come (onLightField); a download cut short (a page busy drawing for long stops reading,
+  /// and the server gives up on it) is tried again, WHOLE_TRIES times in all.
+  wholeLightField(step, view, tries = WHOLE_TRIES) {
+    this.lightField(step, view).then(() => this.onLightField(step, view), (error) => {
+      if (tries > 1 && this.wanted(step, view)) {
+        setTimeout(() => this.wholeLightField(step, view, tries - 1), RETRY_MS);
+      } else {
+        console.warn(`the whole light field of step ${step} did not come: ${error.message}`);
+      }
+    });
+  }
+
+  /// Starts downloading the cameras around `toward` of (step, view) ahead of an orbit's first
+  /// frame (a drag starting), unless the whole light field is here or on its way.
+  prefetchNear(step, view, toward) {
+    this.streamedLightField(step, view, toward).catch(() => {});
+  }
+
+  /// Starts downloading what the next step draws from ahead of need: its light field (where the
+  /// user orbits: the stored view and its edits draw from the proxies) and its compressed field
+  /// where this step has them (steps of one run hold the same), and its stored view's proxies
+  /// where they are drawn here and hold attenuation.
   prefetch(step, view, { lightField = false, volume = false, proxies = false } = {}) {
     if (volume && this.volumeRenderer) this.volume(step, view).catch(() => {});
     if (lightField) this.lightField(step, view).catch(() => {});
     if (proxies && this.proxyRenderer) this.proxies(step, view).catch(() => {});
-  }
-
-  /// Whether (step, view) has a light field (downloads it if needed).
-  async has(step, view) {
-    return (await this.lightField(step, view)).lightField !== null;
   }
 
   /// Draws (step, view) from `storedCamera` (Camera::to_json) reorbited to the angles, with
@@ -251,8 +316,9 @@ export class GpuFrames {
   /// field.
   async draw(step, view, storedCamera, azimuthDeg, elevationDeg, segmentScales, dragging = false,
     recipe = null, withTrust = false) {
-    const key = `${step}/${view}`;
-    const { lightField, downloadMs } = await this.lightField(step, view);
+    const target = reorbit(storedCamera, azimuthDeg, elevationDeg);
+    const { lightField, downloadMs, partial, key } = await this.streamedLightField(step, view,
+      target.forward.map((c) => -c));
     if (!this.wanted(step, view)) return DROPPED;
     if (!lightField) return null;
     let uploadMs = 0;
@@ -272,20 +338,22 @@ export class GpuFrames {
     if (finished && !this.renderer.finishes(attenuation)) return null;
     const cost = this.cost(finished ? ['light field', attenuation, recipe.opacity_edited,
       Boolean(recipe.lighting), Boolean(recipe.ambient_occlusion), Boolean(recipe.enhancement)]
-      .join('/') : 'light field', FULL_SEARCH_STEPS / PREVIEW_SEARCH_STEPS);
-    const divisor = dragging ? cost.dragDivisor(width, height, this.dragFrameMs) : 1;
+      .join('/') : 'light field');
+    const { divisor, factor } = dragging
+      ? cost.dragPlan(width, height, this.dragFrameMs, PREVIEW_SEARCH_FACTORS) : FULL_FRAME;
     const preview = divisor > 1;
     const size = [Math.max(1, Math.round(width / divisor)),
       Math.max(1, Math.round(height / divisor))];
     const started = performance.now();
     this.renderer.render(reorbit({ ...storedCamera, size }, azimuthDeg, elevationDeg),
-      segmentScales, preview ? PREVIEW_SEARCH_STEPS : FULL_SEARCH_STEPS,
+      segmentScales, FULL_SEARCH_STEPS / factor,
       finished ? (preview ? previewRecipe(recipe, divisor) : recipe) : null,
       withTrust && !preview);
     await this.renderer.finish();
     const milliseconds = performance.now() - started;
-    cost.record(preview, milliseconds, size[0] * size[1]);
-    return { milliseconds, uploadMs, preview, size };
+    cost.record(preview, milliseconds, size[0] * size[1], factor);
+    return { milliseconds, uploadMs, preview, size, partial,
+      cameras: lightField.header.present.length, rigCameras: lightField.header.cameras };
   }
 }
 

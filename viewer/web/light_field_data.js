@@ -5,7 +5,7 @@
 // float32.
 
 import { fetchPayload, readPayloadHeader } from './page.js';
-import { stepUrl } from './source.js';
+import { exportedViews, stepUrl } from './source.js';
 
 const MAGIC = 'insituLF';
 const VERSION = 2;
@@ -37,9 +37,22 @@ export function parseLightField(buffer) {
     meanDepth: grouped(planes.mean_depth), bytes: buffer.byteLength };
 }
 
-/// Fetches and parses the light field of (step, view); null when the step has none (404).
-export async function fetchLightField(step, view) {
-  const buffer = await fetchPayload(stepUrl('lightfield', step, view),
-    `light field of step ${step}`);
+// The cameras sent ahead of the rest: those within this angle of the view's direction (42
+// cameras: about a quarter of the rig, bench/RESULTS.md "Streaming the light field").
+export const NEAR_CAMERAS_DEG = 60;
+
+/// Whether the light field can be asked for by part (the server can; a gallery's files hold it
+/// whole).
+export function streamsLightField() {
+  return !exportedViews();
+}
+
+/// Fetches and parses the light field of (step, view); null when the step has none (404). With
+/// `toward` ([x, y, z], from the rig's centre toward the eye), only the cameras within
+/// NEAR_CAMERAS_DEG of it (the header's `present` lists them).
+export async function fetchLightField(step, view, toward = null) {
+  let url = stepUrl('lightfield', step, view);
+  if (toward) url += `&toward=${toward.map((c) => c.toPrecision(6)).join(',')}&within=${NEAR_CAMERAS_DEG}`;
+  const buffer = await fetchPayload(url, `light field of step ${step}`);
   return buffer && parseLightField(buffer);
 }

@@ -1,6 +1,8 @@
 // Orbit: the drag and the angle inputs, and the trusted range around the stored view
 // (/api/trust), drawn as a map of offsets.
-import { $, DEGREES_PER_PIXEL, REST_MS, getJson, short, state, svg } from './page.js';
+import { $, DEGREES_PER_PIXEL, REST_MS, getJson, short, state, svg, viewer } from './page.js';
+import { reorbit } from './camera.js';
+import { askedStep } from './timeline.js';
 import { requestFrame } from './frames.js';
 import { stepUrl } from './source.js';
 
@@ -164,6 +166,12 @@ export function installOrbitDrag(viewport = $('viewport')) {
       elevation: state.elevation ?? el };
     viewport.setPointerCapture(event.pointerId);
     viewport.classList.add('dragging');
+    // The light field's cameras around where the drag starts, on their way before it moves.
+    const asked = askedStep();
+    if (state.lightField && viewer.gpu && asked) {
+      const camera = reorbit(state.info.camera, drag.azimuth, drag.elevation);
+      viewer.gpu.prefetchNear(asked.step, asked.view, camera.forward.map((c) => -c));
+    }
   });
   let rest = null;
   viewport.addEventListener('pointermove', (event) => {

@@ -52,6 +52,11 @@ function updateStepLabel() {
 // shown, and a reply for a step or view no longer asked for is dropped.
 let stepRequests = 0;
 
+/// Whether the user has left the stored view (frames then draw from the light field).
+function orbiting() {
+  return state.azimuth !== null && state.azimuth !== undefined;
+}
+
 /// The (step, view) the page asks for now: the slider's step and the view selected.
 export function askedStep() {
   const entry = state.timeline[state.stepIndex];
@@ -68,19 +73,17 @@ export async function stepChanged() {
   $('step-label').classList.toggle('loading', !state.info || state.info.step !== step ||
     state.info.view !== view);
   const info = await getJson(stepUrl('step', step, view));
-  let lightField = false;
+  // A step that lists a light field of the view's field (its segments) is drawn from it in the
+  // browser once the view leaves the stored view; it is downloaded then, by need (gpu_frames.js
+  // streams it), not here: the stored view and its edits draw from the view's proxies, and a
+  // step's frame must not wait for a payload it does not draw from.
+  const lightField = Boolean(viewer.gpu) && info.light_field_segments > 0;
   // A compressed field of the view's field (/api/step lists it): the recipe may draw from it.
   const volume = Boolean(info.volume);
-  if (viewer.gpu) {
-    // Only a step that lists a light field of the view's field (its segments) is asked for one:
-    // probing the others cost a 404 each.
-    lightField = info.light_field_segments > 0 &&
-      await viewer.gpu.has(step, view).catch(() => false);
-    const next = state.timeline[state.stepIndex + 1];
-    if ((lightField || volume) && next) {
-      viewer.gpu.prefetch(next.step, view,
-        { lightField, volume, proxies: viewHasAttenuation(view) });
-    }
+  const next = state.timeline[state.stepIndex + 1];
+  if (viewer.gpu && (lightField || volume) && next) {
+    viewer.gpu.prefetch(next.step, view, { lightField: lightField && orbiting(), volume,
+      proxies: viewHasAttenuation(view) });
   }
   if (request !== stepRequests) return;  // another step or view was asked for meanwhile
   $('step-label').classList.remove('loading');
