@@ -218,7 +218,9 @@ viewer_browser_test(trust volume
 viewer_browser_test(gallery lf ENVIRONMENT ARCHIVE_VOLUME=${viewer_work}/viewer_volume.cdb
                                           ARCHIVE_MODEL=${viewer_archive}
                          ARCHIVE_LF_ATTENUATION=${viewer_work}/viewer_lf_attenuation.cdb
-                    FIXTURES viewer_volume_archive viewer_archive viewer_lf_attenuation_archive)
+                         ARCHIVE_LF_SEGMENTS=${viewer_work}/viewer_lf_segments.cdb
+                    FIXTURES viewer_volume_archive viewer_archive viewer_lf_attenuation_archive
+                             viewer_lf_segments_archive)
 # Four galleries, a dozen frames held to render and serve's recipes: about 2 minutes on 2 loaded
 # cores.
 set_tests_properties(viewer.gallery PROPERTIES TIMEOUT 480)

@@ -30,6 +30,7 @@ const archive = env('ARCHIVE');
 const volumeArchive = env('ARCHIVE_VOLUME');
 const modelArchive = env('ARCHIVE_MODEL');
 const lfAttenuationArchive = env('ARCHIVE_LF_ATTENUATION');
+const lfSegmentsArchive = env('ARCHIVE_LF_SEGMENTS');
 const workDir = makeWorkDir('gallery-');
 // The served page's bar (webgl, proxies and volume tests): the issue's.
 const MIN_PSNR_DB = 40;
@@ -406,7 +407,10 @@ async function recipesMatch(from, name) {
       { 'opacity-scale': '1=2,1=0.5,4=0.3', colour: 'recompose', ao: '4,1', enhance: '1,2' },
       { tf: JSON.stringify(recoloured(info.transfer_function)) },
       { ...other, tf: JSON.stringify(sharper(info.transfer_function)), light: 'camera' },
-      { tf: JSON.stringify(sharper(info.transfer_function)), 'opacity-scale': '0=3' }];
+      { tf: JSON.stringify(sharper(info.transfer_function)), 'opacity-scale': '0=3' },
+      // Segment fades (the page applies them to the light field) with lights and occlusion.
+      ...(info.light_field_segments > 1 ? [{ ...other, 'segment-opacity': '1=0.3', light: 'camera' },
+        { ...other, 'segment-opacity': '0=0.5', ao: '4,1', 'opacity-scale': '2=0.5' }] : [])];
     for (const extra of cases) {
       const options = { step, view: '0', ...extra };
       const served = await (await fetch(`${server.url}api/recipe`,
@@ -428,8 +432,7 @@ async function recipesMatch(from, name) {
     assert.throws(() => galleryRecipe(recipes, tf2d, false, info),
       /is 2D; per-interval summaries need/);
     // What only the engine makes: the gallery says it cannot, rather than drawing it.
-    assert.equal(galleryRecipe(recipes, { step, view: '0', 'segment-opacity': '0=0.5' }, false,
-      info), null);
+    assert.equal(galleryRecipe(recipes, { step, view: '0', source: 'multi' }, false, info), null);
     assert.throws(() => galleryRecipe(recipes, { step, view: '0', 'opacity-scale': '99=0.5' },
       false, info), /opacity-scale interval 99/);
   } finally {
@@ -443,6 +446,8 @@ test('the recipes the gallery\'s page makes are serve\'s (Explorer::recipe)', as
   await recipesMatch(modelArchive, 'recipes-model');
   // An attenuation light field, whose edits at other views are made on its own intervals.
   await recipesMatch(lfAttenuationArchive, 'recipes-lf-attenuation');
+  // A light field in two segments, faded with lights.
+  await recipesMatch(lfSegmentsArchive, 'recipes-lf-segments');
 });
 
 test('a gallery of several runs lists each with its thumbnail and size, opening its explorer',

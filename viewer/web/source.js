@@ -7,8 +7,9 @@
 // lambda and gamma, an edit's per-interval scales and colours: tf_estimate.js) the page sets
 // here itself, as Explorer::recipe does, an edit over a light field on the light field's own
 // intervals (step.json's light_field_intervals). A compressed field takes any transfer function
-// (the page ray-marches it); proxies and light fields take 1D ones, in serve as here. Only the
-// engine makes frames with segment fades and lights; a gallery says so instead of drawing them.
+// (the page ray-marches it); proxies and light fields take 1D ones, in serve as here. Segment
+// fades with lights are the page's light field with the recipe's lights, as in serve. Only the
+// engine makes segment fades on a step that also holds a compressed field; a gallery says so.
 
 import {
   intervalColours, intervalColourSpread, opacityScalesOf, parseTf, sameColours,
@@ -231,8 +232,13 @@ function applyEdit(recipe, rest, info, model) {
 /// description `info` (null: the gallery cannot make it), with the options' own edit, light,
 /// occlusion and enhancement terms.
 export function galleryRecipe(recipes, options, synthesised, info) {
-  const { step, view, azimuth, elevation, session, ...rest } = options;
-  if (rest['segment-opacity'] || rest.source || rest.fill) return null;
+  const {
+    step, view, azimuth, elevation, session, 'segment-opacity': segments, ...rest
+  } = options;
+  if (rest.source || rest.fill) return null;
+  // Segment fades are drawn by the page on the light field; Explorer::recipe reads them only to
+  // keep a compressed field from making the frame, a recipe the gallery does not hold.
+  if (segments && recipes.volume) return null;
   // The compressed field takes an edited function itself (opacity scales are edits of proxies).
   if (rest.tf && !rest['opacity-scale'] && recipes.volume && !recipes.volume.error) {
     return { ...recipes.volume, synthesised, shading: Boolean(rest.light) };
