@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -9,11 +10,13 @@
 #include "harness.hpp"
 #include "insitu/archive/archive.hpp"
 #include "insitu/core/image.hpp"
+#include "insitu/error.hpp"
 #include "insitu/explore/explorer.hpp"
 #include "insitu/instrument.hpp"
 #include "insitu/render/light_field_capture.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/metrics.hpp"
+#include "light_field_payload.hpp"
 #include "median_time.hpp"
 
 namespace insitu::evaluation {
@@ -31,7 +34,7 @@ double crack_share(const Image& truth, const Image& frame) {
     return static_cast<double>(cracks) / static_cast<double>(truth.pixel_count());
 }
 
-double mean_abs_percent(const Image& truth, const Image& frame) {
+double mean_abs_percent_of(const Image& truth, const Image& frame) {
     double sum = 0.0;
     for (std::size_t p = 0; p < truth.pixel_count(); ++p) {
         for (int c = 0; c < 3; ++c)
@@ -41,12 +44,12 @@ double mean_abs_percent(const Image& truth, const Image& frame) {
 }
 
 // One step's light field of `scene` in an archive at `path`, as the Instrument writes it (the
-// archive's codec quantises the depth as a reader sees it).
-void write_archive(const Scene& scene, ProxyRenderer& renderer, const LightFieldRequest& request,
-                   const std::string& path, int image) {
+// archive's codec quantises the depth as a reader sees it); `light_field` as captured with
+// `request`. Returns the light field's stored bytes.
+std::uintmax_t write_archive(const Scene& scene, ProxyRenderer& renderer,
+                             const LightFieldRequest& request, LightField light_field,
+                             const std::string& path, int image) {
     const Bounds& bounds = renderer.volume().bounds;
-    const LightFieldRig rig =
-        LightFieldRig::around(bounds, request.settings.cameras, request.settings.size);
     InstrumentConfig config;
     config.fields = {scene.volume.name};
     config.views[0].orbit = stored_view(image);
@@ -68,8 +71,53 @@ void write_archive(const Scene& scene, ProxyRenderer& renderer, const LightField
     view.preview = renderer.render_ground_truth(stored, request.transfer_function).rgba;
     view.transfer_function = request.transfer_function;
     record.views.push_back(std::move(view));
-    record.light_fields.push_back({scene.volume.name, capture_light_field(renderer, rig, request)});
+    light_field.settings = request.settings;
+    record.light_fields.push_back({scene.volume.name, std::move(light_field)});
     ArchiveWriter(config).write(record);
+    const std::vector<ArchivedLightField> files = ArchiveReader(path).light_fields(record.step);
+    return files.empty() ? 0 : fs::file_size(files.front().exr_path);
+}
+
+std::uintmax_t write_archive(const Scene& scene, ProxyRenderer& renderer,
+                             const LightFieldRequest& request, const std::string& path, int image) {
+    const LightFieldRig rig = LightFieldRig::around(
+        renderer.volume().bounds, request.settings.cameras, request.settings.size);
+    return write_archive(scene, renderer, request, capture_light_field(renderer, rig, request),
+                         path, image);
+}
+
+/// Means over views of one archive's frames against their truths.
+struct ViewScores {
+    double mean_abs_percent = 0.0, psnr = 0.0, crack_percent = 0.0, worst_crack_percent = 0.0;
+    double worst_psnr = 1e9;
+    std::pair<double, double> worst_view{0.0, 0.0};
+
+    void add(const Image& truth, const Image& frame, std::pair<double, double> view, int views) {
+        const double frame_psnr = psnr_db(truth, frame);
+        const double cracks = 100.0 * crack_share(truth, frame);
+        mean_abs_percent += mean_abs_percent_of(truth, frame) / views;
+        psnr += frame_psnr / views;
+        crack_percent += cracks / views;
+        worst_crack_percent = std::max(worst_crack_percent, cracks);
+        if (frame_psnr < worst_psnr) worst_psnr = frame_psnr, worst_view = view;
+    }
+};
+
+// The stored view turned 20 degrees, frame and truth, as the orbit screenshots are.
+void write_orbit_pngs(const Scene& scene, ProxyRenderer& renderer, Explorer& explorer,
+                      const Camera& stored, const fs::path& out, int image) {
+    ExploreRequest explore;
+    explore.azimuth_deg = stored_view(image).azimuth_deg + 20.0;
+    explore.elevation_deg = stored_view(image).elevation_deg;
+    explore.source = ProxySource::lightfield;
+    const std::string stem = scene.name + "_" + std::to_string(image);
+    write_png((out / ("light_field_orbit_" + stem + ".png")).string(),
+              explorer.render(explore).colour);
+    write_png((out / ("light_field_orbit_" + stem + "_truth.png")).string(),
+              renderer
+                  .render_ground_truth(stored.reorbit(*explore.azimuth_deg, *explore.elevation_deg),
+                                       make_tf(scene), truth_settings())
+                  .rgba);
 }
 
 }  // namespace
@@ -78,70 +126,151 @@ void section_light_field_cracks(const std::vector<const Scene*>& scenes, bool sm
                                 const fs::path& out, const fs::path& scratch, int image) {
     Csv csv(out / "light_field_cracks.csv",
             "scene,cameras,map,views,mean_abs_percent,psnr,worst_psnr,worst_view_azimuth,"
-            "worst_view_elevation,crack_percent,worst_crack_percent,reconstruct_ms");
+            "worst_view_elevation,crack_percent,worst_crack_percent,reconstruct_ms,stored_bytes,"
+            "payload_bytes,relit_psnr,relit_worst_psnr");
     const int views = smoke ? 3 : 30;
     const std::vector<std::pair<double, double>> angles = random_views(views);
+    // Relit: a headlight, against the ground truth's headlight Phong (what the Explorer's volume
+    // source shades with), the light's terms set to the renderer's.
+    const PhongParameters phong;
+    LightingSettings lighting;
+    lighting.ambient = phong.ambient;
+    lighting.lights[0].direction_world = glm::dvec3(0.0);
+    lighting.lights[0].diffuse = phong.diffuse;
+    lighting.lights[0].specular = phong.specular;
+    lighting.lights[0].shininess = phong.shininess;
+    RenderSettings shaded = truth_settings();
+    shaded.shading = true;
+    shaded.phong = phong;
     for (const Scene* scene : scenes) {
         ProxyRenderer renderer;
         renderer.upload(scene->volume.field());
         const Bounds& bounds = renderer.volume().bounds;
         const TransferFunction tf = make_tf(*scene);
         const Camera stored = Camera::orbit(stored_view(image), bounds);
-        for (const int map : smoke ? std::vector<int>{64} : std::vector<int>{256}) {
-            LightFieldRequest request;
-            request.settings.cameras = 42;
-            request.settings.size = map;
-            request.settings.attenuation = false;
-            request.transfer_function = tf;
-            request.intervals = scene_intervals(*scene, 16);
-            const fs::path archive = scratch / ("cracks_" + scene->name + std::to_string(map));
+        const int map = smoke ? 64 : 256;
+        LightFieldRequest request;
+        request.settings.cameras = 42;
+        request.settings.size = map;
+        request.settings.attenuation = false;
+        request.transfer_function = tf;
+        request.intervals = scene_intervals(*scene, 16);
+        const fs::path archive = scratch / ("cracks_" + scene->name + std::to_string(map));
+        const std::uintmax_t stored_bytes =
             write_archive(*scene, renderer, request, archive.string(), image);
+        // What `insitu-view serve` sends the page for the step (uncompressed).
+        const std::size_t payload_bytes =
+            viewer::light_field_payload(
+                ArchiveReader(archive.string()).load_light_field(0, scene->volume.name), 0,
+                scene->volume.name)
+                .size();
+        Explorer explorer(archive.string());
+        ViewScores unlit, relit;
+        double ms = 0.0;
+        for (int v = 0; v < views; ++v) {
+            const Camera view = stored.reorbit(angles[v].first, angles[v].second);
+            ExploreRequest explore;
+            explore.azimuth_deg = angles[v].first;
+            explore.elevation_deg = angles[v].second;
+            explore.source = ProxySource::lightfield;
+            const ExploreFrame frame = explorer.render(explore);
+            unlit.add(renderer.render_ground_truth(view, tf, truth_settings()).rgba, frame.colour,
+                      angles[v], views);
+            ms += frame.milliseconds / views;
+            explore.lighting = lighting;
+            relit.add(renderer.render_ground_truth(view, tf, shaded).rgba,
+                      explorer.render(explore).colour, angles[v], views);
+            // The stored view turned 20 degrees, as the orbit screenshots are.
+            if (v == 0 && !smoke) write_orbit_pngs(*scene, renderer, explorer, stored, out, image);
+        }
+        csv.row(scene->name, 42, map, views, unlit.mean_abs_percent, unlit.psnr, unlit.worst_psnr,
+                unlit.worst_view.first, unlit.worst_view.second, unlit.crack_percent,
+                unlit.worst_crack_percent, ms, stored_bytes, payload_bytes, relit.psnr,
+                relit.worst_psnr);
+        std::printf(
+            "light-field cracks: %s 42 cameras %d^2: mean error %.2f %%, PSNR %.1f dB, worst "
+            "view %.1f dB (az %.0f el %.0f), cracks %.3f %% (worst view %.3f %%), %.0f ms/frame, "
+            "%.2f MB stored, %.2f MB to the page, relit %.1f dB (worst %.1f)\n",
+            scene->name.c_str(), map, unlit.mean_abs_percent, unlit.psnr, unlit.worst_psnr,
+            unlit.worst_view.first, unlit.worst_view.second, unlit.crack_percent,
+            unlit.worst_crack_percent, ms, stored_bytes / 1e6, payload_bytes / 1e6, relit.psnr,
+            relit.worst_psnr);
+        fs::remove_all(archive);
+    }
+}
+
+void section_light_field_bytes(const std::vector<const Scene*>& scenes, bool smoke,
+                               const fs::path& out, const fs::path& scratch, int image) {
+    Csv csv(out / "light_field_bytes.csv",
+            "scene,cameras,map,attenuation_subsampling,stored_bytes,edit,views,mean_abs_percent,"
+            "psnr,worst_psnr,worst_view_azimuth,worst_view_elevation,crack_percent,"
+            "worst_crack_percent");
+    const int views = smoke ? 3 : 30;
+    const int map = smoke ? 64 : 256;
+    const std::vector<std::pair<double, double>> angles = random_views(views);
+    const std::vector<TfSpec> edits = held_out_edits(views);
+    for (const Scene* scene : scenes) {
+        ProxyRenderer renderer;
+        renderer.upload(scene->volume.field());
+        const TransferFunction tf = make_tf(*scene);
+        const Camera stored = Camera::orbit(stored_view(image), renderer.volume().bounds);
+        LightFieldRequest request;
+        request.settings.cameras = 42;
+        request.settings.size = map;
+        request.settings.attenuation = true;
+        request.transfer_function = tf;
+        request.intervals = scene_intervals(*scene, 16);
+        const LightField captured = capture_light_field(
+            renderer, LightFieldRig::around(renderer.volume().bounds, 42, map), request);
+        std::vector<Image> truths, edited_truths;
+        for (int v = 0; v < views; ++v) {
+            const Camera view = stored.reorbit(angles[v].first, angles[v].second);
+            truths.push_back(renderer.render_ground_truth(view, tf, truth_settings()).rgba);
+            edited_truths.push_back(
+                renderer.render_ground_truth(view, make_tf(*scene, edits[v]), truth_settings())
+                    .rgba);
+        }
+        Image unedited_first;  // the full-size archive's first view, unedited
+        for (const int subsampling : smoke ? std::vector<int>{1, 2} : std::vector<int>{1, 2, 4}) {
+            request.settings.attenuation_subsampling = subsampling;
+            const fs::path archive = scratch / ("bytes_" + scene->name);
+            const std::uintmax_t bytes =
+                write_archive(*scene, renderer, request, captured, archive.string(), image);
             Explorer explorer(archive.string());
-            double abs_sum = 0.0, psnr_sum = 0.0, crack_sum = 0.0, worst_crack = 0.0, ms = 0.0;
-            double worst_psnr = 1e9;
-            std::pair<double, double> worst_view{0.0, 0.0};
-            for (int v = 0; v < views; ++v) {
-                const auto [azimuth, elevation] = angles[static_cast<std::size_t>(v)];
-                const Image truth = renderer
-                                        .render_ground_truth(stored.reorbit(azimuth, elevation), tf,
-                                                             truth_settings())
-                                        .rgba;
-                ExploreRequest explore;
-                explore.azimuth_deg = azimuth;
-                explore.elevation_deg = elevation;
-                explore.source = ProxySource::lightfield;
-                const ExploreFrame frame = explorer.render(explore);
-                const double psnr = psnr_db(truth, frame.colour);
-                const double cracks = crack_share(truth, frame.colour);
-                abs_sum += mean_abs_percent(truth, frame.colour) / views;
-                psnr_sum += psnr / views;
-                crack_sum += cracks / views;
-                worst_crack = std::max(worst_crack, cracks);
-                ms += frame.milliseconds / views;
-                if (psnr < worst_psnr) worst_psnr = psnr, worst_view = {azimuth, elevation};
-                // The stored view turned 20 degrees, as the orbit screenshots are.
-                if (v == 0 && !smoke) {
-                    explore.azimuth_deg = stored_view(image).azimuth_deg + 20.0;
-                    explore.elevation_deg = stored_view(image).elevation_deg;
-                    const std::string stem = scene->name + "_" + std::to_string(map);
-                    write_png((out / ("light_field_orbit_" + stem + ".png")).string(),
-                              explorer.render(explore).colour);
-                    write_png((out / ("light_field_orbit_" + stem + "_truth.png")).string(),
-                              renderer
-                                  .render_ground_truth(
-                                      stored.reorbit(*explore.azimuth_deg, *explore.elevation_deg),
-                                      tf, truth_settings())
-                                  .rgba);
+            for (const bool edit : {false, true}) {
+                ViewScores scores;
+                for (int v = 0; v < views; ++v) {
+                    ExploreRequest explore;
+                    explore.azimuth_deg = angles[v].first;
+                    explore.elevation_deg = angles[v].second;
+                    explore.source = ProxySource::lightfield;
+                    if (edit) explore.transfer_function = make_tf(*scene, edits[v]);
+                    const Image frame = explorer.render(explore).colour;
+                    // Unedited frames read colour and depth, which subsampling leaves as they
+                    // are: measured once, checked to be the same frame where the maps are smaller.
+                    if (!edit && subsampling == 1 && v == 0) unedited_first = frame;
+                    if (!edit && subsampling > 1) {
+                        if (frame.pixels != unedited_first.pixels) {
+                            fail<Error>("an unedited frame changed with the attenuation maps");
+                        }
+                        break;
+                    }
+                    scores.add(edit ? edited_truths[v] : truths[v], frame, angles[v], views);
                 }
+                if (!edit && subsampling > 1) continue;
+                csv.row(scene->name, 42, map, subsampling, bytes, edit ? 1 : 0, views,
+                        scores.mean_abs_percent, scores.psnr, scores.worst_psnr,
+                        scores.worst_view.first, scores.worst_view.second, scores.crack_percent,
+                        scores.worst_crack_percent);
+                std::printf(
+                    "light-field bytes: %s 42 cameras %d^2, attenuation maps / %d: %.2f MB, %s: "
+                    "mean error %.2f %%, PSNR %.1f dB, worst view %.1f dB (az %.0f el %.0f), "
+                    "cracks %.3f %% (worst %.3f %%)\n",
+                    scene->name.c_str(), map, subsampling, bytes / 1e6,
+                    edit ? "held-out edits" : "unedited", scores.mean_abs_percent, scores.psnr,
+                    scores.worst_psnr, scores.worst_view.first, scores.worst_view.second,
+                    scores.crack_percent, scores.worst_crack_percent);
             }
-            csv.row(scene->name, 42, map, views, abs_sum, psnr_sum, worst_psnr, worst_view.first,
-                    worst_view.second, 100.0 * crack_sum, 100.0 * worst_crack, ms);
-            std::printf(
-                "light-field cracks: %s 42 cameras %d^2: mean error %.2f %%, PSNR %.1f dB, worst "
-                "view %.1f dB (az %.0f el %.0f), cracks %.3f %% (worst view %.3f %%), %.0f "
-                "ms/frame\n",
-                scene->name.c_str(), map, abs_sum, psnr_sum, worst_psnr, worst_view.first,
-                worst_view.second, 100.0 * crack_sum, 100.0 * worst_crack, ms);
             fs::remove_all(archive);
         }
     }

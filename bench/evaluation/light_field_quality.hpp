@@ -16,4 +16,12 @@ void section_light_field_cracks(const std::vector<const Scene*>& scenes, bool sm
                                 const std::filesystem::path& out,
                                 const std::filesystem::path& scratch, int image);
 
+/// Bytes against accuracy (issue 41 item 3): one attenuation light field of 42 cameras at 256^2
+/// stored with its attenuation maps at full size and subsampled by 2 and 4, each through the
+/// archive and the Explorer from the same 30 random views, unedited and with held-out opacity
+/// edits, against the ground truth. Writes light_field_bytes.csv.
+void section_light_field_bytes(const std::vector<const Scene*>& scenes, bool smoke,
+                               const std::filesystem::path& out,
+                               const std::filesystem::path& scratch, int image);
+
 }  // namespace insitu::evaluation

@@ -69,8 +69,13 @@ json segments_json(const LightFieldSettings& settings) {
     fail<Error>("light field settings: a segment rule without a name");  // a bug
 }
 
-constexpr const char* kSettingsKeys[] = {"cameras",     "size",       "segments",
-                                         "attenuation", "depth_bits", "depth_threshold"};
+constexpr const char* kSettingsKeys[] = {"cameras",
+                                         "size",
+                                         "segments",
+                                         "attenuation",
+                                         "depth_bits",
+                                         "depth_threshold",
+                                         "attenuation_subsampling"};
 
 }  // namespace
 
@@ -124,15 +129,27 @@ void LightFieldSettings::validate() const {
         settings_out_of_range(settings_key("depth_threshold"), depth_threshold,
                               "opacity of the first hit, must be in (0, 1)");
     }
+    if (attenuation_subsampling != 1 && attenuation_subsampling != 2 &&
+        attenuation_subsampling != 4) {
+        settings_out_of_range(settings_key("attenuation_subsampling"), attenuation_subsampling,
+                              "expected 1, 2 or 4");
+    }
+    if (size % attenuation_subsampling != 0) {
+        settings_out_of_range(settings_key("attenuation_subsampling"), attenuation_subsampling,
+                              "must divide the map size ", size);
+    }
 }
 
 json LightFieldSettings::to_json() const {
-    return {{"cameras", cameras},
-            {"size", size},
-            {"segments", segments_json(*this)},
-            {"attenuation", attenuation},
-            {"depth_bits", depth_bits},
-            {"depth_threshold", depth_threshold}};
+    json object = {{"cameras", cameras},
+                   {"size", size},
+                   {"segments", segments_json(*this)},
+                   {"attenuation", attenuation},
+                   {"depth_bits", depth_bits},
+                   {"depth_threshold", depth_threshold}};
+    // Only where it is not 1: full-size maps keep the header that readers before it take.
+    if (attenuation_subsampling != 1) object["attenuation_subsampling"] = attenuation_subsampling;
+    return object;
 }
 
 std::vector<std::string> LightFieldSettings::keys() {
@@ -196,6 +213,9 @@ LightFieldSettings LightFieldSettings::from_json(const json& object,
     });
     read("depth_threshold", [&](const json& v, const std::string& k) {
         settings.depth_threshold = settings_number(v, k);
+    });
+    read("attenuation_subsampling", [&](const json& v, const std::string& k) {
+        settings.attenuation_subsampling = settings_integer(v, k);
     });
     settings.validate();
     return settings;

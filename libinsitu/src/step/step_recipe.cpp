@@ -76,6 +76,9 @@ std::optional<LightFieldRequest> light_field_request(const InstrumentConfig& con
     if (plan.budget && plan.budget->light_field) {
         request.settings.cameras = plan.budget->light_field->cameras;
         request.settings.size = plan.budget->light_field->size;
+        // A smaller map keeps the largest attenuation subsampling (4, 2, 1) that divides it.
+        int& factor = request.settings.attenuation_subsampling;
+        while (request.settings.size % factor != 0) factor /= 2;
     }
     request.transfer_function = plan.transfer_function;
     request.isovalues = plan.isovalues;

@@ -67,6 +67,11 @@ struct LightFieldSettings {
     /// on Gray-Scott and Marschner-Lobb in bench/evaluate's sweep (bench/RESULTS.md, "Light-field
     /// depth threshold").
     double depth_threshold = 0.3;
+    /// "attenuation_subsampling": the a_j and mean depth maps are stored at size / this per side
+    /// (1, 2 or 4; size must be a multiple) and read back at the full map size, bilinearly.
+    /// They only matter for edits, whose error is the view synthesis' more than theirs, and they
+    /// are most of an attenuation light field's bytes (bench/RESULTS.md, "Light-field bytes").
+    int attenuation_subsampling = 1;
 
     /// InvalidArgument naming the "light_field" key and value of the first bad member.
     void validate() const;

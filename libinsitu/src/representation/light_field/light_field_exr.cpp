@@ -30,6 +30,8 @@
 #include "archive/archive_format.hpp"
 #include "archive/exr_frame.hpp"
 #include "insitu/error.hpp"
+#include "representation/light_field/light_field_exr_checks.hpp"
+#include "representation/light_field/light_field_subsampling.hpp"
 
 namespace insitu::archive_format {
 
@@ -93,85 +95,6 @@ int depth_code(float fraction) {
 // ---------------------------------------------------------------------------------------------
 // Encoding
 
-void check_image(const Image& image, int channels, int size, const std::string& where,
-                 const std::string& what) {
-    if (image.channels != channels || image.width != size || image.height != size ||
-        image.pixels.size() != image.pixel_count() * static_cast<std::size_t>(channels)) {
-        fail<InvalidArgument>(where, ": ", what, " is ", image.width, "x", image.height, "x",
-                              image.channels, ", expected ", size, "x", size, "x", channels);
-    }
-}
-
-/// Checks what one camera holds against the light field's settings.
-void check_camera(const LightFieldImages& images, const LightField& light_field,
-                  const std::string& where) {
-    const int size = light_field.rig.map_size();
-    const int segments = light_field.segment_count();
-    const std::string camera = "camera " + std::to_string(images.camera);
-    if (static_cast<int>(images.segment_rgba.size()) != segments) {
-        fail<InvalidArgument>(where, ": ", camera, " has ", images.segment_rgba.size(),
-                              " segment images, the settings make ", segments);
-    }
-    const std::size_t depths = segments > 1 ? static_cast<std::size_t>(segments) : 0;
-    if (images.segment_depth.size() != depths) {
-        fail<InvalidArgument>(where, ": ", camera, " has ", images.segment_depth.size(),
-                              " segment depth images, expected ", depths);
-    }
-    for (int s = 0; s < segments; ++s) {
-        check_image(images.segment_rgba[s], 4, size, where,
-                    camera + " segment " + std::to_string(s) + " RGBA");
-        if (segments > 1) {
-            check_image(images.segment_depth[s], 1, size, where,
-                        camera + " segment " + std::to_string(s) + " depth");
-        }
-    }
-    check_image(images.depth, 1, size, where, camera + " depth");
-    const int intervals = light_field.settings.attenuation ? light_field.intervals->count() : 0;
-    if (intervals == 0) {
-        if (!images.attenuation.pixels.empty() || !images.mean_depth.pixels.empty()) {
-            fail<InvalidArgument>(where, ": ", camera,
-                                  " has attenuation images but the settings have "
-                                  "\"attenuation\": false");
-        }
-        return;
-    }
-    check_image(images.attenuation, intervals, size, where, camera + " attenuation");
-    check_image(images.mean_depth, intervals, size, where, camera + " mean depth");
-}
-
-void check_light_field(const LightField& light_field, const std::string& where) {
-    try {
-        light_field.settings.validate();
-    } catch (const InvalidArgument& error) {
-        fail<InvalidArgument>(where, ": ", error.what());
-    }
-    const LightFieldRig& rig = light_field.rig;
-    if (rig.camera_count() != light_field.settings.cameras ||
-        rig.map_size() != light_field.settings.size) {
-        fail<InvalidArgument>(where, ": the rig has ", rig.camera_count(), " cameras of ",
-                              rig.map_size(), "^2, the settings say ", light_field.settings.cameras,
-                              " of ", light_field.settings.size, "^2");
-    }
-    const int segments = light_field.segment_count();
-    if (segments < 1 || segments > kMaxLightFieldSegments) {
-        fail<InvalidArgument>(where, ": ", segments, " segments (at most ", kMaxLightFieldSegments,
-                              ")");
-    }
-    if (light_field.settings.attenuation && !light_field.intervals) {
-        fail<InvalidArgument>(where, ": \"attenuation\" is set but there are no intervals");
-    }
-    if (light_field.cameras.empty()) fail<InvalidArgument>(where, ": no cameras to store");
-    std::set<int> seen;
-    for (const LightFieldImages& images : light_field.cameras) {
-        if (images.camera < 0 || images.camera >= rig.camera_count() ||
-            !seen.insert(images.camera).second) {
-            fail<InvalidArgument>(where, ": camera ", images.camera, " is repeated or outside ",
-                                  "the rig's ", rig.camera_count(), " cameras");
-        }
-        check_camera(images, light_field, where);
-    }
-}
-
 /// The attributes of every part (archive_format.hpp); the rig only on the first.
 Imf::Header camera_header(const StepRecord& record, const LightFieldRecord& source,
                           const LightFieldImages& images, const LightFieldEncoding& encoding,
@@ -192,11 +115,12 @@ Imf::Header camera_header(const StepRecord& record, const LightFieldRecord& sour
     for (const std::string& name : names.rgba) header.channels().insert(name, encoding.compact);
     for (const std::string& name : names.segment_depth) header.channels().insert(name, depth);
     header.channels().insert(names.depth, depth);
+    const int factor = light_field.settings.attenuation_subsampling;
     for (const std::string& name : names.attenuation) {
-        header.channels().insert(name, encoding.compact);
+        header.channels().insert(name, Imf::Channel(encoding.compact, factor, factor));
     }
     for (const std::string& name : names.mean_depth) {
-        header.channels().insert(name, encoding.compact);
+        header.channels().insert(name, Imf::Channel(encoding.compact, factor, factor));
     }
 
     header.insert(kSchemaAttribute, Imf::IntAttribute(kArchiveSchemaVersion));
@@ -249,26 +173,36 @@ public:
             add_depth(names.segment_depth[s], images.segment_depth[s], depth_bits, depth, where);
         }
         add_depth(names.depth, images.depth, depth_bits, depth, where);
+        if (intervals == 0) return;
+        const int factor = light_field.settings.attenuation_subsampling;
+        if (factor > 1) {
+            subsampled_ = subsample_attenuation(images.attenuation, images.mean_depth, factor);
+        }
+        const Image& attenuation = factor > 1 ? subsampled_.attenuation : images.attenuation;
+        const Image& mean_depth = factor > 1 ? subsampled_.mean_depth : images.mean_depth;
         for (int j = 0; j < intervals; ++j) {
-            add(names.attenuation[j], images.attenuation, j, encoding.compact);
-            add(names.mean_depth[j], images.mean_depth, j, encoding.compact);
+            add(names.attenuation[j], attenuation, j, encoding.compact, factor);
+            add(names.mean_depth[j], mean_depth, j, encoding.compact, factor);
         }
     }
     const Imf::FrameBuffer& frame_buffer() const { return frame_buffer_; }
 
 private:
-    void add(const std::string& name, const Image& image, int channel, Imf::PixelType type) {
+    /// Channel `channel` of `image`, which holds every `sampling`-th pixel of the part per side.
+    void add(const std::string& name, const Image& image, int channel, Imf::PixelType type,
+             int sampling = 1) {
         if (type == Imf::HALF) {
             std::vector<half>& plane = halves_.emplace_back(image.pixel_count());
             for (std::size_t i = 0; i < plane.size(); ++i) {
                 plane[i] = half(image.pixels[i * image.channels + channel]);
             }
-            insert_half(name, plane);
+            insert_half(name, plane, image.width, sampling);
             return;
         }
         const std::size_t x_stride = sizeof(float) * image.channels;
         char* base = reinterpret_cast<char*>(const_cast<float*>(image.pixels.data()) + channel);
-        frame_buffer_.insert(name, Imf::Slice(Imf::FLOAT, base, x_stride, x_stride * size_));
+        frame_buffer_.insert(name, Imf::Slice(Imf::FLOAT, base, x_stride, x_stride * image.width,
+                                              sampling, sampling));
     }
 
     void add_depth(const std::string& name, const Image& image, int depth_bits, Imf::PixelType type,
@@ -300,18 +234,20 @@ private:
             plane[i] = code == kNoHitDepthCode ? half(std::numeric_limits<float>::infinity())
                                                : half(static_cast<float>(code) / kDepthCodeSteps);
         }
-        insert_half(name, plane);
+        insert_half(name, plane, size_, 1);
     }
 
-    void insert_half(const std::string& name, std::vector<half>& plane) {
-        frame_buffer_.insert(name, Imf::Slice(Imf::HALF, reinterpret_cast<char*>(plane.data()),
-                                              sizeof(half), sizeof(half) * size_));
+    void insert_half(const std::string& name, std::vector<half>& plane, int width, int sampling) {
+        frame_buffer_.insert(
+            name, Imf::Slice(Imf::HALF, reinterpret_cast<char*>(plane.data()), sizeof(half),
+                             sizeof(half) * width, sampling, sampling));
     }
 
     int size_;
     // Reserved up front: slices point into these planes.
     std::vector<std::vector<half>> halves_;
     std::vector<std::vector<std::uint32_t>> codes_;
+    SubsampledAttenuation subsampled_;
     Imf::FrameBuffer frame_buffer_;
 };
 
@@ -413,13 +349,27 @@ LightFieldImages read_camera(Imf::InputPart& part, int camera, const LightField&
     const int segments = light_field.segment_count();
     const int intervals = light_field.settings.attenuation ? light_field.intervals->count() : 0;
     const CameraChannels names = camera_channels(camera, segments, intervals);
-    const std::vector<std::string> all_names = names.all();
+    // Attenuation maps subsampled by the settings' factor are read in a pass of their own.
+    const int factor = light_field.settings.attenuation_subsampling;
+    std::vector<std::string> all_names = names.all();
+    std::vector<std::string> subsampled;
+    if (factor > 1) {
+        all_names.resize(all_names.size() - 2 * static_cast<std::size_t>(intervals));
+        subsampled = names.attenuation;
+        subsampled.insert(subsampled.end(), names.mean_depth.begin(), names.mean_depth.end());
+    }
     const Imf::ChannelList& channels = part.header().channels();
-    for (const std::string& name : all_names) {
+    for (const std::string& name : names.all()) {
         const Imf::Channel* channel = channels.findChannel(name);
         if (!channel) where.error("no channel \"" + name + "\"");
-        if (channel->xSampling != 1 || channel->ySampling != 1) {
-            where.error("channel \"" + name + "\" is subsampled");
+        const bool is_subsampled =
+            std::find(subsampled.begin(), subsampled.end(), name) != subsampled.end();
+        const int expected = is_subsampled ? factor : 1;
+        if (channel->xSampling != expected || channel->ySampling != expected) {
+            where.error("channel \"" + name + "\" is subsampled by " +
+                        std::to_string(channel->xSampling) + "x" +
+                        std::to_string(channel->ySampling) + ", the settings say " +
+                        std::to_string(expected));
         }
     }
     const Image all = read_channels(part, all_names, where);
@@ -441,9 +391,21 @@ LightFieldImages read_camera(Imf::InputPart& part, int camera, const LightField&
     }
     images.depth = channel_range(all, first++, 1);
     decode_depth(images.depth, *channels.findChannel(names.depth), depth_bits, names.depth, where);
-    if (intervals > 0) {
+    if (intervals > 0 && factor == 1) {
         images.attenuation = channel_range(all, first, intervals);
         images.mean_depth = channel_range(all, first + intervals, intervals);
+    } else if (intervals > 0) {
+        const Image stored = read_subsampled_channels(part, subsampled, factor, where);
+        // The whole ray's opacity, the segments composited front to back.
+        std::vector<float> alpha(images.depth.pixel_count(), 0.0f);
+        for (const Image& rgba : images.segment_rgba) {
+            for (std::size_t p = 0; p < alpha.size(); ++p) {
+                alpha[p] += (1.0f - alpha[p]) * rgba.pixels[4 * p + 3];
+            }
+        }
+        upsample_attenuation(
+            {channel_range(stored, 0, intervals), channel_range(stored, intervals, intervals)},
+            alpha, images.attenuation, images.mean_depth);
     }
     return images;
 }

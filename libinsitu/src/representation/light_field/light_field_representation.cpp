@@ -66,6 +66,12 @@ BudgetRecord::LightFieldChoice LightFieldCandidates::measure(int cameras, int si
     INSITU_CHECK(!seen.empty());
     request_.settings.cameras = cameras;
     request_.settings.size = size;
+    // As the step's request will have it (step_recipe.cpp): the largest attenuation subsampling
+    // the configuration allows that divides this map size.
+    request_.settings.attenuation_subsampling = check_.config.light_field->attenuation_subsampling;
+    while (size % request_.settings.attenuation_subsampling != 0) {
+        request_.settings.attenuation_subsampling /= 2;
+    }
     request_.cameras.assign(seen.begin(), seen.end());
     const auto start = SteadyClock::now();
     LightFieldRecord record{check_.plan.name, capture_light_field(check_.renderer, rig, request_)};
