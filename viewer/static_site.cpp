@@ -386,8 +386,9 @@ std::unique_ptr<Routes> fit_to_budget(std::unique_ptr<Routes> routes, const Expo
             smallest = std::min(smallest, step.bytes - step.light_field_bytes);
         }
         fail<InvalidArgument>("--max-bytes ", *options.max_bytes, ": smaller than one step (the ",
-                              "smallest takes ", smallest, " bytes without its light field, the ",
-                              "page ", fixed_bytes, ")");
+                              "smallest takes ", smallest, " bytes",
+                              fit.omitted.light_fields ? " without its light field" : "",
+                              ", the page ", fixed_bytes, ")");
     }
     for (const StepBytes& step : measured) {
         if (!std::binary_search(fit.steps.begin(), fit.steps.end(), step.step)) {

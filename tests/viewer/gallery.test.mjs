@@ -408,6 +408,9 @@ async function recipesMatch(from, name) {
       { tf: JSON.stringify(recoloured(info.transfer_function)) },
       { ...other, tf: JSON.stringify(sharper(info.transfer_function)), light: 'camera' },
       { tf: JSON.stringify(sharper(info.transfer_function)), 'opacity-scale': '0=3' },
+      // A function of one gradient row is a function of the value.
+      { tf: JSON.stringify({ unit_length: info.transfer_function.unit_length,
+        gradient_rows: [{ gradient_magnitude: 0, points: sharper(info.transfer_function).points }] }) },
       // Segment fades (the page applies them to the light field) with lights and occlusion.
       ...(info.light_field_segments > 1 ? [{ ...other, 'segment-opacity': '1=0.3', light: 'camera' },
         { ...other, 'segment-opacity': '0=0.5', ao: '4,1', 'opacity-scale': '2=0.5' }] : [])];

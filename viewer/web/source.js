@@ -197,11 +197,16 @@ function applyEdit(recipe, rest, info, model) {
   let scales = new Array(count).fill(1);
   let coloursChanged = false;
   if (rest.tf) {
-    const shownJson = JSON.parse(rest.tf);
-    // serve refuses it the same way: scales and colours per interval are a 1D function's.
-    if (shownJson && shownJson.gradient_rows) {
+    let shownJson = JSON.parse(rest.tf);
+    const rows = shownJson && shownJson.gradient_rows;
+    if (Array.isArray(rows) && rows.length > 1) {
+      // serve refuses it the same way: scales and colours per interval are a 1D function's.
       throw new Error('the edited transfer function is 2D; per-interval summaries need a ' +
         'function of the value only (a step with a compressed field renders it)');
+    }
+    // One row is a function of the value (TransferFunction::is_2d).
+    if (Array.isArray(rows) && rows.length === 1) {
+      shownJson = { points: rows[0].points, unit_length: shownJson.unit_length };
     }
     const shown = parseTf(shownJson);
     const stored = parseTf(info.transfer_function);
