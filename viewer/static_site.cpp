@@ -252,9 +252,10 @@ std::string readme_text(const std::string& name, const ExportReport& report) {
         text << "Left out: step " << step << ": " << why << "\n";
     }
     for (const std::string& what : report.omitted) text << "Left out: " << what << "\n";
-    text << "\nWhat needs `insitu-view serve` instead: light-field segment fades with lights or\n"
-         << "occlusion, and the frames a browser without WebGL2 would ask the server for. A 2D\n"
-         << "transfer function needs a step with a compressed field, here as in serve.\n\n"
+    text << "\nWhat needs `insitu-view serve` instead: light-field segment fades on a step that\n"
+         << "also holds a compressed field, and the frames a browser without WebGL2 would ask the\n"
+         << "server for. A 2D transfer function needs a step with a compressed field, here as in\n"
+         << "serve.\n\n"
          << "data.csv and previews/ are the run's Cinema database (Spec D): Cinema viewers open\n"
          << "this folder too.\n";
     return text.str();
