@@ -357,14 +357,17 @@ std::optional<SiteFiles> step_site_files(Routes& routes, std::int64_t step,
     return files;
 }
 
-/// Fits the chosen steps into --max-bytes (export_fit.hpp): each step measured as exported
-/// whole, then the light fields and steps that do not fit left out (and said so in `report`,
-/// with the damaged steps found). Returns the routes to export with: those given, or new ones
-/// over the archive without what was left out.
+/// Fits the chosen steps into --max-bytes (export_fit.hpp): each step exported whole into
+/// `temporary` and measured. Where the run fits, those are the site's steps (`written` set, the
+/// report filled); else the folder is emptied and the light fields and steps that do not fit are
+/// left out (and said so in `report`, with the damaged steps found). Returns the routes to export
+/// with: those given, or new ones over the archive without what was left out.
 std::unique_ptr<Routes> fit_to_budget(std::unique_ptr<Routes> routes, const ExportOptions& options,
-                                      std::uintmax_t fixed_bytes, Choice& choice,
-                                      ExportReport& report) {
+                                      const fs::path& temporary, std::uintmax_t fixed_bytes,
+                                      Choice& choice, ExportReport& report, bool& written) {
     std::vector<StepBytes> measured;
+    std::uintmax_t whole_bytes = 0;
+    std::size_t whole_files = 0;
     for (const std::int64_t step : choice.first) {
         const std::optional<SiteFiles> files =
             step_site_files(*routes, step, choice.second, report);
@@ -375,8 +378,19 @@ std::unique_ptr<Routes> fit_to_budget(std::unique_ptr<Routes> routes, const Expo
                 bytes.light_field_bytes += content.size();
             }
         }
+        write_files(temporary, *files);
+        whole_bytes += bytes.bytes;
+        whole_files += files->size();
         measured.push_back(bytes);
     }
+    written = !measured.empty() && fixed_bytes + whole_bytes <= *options.max_bytes;
+    if (written) {
+        for (const StepBytes& step : measured) report.steps.push_back(step.step);
+        report.bytes = fixed_bytes + whole_bytes;
+        report.files = whole_files;
+        return routes;
+    }
+    fs::remove_all(temporary);
     const std::uintmax_t budget =
         *options.max_bytes > fixed_bytes ? *options.max_bytes - fixed_bytes : 0;
     const SiteFit fit = fit_site(measured, budget);
@@ -493,12 +507,13 @@ ExportReport export_site(const ExportOptions& options) {
         // The page, the index, README and the Cinema database: what the steps' share leaves.
         constexpr std::uintmax_t kIndexReserve = 64 << 10;
         const std::uintmax_t fixed_bytes = size_of(page) + kIndexReserve;
+        bool written = false;
         const std::unique_ptr<Routes> fitted =
-            options.max_bytes
-                ? fit_to_budget(std::move(whole), options, fixed_bytes, choice, report)
-                : std::move(whole);
+            options.max_bytes ? fit_to_budget(std::move(whole), options, temporary, fixed_bytes,
+                                              choice, report, written)
+                              : std::move(whole);
         Routes& routes = *fitted;
-        export_steps(routes, options, temporary, choice, fixed_bytes, report);
+        if (!written) export_steps(routes, options, temporary, choice, fixed_bytes, report);
         page["api/archive"] = site_index(routes, report, choice.second);
         page["README.txt"] = readme_text(routes.archive.root().filename().string(), report);
         const SiteFiles cinema = cinema_files(routes.archive.root(), report.steps, choice.second);
