@@ -160,4 +160,11 @@ void PayloadRoutes::send_payload(const httplib::Request& request, httplib::Respo
     }
 }
 
+const std::vector<PagePayload>& page_payloads() {
+    static const std::vector<PagePayload> registered{{"lightfield", &PayloadRoutes::light_field},
+                                                     {"proxies", &PayloadRoutes::proxies},
+                                                     {"volume", &PayloadRoutes::volume}};
+    return registered;
+}
+
 }  // namespace insitu::viewer

@@ -42,4 +42,15 @@ private:
     std::vector<std::pair<std::string, std::pair<std::string, std::string>>> payloads_;
 };
 
+/// A representation's payload for the page: served at /api/<name>, exported to a gallery as
+/// <name>.bin beside the step's other files (static_site), 404 where the step has none.
+struct PagePayload {
+    const char* name;
+    void (PayloadRoutes::*route)(const httplib::Request&, httplib::Response&);
+};
+
+/// Every payload, in the order a gallery exports a step's (a line here per representation that
+/// has one).
+const std::vector<PagePayload>& page_payloads();
+
 }  // namespace insitu::viewer

@@ -192,17 +192,11 @@ SiteFiles step_files(Routes& routes, std::int64_t step, int view) {
     files[dir + "step.json"] = info.dump();
     files[dir + "trust.json"] = required(
         call([&](const auto& r, auto& s) { routes.frames.trust(r, s); }, key), "trusted range");
-    const std::pair<const char*,
-                    void (PayloadRoutes::*)(const httplib::Request&, httplib::Response&)>
-        payloads[] = {{"lightfield", &PayloadRoutes::light_field},
-                      {"proxies", &PayloadRoutes::proxies},
-                      {"volume", &PayloadRoutes::volume}};
-    for (const auto& [name, route] : payloads) {
-        const Answer answer =
-            call([&, route = route](const auto& r, auto& s) { (routes.payloads.*route)(r, s); },
-                 key, true);
+    for (const PagePayload& payload : page_payloads()) {
+        const Answer answer = call(
+            [&](const auto& r, auto& s) { (routes.payloads.*payload.route)(r, s); }, key, true);
         if (answer.status == 404) continue;  // the step has none
-        files[dir + name + ".bin"] = required(answer, name);
+        files[dir + payload.name + ".bin"] = required(answer, payload.name);
     }
     Params frame = key;
     frame["session"] = "export";

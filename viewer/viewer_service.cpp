@@ -1,6 +1,7 @@
 #include "viewer_service.hpp"
 
 #include <map>
+#include <string>
 
 namespace insitu::viewer {
 
@@ -54,12 +55,12 @@ void ViewerService::install(httplib::Server& server) {
     install_page(server);
     server.Get("/api/archive",
                guarded([this](const auto& r, auto& s) { archive_routes_.archive(r, s); }));
-    server.Get("/api/lightfield",
-               guarded([this](const auto& r, auto& s) { payload_routes_.light_field(r, s); }));
-    server.Get("/api/proxies",
-               guarded([this](const auto& r, auto& s) { payload_routes_.proxies(r, s); }));
-    server.Get("/api/volume",
-               guarded([this](const auto& r, auto& s) { payload_routes_.volume(r, s); }));
+    for (const PagePayload& payload : page_payloads()) {
+        server.Get("/api/" + std::string(payload.name),
+                   guarded([this, route = payload.route](const auto& r, auto& s) {
+                       (payload_routes_.*route)(r, s);
+                   }));
+    }
     server.Get("/api/step",
                guarded([this](const auto& r, auto& s) { archive_routes_.step_info(r, s); }));
     server.Get("/api/trust",

@@ -253,6 +253,15 @@ FramePlan plan_frame(const ExploreRequest& request, StepCache& steps,
     return plan;
 }
 
+bool may_make_from_volume(const ExploreRequest& request, const ArchiveReader& archive) {
+    if (request.source == ProxySource::volume) return true;
+    if (request.source != ProxySource::automatic) return false;
+    const std::string field = archive.entry(request.step, request.view).field;
+    const std::vector<ArchivedVolume> volumes = archive.volumes(request.step);
+    return std::any_of(volumes.begin(), volumes.end(),
+                       [&](const ArchivedVolume& volume) { return volume.field == field; });
+}
+
 bool has_attenuation(const ProxyFrame& frame) {
     return frame.attenuation.channels > 0;
 }

@@ -78,6 +78,10 @@ FramePlan plan_frame(const ExploreRequest& request, StepCache& steps,
 
 bool has_attenuation(const ProxyFrame& frame);
 
+/// Whether the step's compressed field may make the request's frame: asked for by name, or in
+/// auto where the step holds one of the view's field (plan_frame then decides).
+bool may_make_from_volume(const ExploreRequest& request, const ArchiveReader& archive);
+
 /// Per-index scales (1 where none is given) from (index, factor) pairs, checked: "`what`
 /// index" names an index out of [0, count), "`value_what` index" a negative or non-finite
 /// factor.

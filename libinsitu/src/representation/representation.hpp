@@ -1,8 +1,9 @@
 #pragma once
 // A representation: what a step stores of a field (DESIGN.md "Representations"), one room with
-// the same verbs. Here the in-situ ones: capture (its part of the step, through the step's
-// passes) and choose (its budget candidates measured, its choice recorded). The registry lists
-// them in the order a step captures and a budget check chooses them.
+// the same verbs: capture (its part of the step, through the step's passes), choose (its budget
+// candidates measured, its choice recorded) and explore (the maker of its frames for the
+// Explorer). Its files in the archive are its EntryList (archive/entry_list.hpp). The registry
+// lists them in the order a step captures and a budget check chooses them.
 #include <memory>
 #include <vector>
 
@@ -14,6 +15,11 @@
 
 namespace insitu {
 
+class ComputeDevice;
+namespace detail {
+class FrameMaker;
+}
+
 class Representation {
 public:
     virtual ~Representation() = default;
@@ -24,6 +30,9 @@ public:
     /// Measures its candidates (where the configuration lets the budget choose them) and
     /// records its choice in `choice`; the representations before it have chosen.
     virtual void choose(const FieldBudgetCheck& check, BudgetRecord& choice) const = 0;
+    /// The maker of its frames for one Explorer (explore/frame_maker.hpp) on `device`.
+    virtual std::unique_ptr<detail::FrameMaker> frame_maker(
+        std::shared_ptr<ComputeDevice> device) const = 0;
 };
 
 /// Every representation, in capture order: the views' proxies first, then the compressed field,

@@ -171,7 +171,7 @@ struct FrameRecipe {
 };
 
 namespace detail {
-class VolumeFrames;
+class FrameMaker;
 }
 
 class Explorer {
@@ -200,8 +200,9 @@ private:
     std::string path_;
     std::shared_ptr<ComputeDevice> device_;
     StepCache steps_;
-    /// The compressed field's renderer, made on its first frame and kept with its upload.
-    std::unique_ptr<detail::VolumeFrames> volume_frames_;
+    /// Each registered representation's frames (src/representation/representations.cpp), kept
+    /// with what they uploaded.
+    std::vector<std::unique_ptr<detail::FrameMaker>> frame_makers_;
     std::mutex mutex_;
 };
 

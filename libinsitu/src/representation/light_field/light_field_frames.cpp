@@ -7,7 +7,9 @@
 #include <vector>
 
 #include "explore/frame_basis.hpp"
+#include "explore/recipe_terms.hpp"
 #include "insitu/explore/light_field_reconstruction.hpp"
+#include "representation/view_proxies/view_frames.hpp"
 
 namespace insitu::detail {
 
@@ -85,6 +87,44 @@ ExploreFrame fuse_frames(ExploreFrame from_proxies, ExploreFrame from_light_fiel
     frame.light_field_share = pixels > 0 ? static_cast<double>(taken) / pixels : 0.0;
     if (frame.opacity_scales.empty()) frame.opacity_scales = from_proxies.opacity_scales;
     return frame;
+}
+
+ExploreFrame LightFieldFrameMaker::render(const FramePlan& plan, const ExploreRequest& request,
+                                          StepCache& steps, double attenuation_resolution) {
+    ComputeDevice& device = *device_;
+    if (plan.source == FrameSource::light_field) {
+        return light_field_frame(plan, request, steps, attenuation_resolution, device);
+    }
+    // Fused per pixel: the view's proxies fill in only where the light field knows nothing of the
+    // ray (none of its cameras there: empty, confidence 0). Everywhere else the light field's
+    // pixel is the better one, whatever the two confidences say: even its least trusted pixels
+    // are off by little, a view synthesised from one camera's proxies is off by a few times the
+    // light field's mean error, and fusing below a confidence threshold lost accuracy once the
+    // light field's blend stopped mixing in cameras that do not see the ray; at large rotations
+    // the synthesised view's samples land on the wrong side of the object with full confidence,
+    // so fusing by the larger confidence loses badly there (bench/RESULTS.md, "Fused frames: the
+    // light field's pixel over the proxies'").
+    ExploreFrame from_proxies = proxies_frame(plan, request, attenuation_resolution, device);
+    ExploreFrame from_light_field =
+        light_field_frame(plan, request, steps, attenuation_resolution, device);
+    return fuse_frames(std::move(from_proxies), std::move(from_light_field));
+}
+
+FrameRecipe LightFieldFrameMaker::recipe(const FramePlan& plan, const ExploreRequest& request,
+                                         StepCache& steps) {
+    // The client reconstructs the light field's colour and first-hit depth; where render()
+    // reconstructs its a_j and mean depths (edits, lighting, enhancement of an attenuation light
+    // field) those too, then edits, lights (through the mean depths, else the first hit's
+    // normals), occludes and enhances.
+    FrameRecipe recipe;
+    recipe.synthesised = !plan.same_view;
+    recipe.light_field = true;
+    recipe.light_field_attenuation =
+        plan.light_field->settings.attenuation &&
+        (plan.edits || request.lighting.has_value() || request.enhancement.has_value());
+    recipe.colour_source = ColourSource::captured;
+    if (plan.edits) add_edit(recipe, plan, request, *plan.light_field->intervals, steps);
+    return finished(std::move(recipe), request, plan.stored);
 }
 
 }  // namespace insitu::detail

@@ -9,6 +9,7 @@
 #include "insitu/explore/light_field_reconstruction.hpp"
 #include "insitu/explore/transfer_function_edit.hpp"
 #include "representation/light_field/light_field_exr.hpp"
+#include "representation/light_field/light_field_frames.hpp"
 
 namespace insitu {
 
@@ -135,6 +136,11 @@ void LightFieldRepresentation::choose(const FieldBudgetCheck& check, BudgetRecor
     choice.light_field = choose_light_field(
         check.share_after(choice), light_field_candidates(check.config.light_field->size),
         [&](int cameras, int size) { return candidates.measure(cameras, size); });
+}
+
+std::unique_ptr<detail::FrameMaker> LightFieldRepresentation::frame_maker(
+    std::shared_ptr<ComputeDevice> device) const {
+    return std::make_unique<detail::LightFieldFrameMaker>(std::move(device));
 }
 
 }  // namespace insitu

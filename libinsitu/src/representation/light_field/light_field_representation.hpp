@@ -11,6 +11,8 @@ public:
     void capture(const InstrumentConfig& config, const FieldPlan& plan, const FieldRecipe& recipe,
                  StepPasses& passes, StepRecord& record) const override;
     void choose(const FieldBudgetCheck& check, BudgetRecord& choice) const override;
+    std::unique_ptr<detail::FrameMaker> frame_maker(
+        std::shared_ptr<ComputeDevice> device) const override;
 };
 
 }  // namespace insitu

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "explore/frame_basis.hpp"
+#include "explore/recipe_terms.hpp"
 #include "insitu/explore/view_synthesis.hpp"
 
 namespace insitu::detail {
@@ -103,6 +104,36 @@ ExploreFrame proxies_frame(const FramePlan& plan, const ExploreRequest& request,
     }
     finish_frame(std::move(basis), request, plan.stored_tf, plan.shown_tf, plan.where, device, out);
     return out;
+}
+
+ExploreFrame ViewFrameMaker::render(const FramePlan& plan, const ExploreRequest& request,
+                                    StepCache&, double attenuation_resolution) {
+    return proxies_frame(plan, request, attenuation_resolution, *device_);
+}
+
+FrameRecipe ViewFrameMaker::recipe(const FramePlan& plan, const ExploreRequest& request,
+                                   StepCache& steps) {
+    FrameRecipe recipe;
+    recipe.synthesised = !plan.same_view;
+    const ProxyFrame* single = plan.single;
+    if (!single || !has_attenuation(*single)) {
+        recipe.why_not = plan.where + " has no single-perspective attenuation proxies";
+        return recipe;
+    }
+    if (request.ambient_occlusion && single->depth_layers.empty()) {
+        // render() takes them from the multi-perspective proxies, or says there are none.
+        recipe.why_not = "ambient occlusion without single-perspective depth layers";
+        return recipe;
+    }
+    recipe.fill_radius_pixels = request.synthesis.hole_fill_radius_pixels;
+    recipe.stored_rendering = plan.stored_rendering;
+    if (recipe.stored_rendering) {
+        recipe.opacity_scales.assign(static_cast<std::size_t>(single->intervals->count()), 1.0);
+        recipe.colour_source = ColourSource::stored;
+    } else {
+        add_edit(recipe, plan, request, *single->intervals, steps);
+    }
+    return finished(std::move(recipe), request, plan.stored);
 }
 
 }  // namespace insitu::detail

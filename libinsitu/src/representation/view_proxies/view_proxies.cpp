@@ -9,6 +9,7 @@
 #include "insitu/explore/transfer_function_edit.hpp"
 #include "insitu/parallel/compositing.hpp"
 #include "representation/view_proxies/view_candidates.hpp"
+#include "representation/view_proxies/view_frames.hpp"
 
 namespace insitu {
 
@@ -146,6 +147,11 @@ void ViewProxies::choose(const FieldBudgetCheck& check, BudgetRecord& choice) co
         choice.colour_model = choose_colour_model(
             check.share_after(choice), [&](int clusters) { return models.measure(clusters); });
     }
+}
+
+std::unique_ptr<detail::FrameMaker> ViewProxies::frame_maker(
+    std::shared_ptr<ComputeDevice> device) const {
+    return std::make_unique<detail::ViewFrameMaker>(std::move(device));
 }
 
 }  // namespace insitu

@@ -1,5 +1,6 @@
 #include "representation/volume/volume_frames.hpp"
 
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -44,6 +45,26 @@ ExploreFrame volume_frame(const FramePlan& plan, const ExploreRequest& request,
                      frame.note + (ignored.size() == 1 ? " does" : " do") + " not apply";
     }
     return frame;
+}
+
+ExploreFrame VolumeFrameMaker::render(const FramePlan& plan, const ExploreRequest& request,
+                                      StepCache& steps, double) {
+    if (!frames_) frames_ = std::make_unique<VolumeFrames>(device_);
+    return volume_frame(plan, request, steps.archive().configuration(), *frames_);
+}
+
+FrameRecipe VolumeFrameMaker::recipe(const FramePlan& plan, const ExploreRequest& request,
+                                     StepCache& steps) {
+    // The client ray-marches the compressed field with render()'s settings.
+    const RenderSettings settings = preview_settings(steps.archive().configuration());
+    FrameRecipe recipe;
+    recipe.volume = true;
+    recipe.synthesised = !plan.same_view;
+    recipe.step_voxels = settings.step_voxels;
+    recipe.early_termination_opacity = settings.early_termination_opacity;
+    recipe.shading = request.lighting.has_value();
+    recipe.drawable = true;
+    return recipe;
 }
 
 }  // namespace insitu::detail

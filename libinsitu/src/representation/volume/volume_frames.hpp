@@ -1,11 +1,13 @@
 #pragma once
 // Frames of a step's compressed field for the Explorer (ProxySource::volume): the decoded grid on
 // the ground-truth VolumeRenderer, uploaded once per (step, field) and kept while frames of it are
-// asked, so that turning the view or editing the function re-renders without re-uploading.
+// asked, so that turning the view or editing the function re-renders without re-uploading; and
+// the terms for a client that ray-marches it itself.
 #include <cstdint>
 #include <memory>
 #include <string>
 
+#include "explore/frame_maker.hpp"
 #include "explore/frame_plan.hpp"
 #include "insitu/archive/archive_reader.hpp"
 #include "insitu/render/volume_renderer.hpp"
@@ -31,5 +33,20 @@ private:
 /// renderer's headlight Phong where the request asks lighting; confidence 1.
 ExploreFrame volume_frame(const FramePlan& plan, const ExploreRequest& request,
                           const InstrumentConfig& configuration, VolumeFrames& frames);
+
+/// The frames the compressed field makes (FrameSource::volume); a client ray-marches it with
+/// render()'s settings. Its renderer is made on its first frame and kept with its upload.
+class VolumeFrameMaker final : public FrameMaker {
+public:
+    using FrameMaker::FrameMaker;
+    bool makes(FrameSource source) const override { return source == FrameSource::volume; }
+    ExploreFrame render(const FramePlan& plan, const ExploreRequest& request, StepCache& steps,
+                        double attenuation_resolution) override;
+    FrameRecipe recipe(const FramePlan& plan, const ExploreRequest& request,
+                       StepCache& steps) override;
+
+private:
+    std::unique_ptr<VolumeFrames> frames_;
+};
 
 }  // namespace insitu::detail

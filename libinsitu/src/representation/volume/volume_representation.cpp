@@ -10,6 +10,7 @@
 #include "insitu/explore/transfer_function_edit.hpp"
 #include "insitu/render/volume_renderer.hpp"
 #include "representation/volume/volume_entries.hpp"
+#include "representation/volume/volume_frames.hpp"
 #include "representation/volume/zfp_volume.hpp"
 
 namespace insitu {
@@ -223,6 +224,11 @@ void VolumeRepresentation::choose(const FieldBudgetCheck& check, BudgetRecord& c
     choice.volume = choose_volume(check.share_after(choice), [&](double relative_tolerance) {
         return candidates.measure(relative_tolerance);
     });
+}
+
+std::unique_ptr<detail::FrameMaker> VolumeRepresentation::frame_maker(
+    std::shared_ptr<ComputeDevice> device) const {
+    return std::make_unique<detail::VolumeFrameMaker>(std::move(device));
 }
 
 }  // namespace insitu
