@@ -34,6 +34,20 @@ double crack_share(const Image& truth, const Image& frame) {
     return static_cast<double>(cracks) / static_cast<double>(truth.pixel_count());
 }
 
+// Where a frame's cracks and ghosts lie, to look at: the truth at half brightness, cracks red,
+// ghosts (the frame shows something, alpha > 0.1, where the truth's alpha < 0.02) blue.
+Image crack_mask(const Image& truth, const Image& frame) {
+    Image mask(truth.width, truth.height, 4, 1.0f);
+    for (std::size_t p = 0; p < truth.pixel_count(); ++p) {
+        float* out = &mask.pixels[4 * p];
+        for (int c = 0; c < 3; ++c) out[c] = 0.5f * truth.pixels[4 * p + c];
+        const float truth_alpha = truth.pixels[4 * p + 3], alpha = frame.pixels[4 * p + 3];
+        if (truth_alpha > 0.1f && alpha < 0.02f) out[0] = 1.0f, out[1] = out[2] = 0.0f;
+        if (truth_alpha < 0.02f && alpha > 0.1f) out[0] = out[1] = 0.0f, out[2] = 1.0f;
+    }
+    return mask;
+}
+
 double mean_abs_percent_of(const Image& truth, const Image& frame) {
     double sum = 0.0;
     for (std::size_t p = 0; p < truth.pixel_count(); ++p) {
@@ -174,8 +188,14 @@ void section_light_field_cracks(const std::vector<const Scene*>& scenes, bool sm
             explore.elevation_deg = angles[v].second;
             explore.source = ProxySource::lightfield;
             const ExploreFrame frame = explorer.render(explore);
-            unlit.add(renderer.render_ground_truth(view, tf, truth_settings()).rgba, frame.colour,
-                      angles[v], views);
+            const Image truth = renderer.render_ground_truth(view, tf, truth_settings()).rgba;
+            unlit.add(truth, frame.colour, angles[v], views);
+            if (v < 3) {  // the first views' cracks and ghosts, to look at
+                write_png((out / ("light_field_cracks_" + scene->name + "_view" +
+                                  std::to_string(v) + ".png"))
+                              .string(),
+                          crack_mask(truth, frame.colour));
+            }
             ms += frame.milliseconds / views;
             explore.lighting = lighting;
             relit.add(renderer.render_ground_truth(view, tf, shaded).rgba,
