@@ -3,7 +3,7 @@
 #include <zlib.h>
 
 #include <algorithm>
-#include <iterator>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
@@ -55,109 +55,138 @@ std::string payload_etag(const char* kind, std::uint32_t version, const StepKey&
 
 void PayloadRoutes::light_field(const httplib::Request& request, httplib::Response& response) {
     const StepKey key = step_key(request, archive_, {"toward", "within"});
-    std::lock_guard<std::mutex> lock(archive_.mutex());
-    const ArchiveReader& reader = archive_.reader_locked();
-    const std::string field = reader.entry(key.step, key.view).field;
-    std::optional<ArchivedLightField> stored;
-    for (const ArchivedLightField& candidate : reader.light_fields(key.step)) {
-        if (candidate.field == field) stored = candidate;
+    Prepared prepared;
+    {
+        std::lock_guard<std::mutex> lock(archive_.mutex());
+        const auto reader = reader_snapshot_locked();
+        const std::string field = reader->entry(key.step, key.view).field;
+        std::optional<ArchivedLightField> stored;
+        for (const ArchivedLightField& candidate : reader->light_fields(key.step)) {
+            if (candidate.field == field) stored = candidate;
+        }
+        if (!stored) {
+            throw HttpError(404, "step " + std::to_string(key.step) +
+                                     " has no light field of field \"" + field + "\"");
+        }
+        archive_.require_inside(stored->exr_path);
+        // A page streams the light field: the cameras around its view first (only their parts
+        // are decoded), the whole rig after.
+        const std::vector<int> cameras = light_field_cameras(request, stored->cameras);
+        std::string subset;
+        for (const int camera : cameras) subset += "c" + std::to_string(camera);
+        prepared.etag = payload_etag(("lf" + subset + "-").c_str(), kLightFieldPayloadVersion, key,
+                                     stored->exr_path);
+        prepared.make = [reader, key, field, cameras] {
+            return light_field_payload(reader->load_light_field(key.step, field, cameras), key.step,
+                                       field);
+        };
     }
-    if (!stored) {
-        throw HttpError(404, "step " + std::to_string(key.step) +
-                                 " has no light field of field \"" + field + "\"");
-    }
-    archive_.require_inside(stored->exr_path);
-    // A page streams the light field: the cameras around its view first (only their parts are
-    // decoded), the whole rig after.
-    const std::vector<int> cameras = light_field_cameras(request, stored->cameras);
-    std::string subset;
-    for (const int camera : cameras) subset += "c" + std::to_string(camera);
-    const std::string etag = payload_etag(("lf" + subset + "-").c_str(), kLightFieldPayloadVersion,
-                                          key, stored->exr_path);
-    send_payload(request, response, etag, [&] {
-        return light_field_payload(reader.load_light_field(key.step, field, cameras), key.step,
-                                   field);
-    });
+    send_payload(request, response, prepared);
 }
 
 void PayloadRoutes::proxies(const httplib::Request& request, httplib::Response& response) {
     const StepKey key = step_key(request, archive_);
-    std::lock_guard<std::mutex> lock(archive_.mutex());
-    const ArchiveReader& reader = archive_.reader_locked();
-    const ArchivedView entry = reader.entry(key.step, key.view);
-    const std::string where =
-        "step " + std::to_string(key.step) + " view " + std::to_string(key.view);
-    if (entry.exr_path.empty()) throw HttpError(404, where + " has no proxies");
-    archive_.require_inside(entry.exr_path);
-    send_payload(request, response, payload_etag("px", kProxyPayloadVersion, key, entry.exr_path),
-                 [&] {
-                     const ProxyFrame frame = reader.load(key.step, key.view);
-                     if (frame.attenuation.channels < 1) {
-                         throw HttpError(404, where + " has no attenuation proxies");
-                     }
-                     return proxy_payload(frame, key.step, key.view, entry.field);
-                 });
+    Prepared prepared;
+    {
+        std::lock_guard<std::mutex> lock(archive_.mutex());
+        const auto reader = reader_snapshot_locked();
+        const ArchivedView entry = reader->entry(key.step, key.view);
+        const std::string where =
+            "step " + std::to_string(key.step) + " view " + std::to_string(key.view);
+        if (entry.exr_path.empty()) throw HttpError(404, where + " has no proxies");
+        archive_.require_inside(entry.exr_path);
+        prepared.etag = payload_etag("px", kProxyPayloadVersion, key, entry.exr_path);
+        prepared.make = [reader, key, where, field = entry.field] {
+            const ProxyFrame frame = reader->load(key.step, key.view);
+            if (frame.attenuation.channels < 1) {
+                throw HttpError(404, where + " has no attenuation proxies");
+            }
+            return proxy_payload(frame, key.step, key.view, field);
+        };
+    }
+    send_payload(request, response, prepared);
 }
 
 void PayloadRoutes::volume(const httplib::Request& request, httplib::Response& response) {
     const StepKey key = step_key(request, archive_);
-    std::lock_guard<std::mutex> lock(archive_.mutex());
-    const ArchiveReader& reader = archive_.reader_locked();
-    const std::string field = reader.entry(key.step, key.view).field;
-    std::optional<ArchivedVolume> stored;
-    for (const ArchivedVolume& candidate : reader.volumes(key.step)) {
-        if (candidate.field == field) stored = candidate;
+    Prepared prepared;
+    {
+        std::lock_guard<std::mutex> lock(archive_.mutex());
+        const auto reader = reader_snapshot_locked();
+        const std::string field = reader->entry(key.step, key.view).field;
+        std::optional<ArchivedVolume> stored;
+        for (const ArchivedVolume& candidate : reader->volumes(key.step)) {
+            if (candidate.field == field) stored = candidate;
+        }
+        if (!stored) {
+            throw HttpError(404, "step " + std::to_string(key.step) + " has no volume of field \"" +
+                                     field + "\"");
+        }
+        archive_.require_files_inside_locked(key.step, key.view);
+        // The step's files are written together and never change once listed: the view's
+        // preview stamps them, the field's bytes tell the volume from the view's other payloads.
+        prepared.etag = payload_etag(("vf" + std::to_string(stored->bytes) + "-").c_str(),
+                                     kVolumePayloadVersion, key,
+                                     reader->entry(key.step, key.view).preview_path);
+        prepared.make = [reader, key, field, stored = *stored] {
+            return volume_payload(reader->load_volume(key.step, field), stored, key.view);
+        };
     }
-    if (!stored) {
-        throw HttpError(
-            404, "step " + std::to_string(key.step) + " has no volume of field \"" + field + "\"");
-    }
-    archive_.require_files_inside_locked(key.step, key.view);
-    // The step's files are written together and never change once listed: the view's preview
-    // stamps them, the field's bytes tell the volume from the view's other payloads.
-    const std::string etag =
-        payload_etag(("vf" + std::to_string(stored->bytes) + "-").c_str(), kVolumePayloadVersion,
-                     key, reader.entry(key.step, key.view).preview_path);
-    send_payload(request, response, etag, [&] {
-        return volume_payload(reader.load_volume(key.step, field), *stored, key.view);
-    });
+    send_payload(request, response, prepared);
+}
+
+std::shared_ptr<const ArchiveReader> PayloadRoutes::reader_snapshot_locked() const {
+    // Copies of a reader share its manifest, which never changes once read.
+    return std::make_shared<const ArchiveReader>(archive_.reader_locked());
 }
 
 void PayloadRoutes::send_payload(const httplib::Request& request, httplib::Response& response,
-                                 const std::string& etag,
-                                 const std::function<std::string()>& make) {
-    response.set_header("ETag", etag);
+                                 const Prepared& prepared) {
+    response.set_header("ETag", prepared.etag);
     response.set_header("Cache-Control", "no-cache");
-    if (request.get_header_value("If-None-Match") == etag) {
+    if (request.get_header_value("If-None-Match") == prepared.etag) {
         response.status = 304;
         return;
     }
-    auto cached = std::find_if(payloads_.begin(), payloads_.end(),
-                               [&](const auto& entry) { return entry.first == etag; });
-    if (cached == payloads_.end()) {
-        const std::string payload = make();
-        std::string compressed = gzip(payload);
-        const auto bytes = [](const auto& entry) {
-            return entry.second.first.size() + entry.second.second.size();
-        };
-        std::size_t held = payload.size() + compressed.size();
-        for (const auto& entry : payloads_) held += bytes(entry);
-        while (!payloads_.empty() &&
-               (payloads_.size() >= kMaxPayloads || held > kMaxPayloadBytes)) {
-            held -= bytes(payloads_.front());
-            payloads_.erase(payloads_.begin());
-        }
-        payloads_.emplace_back(etag, std::pair{payload, std::move(compressed)});
-        cached = std::prev(payloads_.end());
+    std::shared_ptr<const Payload> payload = cached(prepared.etag);
+    if (!payload) {
+        // Made without any lock held: two requests for the same payload may both make it.
+        auto made = std::make_shared<Payload>();
+        made->raw = prepared.make();
+        made->compressed = gzip(made->raw);
+        payload = made;
+        remember(prepared.etag, std::move(made));
     }
-    const auto& [raw, compressed] = cached->second;
-    response.set_header("X-Insitu-Payload-Bytes", std::to_string(raw.size()));
+    response.set_header("X-Insitu-Payload-Bytes", std::to_string(payload->raw.size()));
     if (request.get_header_value("Accept-Encoding").find("gzip") != std::string::npos) {
         response.set_header("Content-Encoding", "gzip");
-        response.set_content(compressed, "application/octet-stream");
+        response.set_content(payload->compressed, "application/octet-stream");
     } else {
-        response.set_content(raw, "application/octet-stream");
+        response.set_content(payload->raw, "application/octet-stream");
     }
+}
+
+std::shared_ptr<const PayloadRoutes::Payload> PayloadRoutes::cached(const std::string& etag) {
+    std::lock_guard<std::mutex> lock(payloads_mutex_);
+    for (const auto& [held_etag, payload] : payloads_) {
+        if (held_etag == etag) return payload;
+    }
+    return nullptr;
+}
+
+void PayloadRoutes::remember(const std::string& etag, std::shared_ptr<const Payload> payload) {
+    std::lock_guard<std::mutex> lock(payloads_mutex_);
+    const auto bytes = [](const Payload& held) { return held.raw.size() + held.compressed.size(); };
+    std::size_t held = bytes(*payload);
+    for (const auto& entry : payloads_) {
+        if (entry.first == etag) return;  // another request made it meanwhile
+        held += bytes(*entry.second);
+    }
+    while (!payloads_.empty() && (payloads_.size() >= kMaxPayloads || held > kMaxPayloadBytes)) {
+        held -= bytes(*payloads_.front().second);
+        payloads_.erase(payloads_.begin());
+    }
+    payloads_.emplace_back(etag, std::move(payload));
 }
 
 const std::vector<PagePayload>& page_payloads() {

@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -30,16 +32,34 @@ public:
     void volume(const httplib::Request& request, httplib::Response& response);
 
 private:
+    /// A payload and its gzip.
+    struct Payload {
+        std::string raw;
+        std::string compressed;
+    };
+    /// What a route found under the archive's lock: the payload's ETag and how to make it from a
+    /// snapshot of the reader, so that making it (decoding files, gzip: seconds for a large light
+    /// field) holds up no frame, recipe or other payload.
+    struct Prepared {
+        std::string etag;
+        std::function<std::string()> make;
+    };
+
+    /// A copy of the served reader that stays valid after the lock is released.
+    std::shared_ptr<const ArchiveReader> reader_snapshot_locked() const;
     /// Sends a binary payload: gzip-compressed when the client accepts it, a 304 when the client
-    /// holds `etag` already; the last few payloads stay in memory for a scrubbing page. Caller
-    /// holds the archive's lock (`make` reads the archive).
+    /// holds its ETag already; the last few payloads stay in memory for a scrubbing page. Called
+    /// without the archive's lock.
     void send_payload(const httplib::Request& request, httplib::Response& response,
-                      const std::string& etag, const std::function<std::string()>& make);
+                      const Prepared& prepared);
+    std::shared_ptr<const Payload> cached(const std::string& etag);
+    /// Keeps `payload` as the newest, dropping the oldest past kMaxPayloads or kMaxPayloadBytes.
+    void remember(const std::string& etag, std::shared_ptr<const Payload> payload);
 
     ServedArchive& archive_;
-    /// (ETag, (payload, its gzip)), oldest first: light fields and proxies. Guarded by
-    /// archive_.mutex().
-    std::vector<std::pair<std::string, std::pair<std::string, std::string>>> payloads_;
+    /// (ETag, payload), oldest first: light fields, proxies and compressed fields.
+    std::vector<std::pair<std::string, std::shared_ptr<const Payload>>> payloads_;
+    std::mutex payloads_mutex_;  ///< guards payloads_ (not the archive's lock)
 };
 
 /// A representation's payload for the page: served at /api/<name>, exported to a gallery as
