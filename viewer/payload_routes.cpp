@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <memory>
 #include <mutex>
-#include <optional>
 #include <stdexcept>
 
 #include "http_boundary.hpp"
@@ -51,6 +50,18 @@ std::string payload_etag(const char* kind, std::uint32_t version, const StepKey&
            std::to_string(size) + "\"";
 }
 
+/// The entry of `field` in a step's list of `entries` (its light fields, its compressed fields);
+/// 404 naming `what` where the step has none of that field.
+template <typename Entry>
+Entry entry_of_field(const std::vector<Entry>& entries, const std::string& field, std::int64_t step,
+                     const char* what) {
+    for (const Entry& candidate : entries) {
+        if (candidate.field == field) return candidate;
+    }
+    throw HttpError(
+        404, "step " + std::to_string(step) + " has no " + what + " of field \"" + field + "\"");
+}
+
 }  // namespace
 
 void PayloadRoutes::light_field(const httplib::Request& request, httplib::Response& response) {
@@ -60,22 +71,16 @@ void PayloadRoutes::light_field(const httplib::Request& request, httplib::Respon
         std::lock_guard<std::mutex> lock(archive_.mutex());
         const auto reader = reader_snapshot_locked();
         const std::string field = reader->entry(key.step, key.view).field;
-        std::optional<ArchivedLightField> stored;
-        for (const ArchivedLightField& candidate : reader->light_fields(key.step)) {
-            if (candidate.field == field) stored = candidate;
-        }
-        if (!stored) {
-            throw HttpError(404, "step " + std::to_string(key.step) +
-                                     " has no light field of field \"" + field + "\"");
-        }
-        archive_.require_inside(stored->exr_path);
+        const ArchivedLightField stored =
+            entry_of_field(reader->light_fields(key.step), field, key.step, "light field");
+        archive_.require_inside(stored.exr_path);
         // A page streams the light field: the cameras around its view first (only their parts
         // are decoded), the whole rig after.
-        const std::vector<int> cameras = light_field_cameras(request, stored->cameras);
+        const std::vector<int> cameras = light_field_cameras(request, stored.cameras);
         std::string subset;
         for (const int camera : cameras) subset += "c" + std::to_string(camera);
         prepared.etag = payload_etag(("lf" + subset + "-").c_str(), kLightFieldPayloadVersion, key,
-                                     stored->exr_path);
+                                     stored.exr_path);
         prepared.make = [reader, key, field, cameras] {
             return light_field_payload(reader->load_light_field(key.step, field, cameras), key.step,
                                        field);
@@ -114,21 +119,15 @@ void PayloadRoutes::volume(const httplib::Request& request, httplib::Response& r
         std::lock_guard<std::mutex> lock(archive_.mutex());
         const auto reader = reader_snapshot_locked();
         const std::string field = reader->entry(key.step, key.view).field;
-        std::optional<ArchivedVolume> stored;
-        for (const ArchivedVolume& candidate : reader->volumes(key.step)) {
-            if (candidate.field == field) stored = candidate;
-        }
-        if (!stored) {
-            throw HttpError(404, "step " + std::to_string(key.step) + " has no volume of field \"" +
-                                     field + "\"");
-        }
+        const ArchivedVolume stored =
+            entry_of_field(reader->volumes(key.step), field, key.step, "volume");
         archive_.require_files_inside_locked(key.step, key.view);
         // The step's files are written together and never change once listed: the view's
         // preview stamps them, the field's bytes tell the volume from the view's other payloads.
-        prepared.etag = payload_etag(("vf" + std::to_string(stored->bytes) + "-").c_str(),
-                                     kVolumePayloadVersion, key,
-                                     reader->entry(key.step, key.view).preview_path);
-        prepared.make = [reader, key, field, stored = *stored] {
+        prepared.etag =
+            payload_etag(("vf" + std::to_string(stored.bytes) + "-").c_str(), kVolumePayloadVersion,
+                         key, reader->entry(key.step, key.view).preview_path);
+        prepared.make = [reader, key, field, stored] {
             return volume_payload(reader->load_volume(key.step, field), stored, key.view);
         };
     }
