@@ -18,7 +18,7 @@
 #include "insitu/render/proxy_renderer.hpp"
 #include "parallel/agreement.hpp"
 #include "parallel/composited_passes.hpp"
-#include "parallel/distributed_config.hpp"
+#include "parallel/distributed_budget.hpp"
 #include "parallel/reduced_field_statistics.hpp"
 #include "representation/representation.hpp"
 #include "run_statistics.hpp"
@@ -66,8 +66,10 @@ struct Instrument::Impl {
     std::vector<float> joined_blocks;  ///< storage of a field joined from several blocks
     /// When the last execute() returned: the simulation's own time runs from there.
     std::optional<SteadyClock::time_point> last_return;
-    /// With a "budget": its choice per field.
+    /// With a "budget": its choice per field (the same on every rank of a distributed run).
     std::optional<BudgetController> budget;
+    /// Rank 0's renderer of the whole field a distributed budget check gathers.
+    std::unique_ptr<ProxyRenderer> whole_field_renderer;
 
     /// The ranks of a distributed run (InstrumentOptions::communicator), or null.
     std::shared_ptr<Communicator> communicator;
@@ -186,11 +188,9 @@ void Instrument::Impl::open_archive() {
 
 void Instrument::Impl::open_distributed(InstrumentConfig distributed_config) {
     LocalFailure failure;
-    failure.guard([&] {
-        distributed_config.validate();
-        refuse_what_ranks_cannot_composite(distributed_config);
-    });
+    failure.guard([&] { distributed_config.validate(); });
     config = std::move(distributed_config);
+    if (config.budget) budget.emplace(*config.budget, config.fields.size());
     if (config.proxies.attenuation && (config.proxies.interleaving || config.proxies.entry_depth)) {
         config.proxies.interleaving = config.proxies.entry_depth = false;
         log("notice: a distributed run writes no \"interleaving\" or \"entry_depth\" (the "
@@ -411,8 +411,14 @@ void Instrument::Impl::check_range(const std::string& name, const ValueRange& ra
 }
 
 void Instrument::Impl::apply_budget(FieldPlan& plan, FieldStatistics& statistics) {
+    // The controller's state is the same on every rank (the histogram is reduced over them), so
+    // every rank takes part in the same checks.
     plan.budget = budget->choice_for(plan.name, plan.summary.histogram, [&] {
-        return check_field_budget(config, *renderer, statistics, plan);
+        if (!communicator) return check_field_budget(config, *renderer, statistics, plan);
+        // upload() makes a distributed field's statistics reduced over the ranks.
+        return check_distributed_field_budget(*communicator, config,
+                                              static_cast<ReducedFieldStatistics&>(statistics),
+                                              plan, whole_field_renderer);
     });
     if (config.budget->chooses_intervals) {
         plan.intervals = statistics.intervals(plan.budget->intervals, plan.budget->interval_mode,
