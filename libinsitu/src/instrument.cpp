@@ -147,9 +147,9 @@ struct Instrument::Impl {
                                             double& composite_seconds);
     /// Checks the value range and reports NaN/Inf samples (once per run).
     void check_range(const std::string& name, const ValueRange& range, std::int64_t step);
-    /// The budget's choice for the plan's field at this step (checking when one is due),
-    /// applied to the plan's intervals where the budget chooses them.
-    void apply_budget(FieldPlan& plan, FieldStatistics& statistics);
+    /// The budget's choice for the plan's field at this step (checking when one is due; a
+    /// distributed check's gather and wait in `composite_seconds`), applied to its intervals.
+    void apply_budget(FieldPlan& plan, FieldStatistics& statistics, double& composite_seconds);
     /// Captures every representation of one planned field into `record`, by its recipe.
     void capture(const FieldPlan& plan, StepRecord& record, double& composite_seconds);
     /// Hands the record to the writer: ok, or dropped where the queue is full.
@@ -361,7 +361,7 @@ StepRecord Instrument::Impl::compute(std::int64_t step, double time,
             upload(step, name, blocks, composite_seconds);
         check_range(name, statistics->range(), step);
         FieldPlan plan = plan_field(config, name, *statistics);
-        if (budget) apply_budget(plan, *statistics);
+        if (budget) apply_budget(plan, *statistics, composite_seconds);
         capture(plan, record, composite_seconds);
     }
     return record;
@@ -410,15 +410,15 @@ void Instrument::Impl::check_range(const std::string& name, const ValueRange& ra
     }
 }
 
-void Instrument::Impl::apply_budget(FieldPlan& plan, FieldStatistics& statistics) {
-    // The controller's state is the same on every rank (the histogram is reduced over them), so
-    // every rank takes part in the same checks.
+void Instrument::Impl::apply_budget(FieldPlan& plan, FieldStatistics& statistics,
+                                    double& composite_seconds) {
+    // Fed the reduced histogram, every rank's controller makes the same checks; upload() made a
+    // distributed field's statistics reduced over the ranks.
     plan.budget = budget->choice_for(plan.name, plan.summary.histogram, [&] {
         if (!communicator) return check_field_budget(config, *renderer, statistics, plan);
-        // upload() makes a distributed field's statistics reduced over the ranks.
         return check_distributed_field_budget(*communicator, config,
                                               static_cast<ReducedFieldStatistics&>(statistics),
-                                              plan, whole_field_renderer);
+                                              plan, whole_field_renderer, composite_seconds);
     });
     if (config.budget->chooses_intervals) {
         plan.intervals = statistics.intervals(plan.budget->intervals, plan.budget->interval_mode,

@@ -6,6 +6,7 @@
 
 #include "archive/manifest.hpp"
 #include "budget/field_budget_check.hpp"
+#include "core/elapsed.hpp"
 #include "parallel/agreement.hpp"
 #include "step/local_field_statistics.hpp"
 
@@ -14,7 +15,8 @@ namespace insitu {
 BudgetRecord check_distributed_field_budget(Communicator& ranks, const InstrumentConfig& config,
                                             ReducedFieldStatistics& statistics,
                                             const FieldPlan& plan,
-                                            std::unique_ptr<ProxyRenderer>& whole_field_renderer) {
+                                            std::unique_ptr<ProxyRenderer>& whole_field_renderer,
+                                            double& collective_seconds) {
     constexpr int kRoot = 0;
     const std::vector<Bytes> owned = statistics.gather_owned(kRoot);
     LocalFailure failure;
@@ -36,7 +38,9 @@ BudgetRecord check_distributed_field_budget(Communicator& ranks, const Instrumen
             said.assign(text.begin(), text.end());
         });
     }
+    const auto start = SteadyClock::now();
     const std::vector<Bytes> told = agree(ranks, failure, said);
+    collective_seconds += seconds_since(start);
     const Bytes& chosen = told.at(kRoot);
     return archive_format::budget_from_entry(
         nlohmann::json::parse(std::string(chosen.begin(), chosen.end())));

@@ -21,10 +21,13 @@
 namespace insitu {
 
 /// One budget check of `plan`'s field, on every rank; `whole_field_renderer` is rank 0's
-/// renderer of the gathered field (made at its first check, kept for the next).
+/// renderer of the gathered field (made at its first check, kept for the next). The gather and
+/// the closing agreement (the other ranks' wait for rank 0's check) add to
+/// `collective_seconds`.
 BudgetRecord check_distributed_field_budget(Communicator& ranks, const InstrumentConfig& config,
                                             ReducedFieldStatistics& statistics,
                                             const FieldPlan& plan,
-                                            std::unique_ptr<ProxyRenderer>& whole_field_renderer);
+                                            std::unique_ptr<ProxyRenderer>& whole_field_renderer,
+                                            double& collective_seconds);
 
 }  // namespace insitu
