@@ -87,7 +87,8 @@ std::string configuration(const std::string& archive, const std::string& layers,
                   {"azimuth": 200, "elevation": -35, "size": [40, 40]}],
         "layers": )" +
            layers + R"(, "intervals": {"count": 6, "mode": ")" + interval_mode + R"("},
-        "proxies": ["depth", "distortion", "attenuation", "optical_depth", "multi_attenuation"],
+        "proxies": ["depth", "distortion", "attenuation", "optical_depth", "entry_depth",
+                    "multi_attenuation"],
         "precision": "float",
         "transfer_function": )" +
            transfer_function + R"(,
@@ -721,10 +722,11 @@ TEST(InstrumentMpi, AFailedStepLeavesTheBudgetDueOnEveryRank) {
     }
 }
 
-// "interleaving" and "entry_depth" count what the ray met in front of a block, which a block
-// cannot know: listed or left to the default list, a distributed run drops them with a notice,
-// and the archive's configuration says they were not written (no silent drop, no false echo).
-TEST(InstrumentMpi, DropsInterleavingAndEntryDepthAndSaysSo) {
+// "interleaving" counts re-entries of intervals the ray met in front of a block, which a block
+// cannot know: listed or left to the default list, a distributed run drops it with a notice,
+// and the archive's configuration says it was not written (no silent drop, no false echo).
+// "entry_depth" is composited (the archives above compare it with one process's).
+TEST(InstrumentMpi, DropsInterleavingAndSaysSoButKeepsEntryDepth) {
     const std::string directory = shared_directory("interleaving");
     std::string config = configuration(directory + "/dropped.cdb", "[0.35]", "uniform");
     const std::size_t at = config.find("\"proxies\"");
@@ -740,15 +742,18 @@ TEST(InstrumentMpi, DropsInterleavingAndEntryDepthAndSaysSo) {
     instrument.reset();
     if (world_rank() == 0) {
         const std::string log = ::testing::internal::GetCapturedStderr();
-        EXPECT_NE(log.find("notice: a distributed run writes no \"interleaving\" or "
-                           "\"entry_depth\""),
+        EXPECT_NE(log.find("notice: a distributed run writes no \"interleaving\""),
                   std::string::npos)
             << log;
+        EXPECT_EQ(log.find("entry_depth"), std::string::npos) << log;
         const ProxySelection written =
             ArchiveReader(directory + "/dropped.cdb").configuration().proxies;
         EXPECT_TRUE(written.attenuation);
         EXPECT_FALSE(written.interleaving);
-        EXPECT_FALSE(written.entry_depth);
+        EXPECT_TRUE(written.entry_depth);
+        const ProxyFrame frame = ArchiveReader(directory + "/dropped.cdb").load(0, 0, false);
+        EXPECT_EQ(frame.entry_depth.channels, frame.attenuation.channels);
+        EXPECT_EQ(frame.interleaving.channels, 0);
     }
 }
 
