@@ -4,6 +4,7 @@
 //   mpirun -np N bench_mpi [--size 128] [--image 256] [--steps 5] [--layers 4] [--intervals 16]
 //                          [--archive DIR] [--latency-us A --bandwidth-gbs B] [--radix K]
 //                          [--light-field CAMERAS --light-field-size S --segments none|layers]
+//                          [--budget PSNR]
 //
 // Every rank steps its block of the Gray-Scott box (examples/gray_scott_mpi: a periodic process
 // grid, halo exchange) and hands it to one Instrument over insitu::mpi::communicator, every step
@@ -21,6 +22,9 @@
 // --light-field adds a light field of CAMERAS cameras and S^2 maps (segments split at the layers
 // or none) to every step: each rank then marches each camera up to three times, and the three
 // exchanges of insitu/parallel/light_field_compositing.hpp count as composite ms.
+// --budget checks an error budget of PSNR dB at every step ("check_every": 1, everything it
+// may choose): rank 0 gathers the field and measures the candidates on it (the gather counts as
+// composite ms; the check as rank 0's march ms, and as the other ranks' wait in composite ms).
 // Rank 0 prints the steps (the slowest rank's times, the bytes of all ranks), then one row per
 // rank: best / median / spread (max - min) over the steps, the bench/median_time.hpp way.
 //
@@ -60,6 +64,7 @@
 
 #include "arguments.hpp"
 #include "gray_scott_mpi_simulation.hpp"
+#include "insitu/archive/archive.hpp"
 #include "insitu/config.hpp"
 #include "insitu/core/light_field.hpp"
 #include "insitu/core/transfer_function.hpp"
@@ -87,6 +92,7 @@ struct Options {
     int light_field_cameras = 0;  ///< 0: no light field
     int light_field_size = 64;
     std::string segments = "none";
+    double budget_psnr_db = 0.0;  ///< 0: no budget
 };
 
 Options parse(int argc, char** argv) {
@@ -118,6 +124,11 @@ Options parse(int argc, char** argv) {
                 throw cli::UsageError(flag + " " + value + ": must be none or layers");
             }
             options.segments = value;
+        } else if (flag == "--budget") {
+            options.budget_psnr_db = cli::parse_finite(flag, value);
+            if (!(options.budget_psnr_db > 0.0)) {
+                throw cli::UsageError(flag + " " + value + ": must be > 0");
+            }
         } else if (flag == "--latency-us" || flag == "--bandwidth-gbs") {
             const double parsed = cli::parse_finite(flag, value);
             if (!(parsed > 0.0)) throw cli::UsageError(flag + " " + value + ": must be > 0");
@@ -174,6 +185,12 @@ insitu::InstrumentConfig make_config(const Options& options) {
         light_field.validate();
         config.light_field = light_field;
     }
+    if (options.budget_psnr_db > 0.0) {
+        insitu::BudgetConfig budget;
+        budget.psnr_db = options.budget_psnr_db;
+        budget.check_every = 1;
+        config.budget = budget;
+    }
     return config;
 }
 
@@ -198,6 +215,28 @@ struct Summary {
 Summary summarize(const std::vector<double>& values) {
     const auto [low, high] = std::minmax_element(values.begin(), values.end());
     return {*low, insitu::bench::median(values), *high - *low};
+}
+
+/// What rank 0's budget checks took (the whole check, gathered field measured on rank 0), as
+/// the archive records them, and the last choice.
+void print_budget_checks(const std::string& archive) {
+    const insitu::ArchiveReader reader(archive);
+    std::vector<double> check_ms;
+    insitu::BudgetRecord last;
+    for (const std::int64_t step : reader.steps()) {
+        for (const insitu::BudgetRecord& choice : reader.budget(step)) {
+            if (choice.checked) check_ms.push_back(choice.check_milliseconds);
+            last = choice;
+        }
+    }
+    if (check_ms.empty()) return;
+    const Summary check = summarize(check_ms);
+    std::printf(
+        "budget checks at rank 0 (warm-up included): %zu, best / median / spread %.1f / %.1f / "
+        "%.1f ms; last choice %d %s intervals, size 1/%d, %.1f dB (%s)\n",
+        check_ms.size(), check.best, check.median, check.spread, last.intervals,
+        insitu::to_string(last.interval_mode).c_str(), last.size_divisor, last.psnr_db,
+        last.met ? "met" : "not met");
 }
 
 /// Latency (s) and bandwidth (bytes/s) of the link between ranks 0 and 1.
@@ -341,6 +380,9 @@ int run(const Options& options) {
                         options.light_field_cameras, options.light_field_size,
                         options.segments.c_str());
         }
+        if (options.budget_psnr_db > 0.0) {
+            std::printf("budget: %g dB, checked at every step\n", options.budget_psnr_db);
+        }
     }
 
     simulation.step();
@@ -374,6 +416,7 @@ int run(const Options& options) {
     }
     instrument->finalize();
     instrument.reset();  // before the communicator it shares and MPI go
+    if (rank == 0 && options.budget_psnr_db > 0.0) print_budget_checks(options.archive);
 
     // Per step: the slowest rank's times, the bytes of all ranks.
     constexpr int kFigures = 7;

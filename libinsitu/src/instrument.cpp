@@ -18,7 +18,7 @@
 #include "insitu/render/proxy_renderer.hpp"
 #include "parallel/agreement.hpp"
 #include "parallel/composited_passes.hpp"
-#include "parallel/distributed_config.hpp"
+#include "parallel/distributed_budget.hpp"
 #include "parallel/reduced_field_statistics.hpp"
 #include "representation/representation.hpp"
 #include "run_statistics.hpp"
@@ -66,8 +66,10 @@ struct Instrument::Impl {
     std::vector<float> joined_blocks;  ///< storage of a field joined from several blocks
     /// When the last execute() returned: the simulation's own time runs from there.
     std::optional<SteadyClock::time_point> last_return;
-    /// With a "budget": its choice per field.
+    /// With a "budget": its choice per field (the same on every rank of a distributed run).
     std::optional<BudgetController> budget;
+    /// Rank 0's renderer of the whole field a distributed budget check gathers.
+    std::unique_ptr<ProxyRenderer> whole_field_renderer;
 
     /// The ranks of a distributed run (InstrumentOptions::communicator), or null.
     std::shared_ptr<Communicator> communicator;
@@ -145,9 +147,9 @@ struct Instrument::Impl {
                                             double& composite_seconds);
     /// Checks the value range and reports NaN/Inf samples (once per run).
     void check_range(const std::string& name, const ValueRange& range, std::int64_t step);
-    /// The budget's choice for the plan's field at this step (checking when one is due),
-    /// applied to the plan's intervals where the budget chooses them.
-    void apply_budget(FieldPlan& plan, FieldStatistics& statistics);
+    /// The budget's choice for the plan's field at this step (checking when one is due; a
+    /// distributed check's gather and wait in `composite_seconds`), applied to its intervals.
+    void apply_budget(FieldPlan& plan, FieldStatistics& statistics, double& composite_seconds);
     /// Captures every representation of one planned field into `record`, by its recipe.
     void capture(const FieldPlan& plan, StepRecord& record, double& composite_seconds);
     /// Hands the record to the writer: ok, or dropped where the queue is full.
@@ -186,17 +188,15 @@ void Instrument::Impl::open_archive() {
 
 void Instrument::Impl::open_distributed(InstrumentConfig distributed_config) {
     LocalFailure failure;
-    failure.guard([&] {
-        distributed_config.validate();
-        refuse_what_ranks_cannot_composite(distributed_config);
-    });
+    failure.guard([&] { distributed_config.validate(); });
     config = std::move(distributed_config);
-    if (config.proxies.attenuation && (config.proxies.interleaving || config.proxies.entry_depth)) {
-        config.proxies.interleaving = config.proxies.entry_depth = false;
-        log("notice: a distributed run writes no \"interleaving\" or \"entry_depth\" (the "
-            "default \"proxies\" name them; a block cannot count what the ray met in front of "
-            "it): the archive's configuration lists neither, and the viewer's edit trust goes "
-            "without them");
+    if (config.budget) budget.emplace(*config.budget, config.fields.size());
+    if (config.proxies.attenuation && config.proxies.interleaving) {
+        config.proxies.interleaving = false;
+        log("notice: a distributed run writes no \"interleaving\" (the default \"proxies\" "
+            "name it; a block cannot count re-entries of intervals the ray met in front of it): "
+            "the archive's configuration does not list it, and the viewer's edit trust goes "
+            "without it");
     }
     failure.guard([&] { renderer = std::make_unique<ProxyRenderer>(); });
     std::vector<double> archived;
@@ -361,7 +361,7 @@ StepRecord Instrument::Impl::compute(std::int64_t step, double time,
             upload(step, name, blocks, composite_seconds);
         check_range(name, statistics->range(), step);
         FieldPlan plan = plan_field(config, name, *statistics);
-        if (budget) apply_budget(plan, *statistics);
+        if (budget) apply_budget(plan, *statistics, composite_seconds);
         capture(plan, record, composite_seconds);
     }
     return record;
@@ -410,9 +410,15 @@ void Instrument::Impl::check_range(const std::string& name, const ValueRange& ra
     }
 }
 
-void Instrument::Impl::apply_budget(FieldPlan& plan, FieldStatistics& statistics) {
+void Instrument::Impl::apply_budget(FieldPlan& plan, FieldStatistics& statistics,
+                                    double& composite_seconds) {
+    // Fed the reduced histogram, every rank's controller makes the same checks; upload() made a
+    // distributed field's statistics reduced over the ranks.
     plan.budget = budget->choice_for(plan.name, plan.summary.histogram, [&] {
-        return check_field_budget(config, *renderer, statistics, plan);
+        if (!communicator) return check_field_budget(config, *renderer, statistics, plan);
+        return check_distributed_field_budget(*communicator, config,
+                                              static_cast<ReducedFieldStatistics&>(statistics),
+                                              plan, whole_field_renderer, composite_seconds);
     });
     if (config.budget->chooses_intervals) {
         plan.intervals = statistics.intervals(plan.budget->intervals, plan.budget->interval_mode,

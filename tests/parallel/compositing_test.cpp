@@ -59,6 +59,7 @@ ProxyRequest full_request(const SampledVolume& volume, std::vector<double> isova
     ProxyRequest request;
     request.isovalues = std::move(isovalues);
     request.optical_depth = true;
+    request.entry_depth = true;
     float lo = std::numeric_limits<float>::max();
     float hi = -lo;
     for (float v : volume.values) {
@@ -110,6 +111,9 @@ void expect_frames_close(const ProxyFrame& whole, const ProxyFrame& composited) 
                      "distortion layer " + std::to_string(l));
     }
     expect_close(whole.attenuation, composited.attenuation, 2e-6, 0.0, "attenuation");
+    // The first sample that gave each interval light: the front-most block's.
+    ASSERT_EQ(whole.entry_depth.channels, whole.attenuation.channels);
+    expect_close(whole.entry_depth, composited.entry_depth, 1e-4, 1e-5, "entry depth");
     // Beyond where the whole pass saturates, what a block behind adds is invisible and not
     // compared (insitu/parallel/compositing.hpp): mean depth of intervals holding attenuation
     // below 1e-6, optical depth of saturated rays.

@@ -106,7 +106,7 @@ struct ProxySelection {
     /// orders (issue 17). On by default: with it the trust flags more of the wrong pixels of
     /// thickening edits and far fewer of the right ones than the interleaving counts alone, for
     /// a modest share of bytes and little time (bench/RESULTS.md, "Entry depth on by default").
-    /// Not written by distributed runs, like "interleaving".
+    /// Distributed runs composite it: the front-most block's entry that got light.
     bool entry_depth = true;
 };
 

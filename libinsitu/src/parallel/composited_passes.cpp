@@ -49,8 +49,6 @@ ProxyFrame CompositedPasses::proxies(const OrbitView& orbit, const Bounds& bound
     // ProxyRequest::interleaving): distributed archives carry no interleaving, and the
     // Explorer's edit trust then goes without that term.
     march.interleaving = false;
-    // Likewise the entry depth: the first interval a block sees may not be the ray's.
-    march.entry_depth = false;
     std::optional<ProxyFrame> partial;
     if (has_block_) {
         failure_.guard([&] {

@@ -39,12 +39,14 @@ struct ProxyLayout {
     bool attenuation = false;
     bool mean_depth = false;
     bool optical_depth = false;
+    bool entry_depth = false;  ///< per interval, the depth of the first sample that gave it light
     float sin_tilt = 0.0f;
     std::vector<float> isovalues;
 
     int outputs() const {
         return layers * (distortion ? 2 : 1) +
-               intervals * ((attenuation ? 1 : 0) + (mean_depth ? 1 : 0) + (optical_depth ? 1 : 0));
+               intervals * ((attenuation ? 1 : 0) + (mean_depth ? 1 : 0) + (optical_depth ? 1 : 0) +
+                            (entry_depth ? 1 : 0));
     }
     int record() const { return kFragmentChannels + outputs(); }
 };
@@ -56,9 +58,10 @@ ProxyLayout layout_of(const ProxyFrame& shell) {
     layout.attenuation = shell.attenuation.channels > 0;
     layout.mean_depth = shell.mean_depth.channels > 0;
     layout.optical_depth = shell.optical_depth.channels > 0;
+    layout.entry_depth = shell.entry_depth.channels > 0;
     layout.intervals = shell.intervals ? shell.intervals->count() : 0;
-    if (layout.mean_depth && !layout.attenuation) {
-        fail<InvalidArgument>("compositing mean depth needs the attenuation it is weighted by");
+    if ((layout.mean_depth || layout.entry_depth) && !layout.attenuation) {
+        fail<InvalidArgument>("compositing mean and entry depths needs the attenuation they read");
     }
     layout.sin_tilt = static_cast<float>(std::sin(glm::radians(shell.distortion_tilt_deg)));
     layout.isovalues.assign(shell.isovalues.begin(), shell.isovalues.end());
@@ -79,7 +82,8 @@ void allocate_images(ProxyFrame& frame) {
     for (std::vector<Image>* list : {&frame.depth_layers, &frame.distortion_layers}) {
         for (Image& image : *list) image.pixels.assign(image.pixel_count() * image.channels, 0.0f);
     }
-    for (Image* image : {&frame.attenuation, &frame.mean_depth, &frame.optical_depth}) {
+    for (Image* image :
+         {&frame.attenuation, &frame.mean_depth, &frame.optical_depth, &frame.entry_depth}) {
         image->pixels.assign(image->pixel_count() * image->channels, 0.0f);
     }
 }
@@ -115,8 +119,8 @@ Bytes pack_proxy_records(const ProxyLayout& layout, const ProxyFrame& partial, s
         std::size_t next = kFragmentChannels;
         for (const Image& layer : partial.depth_layers) record[next++] = layer.pixels[pixel];
         for (const Image& layer : partial.distortion_layers) record[next++] = layer.pixels[pixel];
-        for (const Image* image :
-             {&partial.attenuation, &partial.mean_depth, &partial.optical_depth}) {
+        for (const Image* image : {&partial.attenuation, &partial.mean_depth,
+                                   &partial.optical_depth, &partial.entry_depth}) {
             if (image->pixels.empty()) continue;
             const float* channels = &image->pixels[pixel * I];
             std::copy(channels, channels + I, record.begin() + static_cast<std::ptrdiff_t>(next));
@@ -211,6 +215,9 @@ void identity_outputs(const ProxyLayout& layout, float* out) {
     if (layout.optical_depth) {
         for (int j = 0; j < I; ++j) out[next++] = 0.0f;
     }
+    if (layout.entry_depth) {
+        for (int j = 0; j < I; ++j) out[next++] = kInf;
+    }
 }
 
 // Scratch memory of a fold, allocated once per tile.
@@ -229,6 +236,7 @@ void fold_proxy_pixel(const ProxyLayout& layout, const RecordRef* first, const R
     const int attenuation_at = L * (layout.distortion ? 2 : 1);
     const int mean_at = attenuation_at + (layout.attenuation ? I : 0);
     const int optical_at = mean_at + (layout.mean_depth ? I : 0);
+    const int entry_at = optical_at + (layout.optical_depth ? I : 0);
     scratch.record.resize(static_cast<std::size_t>(layout.record()));
     float* const record = scratch.record.data();
     load_record(*first, layout.record(), record);
@@ -283,6 +291,12 @@ void fold_proxy_pixel(const ProxyLayout& layout, const RecordRef* first, const R
                     weighted[j] += transmittance * a_back * b_out[mean_at + j];
                 }
                 if (layout.optical_depth) out[optical_at + j] += b_out[optical_at + j];
+                // The entry depth of the front-most block that gave the interval light (one
+                // that got light through what is in front: the whole pass's weight > 0).
+                if (layout.entry_depth && std::isinf(out[entry_at + j]) &&
+                    transmittance * a_back > 0.0) {
+                    out[entry_at + j] = b_out[entry_at + j];
+                }
             }
             transmittance *= b[kTransmittance];
         }
@@ -330,7 +344,8 @@ void unpack_proxy_outputs(const ProxyLayout& layout, const float* values, std::i
         int next = 0;
         for (Image& layer : frame.depth_layers) layer.pixels[pixel] = in[next++];
         for (Image& layer : frame.distortion_layers) layer.pixels[pixel] = in[next++];
-        for (Image* image : {&frame.attenuation, &frame.mean_depth, &frame.optical_depth}) {
+        for (Image* image :
+             {&frame.attenuation, &frame.mean_depth, &frame.optical_depth, &frame.entry_depth}) {
             if (image->pixels.empty()) continue;
             std::copy(in + next, in + next + I, &image->pixels[pixel * I]);
             next += I;
@@ -352,7 +367,8 @@ void check_partial(const ProxyLayout& layout, const ProxyFrame& shell, const Pro
                    partial.distortion_layers.size() == shell.distortion_layers.size() &&
                    same(partial.attenuation, shell.attenuation) &&
                    same(partial.mean_depth, shell.mean_depth) &&
-                   same(partial.optical_depth, shell.optical_depth);
+                   same(partial.optical_depth, shell.optical_depth) &&
+                   same(partial.entry_depth, shell.entry_depth);
     for (std::size_t l = 0; matches && l < shell.depth_layers.size(); ++l) {
         matches = same(partial.depth_layers[l], shell.depth_layers[l]);
     }
@@ -448,6 +464,7 @@ ProxyFrame frame_shell(const Camera& camera, double tilt_deg, bool multi_perspec
         if (request.attenuation) frame.attenuation = sized(width, height, I);
         if (request.mean_depth) frame.mean_depth = sized(width, height, I);
         if (request.optical_depth) frame.optical_depth = sized(width, height, I);
+        if (request.entry_depth) frame.entry_depth = sized(width, height, I);
     }
     return frame;
 }

@@ -375,22 +375,28 @@ Field Decomposition::marched_block(const Field& block, int rank) const {
     return marched;
 }
 
-template <typename Visit>
-void Decomposition::visit_owned_rows(const std::vector<float>& values, const Index3& block_dims,
-                                     int rank, Visit visit) const {
+Index3 Decomposition::owned_dims(const Index3& block_dims, int rank) const {
     const Part& part = parts.at(static_cast<std::size_t>(rank));
-    if (values.size() != static_cast<std::size_t>(block_dims[0] * block_dims[1] * block_dims[2])) {
-        fail<InvalidArgument>(field, ": ", values.size(), " values for a block of ", block_dims[0],
-                              "x", block_dims[1], "x", block_dims[2]);
-    }
     Index3 end{0, 0, 0};
     for (int axis = 0; axis < 3; ++axis) {
         // Samples at grid index g < owned_upper; the grid's last sample at +inf.
         const double upper = std::isinf(part.owned_upper[axis]) ? static_cast<double>(dims[axis])
                                                                 : part.owned_upper[axis];
-        end[axis] = std::min<std::int64_t>(
-            block_dims[axis], static_cast<std::int64_t>(upper) - part.interior_lower[axis]);
+        end[axis] = std::max<std::int64_t>(
+            0, std::min<std::int64_t>(
+                   block_dims[axis], static_cast<std::int64_t>(upper) - part.interior_lower[axis]));
     }
+    return end;
+}
+
+template <typename Visit>
+void Decomposition::visit_owned_rows(const std::vector<float>& values, const Index3& block_dims,
+                                     int rank, Visit visit) const {
+    if (values.size() != static_cast<std::size_t>(block_dims[0] * block_dims[1] * block_dims[2])) {
+        fail<InvalidArgument>(field, ": ", values.size(), " values for a block of ", block_dims[0],
+                              "x", block_dims[1], "x", block_dims[2]);
+    }
+    const Index3 end = owned_dims(block_dims, rank);
     for (std::int64_t k = 0; k < end[2]; ++k) {
         for (std::int64_t j = 0; j < end[1]; ++j) {
             const std::size_t row =

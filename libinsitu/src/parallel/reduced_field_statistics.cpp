@@ -1,5 +1,7 @@
 #include "parallel/reduced_field_statistics.hpp"
 
+#include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "core/elapsed.hpp"
@@ -129,6 +131,58 @@ BlockPlacement ReducedFieldStatistics::placement() const {
         ++mine.count;
     }
     return mine;
+}
+
+std::vector<Bytes> ReducedFieldStatistics::gather_owned(int root) {
+    Bytes mine;
+    failure_.guard([&] {
+        if (!block_) return;
+        const DeviceVolume& volume = renderer_.volume();
+        const std::vector<float> owned =
+            grid_->owned_values(volume.host_values, volume.dims, ranks_.rank());
+        mine.resize(owned.size() * sizeof(float));
+        if (!owned.empty()) std::memcpy(mine.data(), owned.data(), mine.size());
+    });
+    const auto start = SteadyClock::now();
+    agree(ranks_, failure_);
+    std::vector<Bytes> owned = ranks_.gather(mine, root);
+    collective_seconds_ += seconds_since(start);
+    return owned;
+}
+
+Field ReducedFieldStatistics::assemble_whole(const std::vector<Bytes>& owned,
+                                             std::vector<float>& storage) const {
+    const Index3& dims = grid_->dims;
+    storage.assign(static_cast<std::size_t>(dims[0] * dims[1] * dims[2]),
+                   std::numeric_limits<float>::quiet_NaN());
+    for (std::size_t r = 0; r < grid_->parts.size(); ++r) {
+        const Decomposition::Part& part = grid_->parts[r];
+        if (!part.present) continue;
+        Index3 marched = part.interior_dims;
+        for (int axis = 0; axis < 3; ++axis) marched[axis] += part.marched_ghosts[axis];
+        const Index3 box = grid_->owned_dims(marched, static_cast<int>(r));
+        const std::size_t row = static_cast<std::size_t>(box[0]);
+        const std::size_t count = row * static_cast<std::size_t>(box[1] * box[2]);
+        if (r >= owned.size() || owned[r].size() != count * sizeof(float)) {
+            fail<Error>(grid_->field, ": rank ", r, " sent ",
+                        r < owned.size() ? owned[r].size() / sizeof(float) : 0, " samples of the ",
+                        count, " it owns");
+        }
+        for (std::int64_t k = 0; k < box[2]; ++k) {
+            for (std::int64_t j = 0; j < box[1]; ++j) {
+                const Index3& at = part.interior_lower;
+                const std::size_t to =
+                    static_cast<std::size_t>(((at[2] + k) * dims[1] + at[1] + j) * dims[0] + at[0]);
+                const std::size_t from = static_cast<std::size_t>(k * box[1] + j) * row;
+                std::memcpy(storage.data() + to, owned[r].data() + from * sizeof(float),
+                            row * sizeof(float));
+            }
+        }
+    }
+    Field whole(grid_->field, storage.data(), ScalarType::float32, dims);
+    // Node centring at the first sample: where the renderers sample a cell-centred grid too.
+    whole.set_origin(grid_->first_sample).set_spacing(grid_->spacing);
+    return whole;
 }
 
 std::vector<std::string> ReducedFieldStatistics::check_halos(std::int64_t step) {

@@ -35,6 +35,14 @@ public:
     /// line per ghost layer that differs from its owner's interior, on every rank.
     std::vector<std::string> check_halos(std::int64_t step);
 
+    /// The samples every rank owns, at `root` (by rank; empty lists elsewhere), agreed first:
+    /// what assemble_whole() makes the whole grid of. Collective.
+    std::vector<Bytes> gather_owned(int root);
+    /// The whole grid as one process holds it, from gather_owned()'s lists (`storage` holds the
+    /// values): float samples from the first one on, the grid's spacing. Local; throws Error
+    /// where a rank's list does not fill its part.
+    Field assemble_whole(const std::vector<Bytes>& owned, std::vector<float>& storage) const;
+
 private:
     /// Sums `counts` over the ranks and agrees (raising any rank's failure since the last).
     void sum_over_ranks(std::vector<double>& counts);

@@ -77,11 +77,6 @@ void check_partial_request(const ProxyRequest& request, bool want_segments) {
             "interleaving counts are not composited across blocks: a block of a distributed "
             "run cannot know which intervals the ray met in front of it");
     }
-    if (request.entry_depth) {
-        fail<InvalidArgument>(
-            "entry depths are not composited across blocks: a block of a distributed run "
-            "cannot know which intervals the ray met in front of it");
-    }
     // A segment's and the first hit's opacity thresholds depend on the opacity in front of
     // the block: the caller finds it (parallel/light_field_compositing.cpp).
     if (want_segments && request.front.pixels.empty()) {

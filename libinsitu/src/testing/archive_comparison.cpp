@@ -124,6 +124,7 @@ std::vector<ProxyMeasurement> compare_frames(ProxyFrame& one, ProxyFrame& other,
         compare_images("mean_depth", {one.mean_depth}, {other.mean_depth}, true, stored_depth),
         compare_images("optical_depth", {one.optical_depth}, {other.optical_depth}, true,
                        stored_depth),
+        compare_images("entry_depth", {one.entry_depth}, {other.entry_depth}, true, stored_depth),
     };
     if (one.multi_perspective || other.multi_perspective) {
         measurements.push_back(compare_images("distortion", one.distortion_layers,

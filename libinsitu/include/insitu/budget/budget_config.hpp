@@ -20,8 +20,8 @@ namespace insitu {
 /// chosen), and in float only for the most accurate affordable one when none meets it. Any
 /// subset of the three limits; with several fields each gets an even share of bytes and time.
 /// The bytes and time are the field's views' single-perspective proxies, rendering and preview
-/// (the multi-perspective, training and light-field passes come on top). Distributed runs
-/// refuse it (its ground truth needs the whole field on one process).
+/// (the multi-perspective, training and light-field passes come on top). A distributed run's
+/// rank 0 checks the whole field, gathered (src/parallel/distributed_budget.hpp).
 /// With a "light_field" (and "choose" allowing it), the budget then chooses its camera count
 /// and map size too (kBudgetLightFieldCameraCounts x kBudgetLightFieldSizeDivisors), within
 /// what the views' choice left of the bytes and time: each candidate rig is measured in the same

@@ -9,6 +9,8 @@
 //  * attenuation a_j = a_front + T_front a_back, T = T_front T_back (seed 000 Eq. 7 split at a
 //    sample); nothing behind a fragment with T = 0 counts (the whole pass stops there);
 //  * mean depth: the attenuation-weighted mean of the two; optical depth: the sum;
+//  * entry depth (per interval, the first sample that gave it light): the front's; else the
+//    back's where it got light through the front (T_front a_back > 0);
 //  * depth layers: the front's crossing; else the crossing between the front's last and the
 //    back's first sample (the pair the whole pass compares there, refined the same way), so a
 //    crossing on a block boundary is found once; else the back's;

@@ -66,6 +66,9 @@ struct Decomposition {
     /// sample of the grid counted by one rank only: for the agreed value range and histogram.
     std::vector<float> owned_values(const std::vector<float>& values, const Index3& dims,
                                     int rank) const;
+    /// The box of those samples (they begin at the block's first interior sample): x-fastest
+    /// rows of this many, as owned_values() lists them.
+    Index3 owned_dims(const Index3& block_dims, int rank) const;
     /// How many of those are NaN (non-finite in the simulation's data) and how many not.
     ValueRange owned_counts(const std::vector<float>& values, const Index3& dims, int rank) const;
 

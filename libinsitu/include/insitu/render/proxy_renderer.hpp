@@ -50,8 +50,8 @@ struct ProxyRequest {
     /// run (a block cannot know what the ray met in front of it).
     bool interleaving = false;
     /// Per pixel and interval, the depth where the interval first took light
-    /// (ProxyFrame::entry_depth); needs intervals, and is refused for a block of a distributed
-    /// run, as interleaving is.
+    /// (ProxyFrame::entry_depth); needs intervals. A block of a distributed run gives its own,
+    /// and compositing keeps the front-most block's that got light (parallel/compositing.cpp).
     bool entry_depth = false;
     /// Per segment of each ray, RGBA (premultiplied) and first-hit depth; the whole ray's
     /// first-hit depth. Each needs the transfer function.
