@@ -10,8 +10,20 @@ import { requestTrust, syncOrbitInputs } from './orbit.js';
 import { applyValueEdits } from './value_edits.js';
 import { exportedViews, noteIndex, stepUrl } from './source.js';
 
+// The index that index.html asked for while the modules loaded: the first loadArchive's answer
+// (one round trip less before the first frame); asked again where it failed, for its error.
+let earlyIndex = window.insituEarlyIndex || null;
+
+async function fetchIndex() {
+  const early = earlyIndex;
+  earlyIndex = null;
+  const response = early && await early.catch(() => null);
+  if (!response || !response.ok) return getJson('api/archive');
+  return response.json();
+}
+
 export async function loadArchive() {
-  const archive = await getJson('api/archive');
+  const archive = await fetchIndex();
   noteIndex(archive);
   const grew = state.archive && archive.timeline.length !== state.timeline.length;
   state.archive = archive;
