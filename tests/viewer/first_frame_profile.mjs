@@ -2,9 +2,11 @@
 // time to first byte and end, the main thread's long tasks (over 50 ms: script, shader builds
 // that block, decoding) and the first frame shown, all on the page's clock from navigation, in
 // headless chromium with WebGL2 through SwiftShader (or --gpu=off); RUNS fresh pages after a
-// warm-up, the median run printed whole and each part's best / median.
+// warm-up, the median run printed whole and each part's best / median. With --cold=S each run
+// opens the page on a server started S seconds before (as a user who starts `serve` and then
+// opens its address), after one warm-up page on another server (the browser's own start).
 //
-//   node tests/viewer/first_frame_profile.mjs INSITU_VIEW ARCHIVE [RUNS] [--gpu=off]
+//   node tests/viewer/first_frame_profile.mjs INSITU_VIEW ARCHIVE [RUNS] [--gpu=off] [--cold=S]
 import { cpus } from 'node:os';
 
 import { CHROMIUM, CHROMIUM_ARGS, loadPlaywright, startServer, stopServer, WEBGL_ARGS } from './lib.mjs';
@@ -17,6 +19,8 @@ if (!binary || !archive) {
   process.exit(2);
 }
 const runs = Number(runsText || 5);
+const coldArg = args.find((a) => a.startsWith('--cold='));
+const coldSeconds = coldArg ? Number(coldArg.slice('--cold='.length)) : null;
 
 // Observes long tasks from the page's start (an init script runs before the page's own).
 const OBSERVE = `window.__longTasks = [];
@@ -57,19 +61,34 @@ async function oneRun(browser, url) {
   return profile;
 }
 
-const server = await startServer(binary, archive);
 const browser = await loadPlaywright().chromium.launch({ executablePath: CHROMIUM,
   args: gpuOff ? CHROMIUM_ARGS : WEBGL_ARGS });
+const query = gpuOff ? '?gpu=off' : '';
+// One page on its own server: warm (the runs' server after one page) or cold (a new one each).
+async function profiled(warm) {
+  if (warm) return oneRun(browser, warm.url + query);
+  const server = await startServer(binary, archive);
+  try {
+    await new Promise((resolve) => { setTimeout(resolve, coldSeconds * 1000); });
+    return await oneRun(browser, server.url + query);
+  } finally {
+    await stopServer(server);
+  }
+}
+const server = await startServer(binary, archive);
 try {
-  const url = server.url + (gpuOff ? '?gpu=off' : '');
-  await oneRun(browser, url);  // warm-up
+  await oneRun(browser, server.url + query);  // warm-up
+  if (coldSeconds !== null) await stopServer(server);
+  const warm = coldSeconds === null ? server : null;
   const all = [];
-  for (let r = 0; r < runs; ++r) all.push(await oneRun(browser, url));
+  for (let r = 0; r < runs; ++r) all.push(await profiled(warm));
   const firsts = all.map((p) => p.find(([what]) => what === 'FIRST FRAME')[1]);
   const order = firsts.map((f, i) => [f, i]).sort((a, b) => a[0] - b[0]);
   const median = all[order[Math.floor(runs / 2)][1]];
   console.log(`${archive}: ${runs} runs after one warm-up, ${gpuOff ? 'server frames' :
-    'WebGL2 (SwiftShader)'}; CPU ${cpus()[0].model} (${cpus().length} threads)`);
+    'WebGL2 (SwiftShader)'}, ${coldSeconds === null ? 'warm server' :
+    `server started ${coldSeconds} s before each`}; CPU ${cpus()[0].model} ` +
+    `(${cpus().length} threads)`);
   console.log(`first frame best / median ms: ${order[0][0].toFixed(0)} / ` +
     `${order[Math.floor(runs / 2)][0].toFixed(0)}; the median run:`);
   for (const [what, at] of median) console.log(`${at.toFixed(0).padStart(7)} ms  ${what}`);
