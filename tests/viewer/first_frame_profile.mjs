@@ -4,9 +4,13 @@
 // headless chromium with WebGL2 through SwiftShader (or --gpu=off); RUNS fresh pages after a
 // warm-up, the median run printed whole and each part's best / median. With --cold=S each run
 // opens the page on a server started S seconds before (as a user who starts `serve` and then
-// opens its address), after one warm-up page on another server (the browser's own start).
+// opens its address), after one warm-up page on another server (the browser's own start). With
+// --idle=S each run on the warm server waits S seconds first: the server finishes what the
+// page before asked for (payloads, trusted ranges, under the archive's lock that /api/archive
+// takes too), as for a user who opens the page once.
 //
 //   node tests/viewer/first_frame_profile.mjs INSITU_VIEW ARCHIVE [RUNS] [--gpu=off] [--cold=S]
+//     [--idle=S]
 import { cpus } from 'node:os';
 
 import { CHROMIUM, CHROMIUM_ARGS, loadPlaywright, startServer, stopServer, WEBGL_ARGS } from './lib.mjs';
@@ -21,6 +25,9 @@ if (!binary || !archive) {
 const runs = Number(runsText || 5);
 const coldArg = args.find((a) => a.startsWith('--cold='));
 const coldSeconds = coldArg ? Number(coldArg.slice('--cold='.length)) : null;
+const idleArg = args.find((a) => a.startsWith('--idle='));
+const idleSeconds = idleArg ? Number(idleArg.slice('--idle='.length)) : 0;
+const sleep = (seconds) => new Promise((resolve) => { setTimeout(resolve, seconds * 1000); });
 
 // Observes long tasks from the page's start (an init script runs before the page's own).
 const OBSERVE = `window.__longTasks = [];
@@ -66,10 +73,13 @@ const browser = await loadPlaywright().chromium.launch({ executablePath: CHROMIU
 const query = gpuOff ? '?gpu=off' : '';
 // One page on its own server: warm (the runs' server after one page) or cold (a new one each).
 async function profiled(warm) {
-  if (warm) return oneRun(browser, warm.url + query);
+  if (warm) {
+    await sleep(idleSeconds);
+    return oneRun(browser, warm.url + query);
+  }
   const server = await startServer(binary, archive);
   try {
-    await new Promise((resolve) => { setTimeout(resolve, coldSeconds * 1000); });
+    await sleep(coldSeconds);
     return await oneRun(browser, server.url + query);
   } finally {
     await stopServer(server);
@@ -86,7 +96,7 @@ try {
   const order = firsts.map((f, i) => [f, i]).sort((a, b) => a[0] - b[0]);
   const median = all[order[Math.floor(runs / 2)][1]];
   console.log(`${archive}: ${runs} runs after one warm-up, ${gpuOff ? 'server frames' :
-    'WebGL2 (SwiftShader)'}, ${coldSeconds === null ? 'warm server' :
+    'WebGL2 (SwiftShader)'}, ${coldSeconds === null ? `warm server idle ${idleSeconds} s` :
     `server started ${coldSeconds} s before each`}; CPU ${cpus()[0].model} ` +
     `(${cpus().length} threads)`);
   console.log(`first frame best / median ms: ${order[0][0].toFixed(0)} / ` +
