@@ -59,6 +59,11 @@ add_test(NAME viewer.frame_cost
          COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/frame_cost.test.mjs
          WORKING_DIRECTORY ${viewer_tests_dir})
 set_tests_properties(viewer.frame_cost PROPERTIES TIMEOUT 60)
+# index.html preloads every module of the page (the first frame waits for them all).
+add_test(NAME viewer.page_modules
+         COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/page_modules.test.mjs
+         WORKING_DIRECTORY ${viewer_tests_dir})
+set_tests_properties(viewer.page_modules PROPERTIES TIMEOUT 60)
 
 # Also on this archive, which has a colour model and no light field, frames the page draws
 # (WebGL2 through chromium's SwiftShader): colour_model.test.mjs edits opacity and compares the

@@ -167,6 +167,14 @@ ExploreFrame FrameRoutes::render_checked(const ExploreRequest& request) {
     return archive_.explorer_locked().render(request);
 }
 
+void FrameRoutes::warm_up(std::int64_t step, int view) {
+    httplib::Request request;
+    request.params = {{"step", std::to_string(step)}, {"view", std::to_string(view)}};
+    const ExploreRequest stored = request_from_options(options_of(request).first);
+    scheduler_.run("warm-up", [&] { render_checked(stored); });
+    warmed_up_ = true;
+}
+
 void FrameRoutes::recipe(const httplib::Request& request, httplib::Response& response) {
     const auto [options, session] = options_of(request);
     const ExploreRequest explore = request_from_options(options);
@@ -271,7 +279,8 @@ void FrameRoutes::status(const httplib::Request& request, httplib::Response& res
                               {"frames_rendered", rendered_.load()},
                               {"superseded", superseded_.load()},
                               {"refused", refusals_.refused()},
-                              {"failed", refusals_.failed()}}
+                              {"failed", refusals_.failed()},
+                              {"warmed_up", warmed_up_.load()}}
                              .dump(),
                          "application/json");
 }

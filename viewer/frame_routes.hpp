@@ -33,6 +33,11 @@ public:
     void trust(const httplib::Request& request, httplib::Response& response);
     /// /api/status: frames rendered, superseded, refused, failed, and the scheduler's load.
     void status(const httplib::Request& request, httplib::Response& response);
+    /// Renders the stored view of (step, view) for no one: the work of a page's first /api/frame
+    /// (reading the step's files, building the engine's kernels) done before it comes (not
+    /// counted in /api/status). Throws what that would. Its trusted range is left to the page's
+    /// request: its probes would take turns with the page's frame.
+    void warm_up(std::int64_t step, int view);
 
 private:
     /// Renders, holding the archive's lock, once the step is listed and its files lie inside.
@@ -47,6 +52,7 @@ private:
     /// Per session, the options and confidence of its last frame, for the overlay.
     std::map<std::string, std::pair<std::string, Image>> masks_;
     std::atomic<std::uint64_t> rendered_{0}, superseded_{0};
+    std::atomic<bool> warmed_up_{false};  // warm_up's frame rendered
 };
 
 }  // namespace insitu::viewer

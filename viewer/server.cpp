@@ -131,12 +131,16 @@ int serve_main(const std::vector<std::string>& args) {
         stopping = true;
         server.stop();
     });
+    // The page's first requests prepared while the user opens it (they wait on the same lock if
+    // they come sooner); joined before the service goes.
+    std::thread warm_up([&] { service->warm_up(); });
     const bool clean = server.listen_after_bind();
     if (!stopping) {
         // The server ended by itself: wake the signal thread so it can be joined.
         pthread_kill(signal_thread.native_handle(), SIGTERM);
     }
     signal_thread.join();
+    warm_up.join();
     return clean || stopping ? 0 : kExitCannotServe;
 }
 

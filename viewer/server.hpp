@@ -25,7 +25,9 @@
 //                             light field (any angle: the step's data makes every view), else
 //                             view (probed: mean confidence of views synthesised from it)
 //   /api/status             frames rendered, superseded, refused, failed; whether a frame
-//                           renders now and how many requests wait
+//                           renders now and how many requests wait; warmed_up: whether the
+//                           first step's stored view was rendered ahead of the page (serve
+//                           does it once it listens; not counted as rendered)
 // KEY is an explore_options key, plus `session` (letters, digits, '-', '_'; default: the client
 // address). Coalescing: per session at most one frame renders or waits; a request that a newer
 // one of its session supersedes while waiting gets 409.

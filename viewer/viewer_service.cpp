@@ -1,7 +1,10 @@
 #include "viewer_service.hpp"
 
+#include <cstdint>
 #include <map>
+#include <mutex>
 #include <string>
+#include <vector>
 
 namespace insitu::viewer {
 
@@ -82,6 +85,26 @@ void ViewerService::install(httplib::Server& server) {
     server.set_logger([this](const httplib::Request& request, const httplib::Response& response) {
         refusals_.record(request, response);
     });
+}
+
+void ViewerService::warm_up() {
+    try {
+        httplib::Request request;
+        httplib::Response response;
+        archive_routes_.archive(request, response);
+        std::int64_t first_step = 0;
+        {
+            std::lock_guard<std::mutex> lock(archive_.mutex());
+            const std::vector<std::int64_t> steps = archive_.reader_locked().steps();
+            if (steps.empty() || archive_.reader_locked().view_count() == 0) return;
+            first_step = steps.front();
+        }
+        request.params = {{"step", std::to_string(first_step)}, {"view", "0"}};
+        archive_routes_.step_info(request, response);
+        frame_routes_.warm_up(first_step, 0);
+    } catch (const std::exception&) {
+        // The page's requests meet the same failure and report it.
+    }
 }
 
 }  // namespace insitu::viewer

@@ -29,6 +29,13 @@ public:
     /// Routes the page's files, the API, unrouted paths and the refusal log on `server`.
     void install(httplib::Server& server);
 
+    /// Does the work of a page's first requests ahead of them: the archive's description, the
+    /// first step's description and its stored view's frame (reading the step's files and
+    /// building the engine's kernels on the way). Opening the page on a server
+    /// started cold took about 3 s longer than on a warm one (bench/RESULTS.md, "The first
+    /// frame"). Errors are left to the page's own requests, which report them.
+    void warm_up();
+
 private:
     ServedArchive archive_;
     RefusalLog refusals_;

@@ -50,6 +50,27 @@ async function status() {
   return (await fetch(server.url + 'api/status')).json();
 }
 
+// The first frame (issue 42): serve renders the first step's stored view once it listens, so
+// a page opened a moment later finds the step's files read and the engine's kernels built.
+test('serve prepares the first step\'s stored view before any page asks', async () => {
+  const fresh = await startServer(binary, archive);
+  try {
+    let ready = null;
+    for (let i = 0; i < 600 && !ready; ++i) {
+      const now = await (await fetch(fresh.url + 'api/status')).json();
+      if (now.warmed_up) ready = now;
+      else await new Promise((resolve) => { setTimeout(resolve, 50); });
+    }
+    assert.ok(ready, 'warmed up within 30 s of listening');
+    assert.equal(ready.frames_rendered, 0, 'the warm-up is not counted as a frame rendered');
+    assert.equal(ready.failed, 0);
+    const frame = await fetch(`${fresh.url}api/frame?step=${steps[0]}&view=0`);
+    assert.equal(frame.status, 200);
+  } finally {
+    assert.equal(await stopServer(fresh), 0);
+  }
+});
+
 test('paths outside the page and the API are 404, traversal included', async () => {
   for (const rawPath of ['/../../../../etc/passwd', '/%2e%2e/%2e%2e/%2e%2e/etc/passwd',
     '/api/../../etc/passwd', '/app.js/../../../etc/passwd', '/manifest.json', '/proxies/',

@@ -132,6 +132,31 @@ test('a reply for a step no longer asked for is not shown', async () => {
   await page.close();
 });
 
+// The first frame (issue 42: <= 2 s): creating the WebGL2 context blocks the page (0.1-1.7 s
+// on SwiftShader), so the page creates it only once its first frame, the server's, is done.
+test('the first frame is shown before the page creates its WebGL2 context', async () => {
+  const page = await session.browser.newPage({ viewport: { width: 1280, height: 900 } });
+  const errors = [];
+  page.on('pageerror', (error) => errors.push(error.message));
+  await page.addInitScript(() => {
+    const getContext = HTMLCanvasElement.prototype.getContext;
+    HTMLCanvasElement.prototype.getContext = function (type, ...rest) {
+      if (type === 'webgl2' && window.webgl2At === undefined) window.webgl2At = performance.now();
+      return getContext.call(this, type, ...rest);
+    };
+  });
+  await page.goto(session.server.url);
+  await waitForSettledFrame(page);
+  const at = await page.evaluate(() => ({ firstFrame: window.insituViewer.firstFrameAt,
+    webgl2: window.webgl2At, drawnFrom: window.insituViewer.displayed.drawnFrom }));
+  assert.ok(at.webgl2 !== undefined, 'the page created a WebGL2 context');
+  assert.ok(at.firstFrame < at.webgl2,
+    `first frame at ${at.firstFrame.toFixed(0)} ms, WebGL2 context at ${at.webgl2.toFixed(0)} ms`);
+  assert.equal(at.drawnFrom, 'stored view', 'then the browser draws the stored view');
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
 test('a step change shows the stored view before the step\'s proxies have come', async () => {
   const steps = await timeline();
   const errors = [];

@@ -7,7 +7,9 @@
 // segment_faders.js, annotations.js (caption, colour bar, box & axes), zoom.js, view_state.js
 // (the view in the address), export_png.js, compare.js (side by side); the WebGL2 side: gpu_frames.js,
 // light_field_data.js, light_field_renderer.js, camera.js and the shaders beside them.
-import { $, ARCHIVE_POLL_MS, showError, state, viewer, viewHasAttenuation } from './page.js';
+import {
+  $, ARCHIVE_POLL_MS, firstFrameDone, showError, state, viewer, viewHasAttenuation,
+} from './page.js';
 import { currentOptions } from './explore_options.js';
 import { redrawUpgradable, requestFrame, updateMask } from './frames.js';
 import { forgetTrust, installOrbitDrag, resetView } from './orbit.js';
@@ -88,8 +90,24 @@ function installControls() {
   }
 }
 
-// The page asks for the archive and the stored view's exact frame (the server's) at once: WebGL2
-// builds its shaders meanwhile (seconds on a software GPU) and draws the frames after that one.
+// How long the page waits for its first frame before creating its WebGL2 context anyway (an
+// archive of a run that has written no step yet shows no frame).
+const FIRST_FRAME_WAIT_MS = 5000;
+
+// Resolves once the browser has painted what the page shows now: a frame shown is painted only
+// after the task that showed it ends, so a long task started in it (creating the WebGL2 context)
+// would hold the picture back.
+function painted() {
+  return new Promise((resolve) => {
+    requestAnimationFrame(() => setTimeout(resolve, 0));
+    setTimeout(resolve, 100);  // a hidden page paints nothing and runs no animation frames
+  });
+}
+
+// The page asks for the archive and the stored view's exact frame (the server's) first, and
+// creates its WebGL2 context once that frame is done: creating it blocks the page (0.1–1.7 s on
+// a software GPU), which would hold up the requests and the frame's decoding behind it. Then
+// WebGL2 builds its shaders and draws the frames after that one.
 async function start() {
   installControls();
   installOrbitDrag();
@@ -103,7 +121,6 @@ async function start() {
     $('gpu-toggle').checked = false;
   }
   $('gpu-toggle').addEventListener('change', requestFrame);
-  const gpu = GpuFrames.create($('gpu-frame'));
   try {
     await loadArchive();
     const index = state.timeline.findIndex((entry) => entry.step === linkedStep);
@@ -115,7 +132,10 @@ async function start() {
   } catch (error) {
     showError(error.message);
   }
-  viewer.gpu = await gpu;
+  await Promise.race([firstFrameDone,
+    new Promise((resolve) => { setTimeout(resolve, FIRST_FRAME_WAIT_MS); })]);
+  await painted();
+  viewer.gpu = await GpuFrames.create($('gpu-frame'));
   $('gpu-toggle').disabled = !viewer.gpu;
   if (viewer.gpu) {
     viewer.gpu.wanted = (step, view) => {

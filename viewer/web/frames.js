@@ -5,7 +5,9 @@
 // (gpu_frames.js); every other frame is the server's exploration
 // engine's PNG. The confidence overlay of a frame drawn here is the page's own (its source's
 // confidence, an edit's trust on top); of any other, the engine's mask of the frame shown.
-import { $, FPS_WINDOW_MS, errorText, session, showError, state, viewer } from './page.js';
+import {
+  $, FPS_WINDOW_MS, errorText, noteFrameDone, session, showError, state, viewer,
+} from './page.js';
 import { currentOptions, sameOptions } from './explore_options.js';
 import { baseTf } from './transfer_function.js';
 import { paintOverlay, shownAlpha } from './overlay.js';
@@ -275,6 +277,7 @@ function drawVolume(options, dragging, recipe) {
 
 function frameDone() {
   inFlight = false;
+  noteFrameDone();
   const next = currentOptions();
   // Also redrawn: a preview once the pointer rests, and a frame drawn before the browser's
   // WebGL2 was ready (or before "draw in the browser" was toggled).

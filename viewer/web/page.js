@@ -50,6 +50,15 @@ export const viewer = {
 };
 window.insituViewer = viewer;
 
+// Settles once the page's first frame is done, shown or refused (frames.js): the page creates
+// its WebGL2 context only after it, as that blocks the page for 0.1–1.7 s on a software GPU
+// (bench/RESULTS.md, "The first frame").
+let firstFrameSettles;
+export const firstFrameDone = new Promise((resolve) => { firstFrameSettles = resolve; });
+export function noteFrameDone() {
+  firstFrameSettles();
+}
+
 /// Whether `view`'s stored proxies hold attenuation, the proxies the browser draws from (the
 /// archive's description says; /api/proxies would answer 404 for the others, an error in the
 /// console of every page that asked).

@@ -10,8 +10,20 @@ import { requestTrust, syncOrbitInputs } from './orbit.js';
 import { applyValueEdits } from './value_edits.js';
 import { exportedViews, noteIndex, stepUrl } from './source.js';
 
+// The index that index.html asked for while the modules loaded: the first loadArchive's answer
+// (one round trip less before the first frame); asked again where it failed, for its error.
+let earlyIndex = window.insituEarlyIndex || null;
+
+async function fetchIndex() {
+  const early = earlyIndex;
+  earlyIndex = null;
+  const response = early && await early.catch(() => null);
+  if (!response || !response.ok) return getJson('api/archive');
+  return response.json();
+}
+
 export async function loadArchive() {
-  const archive = await getJson('api/archive');
+  const archive = await fetchIndex();
   noteIndex(archive);
   const grew = state.archive && archive.timeline.length !== state.timeline.length;
   state.archive = archive;
@@ -91,6 +103,10 @@ export async function stepChanged() {
   state.volume = volume;
   // The edits stay on the field values they were made at (value_edits.js).
   applyValueEdits(info.intervals || [0]);
+  // The same step and view described again (the page does once its WebGL2 context exists, after
+  // the first frame): the angle inputs keep what the user may be typing into them.
+  const sameView = Boolean(state.info && state.info.step === info.step &&
+    state.info.view === info.view);
   state.info = info;
   // Faders for a light field captured in segments; the same run keeps its segments, and the
   // factors set, from step to step.
@@ -98,7 +114,7 @@ export async function stepChanged() {
   if (segments !== state.segmentScales.length) state.segmentScales = new Array(segments).fill(1);
   showSegmentFaders($('segments'), state.segmentScales, requestFrame);
   drawTfEditor();
-  syncOrbitInputs();
+  if (!sameView) syncOrbitInputs();
   requestFrame();
   if (!state.playing) requestTrust();
 }
