@@ -173,6 +173,34 @@ inline void half_vectors_of(float3 view, int light_count, __global const float4*
     }
 }
 
+// smooth_depth in relighting.hpp: a Gaussian of sigma 1.5 pixels over the 5x5 pixels around,
+// each neighbour taken only where its depth lies within two footprints per pixel of distance of
+// the centre's (the silhouette threshold of depth_normal), so that no edge is blurred across.
+__kernel void smooth_depth(__global const float* depth, int2 size, float4 forward, float4 right,
+                           float4 up, float4 half_extent, __global float* smoothed_out) {
+    const int x = get_global_id(0);
+    const int y = get_global_id(1);
+    if (x >= size.x || y >= size.y) return;
+    const float z = depth_sample(depth, 1, 0, x, y, size);
+    float sum = z, weights = 1.0f;
+    if (isfinite(z)) {
+        const PixelFrame frame = pixel_frame(x, y, size, forward, right, up, half_extent);
+        const float jump = frame.jump_constant + frame.jump_per_depth * z;
+        for (int dy = -2; dy <= 2; ++dy) {
+            for (int dx = -2; dx <= 2; ++dx) {
+                if (dx == 0 && dy == 0) continue;
+                const float neighbour = depth_sample(depth, 1, 0, x + dx, y + dy, size);
+                const float distance = (float)max(abs(dx), abs(dy));
+                if (!(fabs(neighbour - z) <= jump * distance)) continue;  // also inf, NaN
+                const float weight = exp(-(float)(dx * dx + dy * dy) / (2.0f * 1.5f * 1.5f));
+                sum += weight * neighbour;
+                weights += weight;
+            }
+        }
+    }
+    smoothed_out[y * size.x + x] = sum / weights;
+}
+
 __kernel void normals_from_depth(__global const float* depth, int2 size, float4 forward,
                                  float4 right, float4 up, float4 half_extent,
                                  __global float* normals_out) {

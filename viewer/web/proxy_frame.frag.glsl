@@ -179,10 +179,32 @@ float frontDepth(ivec2 p) {
   return inside(p) ? texelFetch(uFrontDepth, p, 0).r : kInfinity;
 }
 
-// Interval j's mean depth; j = -1: the front depth.
+// smooth_depth (relighting.cl) of the front depth: the normals' depth, without the first hit's
+// steps that rings the lit image.
+float smoothFrontDepth(ivec2 p) {
+  float z = frontDepth(p);
+  if (!finite(z)) return z;
+  PixelFrame f = pixelFrame(p);
+  float jump = f.jumpConstant + f.jumpPerDepth * z;
+  float sum = z, weights = 1.0;
+  for (int dy = -2; dy <= 2; ++dy) {
+    for (int dx = -2; dx <= 2; ++dx) {
+      if (dx == 0 && dy == 0) continue;
+      float neighbour = frontDepth(p + ivec2(dx, dy));
+      float distance = float(max(abs(dx), abs(dy)));
+      if (!(abs(neighbour - z) <= jump * distance)) continue;  // also inf, NaN
+      float weight = exp(-float(dx * dx + dy * dy) / (2.0 * 1.5 * 1.5));
+      sum += weight * neighbour;
+      weights += weight;
+    }
+  }
+  return sum / weights;
+}
+
+// Interval j's mean depth; j = -1: the front depth, smoothed.
 float meanDepth(ivec2 p, int j) {
   if (!inside(p)) return kInfinity;
-  if (j < 0) return frontDepth(p);
+  if (j < 0) return smoothFrontDepth(p);
 #ifdef PACKED
   return texelFetch(uMeanDepth, ivec3(p, j / 4), 0)[j % 4];
 #else

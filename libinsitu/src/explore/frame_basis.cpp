@@ -122,7 +122,8 @@ void light_and_occlude(const FrameBasis& basis, const ExploreRequest& request,
         }
     }
     if (lighting && !has_attenuation) {
-        const Image normals = normals_from_depth(front, target, device);
+        const Image normals =
+            normals_from_depth(smooth_depth(front, target, device), target, device);
         frame.colour = shade(frame.colour, normals, target, *lighting, device);
     }
     Compositor compositor(device, frame.colour);

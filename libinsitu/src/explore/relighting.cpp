@@ -108,18 +108,33 @@ void validate(const AmbientOcclusionSettings& settings) {
     }
 }
 
-Image normals_from_depth(const Image& depth, const Camera& camera, ComputeDevice& device) {
+namespace {
+
+/// A per-pixel pass of kernel `name` over a depth image and its camera's axes (smooth_depth,
+/// normals_from_depth): an image of `channels` named `what`.
+Image depth_pass(const Image& depth, const Camera& camera, const char* name, int channels,
+                 const char* what, ComputeDevice& device) {
     check_image(depth, "depth", 1, camera);
     DeviceImage depth_device;
-    DeviceImage normals_device;
+    DeviceImage out_device;
     depth_device.upload(device, depth, "depth");
-    normals_device.allocate(device, depth.width, depth.height, 3);
-    cl::Kernel kernel = device.opencl().kernel("relighting", "normals_from_depth");
+    out_device.allocate(device, depth.width, depth.height, channels);
+    cl::Kernel kernel = device.opencl().kernel("relighting", name);
     device.opencl().launch(kernel, detail::image_global_range(depth.width, depth.height),
                            detail::image_local_range(), depth_device.buffer(),
                            detail::image_size(camera), detail::camera_axes(camera),
-                           normals_device.buffer());
-    return normals_device.download(device, "normals");
+                           out_device.buffer());
+    return out_device.download(device, what);
+}
+
+}  // namespace
+
+Image smooth_depth(const Image& depth, const Camera& camera, ComputeDevice& device) {
+    return depth_pass(depth, camera, "smooth_depth", 1, "smoothed depth", device);
+}
+
+Image normals_from_depth(const Image& depth, const Camera& camera, ComputeDevice& device) {
+    return depth_pass(depth, camera, "normals_from_depth", 3, "normals", device);
 }
 
 Image shade(const Image& base_colour, const Image& normals, const Camera& camera,

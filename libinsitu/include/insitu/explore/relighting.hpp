@@ -56,6 +56,15 @@ struct AmbientOcclusionSettings {
 };
 std::ostream& operator<<(std::ostream& out, const AmbientOcclusionSettings& settings);
 
+/// The first-hit depth smoothed for normals_from_depth: a Gaussian of sigma 1.5 pixels over the
+/// 5x5 pixels around, each neighbour taken only within two pixel footprints per pixel of distance
+/// of the centre's depth (no blur across silhouettes); +inf stays +inf. A first-hit depth steps
+/// where the rays' samples cross the surface's opacity threshold; central differences of one
+/// pixel turn those steps into concentric rings of the lit image (bench/RESULTS.md, "Relit light
+/// fields without rings").
+Image smooth_depth(const Image& depth, const Camera& camera,
+                   ComputeDevice& device = *ComputeDevice::shared());
+
 /// 3-channel unit normals (world space) per pixel, n . (-ray direction) >= 0; (0, 0, 0) where
 /// depth is +inf or NaN. The normal is the cross product of the world-space tangents along image
 /// x and y (the paper's n ~ (dZ/dx, dZ/dy, 1) up to scale, here in world units, so it is the
