@@ -66,10 +66,7 @@ Entry entry_of_field(const std::vector<Entry>& entries, const std::string& field
 
 void PayloadRoutes::light_field(const httplib::Request& request, httplib::Response& response) {
     const StepKey key = step_key(request, archive_, {"toward", "within"});
-    Prepared prepared;
-    {
-        std::lock_guard<std::mutex> lock(archive_.mutex());
-        const auto reader = reader_snapshot_locked();
+    serve(request, response, [&](const std::shared_ptr<const ArchiveReader>& reader) {
         const std::string field = reader->entry(key.step, key.view).field;
         const ArchivedLightField stored =
             entry_of_field(reader->light_fields(key.step), field, key.step, "light field");
@@ -79,64 +76,64 @@ void PayloadRoutes::light_field(const httplib::Request& request, httplib::Respon
         const std::vector<int> cameras = light_field_cameras(request, stored.cameras);
         std::string subset;
         for (const int camera : cameras) subset += "c" + std::to_string(camera);
-        prepared.etag = payload_etag(("lf" + subset + "-").c_str(), kLightFieldPayloadVersion, key,
-                                     stored.exr_path);
-        prepared.make = [reader, key, field, cameras] {
-            return light_field_payload(reader->load_light_field(key.step, field, cameras), key.step,
-                                       field);
-        };
-    }
-    send_payload(request, response, prepared);
+        return Prepared{payload_etag(("lf" + subset + "-").c_str(), kLightFieldPayloadVersion, key,
+                                     stored.exr_path),
+                        [reader, key, field, cameras] {
+                            return light_field_payload(
+                                reader->load_light_field(key.step, field, cameras), key.step,
+                                field);
+                        }};
+    });
 }
 
 void PayloadRoutes::proxies(const httplib::Request& request, httplib::Response& response) {
     const StepKey key = step_key(request, archive_);
-    Prepared prepared;
-    {
-        std::lock_guard<std::mutex> lock(archive_.mutex());
-        const auto reader = reader_snapshot_locked();
+    serve(request, response, [&](const std::shared_ptr<const ArchiveReader>& reader) {
         const ArchivedView entry = reader->entry(key.step, key.view);
         const std::string where =
             "step " + std::to_string(key.step) + " view " + std::to_string(key.view);
         if (entry.exr_path.empty()) throw HttpError(404, where + " has no proxies");
         archive_.require_inside(entry.exr_path);
-        prepared.etag = payload_etag("px", kProxyPayloadVersion, key, entry.exr_path);
-        prepared.make = [reader, key, where, field = entry.field] {
-            const ProxyFrame frame = reader->load(key.step, key.view);
-            if (frame.attenuation.channels < 1) {
-                throw HttpError(404, where + " has no attenuation proxies");
-            }
-            return proxy_payload(frame, key.step, key.view, field);
-        };
-    }
-    send_payload(request, response, prepared);
+        return Prepared{payload_etag("px", kProxyPayloadVersion, key, entry.exr_path),
+                        [reader, key, where, field = entry.field] {
+                            const ProxyFrame frame = reader->load(key.step, key.view);
+                            if (frame.attenuation.channels < 1) {
+                                throw HttpError(404, where + " has no attenuation proxies");
+                            }
+                            return proxy_payload(frame, key.step, key.view, field);
+                        }};
+    });
 }
 
 void PayloadRoutes::volume(const httplib::Request& request, httplib::Response& response) {
     const StepKey key = step_key(request, archive_);
-    Prepared prepared;
-    {
-        std::lock_guard<std::mutex> lock(archive_.mutex());
-        const auto reader = reader_snapshot_locked();
-        const std::string field = reader->entry(key.step, key.view).field;
+    serve(request, response, [&](const std::shared_ptr<const ArchiveReader>& reader) {
+        const ArchivedView view = reader->entry(key.step, key.view);
+        const std::string field = view.field;
         const ArchivedVolume stored =
             entry_of_field(reader->volumes(key.step), field, key.step, "volume");
         archive_.require_files_inside_locked(key.step, key.view);
         // The step's files are written together and never change once listed: the view's
         // preview stamps them, the field's bytes tell the volume from the view's other payloads.
-        prepared.etag =
-            payload_etag(("vf" + std::to_string(stored.bytes) + "-").c_str(), kVolumePayloadVersion,
-                         key, reader->entry(key.step, key.view).preview_path);
-        prepared.make = [reader, key, field, stored] {
-            return volume_payload(reader->load_volume(key.step, field), stored, key.view);
-        };
-    }
-    send_payload(request, response, prepared);
+        return Prepared{payload_etag(("vf" + std::to_string(stored.bytes) + "-").c_str(),
+                                     kVolumePayloadVersion, key, view.preview_path),
+                        [reader, key, field, stored] {
+                            return volume_payload(reader->load_volume(key.step, field), stored,
+                                                  key.view);
+                        }};
+    });
 }
 
-std::shared_ptr<const ArchiveReader> PayloadRoutes::reader_snapshot_locked() const {
-    // Copies of a reader share its manifest, which never changes once read.
-    return std::make_shared<const ArchiveReader>(archive_.reader_locked());
+void PayloadRoutes::serve(
+    const httplib::Request& request, httplib::Response& response,
+    const std::function<Prepared(const std::shared_ptr<const ArchiveReader>&)>& prepare) {
+    Prepared prepared;
+    {
+        std::lock_guard<std::mutex> lock(archive_.mutex());
+        // Copies of a reader share its manifest, which never changes once read.
+        prepared = prepare(std::make_shared<const ArchiveReader>(archive_.reader_locked()));
+    }
+    send_payload(request, response, prepared);
 }
 
 void PayloadRoutes::send_payload(const httplib::Request& request, httplib::Response& response,

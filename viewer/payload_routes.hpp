@@ -45,8 +45,10 @@ private:
         std::function<std::string()> make;
     };
 
-    /// A copy of the served reader that stays valid after the lock is released.
-    std::shared_ptr<const ArchiveReader> reader_snapshot_locked() const;
+    /// Answers with the payload `prepare` finds under the archive's lock, given a copy of the
+    /// served reader that stays valid after the lock is released; made and sent without it.
+    void serve(const httplib::Request& request, httplib::Response& response,
+               const std::function<Prepared(const std::shared_ptr<const ArchiveReader>&)>& prepare);
     /// Sends a binary payload: gzip-compressed when the client accepts it, a 304 when the client
     /// holds its ETag already; the last few payloads stay in memory for a scrubbing page. Called
     /// without the archive's lock.
