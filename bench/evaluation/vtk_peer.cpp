@@ -6,11 +6,15 @@
 // counted samples of each camera, and the PSNR between VTK's image and ours (a sanity check of
 // our ground truth). Writes peer.csv; measures and prints, asserts nothing.
 //
-//   insitu_evaluate_vtk --out DIR [--size N] [--image P] [--repeats R]
+//   insitu_evaluate_vtk --out DIR [--scene blobs|gray_scott] [--size N] [--image P] [--repeats R]
 //
 // Both renderers: orthographic view at azimuth 30, elevation 20 framing the bounding sphere,
 // trilinear samples 1 voxel apart, unshaded emission-absorption, opacity per unit length
-// (vtkVolumeProperty::SetScalarOpacityUnitDistance), composited over black.
+// (vtkVolumeProperty::SetScalarOpacityUnitDistance), composited over black. Scenes: Gaussian blobs
+// under a function semi-transparent at every value above 0 (no empty space to skip: the
+// marching core's cost per sample), or the Gray-Scott mini-app's v field after 600 steps under
+// its own function, transparent below v = 0.12 (what a run looks at: both renderers skip the
+// empty space, VTK by its space leaping, ours by its transparent blocks).
 #include <vtkCamera.h>
 #include <vtkColorTransferFunction.h>
 #include <vtkFixedPointVolumeRayCastMapper.h>
@@ -37,6 +41,9 @@
 #include <vector>
 
 #include "arguments.hpp"
+#include "gray_scott_coupling.hpp"
+#include "gray_scott_simulation.hpp"
+#include "gray_scott_volume.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/metrics.hpp"
@@ -52,6 +59,7 @@ namespace fs = std::filesystem;
 
 struct Options {
     std::string out;
+    std::string scene = "blobs";
     std::int64_t size = 256;
     int image = 512;
     int repeats = 3;
@@ -59,8 +67,8 @@ struct Options {
 
 [[noreturn]] void usage_error(const std::string& message) {
     std::fprintf(stderr,
-                 "insitu_evaluate_vtk: %s\nusage: insitu_evaluate_vtk --out DIR [--size N] "
-                 "[--image P] [--repeats R]\n",
+                 "insitu_evaluate_vtk: %s\nusage: insitu_evaluate_vtk --out DIR [--scene "
+                 "blobs|gray_scott] [--size N] [--image P] [--repeats R]\n",
                  message.c_str());
     std::exit(2);
 }
@@ -73,6 +81,12 @@ Options parse(int argc, char** argv) {
         const std::string value = argv[++i];
         if (flag == "--out") {
             options.out = value;
+            continue;
+        }
+        if (flag == "--scene") {
+            if (value != "blobs" && value != "gray_scott")
+                usage_error("--scene = " + value + " (must be blobs or gray_scott)");
+            options.scene = value;
             continue;
         }
         int number = 0;
@@ -119,6 +133,34 @@ void print_rounds(const std::vector<Timing>& timings, std::ofstream& csv) {
     }
 }
 
+// The field, its transfer function and the proxies' isovalues.
+struct PeerScene {
+    SampledVolume volume;
+    TransferFunction tf;
+    std::vector<double> isovalues;
+};
+
+PeerScene make_scene(const Options& options) {
+    const std::int64_t n = options.size;
+    if (options.scene == "gray_scott") {
+        gray_scott::Parameters parameters;
+        parameters.size = static_cast<int>(n);
+        gray_scott::Simulation simulation(parameters);
+        for (int s = 0; s < 600; ++s) simulation.step();
+        return {bench::gray_scott_volume(simulation),
+                gray_scott::v_transfer_function(),
+                {0.2, 0.28, 0.36}};
+    }
+    // Semi-transparent throughout, opacity per unit length in voxels (spacing 1).
+    return {make_gaussian_blobs({n, n, n}, 12, 3),
+            TransferFunction({{0.0, {0.1f, 0.2f, 0.9f, 0.0f}},
+                              {0.3, {0.1f, 0.8f, 0.9f, 0.01f}},
+                              {0.6, {0.9f, 0.9f, 0.2f, 0.04f}},
+                              {1.0, {0.9f, 0.2f, 0.1f, 0.1f}}},
+                             1.0),
+            {0.3, 0.45, 0.6, 0.75}};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -126,14 +168,10 @@ int main(int argc, char** argv) {
     try {
         bench::print_machine("start");
         fs::create_directories(options.out);
-        const std::int64_t n = options.size;
-        const SampledVolume volume = make_gaussian_blobs({n, n, n}, 12, 3);
-        // Semi-transparent throughout, opacity per unit length in voxels (spacing 1).
-        const TransferFunction tf({{0.0, {0.1f, 0.2f, 0.9f, 0.0f}},
-                                   {0.3, {0.1f, 0.8f, 0.9f, 0.01f}},
-                                   {0.6, {0.9f, 0.9f, 0.2f, 0.04f}},
-                                   {1.0, {0.9f, 0.2f, 0.1f, 0.1f}}},
-                                  1.0);
+        const PeerScene scene = make_scene(options);
+        const SampledVolume& volume = scene.volume;
+        const TransferFunction& tf = scene.tf;
+        const std::int64_t n = volume.dims[0];
         OrbitView view;
         view.azimuth_deg = 30.0;
         view.elevation_deg = 20.0;
@@ -149,9 +187,12 @@ int main(int argc, char** argv) {
         RenderSettings settings;
         RenderSettings shaded = settings;
         shaded.shading = true;
+        // The ground truth without empty-space skipping: what the skipping buys in this run.
+        RenderSettings marching_all = settings;
+        marching_all.skip_empty_space = false;
         Rendering ours;
         ProxyRequest request;
-        request.isovalues = {0.3, 0.45, 0.6, 0.75};
+        request.isovalues = scene.isovalues;
         request.intervals = proxies.choose_intervals(16, IntervalMode::uniform);
         request.transfer_function = tf;
         const DistortionCamera distortion = DistortionCamera::orbit(view, bounds, 45.0);
@@ -215,11 +256,12 @@ int main(int argc, char** argv) {
         vtk_camera->SetClippingRange(0.01 * camera.orbit_radius(), 4.0 * camera.orbit_radius());
         // Every renderer once per round, best of the rounds (issue 13: best of three).
         const std::vector<Timing> timings = bench::interleaved_timings(
-            options.repeats, {[&] { window->Render(); },
-                              [&] { ours = proxies.render_ground_truth(camera, tf, settings); },
-                              [&] { proxies.render_ground_truth(camera, tf, shaded); },
-                              [&] { proxies.render(camera, request); },
-                              [&] { proxies.render(distortion, request); }});
+            options.repeats,
+            {[&] { window->Render(); },
+             [&] { ours = proxies.render_ground_truth(camera, tf, settings); },
+             [&] { proxies.render_ground_truth(camera, tf, shaded); },
+             [&] { proxies.render(camera, request); }, [&] { proxies.render(distortion, request); },
+             [&] { proxies.render_ground_truth(camera, tf, marching_all); }});
         const Timing& vtk = timings[0];
         const Timing& ground_truth = timings[1];
         const Timing& ground_truth_shaded = timings[2];
@@ -272,6 +314,12 @@ int main(int argc, char** argv) {
         }
         std::ofstream accuracy(fs::path(options.out) / "peer_accuracy.csv");
         accuracy << "psnr_ours_vs_vtk,ssim_ours_vs_vtk\n" << psnr << ',' << ssim << '\n';
+        proxies.render_ground_truth(camera, tf, settings);
+        std::printf(
+            "peer: %s, ground truth's transparent blocks skipped: %.1f %%; without skipping %.1f "
+            "ms (%.1f) = %.2fx VTK\n",
+            options.scene.c_str(), 100.0 * proxies.last_ground_truth_skippable_fraction(),
+            timings[5].best, timings[5].median, timings[5].best / vtk.best);
         std::printf(
             "peer: %lld^3, %d^2, best of %d (median): VTK fixed point %.1f ms (%.1f); ours %.1f "
             "(%.1f) = %.2fx VTK, shaded %.1f (%.1f) = %.2fx unshaded (PSNR %.2f dB vs VTK); "

@@ -625,43 +625,10 @@ __kernel void render_proxies_packets(
         if (want_layers) done &= layers_found == layer_count;
         marching &= ~(usable & done);
 
-        // Empty-space skipping as in render_proxies, per lane: a lane entering a block looks it
-        // up and, if it is skippable, jumps to the block's last sample.
-        intp advance = 1;
-        if (block_size > 0) {
-            const intp look_up = usable & ~done & (t >= next_block_t);
-            if (any(look_up)) {
-                const float bs = (float)block_size;
-                const intp bx = clamp(convert_intp(floor(x / bs)), 0, block_counts.x - 1);
-                const intp by = clamp(convert_intp(floor(y / bs)), 0, block_counts.y - 1);
-                const intp bz = clamp(convert_intp(floor(z / bs)), 0, block_counts.z - 1);
-                const floatp exit_x = convert_floatp(bx * block_size) +
-                                      select((floatp)0.0f, (floatp)bs, rays.direction_x > 0.0f);
-                const floatp exit_y = convert_floatp(by * block_size) +
-                                      select((floatp)0.0f, (floatp)bs, rays.direction_y > 0.0f);
-                const floatp exit_z = convert_floatp(bz * block_size) +
-                                      select((floatp)0.0f, (floatp)bs, rays.direction_z > 0.0f);
-                // start is already in the buffer's coordinates (grid minus offset).
-                const floatp t_x = select((exit_x - rays.start_x) / rays.direction_x,
-                                          (floatp)INFINITY, rays.direction_x == 0.0f);
-                const floatp t_y = select((exit_y - rays.start_y) / rays.direction_y,
-                                          (floatp)INFINITY, rays.direction_y == 0.0f);
-                const floatp t_z = select((exit_z - rays.start_z) / rays.direction_z,
-                                          (floatp)INFINITY, rays.direction_z == 0.0f);
-                next_block_t = select(next_block_t, fmin(fmin(t_x, t_y), t_z), look_up);
-                const intp block_index = (bz * block_counts.y + by) * block_counts.x + bx;
-                intp skippable = 0;
-                for (int lane = 0; lane < PACKET_LANES; ++lane) {
-                    if (LANE_INT(look_up, lane) && skippable_blocks[LANE_INT(block_index, lane)]) {
-                        LANE_INT(skippable, lane) = -1;
-                    }
-                }
-                const intp last =
-                    convert_intp(ceil((next_block_t - rays.t_near) / step - 0.5f)) - 1;
-                const intp jump = skippable & (last > sample + 1);
-                advance = select(advance, last - sample, jump);
-            }
-        }
+        // Empty-space skipping as in render_proxies, per lane.
+        const intp advance =
+            packet_block_skip(&rays, t, x, y, z, sample, usable & ~done, step, skippable_blocks,
+                              block_counts, block_size, &next_block_t);
         sample += advance;
     }
 

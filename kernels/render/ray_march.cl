@@ -312,6 +312,51 @@ PACKET_INLINE void packet_position(const MarchPacket* rays, floatp t, floatp* x,
     *z = rays->start_z + t * rays->direction_z;
 }
 
+// Empty-space skipping per lane (libinsitu/src/render/empty_space.hpp): a lane of `look_up` whose
+// sample (x, y, z, in the buffer's voxels) has entered a new block (t >= its next_block_t) looks
+// the block up and, if the pass may skip it, jumps to the block's last sample, which it still
+// takes, so a float rounding of where the block ends never skips a sample of the next block (and
+// the proxies still find crossings between consecutive samples). Returns each lane's step in
+// samples (1, or the jump); next_block_t becomes where each lane that looked up leaves its block.
+// block_size 0: no lookups.
+PACKET_INLINE intp packet_block_skip(const MarchPacket* rays, floatp t, floatp x, floatp y,
+                                     floatp z, intp sample, intp look_up_lanes, float step,
+                                     __global const uchar* skippable_blocks, int4 block_counts,
+                                     int block_size, floatp* next_block_t) {
+    intp advance = 1;
+    if (block_size == 0) return advance;
+    const intp look_up = look_up_lanes & (t >= *next_block_t);
+    if (!any(look_up)) return advance;
+    const float bs = (float)block_size;
+    const intp bx = clamp(convert_intp(floor(x / bs)), 0, block_counts.x - 1);
+    const intp by = clamp(convert_intp(floor(y / bs)), 0, block_counts.y - 1);
+    const intp bz = clamp(convert_intp(floor(z / bs)), 0, block_counts.z - 1);
+    const floatp exit_x = convert_floatp(bx * block_size) +
+                          select((floatp)0.0f, (floatp)bs, rays->direction_x > 0.0f);
+    const floatp exit_y = convert_floatp(by * block_size) +
+                          select((floatp)0.0f, (floatp)bs, rays->direction_y > 0.0f);
+    const floatp exit_z = convert_floatp(bz * block_size) +
+                          select((floatp)0.0f, (floatp)bs, rays->direction_z > 0.0f);
+    // start is already in the buffer's coordinates (grid minus offset).
+    const floatp t_x = select((exit_x - rays->start_x) / rays->direction_x, (floatp)INFINITY,
+                              rays->direction_x == 0.0f);
+    const floatp t_y = select((exit_y - rays->start_y) / rays->direction_y, (floatp)INFINITY,
+                              rays->direction_y == 0.0f);
+    const floatp t_z = select((exit_z - rays->start_z) / rays->direction_z, (floatp)INFINITY,
+                              rays->direction_z == 0.0f);
+    *next_block_t = select(*next_block_t, fmin(fmin(t_x, t_y), t_z), look_up);
+    const intp block_index = (bz * block_counts.y + by) * block_counts.x + bx;
+    intp skippable = 0;
+    for (int lane = 0; lane < PACKET_LANES; ++lane) {
+        if (LANE_INT(look_up, lane) && skippable_blocks[LANE_INT(block_index, lane)]) {
+            LANE_INT(skippable, lane) = -1;
+        }
+    }
+    const intp last = convert_intp(ceil((*next_block_t - rays->t_near) / step - 0.5f)) - 1;
+    const intp jump = skippable & (last > sample + 1);
+    return select(advance, last - sample, jump);
+}
+
 // The cell of a packet of sample positions (sample_trilinear's clamping and fractions) and its
 // eight corner values c_xyz, x, y, z in {0, 1}. Lanes outside `active` take the grid's first cell
 // (any in-grid address would do): their positions may be anything, and a gather must not leave

@@ -93,15 +93,16 @@ PACKET_INLINE floatp packet_pow_unit(floatp x, float w) {
 
 // render_volume for a whole volume, one packet of rays per work-item (ray_march.cl): the same
 // samples, classification, shading and compositing per lane. A lane stops at the end of its span
-// or at the early-termination opacity, like `break` above; the packet stops when all have.
-__kernel void render_volume_packets(__global const float* volume, int4 dims, float4 origin_world,
-                                    float4 inv_spacing, float4 box_lower, float4 box_upper,
-                                    float4 data_offset, float4 owned_lower, float4 owned_upper,
-                                    __global const float4* tf_table, int2 tf_bins, float4 tf_domain,
-                                    float4 cam_position, float4 cam_forward, float4 cam_right,
-                                    float4 cam_up, float4 cam_half_extent, int2 size, float4 march,
-                                    float4 phong, __global float4* rgba_out,
-                                    __global float* depth_out) {
+// or at the early-termination opacity, like `break` above; the packet stops when all have. Lanes
+// skip blocks where the table is transparent (packet_block_skip; block_size 0: none): the
+// samples skipped there have zero opacity, which render_volume passes over with `continue`.
+__kernel void render_volume_packets(
+    __global const float* volume, int4 dims, float4 origin_world, float4 inv_spacing,
+    float4 box_lower, float4 box_upper, float4 data_offset, float4 owned_lower, float4 owned_upper,
+    __global const float4* tf_table, int2 tf_bins, float4 tf_domain, float4 cam_position,
+    float4 cam_forward, float4 cam_right, float4 cam_up, float4 cam_half_extent, int2 size,
+    float4 march, float4 phong, __global float4* rgba_out, __global float* depth_out,
+    __global const uchar* skippable_blocks, int4 block_counts, int block_size) {
     const int gx = get_global_id(0);
     const int gy = get_global_id(1);
     if (gx * PACKET_W >= size.x || gy * PACKET_H >= size.y) return;
@@ -116,12 +117,18 @@ __kernel void render_volume_packets(__global const float* volume, int4 dims, flo
     floatp red = 0.0f, green = 0.0f, blue = 0.0f, transmittance = 1.0f;
     floatp depth = INFINITY;
     intp marching = rays.hits;
-    for (int i = 0;; ++i) {
-        const floatp t = rays.t_near + ((float)i + 0.5f) * step;
+    floatp next_block_t = -INFINITY;
+    intp sample = 0;  // each lane's sample index: lanes skip empty blocks independently
+    while (true) {
+        const floatp t = rays.t_near + (convert_floatp(sample) + 0.5f) * step;
         const intp active = marching & (t < rays.t_far);
         if (!any(active)) break;
         floatp x, y, z;
         packet_position(&rays, t, &x, &y, &z);
+        // The lanes' next samples are known before this one is classified, so the `continue`s
+        // below need no bookkeeping.
+        sample += packet_block_skip(&rays, t, x, y, z, sample, active, step, skippable_blocks,
+                                    block_counts, block_size, &next_block_t);
         const PacketCell cell = packet_cell(volume, dims, x, y, z, active);
         const floatp sampled = packet_cell_value(&cell);
         const intp usable = active & ~isnan(sampled);  // NaN is empty space

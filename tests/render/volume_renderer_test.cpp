@@ -403,6 +403,40 @@ TEST(VolumeRenderer, PacketsSkipNonFiniteSamplesLikeRays) {
     expect_packets_match_rays(field, camera, blobs_tf(), settings);
 }
 
+// Skipping transparent blocks takes exactly the samples that add something: the same floats as
+// marching every sample, bit for bit, and what one ray per work-item (which never skips) gives.
+TEST(VolumeRenderer, PacketsSkippingTransparentBlocksChangeNothing) {
+    // Blobs in a box mostly below the function's first opaque value (0.15): many blocks to skip,
+    // and rays that enter and leave them at every angle.
+    const SampledVolume volume = make_gaussian_blobs({41, 37, 45}, 4, 11);
+    const Field field = volume.field();
+    const TransferFunction tf(
+        {point(0.0, 0.0f, 0.0f, 0.0f, 0.0f), point(0.15, 0.0f, 0.0f, 0.0f, 0.0f),
+         point(0.4, 0.9f, 0.6f, 0.1f, 0.3f), point(0.8, 0.2f, 0.5f, 1.0f, 0.8f)});
+    for (const Projection projection : {Projection::orthographic, Projection::perspective}) {
+        const Camera camera = Camera::orbit(orbit(37.0, -21.0, projection), field.bounds());
+        for (const bool shading : {false, true}) {
+            RenderSettings settings;
+            settings.shading = shading;
+            settings.early_termination_opacity = 1.0;
+            SCOPED_TRACE(::testing::Message() << camera << " " << settings);
+            VolumeRenderer renderer;
+            renderer.upload(field);
+            const Rendering skipping = renderer.render(camera, tf, settings);
+            ASSERT_TRUE(renderer.last_render_in_packets());
+            EXPECT_GT(renderer.last_skippable_fraction(), 0.25) << "too little to skip to test";
+            settings.skip_empty_space = false;
+            const Rendering marching = renderer.render(camera, tf, settings);
+            EXPECT_EQ(renderer.last_skippable_fraction(), 0.0);
+            EXPECT_EQ(testing::agreement(skipping.rgba, marching.rgba).max_difference, 0.0);
+            EXPECT_EQ(testing::agreement(skipping.depth, marching.depth).max_difference, 0.0);
+            EXPECT_EQ(testing::agreement(skipping.depth, marching.depth).finiteness_mismatches, 0u);
+            settings.skip_empty_space = true;
+            expect_packets_match_rays(field, camera, tf, settings);
+        }
+    }
+}
+
 // --- (b) Identities ---------------------------------------------------------------------------
 
 TEST(VolumeRenderer, FullyTransparentFunctionGivesZeroRgbaAndInfiniteDepth) {

@@ -150,4 +150,33 @@ std::vector<std::uint8_t> skippable_blocks(const BlockRanges& blocks, const Tran
     return skippable;
 }
 
+EmptySpace::EmptySpace(OpenClDevice& opencl)
+    : block_ranges_(opencl.kernel("empty_space", "block_ranges")) {}
+
+SkippedBlocks EmptySpace::skip(OpenClDevice& opencl, const DeviceVolume& volume,
+                               const TransferTable& table, const std::vector<double>& isovalues,
+                               bool accumulates) {
+    if (blocks_generation_ != volume.generation) {
+        blocks_ = scan_blocks_on_device(opencl, block_ranges_, ranges_out_, volume);
+        blocks_generation_ = volume.generation;
+    }
+    const std::vector<std::uint8_t> per_block =
+        skippable_blocks(blocks_, table, isovalues, accumulates);
+    SkippedBlocks skipped;
+    skipped.skippable_fraction =
+        static_cast<double>(std::count(per_block.begin(), per_block.end(), 1)) /
+        static_cast<double>(per_block.size());
+    if (skipped.skippable_fraction > 0.0) {
+        opencl.ensure_buffer(skippable_.buffer, skippable_.capacity, per_block.size(),
+                             CL_MEM_READ_ONLY);
+        opencl.upload(skippable_.buffer, per_block.data(), per_block.size(), "skippable blocks");
+        skipped.skippable = skippable_.buffer;
+        skipped.block_counts = {{static_cast<cl_int>(blocks_.counts[0]),
+                                 static_cast<cl_int>(blocks_.counts[1]),
+                                 static_cast<cl_int>(blocks_.counts[2]), 0}};
+        skipped.block_voxels = blocks_.block_voxels;
+    }
+    return skipped;
+}
+
 }  // namespace insitu::detail

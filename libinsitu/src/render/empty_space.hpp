@@ -1,7 +1,8 @@
 #pragma once
-// Empty-space skipping of the proxy pass (kernels/render/proxy_renderer.cl): the volume in
-// blocks, each block's value range, and which blocks a pass may skip for its transfer table and
-// isovalues without changing a single proxy value. Private to the library.
+// Empty-space skipping of the proxy pass (kernels/render/proxy_renderer.cl) and the ground truth's
+// ray packets (kernels/render/volume_renderer.cl): the volume in blocks, each block's value range,
+// and which blocks a pass may skip for its transfer table and isovalues without changing a single
+// output value. Private to the library.
 #include <cstdint>
 #include <vector>
 
@@ -45,5 +46,34 @@ BlockRanges scan_blocks_on_device(OpenClDevice& opencl, cl::Kernel& kernel, Devi
 /// block adds nothing and lies on one side of every isovalue.
 std::vector<std::uint8_t> skippable_blocks(const BlockRanges& blocks, const TransferTable& table,
                                            const std::vector<double>& isovalues, bool accumulates);
+
+/// The blocks a pass may skip, as its kernel takes them; the defaults make the kernel look up no
+/// blocks (block_voxels 0).
+struct SkippedBlocks {
+    cl::Buffer skippable;  ///< one byte per block, 1 = skippable
+    cl_int4 block_counts = {{1, 1, 1, 0}};
+    cl_int block_voxels = 0;
+    double skippable_fraction = 0.0;
+};
+
+/// One renderer's empty-space state: the uploaded volume's block ranges, scanned on the device
+/// once per upload (DeviceVolume::generation), and the device buffer of a pass's skippable
+/// blocks.
+class EmptySpace {
+public:
+    explicit EmptySpace(OpenClDevice& opencl);
+
+    /// The blocks a pass over `volume` may skip for `table`, `isovalues` and whether it
+    /// `accumulates` opacity (skippable_blocks). Nothing to skip gives the defaults: per-block
+    /// lookups would then be pure overhead.
+    SkippedBlocks skip(OpenClDevice& opencl, const DeviceVolume& volume, const TransferTable& table,
+                       const std::vector<double>& isovalues, bool accumulates);
+
+private:
+    cl::Kernel block_ranges_;  ///< kernels/render/empty_space.cl
+    DeviceMemory ranges_out_, skippable_;
+    BlockRanges blocks_;
+    std::uint64_t blocks_generation_ = 0;
+};
 
 }  // namespace insitu::detail

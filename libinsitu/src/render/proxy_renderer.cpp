@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <glm/trigonometric.hpp>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <string>
@@ -144,14 +145,6 @@ struct PassInputs {
     double uniform_scale = 0.0;
 };
 
-/// The blocks the pass may skip (empty space); defaults make the kernel look up no blocks.
-struct SkippedBlocks {
-    cl::Buffer skippable;
-    cl_int4 block_counts = {{1, 1, 1, 0}};
-    cl_int block_voxels = 0;
-    double skippable_fraction = 0.0;
-};
-
 }  // namespace
 
 void validate(const ProxyRequest& request) {
@@ -212,26 +205,20 @@ struct ProxyRenderer::DeviceState {
     cl::Kernel kernel, packet_kernel;  // one ray per work-item; ray packets
     detail::DeviceMemory table, isovalues, edges, thresholds, depth_out, distortion_out,
         attenuation_out, mean_depth_out, optical_depth_out, interleaving_out, entry_depth_out,
-        segment_rgba_out, segment_depth_out, first_hit_out, skippable, fragment_out,
-        block_ranges_out, front;
-    cl::Kernel block_ranges;  ///< kernels/render/empty_space.cl
-    /// Block ranges of the uploaded volume, rescanned when its generation changes.
-    detail::BlockRanges blocks;
-    std::uint64_t blocks_generation = 0;
+        segment_rgba_out, segment_depth_out, first_hit_out, fragment_out, front;
+    std::optional<detail::EmptySpace> empty_space;
 
     PassOutputs outputs(detail::OpenClDevice& opencl, const ProxyRequest& request,
                         const PassPlan& plan, bool multi_perspective, std::size_t pixels);
     PassInputs upload_inputs(detail::OpenClDevice& opencl, const ProxyRequest& request,
                              const PassPlan& plan, double step_world);
-    SkippedBlocks skip_blocks(detail::OpenClDevice& opencl, const DeviceVolume& volume,
-                              const TransferTable& table, const PassPlan& plan);
 };
 
 ProxyRenderer::ProxyRenderer(std::shared_ptr<ComputeDevice> device)
     : device_(device), renderer_(device), state_(std::make_unique<DeviceState>()) {
     state_->kernel = device_->opencl().kernel("proxy_renderer", "render_proxies");
     state_->packet_kernel = device_->opencl().kernel("proxy_renderer", "render_proxies_packets");
-    state_->block_ranges = device_->opencl().kernel("empty_space", "block_ranges");
+    state_->empty_space.emplace(device_->opencl());
 }
 
 ProxyRenderer::~ProxyRenderer() = default;
@@ -364,34 +351,6 @@ PassInputs ProxyRenderer::DeviceState::upload_inputs(detail::OpenClDevice& openc
     return in;
 }
 
-SkippedBlocks ProxyRenderer::DeviceState::skip_blocks(detail::OpenClDevice& opencl,
-                                                      const DeviceVolume& volume,
-                                                      const TransferTable& table,
-                                                      const PassPlan& plan) {
-    SkippedBlocks skipped;
-    if (blocks_generation != volume.generation) {
-        blocks = detail::scan_blocks_on_device(opencl, block_ranges, block_ranges_out, volume);
-        blocks_generation = volume.generation;
-    }
-    const std::vector<std::uint8_t> per_block =
-        detail::skippable_blocks(blocks, table, plan.crossing_isovalues, plan.want_opacity);
-    skipped.skippable_fraction =
-        static_cast<double>(std::count(per_block.begin(), per_block.end(), 1)) /
-        static_cast<double>(per_block.size());
-    // With nothing to skip, the per-block lookups would be pure overhead.
-    if (skipped.skippable_fraction > 0.0) {
-        opencl.ensure_buffer(skippable.buffer, skippable.capacity, per_block.size(),
-                             CL_MEM_READ_ONLY);
-        opencl.upload(skippable.buffer, per_block.data(), per_block.size(), "skippable blocks");
-        skipped.skippable = skippable.buffer;
-        skipped.block_counts = {{static_cast<cl_int>(blocks.counts[0]),
-                                 static_cast<cl_int>(blocks.counts[1]),
-                                 static_cast<cl_int>(blocks.counts[2]), 0}};
-        skipped.block_voxels = blocks.block_voxels;
-    }
-    return skipped;
-}
-
 namespace {
 
 /// Reads the pass's outputs back into `frame`.
@@ -485,10 +444,11 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
     const PassOutputs outputs = state_->outputs(opencl, request, plan, multi_perspective, pixels);
     const double step_world = volume.step_world(request.march.step_voxels);
     const PassInputs inputs = state_->upload_inputs(opencl, request, plan, step_world);
-    SkippedBlocks skipped;
+    detail::SkippedBlocks skipped;
     last_skippable_fraction_ = 0.0;
     if (request.skip_empty_space) {
-        skipped = state_->skip_blocks(opencl, volume, inputs.table, plan);
+        skipped = state_->empty_space->skip(opencl, volume, inputs.table, plan.crossing_isovalues,
+                                            plan.want_opacity);
         last_skippable_fraction_ = skipped.skippable_fraction;
     }
 

@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <ostream>
 
 #include "device/kernel_args.hpp"
 #include "device/kernel_constants.hpp"
 #include "device/opencl_device.hpp"
 #include "insitu/error.hpp"
+#include "render/empty_space.hpp"
 
 namespace insitu {
 
@@ -115,6 +117,7 @@ void DeviceVolume::upload(ComputeDevice& device, const Field& field) {
 struct VolumeRenderer::DeviceState {
     cl::Kernel kernel, packet_kernel;
     detail::DeviceMemory table, rgba_out, depth_out, fragment_out;
+    std::optional<detail::EmptySpace> empty_space;
 };
 
 VolumeRenderer::VolumeRenderer(std::shared_ptr<ComputeDevice> device)
@@ -122,6 +125,7 @@ VolumeRenderer::VolumeRenderer(std::shared_ptr<ComputeDevice> device)
     if (!device_) fail<InvalidArgument>("VolumeRenderer: compute device is null");
     state_->kernel = device_->opencl().kernel("volume_renderer", "render_volume");
     state_->packet_kernel = device_->opencl().kernel("volume_renderer", "render_volume_packets");
+    state_->empty_space.emplace(device_->opencl());
 }
 
 VolumeRenderer::~VolumeRenderer() = default;
@@ -191,12 +195,20 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
     last_render_in_packets_ =
         settings.ray_packets && !volume_.region && volume_.packets_addressable() && opencl.is_cpu();
     if (last_render_in_packets_) {
+        // A transparent sample adds nothing: opacity alone decides what a packet may skip.
+        detail::SkippedBlocks skipped;
+        if (settings.skip_empty_space) {
+            skipped = state_->empty_space->skip(opencl, volume_, table, {}, true);
+        }
+        last_skippable_fraction_ = skipped.skippable_fraction;
         opencl.launch(state_->packet_kernel, detail::packet_global_range(width, height),
                       detail::packet_local_range(), detail::volume_args(volume_),
                       detail::transfer_args(state_->table.buffer, table),
                       detail::camera_args(camera), detail::image_size(camera), march,
-                      phong_parameters, state_->rgba_out.buffer, state_->depth_out.buffer);
+                      phong_parameters, state_->rgba_out.buffer, state_->depth_out.buffer,
+                      skipped.skippable, skipped.block_counts, skipped.block_voxels);
     } else {
+        last_skippable_fraction_ = 0.0;
         opencl.launch(
             state_->kernel, detail::image_global_range(width, height), detail::image_local_range(),
             detail::volume_args(volume_), detail::transfer_args(state_->table.buffer, table),
@@ -241,6 +253,7 @@ std::ostream& operator<<(std::ostream& out, const RenderSettings& settings) {
         << settings.early_termination_opacity << ", shading " << (settings.shading ? "on" : "off");
     if (settings.shading) out << " " << settings.phong;
     if (!settings.ray_packets) out << ", one ray per work-item";
+    if (!settings.skip_empty_space) out << ", no empty-space skipping";
     return out << ", table " << settings.tf_value_bins << "x" << settings.tf_gradient_bins << "}";
 }
 

@@ -175,6 +175,10 @@ public:
 
     /// Fraction of blocks the last pass was allowed to skip (0 when skipping was off).
     double last_skippable_fraction() const { return last_skippable_fraction_; }
+    /// The same for the last ground-truth rendering (VolumeRenderer::last_skippable_fraction).
+    double last_ground_truth_skippable_fraction() const {
+        return renderer_.last_skippable_fraction();
+    }
     /// Whether the last proxy pass marched ray packets (RenderSettings::ray_packets in
     /// ProxyRequest::march) or one ray per work-item.
     bool last_pass_in_packets() const { return last_pass_in_packets_; }

@@ -65,6 +65,10 @@ struct RenderSettings {
     /// work-item, its own SIMD lanes. false marches one ray per work-item, the form blocks of a
     /// distributed run always take: the reference packets are tested against.
     bool ray_packets = true;
+    /// Ray packets skip blocks of 8^3 voxels where the transfer table is transparent: exact (a
+    /// sample there adds nothing), only faster where the function has transparent ranges. Rays
+    /// marched one per work-item never skip: the reference packets are tested against.
+    bool skip_empty_space = true;
 };
 std::ostream& operator<<(std::ostream& out, const RenderSettings& settings);
 
@@ -154,11 +158,15 @@ public:
     /// Whether the last render marched ray packets (RenderSettings::ray_packets) or one ray per
     /// work-item.
     bool last_render_in_packets() const { return last_render_in_packets_; }
+    /// Share of the volume's blocks the last render's packets could skip
+    /// (RenderSettings::skip_empty_space); 0 where it marched one ray per work-item.
+    double last_skippable_fraction() const { return last_skippable_fraction_; }
 
 private:
     std::shared_ptr<ComputeDevice> device_;
     DeviceVolume volume_;
     bool last_render_in_packets_ = false;
+    double last_skippable_fraction_ = 0.0;
     /// Kernel and reused device buffers (libinsitu/src/render/volume_renderer.cpp).
     struct DeviceState;
     std::unique_ptr<DeviceState> state_;
