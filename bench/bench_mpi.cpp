@@ -17,6 +17,8 @@
 //                 composite (direct send over image tiles, insitu/parallel/compositing.hpp),
 //                 including the wait for the slowest rank's march at the first exchange: the
 //                 model below is the transfer alone;
+//   comm ms       of composite ms, the wall time inside the communicator's calls (transfers and
+//                 waits for other ranks; the rest of composite ms is packing and folding);
 //   execute ms    execute_seconds: the time the simulation waited in execute();
 //   MB sent, MB received: payload bytes between ranks.
 // --light-field adds a light field of CAMERAS cameras and S^2 maps (segments split at the layers
@@ -198,6 +200,7 @@ insitu::InstrumentConfig make_config(const Options& options) {
 struct StepFigures {
     double march_ms = 0.0;
     double composite_ms = 0.0;
+    double comm_ms = 0.0;
     double execute_ms = 0.0;
     double sent_bytes = 0.0;
     double received_bytes = 0.0;
@@ -405,6 +408,7 @@ int run(const Options& options) {
         const double composite = after.composite_seconds - before.composite_seconds;
         figures.march_ms = 1e3 * (after.compute_seconds - before.compute_seconds - composite);
         figures.composite_ms = 1e3 * composite;
+        figures.comm_ms = 1e3 * (sent_after.seconds - sent_before.seconds);
         figures.execute_ms = 1e3 * (after.execute_seconds - before.execute_seconds);
         figures.sent_bytes = static_cast<double>(sent_after.bytes_sent - sent_before.bytes_sent);
         figures.received_bytes =
@@ -419,12 +423,12 @@ int run(const Options& options) {
     if (rank == 0 && options.budget_psnr_db > 0.0) print_budget_checks(options.archive);
 
     // Per step: the slowest rank's times, the bytes of all ranks.
-    constexpr int kFigures = 7;
+    constexpr int kFigures = 8;
     const auto flatten = [&](const std::vector<StepFigures>& rows) {
         std::vector<double> values;
         for (const StepFigures& f : rows) {
             values.insert(values.end(), {f.march_ms, f.composite_ms, f.execute_ms, f.sent_bytes,
-                                         f.received_bytes, f.messages, f.simulation_ms});
+                                         f.received_bytes, f.messages, f.simulation_ms, f.comm_ms});
         }
         return values;
     };
@@ -445,19 +449,21 @@ int run(const Options& options) {
 
     if (rank == 0) {
         std::printf("\nPer step (times: the slowest rank; bytes: all ranks together)\n");
-        std::printf("  %6s %10s %13s %11s %9s %9s %8s %9s\n", "step", "march ms", "composite ms",
-                    "execute ms", "MB sent", "MB recv", "msgs", "sim ms");
+        std::printf("  %6s %10s %13s %9s %11s %9s %9s %8s %9s\n", "step", "march ms",
+                    "composite ms", "comm ms", "execute ms", "MB sent", "MB recv", "msgs",
+                    "sim ms");
         for (int s = 0; s < options.steps; ++s) {
             const double* max = &slowest[static_cast<std::size_t>(s) * kFigures];
             const double* sum = &summed[static_cast<std::size_t>(s) * kFigures];
-            std::printf("  %6d %10.2f %13.2f %11.2f %9.3f %9.3f %8.0f %9.2f\n", 2 + s, max[0],
-                        max[1], max[2], sum[3] / 1e6, sum[4] / 1e6, sum[5], max[6]);
+            std::printf("  %6d %10.2f %13.2f %9.2f %11.2f %9.3f %9.3f %8.0f %9.2f\n", 2 + s, max[0],
+                        max[1], max[7], max[2], sum[3] / 1e6, sum[4] / 1e6, sum[5], max[6]);
         }
         std::printf(
             "\nPer rank over the steps: best / median / spread (max - min); bytes per step "
             "(median)\n");
-        std::printf("  %4s %-22s %-22s %-22s %9s %9s %7s %9s\n", "rank", "march ms", "composite ms",
-                    "execute ms", "MB sent", "MB recv", "msgs", "sim ms");
+        std::printf("  %4s %-22s %-22s %-22s %-22s %9s %9s %7s %9s\n", "rank", "march ms",
+                    "composite ms", "comm ms", "execute ms", "MB sent", "MB recv", "msgs",
+                    "sim ms");
         double slowest_composite_median = 0.0;
         for (int r = 0; r < ranks; ++r) {
             std::vector<double> columns[kFigures];
@@ -469,14 +475,16 @@ int run(const Options& options) {
             const Summary march = summarize(columns[0]);
             const Summary composite = summarize(columns[1]);
             const Summary blocked = summarize(columns[2]);
+            const Summary comm = summarize(columns[7]);
             slowest_composite_median = std::max(slowest_composite_median, composite.median);
             std::printf(
-                "  %4d %6.2f / %6.2f / %5.2f %6.2f / %6.2f / %5.2f %6.2f / %6.2f / %5.2f %9.3f "
-                "%9.3f %7.0f %9.2f\n",
+                "  %4d %6.2f / %6.2f / %5.2f %6.2f / %6.2f / %5.2f %6.2f / %6.2f / %5.2f "
+                "%6.2f / %6.2f / %5.2f %9.3f %9.3f %7.0f %9.2f\n",
                 r, march.best, march.median, march.spread, composite.best, composite.median,
-                composite.spread, blocked.best, blocked.median, blocked.spread,
-                insitu::bench::median(columns[3]) / 1e6, insitu::bench::median(columns[4]) / 1e6,
-                insitu::bench::median(columns[5]), insitu::bench::median(columns[6]));
+                composite.spread, comm.best, comm.median, comm.spread, blocked.best, blocked.median,
+                blocked.spread, insitu::bench::median(columns[3]) / 1e6,
+                insitu::bench::median(columns[4]) / 1e6, insitu::bench::median(columns[5]),
+                insitu::bench::median(columns[6]));
         }
         const double pixels = static_cast<double>(options.image) * options.image;
         double sent_total = 0.0;

@@ -8,6 +8,13 @@
 // is packed into or copied out of one contiguous buffer. MPI counts are int; the checks that a
 // call fits are made where every rank sees the same numbers, or agreed over the ranks, so that
 // an oversized call throws on every rank instead of throwing on one while the others wait.
+//
+// Every wait is polite (wait_for): the collectives are their non-blocking forms, tested in a
+// loop that spins for a few microseconds and then sleeps. A blocking MPI wait busy-polls a core
+// (Open MPI yields only when it sees more ranks than cores), and at as many ranks as cores that
+// core is the one the rank's own writer thread, the device's threads and the simulation's other
+// threads need while the rank waits for the slowest march (bench/RESULTS.md, "Compositing cost
+// under MPI").
 #include <algorithm>
 #include <chrono>
 #include <cstddef>
@@ -15,6 +22,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "insitu/error.hpp"
@@ -57,6 +65,36 @@ void* receive_data(Bytes& bytes) {
     return bytes.empty() ? no_bytes : bytes.data();
 }
 
+// Waits until `requests` complete: MPI_Testall in a loop, spinning for the first 50 us (a
+// message in flight completes within that), then sleeping an eighth of the time waited so far
+// (between 20 and 500 us), so that a long wait for another rank leaves the core to this
+// process's other threads and oversleeps by at most about 1/8 of it.
+void wait_for(int count, MPI_Request* requests, const char* operation, const char* mpi_function) {
+    using Clock = std::chrono::steady_clock;
+    constexpr auto kSpin = std::chrono::microseconds(50);
+    constexpr auto kShortest = std::chrono::microseconds(20);
+    constexpr auto kLongest = std::chrono::microseconds(500);
+    const Clock::time_point start = Clock::now();
+    for (;;) {
+        int done = 0;
+        check(MPI_Testall(count, requests, &done, MPI_STATUSES_IGNORE), operation, mpi_function);
+        if (done != 0) return;
+        const auto waited = Clock::now() - start;
+        if (waited < kSpin) continue;
+        std::this_thread::sleep_for(
+            std::clamp(std::chrono::duration_cast<std::chrono::microseconds>(waited / 8), kShortest,
+                       kLongest));
+    }
+}
+
+// One non-blocking collective started by `start` (which fills the request), waited for politely.
+template <typename Start>
+void collective(Start start, const char* operation, const char* mpi_function) {
+    MPI_Request request = MPI_REQUEST_NULL;
+    check(start(&request), operation, mpi_function);
+    wait_for(1, &request, operation, mpi_function);
+}
+
 // Tags of the point-to-point messages on the duplicate, which carries nothing else: each call
 // completes all its messages before it returns, so the calls' messages never mix.
 constexpr int kAllToAllTag = 1;
@@ -82,8 +120,7 @@ void exchange(MPI_Comm comm, int me, std::vector<Bytes>& receive,
                         static_cast<int>(r), tag, comm, &requests.back()),
               operation, "MPI_Isend");
     }
-    check(MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE),
-          operation, "MPI_Waitall");
+    wait_for(static_cast<int>(requests.size()), requests.data(), operation, "MPI_Testall");
 }
 
 std::uint64_t total_of(const std::vector<std::uint64_t>& sizes) {
@@ -198,8 +235,11 @@ public:
         // mismatch throws on every rank.
         const long long count = static_cast<long long>(values.size());
         long long extremes[2] = {count, -count};
-        check(MPI_Allreduce(MPI_IN_PLACE, extremes, 2, MPI_LONG_LONG, MPI_MAX, comm_), "all_reduce",
-              "MPI_Allreduce");
+        collective(
+            [&](MPI_Request* r) {
+                return MPI_Iallreduce(MPI_IN_PLACE, extremes, 2, MPI_LONG_LONG, MPI_MAX, comm_, r);
+            },
+            "all_reduce", "MPI_Iallreduce");
         if (extremes[0] != -extremes[1]) {
             fail<InvalidArgument>("MPI communicator: all_reduce: the ranks pass between ",
                                   -extremes[1], " and ", extremes[0], " values (rank ", rank_, ": ",
@@ -212,9 +252,12 @@ public:
                                   " that MPI's int counts address in one call");
         }
         if (values.empty()) return;
-        check(MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()),
-                            MPI_DOUBLE, operation, comm_),
-              "all_reduce", "MPI_Allreduce");
+        collective(
+            [&](MPI_Request* r) {
+                return MPI_Iallreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()),
+                                      MPI_DOUBLE, operation, comm_, r);
+            },
+            "all_reduce", "MPI_Iallreduce");
         if (size_ > 1) {
             counters_.bytes_sent += bytes;
             counters_.bytes_received += bytes;
@@ -226,16 +269,23 @@ public:
         CallTimer timer(counters_.seconds);
         const std::uint64_t my_bytes = mine.size();
         std::vector<std::uint64_t> sizes(static_cast<std::size_t>(size_));
-        check(MPI_Allgather(&my_bytes, 1, MPI_UINT64_T, sizes.data(), 1, MPI_UINT64_T, comm_),
-              "all_gather", "MPI_Allgather");
+        collective(
+            [&](MPI_Request* r) {
+                return MPI_Iallgather(&my_bytes, 1, MPI_UINT64_T, sizes.data(), 1, MPI_UINT64_T,
+                                      comm_, r);
+            },
+            "all_gather", "MPI_Iallgather");
         // The same total on every rank.
         require_int_count(total_of(sizes), "all_gather", "the ranks' messages total");
         const Layout layout = layout_of(sizes);
         Bytes received(layout.total_bytes);
-        check(MPI_Allgatherv(send_data(mine), static_cast<int>(my_bytes), MPI_BYTE,
-                             receive_data(received), layout.counts.data(),
-                             layout.displacements.data(), MPI_BYTE, comm_),
-              "all_gather", "MPI_Allgatherv");
+        collective(
+            [&](MPI_Request* r) {
+                return MPI_Iallgatherv(send_data(mine), static_cast<int>(my_bytes), MPI_BYTE,
+                                       receive_data(received), layout.counts.data(),
+                                       layout.displacements.data(), MPI_BYTE, comm_, r);
+            },
+            "all_gather", "MPI_Iallgatherv");
         if (size_ > 1) {
             counters_.bytes_sent += my_bytes;
             counters_.bytes_received += layout.total_bytes - my_bytes;
@@ -255,9 +305,12 @@ public:
             for (std::size_t r = 0; r < ranks; ++r) send_sizes[r] = to_each[r].size();
         }
         std::vector<std::uint64_t> receive_sizes(ranks, 0);
-        check(MPI_Alltoall(send_sizes.data(), 1, MPI_UINT64_T, receive_sizes.data(), 1,
-                           MPI_UINT64_T, comm_),
-              "all_to_all", "MPI_Alltoall");
+        collective(
+            [&](MPI_Request* r) {
+                return MPI_Ialltoall(send_sizes.data(), 1, MPI_UINT64_T, receive_sizes.data(), 1,
+                                     MPI_UINT64_T, comm_, r);
+            },
+            "all_to_all", "MPI_Ialltoall");
         // Each message is one point-to-point call: its own size must fit an int count.
         const std::uint64_t largest =
             std::max(*std::max_element(send_sizes.begin(), send_sizes.end()),
@@ -266,8 +319,11 @@ public:
         // and the largest message that does not fit MPI's counts.
         long long problems[2] = {wrong_list ? rank_ + 1LL : 0LL,
                                  largest > max_count_bytes ? static_cast<long long>(largest) : 0};
-        check(MPI_Allreduce(MPI_IN_PLACE, problems, 2, MPI_LONG_LONG, MPI_MAX, comm_), "all_to_all",
-              "MPI_Allreduce");
+        collective(
+            [&](MPI_Request* r) {
+                return MPI_Iallreduce(MPI_IN_PLACE, problems, 2, MPI_LONG_LONG, MPI_MAX, comm_, r);
+            },
+            "all_to_all", "MPI_Iallreduce");
         if (wrong_list) {
             fail<InvalidArgument>("MPI communicator: all_to_all: ", to_each.size(),
                                   " messages for ", size_, " ranks");
@@ -305,8 +361,12 @@ public:
         // bytes), so that a total the root cannot receive throws on every rank.
         const std::uint64_t my_bytes = mine.size();
         std::vector<std::uint64_t> sizes(static_cast<std::size_t>(size_));
-        check(MPI_Allgather(&my_bytes, 1, MPI_UINT64_T, sizes.data(), 1, MPI_UINT64_T, comm_),
-              "gather", "MPI_Allgather");
+        collective(
+            [&](MPI_Request* r) {
+                return MPI_Iallgather(&my_bytes, 1, MPI_UINT64_T, sizes.data(), 1, MPI_UINT64_T,
+                                      comm_, r);
+            },
+            "gather", "MPI_Iallgather");
         require_int_count(*std::max_element(sizes.begin(), sizes.end()), "gather", "a message of");
         const bool is_root = rank_ == root;
         std::vector<Bytes> received(is_root ? sizes.size() : 0);
@@ -333,12 +393,18 @@ public:
         CallTimer timer(counters_.seconds);
         require_root(root, "broadcast");
         std::uint64_t size = bytes.size();
-        check(MPI_Bcast(&size, 1, MPI_UINT64_T, root, comm_), "broadcast", "MPI_Bcast");
+        collective(
+            [&](MPI_Request* r) { return MPI_Ibcast(&size, 1, MPI_UINT64_T, root, comm_, r); },
+            "broadcast", "MPI_Ibcast");
         require_int_count(size, "broadcast", "the root broadcasts");  // root's size, everywhere
         const bool is_root = rank_ == root;
         if (!is_root) bytes.resize(static_cast<std::size_t>(size));
-        check(MPI_Bcast(receive_data(bytes), static_cast<int>(size), MPI_BYTE, root, comm_),
-              "broadcast", "MPI_Bcast");
+        collective(
+            [&](MPI_Request* r) {
+                return MPI_Ibcast(receive_data(bytes), static_cast<int>(size), MPI_BYTE, root,
+                                  comm_, r);
+            },
+            "broadcast", "MPI_Ibcast");
         if (size_ == 1) return;
         if (is_root) {
             counters_.bytes_sent += size;

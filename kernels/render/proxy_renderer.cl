@@ -119,6 +119,13 @@ __kernel void render_proxies(
     bool reentering = false;
     float reentries = 0.0f;
     float reentered = 0.0f;
+    // A block of a distributed run (partial) also records its first run's interval and, per
+    // interval, the light of its first run there: what a run re-enters depends on the intervals
+    // in front of the block (parallel/interleaving_fold.cpp folds them).
+    const bool partial_interleaving = partial && want_interleaving;
+    int first_interval = -1;
+    __global float* interleaving_record =
+        interleaving_out + pixel * (INTERLEAVING_HEAD + interval_count);
     __global float* attenuation = attenuation_out + pixel * interval_count;
     __global float* weighted_depth = mean_depth_out + pixel * interval_count;
     __global float* optical_depth = optical_depth_out + pixel * interval_count;
@@ -129,6 +136,7 @@ __kernel void render_proxies(
             if (want_mean_depth) weighted_depth[j] = 0.0f;
             if (want_optical_depth) optical_depth[j] = 0.0f;
             if (want_entry_depth) entry_depth[j] = INFINITY;
+            if (partial_interleaving) interleaving_record[INTERLEAVING_HEAD + j] = 0.0f;
         }
     }
 
@@ -264,6 +272,7 @@ __kernel void render_proxies(
                     if (j != last_interval) {
                         reentering = attenuation[j] > 0.0f;
                         if (reentering) reentries += 1.0f;
+                        if (first_interval < 0) first_interval = j;
                         last_interval = j;
                     }
                     const float weight = absorb(&transmittance, alpha);  // seed 000 Eq. 7
@@ -273,6 +282,9 @@ __kernel void render_proxies(
                         entry_depth[j] = sample_depth(&ray, t);
                     }
                     if (reentering) reentered += weight;
+                    if (partial_interleaving && !reentering) {
+                        interleaving_record[INTERLEAVING_HEAD + j] += weight;
+                    }
                     attenuation[j] += weight;
                     if (want_mean_depth) weighted_depth[j] += weight * sample_depth(&ray, t);
                     if (want_optical_depth) {
@@ -362,7 +374,15 @@ __kernel void render_proxies(
                 attenuation[j] > 0.0f ? weighted_depth[j] / attenuation[j] : INFINITY;
         }
     }
-    if (want_interleaving) vstore2((float2)(reentries, reentered), pixel, interleaving_out);
+    if (partial_interleaving) {
+        interleaving_record[0] = reentries;
+        interleaving_record[1] = reentered;
+        interleaving_record[2] = (float)first_interval;
+        interleaving_record[3] = (float)last_interval;
+        interleaving_record[4] = reentering ? 1.0f : 0.0f;
+    } else if (want_interleaving) {
+        vstore2((float2)(reentries, reentered), pixel, interleaving_out);
+    }
     if (partial) {
         __global float* fragment = fragment_out + pixel * FRAGMENT_CHANNELS;
         fragment[0] = (float)fragment_first;

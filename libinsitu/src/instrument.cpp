@@ -191,13 +191,6 @@ void Instrument::Impl::open_distributed(InstrumentConfig distributed_config) {
     failure.guard([&] { distributed_config.validate(); });
     config = std::move(distributed_config);
     if (config.budget) budget.emplace(*config.budget, config.fields.size());
-    if (config.proxies.attenuation && config.proxies.interleaving) {
-        config.proxies.interleaving = false;
-        log("notice: a distributed run writes no \"interleaving\" (the default \"proxies\" "
-            "name it; a block cannot count re-entries of intervals the ray met in front of it): "
-            "the archive's configuration does not list it, and the viewer's edit trust goes "
-            "without it");
-    }
     failure.guard([&] { renderer = std::make_unique<ProxyRenderer>(); });
     std::vector<double> archived;
     if (writes()) {

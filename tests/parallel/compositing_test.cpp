@@ -60,6 +60,7 @@ ProxyRequest full_request(const SampledVolume& volume, std::vector<double> isova
     request.isovalues = std::move(isovalues);
     request.optical_depth = true;
     request.entry_depth = true;
+    request.interleaving = true;
     float lo = std::numeric_limits<float>::max();
     float hi = -lo;
     for (float v : volume.values) {
@@ -114,6 +115,9 @@ void expect_frames_close(const ProxyFrame& whole, const ProxyFrame& composited) 
     // The first sample that gave each interval light: the front-most block's.
     ASSERT_EQ(whole.entry_depth.channels, whole.attenuation.channels);
     expect_close(whole.entry_depth, composited.entry_depth, 1e-4, 1e-5, "entry depth");
+    // Re-entry counts exactly, their light as the attenuation.
+    ASSERT_EQ(whole.interleaving.channels, 2);
+    expect_close(whole.interleaving, composited.interleaving, 2e-6, 0.0, "interleaving");
     // Beyond where the whole pass saturates, what a block behind adds is invisible and not
     // compared (insitu/parallel/compositing.hpp): mean depth of intervals holding attenuation
     // below 1e-6, optical depth of saturated rays.
@@ -143,10 +147,25 @@ void expect_frames_close(const ProxyFrame& whole, const ProxyFrame& composited) 
     EXPECT_LT(masked, static_cast<int>(whole.optical_depth.pixels.size()) / 2);
 }
 
-// Renders `blocks` one by one as the ranks would, and the whole volume once.
-void check_blocks_composite_to_whole(const SampledVolume& volume, const std::vector<Block>& blocks,
-                                     const ProxyRequest& request, const OrbitView& view,
-                                     double tilt_deg = 0.0, double* skipped = nullptr) {
+// How many pixels re-enter more often than their blocks count on their own (runs that re-enter
+// intervals lit in another block): where the interleaving fold has work to do.
+int reentries_across_blocks(const ProxyFrame& whole, const std::vector<ProxyFrame>& partials) {
+    int pixels = 0;
+    for (std::size_t p = 0; p < whole.interleaving.pixel_count(); ++p) {
+        float own = 0.0f;
+        for (const ProxyFrame& partial : partials) {
+            own += partial.interleaving.pixels[p * partial.interleaving.channels];
+        }
+        if (whole.interleaving.pixels[p * 2] > own) ++pixels;
+    }
+    return pixels;
+}
+
+// Renders `blocks` one by one as the ranks would, and the whole volume once; returns
+// reentries_across_blocks.
+int check_blocks_composite_to_whole(const SampledVolume& volume, const std::vector<Block>& blocks,
+                                    const ProxyRequest& request, const OrbitView& view,
+                                    double tilt_deg = 0.0, double* skipped = nullptr) {
     const Decomposition grid = decompose_blocks(blocks);
     ProxyRenderer renderer;
     renderer.upload(volume.field());
@@ -180,6 +199,7 @@ void check_blocks_composite_to_whole(const SampledVolume& volume, const std::vec
     const Rendering composited_truth = composite_rendering(camera.width(), camera.height(), truths);
     expect_close(whole_truth.rgba, composited_truth.rgba, 2e-6, 1e-6, "ground truth RGBA");
     expect_close(whole_truth.depth, composited_truth.depth, 1e-4, 1e-5, "ground truth depth");
+    return reentries_across_blocks(whole, partials);
 }
 
 OrbitView view_at(double azimuth, double elevation, Projection projection, int size = 48) {
@@ -195,8 +215,9 @@ OrbitView view_at(double azimuth, double elevation, Projection projection, int s
 TEST(Compositing, TwoSlabsEqualOnePass) {
     const SampledVolume volume = make_gaussian_blobs({33, 30, 28}, 6, 7);
     const std::vector<Block> blocks = cut_blocks(volume, {17}, {}, {}, false);
-    check_blocks_composite_to_whole(volume, blocks, full_request(volume, {0.3, 0.6}),
-                                    view_at(30, 20, Projection::perspective));
+    const int across = check_blocks_composite_to_whole(
+        volume, blocks, full_request(volume, {0.3, 0.6}), view_at(30, 20, Projection::perspective));
+    EXPECT_GT(across, 0) << "no ray re-enters an interval lit in the other block";
 }
 
 // Where the transfer function is transparent, blocks skip empty space in their own buffer's
@@ -223,11 +244,14 @@ TEST(Compositing, UnevenBlocksInThreeDimensionsEqualOnePass) {
     const SampledVolume volume = make_gaussian_blobs({31, 29, 27}, 8, 3);
     const std::vector<Block> blocks = cut_blocks(volume, {7, 20}, {15}, {9}, false);
     ASSERT_EQ(blocks.size(), 12u);
+    int across = 0;
     for (double azimuth : {0.0, 75.0, 200.0}) {
         SCOPED_TRACE(azimuth);
-        check_blocks_composite_to_whole(volume, blocks, full_request(volume, {0.2, 0.45, 0.7}),
-                                        view_at(azimuth, -35, Projection::orthographic));
+        across +=
+            check_blocks_composite_to_whole(volume, blocks, full_request(volume, {0.2, 0.45, 0.7}),
+                                            view_at(azimuth, -35, Projection::orthographic));
     }
+    EXPECT_GT(across, 0) << "no ray re-enters an interval lit in another block";
 }
 
 TEST(Compositing, FaceSharingTilesEqualOnePass) {

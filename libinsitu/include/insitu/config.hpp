@@ -96,8 +96,7 @@ struct ProxySelection {
     /// for edits reads it (issue 17; bench/RESULTS.md, "Where the methods fail"). On by default:
     /// it costs a small share of the archive's bytes and no measurable time (bench/RESULTS.md,
     /// "Interleaving counts on by default").
-    /// Not written by distributed runs: a block cannot count what the ray met in front of it
-    /// (dropped there with a notice, and left out of the archive's configuration).
+    /// Distributed runs composite it (parallel/interleaving_fold.hpp).
     bool interleaving = true;
     /// "entry_depth" (with "attenuation"): per pixel and interval, the depth where the
     /// interval first took light, counted in the attenuation pass. Opacity edits that thicken

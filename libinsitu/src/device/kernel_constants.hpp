@@ -38,6 +38,11 @@ constexpr int kWantFront = 2048;
 /// Transmittance in front, the entry segment's transmittance in front, the isovalues crossed in
 /// front (bits), the value of the sample just in front (NaN when none adjoins).
 constexpr int kFrontChannels = 4;
+/// A block's interleaving record (kWantInterleaving with kWantFragment): re-entries and their
+/// light counted from the block's entry, the intervals of its first and last run, whether that
+/// last run re-enters within the block, then per interval the light of its first run in the
+/// block (parallel/interleaving_fold.hpp).
+constexpr int kInterleavingHead = 5;
 /// Floats per pixel of that record (kernels/render/proxy_renderer.cl writes them).
 constexpr int kFragmentChannels = 9;
 
@@ -61,7 +66,7 @@ struct KernelConstant {
 
 /// Every constant passed to the kernels. Private arrays are sized by the MAX_* limits, so they
 /// bound each work-item's private memory.
-inline constexpr std::array<KernelConstant, 20> kKernelConstants{{
+inline constexpr std::array<KernelConstant, 21> kKernelConstants{{
     {"MAX_LAYERS", kMaxLayers},        // depth layers per pass (layer_t[] in the proxy kernel)
     {"MAX_INTERVALS", kMaxIntervals},  // intensity intervals (a[] in colour model, edits)
     {"MAX_LIGHTS", kMaxLights},        // lights per relighting call (half_vectors[])
@@ -78,6 +83,7 @@ inline constexpr std::array<KernelConstant, 20> kKernelConstants{{
     {"WANT_ENTRY_DEPTH", kWantEntryDepth},
     {"WANT_FRONT", kWantFront},
     {"FRAGMENT_CHANNELS", kFragmentChannels},
+    {"INTERLEAVING_HEAD", kInterleavingHead},
     {"SEGMENTS_WHOLE_RAY", kSegmentsWholeRay},
     {"SEGMENTS_LAYERS", kSegmentsLayers},
     {"SEGMENTS_OPACITY", kSegmentsOpacity},

@@ -45,10 +45,6 @@ ProxyFrame CompositedPasses::proxies(const OrbitView& orbit, const Bounds& bound
     const DistortionCamera distortion = DistortionCamera::orbit(orbit, bounds, tilt_deg);
     ProxyRequest march = request;
     march.training_transfer_functions.clear();
-    // A block cannot count re-entries of intervals the ray met in front of it (see
-    // ProxyRequest::interleaving): distributed archives carry no interleaving, and the
-    // Explorer's edit trust then goes without that term.
-    march.interleaving = false;
     std::optional<ProxyFrame> partial;
     if (has_block_) {
         failure_.guard([&] {

@@ -6,9 +6,11 @@
 #include <glm/trigonometric.hpp>
 #include <limits>
 
+#include "device/kernel_constants.hpp"
 #include "insitu/core/check.hpp"
 #include "insitu/error.hpp"
 #include "parallel/direct_send.hpp"
+#include "parallel/interleaving_fold.hpp"
 
 namespace insitu {
 
@@ -40,15 +42,21 @@ struct ProxyLayout {
     bool mean_depth = false;
     bool optical_depth = false;
     bool entry_depth = false;  ///< per interval, the depth of the first sample that gave it light
+    /// Folded: re-entries and their light (2); a block's record: interleaving_fold.hpp's.
+    bool interleaving = false;
     float sin_tilt = 0.0f;
     std::vector<float> isovalues;
 
     int outputs() const {
         return layers * (distortion ? 2 : 1) +
                intervals * ((attenuation ? 1 : 0) + (mean_depth ? 1 : 0) + (optical_depth ? 1 : 0) +
-                            (entry_depth ? 1 : 0));
+                            (entry_depth ? 1 : 0)) +
+               (interleaving ? 2 : 0);
     }
-    int record() const { return kFragmentChannels + outputs(); }
+    int record() const {
+        return kFragmentChannels + outputs() +
+               (interleaving ? detail::kInterleavingHead + intervals - 2 : 0);
+    }
 };
 
 ProxyLayout layout_of(const ProxyFrame& shell) {
@@ -59,9 +67,11 @@ ProxyLayout layout_of(const ProxyFrame& shell) {
     layout.mean_depth = shell.mean_depth.channels > 0;
     layout.optical_depth = shell.optical_depth.channels > 0;
     layout.entry_depth = shell.entry_depth.channels > 0;
+    layout.interleaving = shell.interleaving.channels > 0;
     layout.intervals = shell.intervals ? shell.intervals->count() : 0;
-    if ((layout.mean_depth || layout.entry_depth) && !layout.attenuation) {
-        fail<InvalidArgument>("compositing mean and entry depths needs the attenuation they read");
+    if ((layout.mean_depth || layout.entry_depth || layout.interleaving) && !layout.attenuation) {
+        fail<InvalidArgument>(
+            "compositing mean and entry depths and interleaving needs the attenuation they read");
     }
     layout.sin_tilt = static_cast<float>(std::sin(glm::radians(shell.distortion_tilt_deg)));
     layout.isovalues.assign(shell.isovalues.begin(), shell.isovalues.end());
@@ -82,8 +92,8 @@ void allocate_images(ProxyFrame& frame) {
     for (std::vector<Image>* list : {&frame.depth_layers, &frame.distortion_layers}) {
         for (Image& image : *list) image.pixels.assign(image.pixel_count() * image.channels, 0.0f);
     }
-    for (Image* image :
-         {&frame.attenuation, &frame.mean_depth, &frame.optical_depth, &frame.entry_depth}) {
+    for (Image* image : {&frame.attenuation, &frame.mean_depth, &frame.optical_depth,
+                         &frame.entry_depth, &frame.interleaving}) {
         image->pixels.assign(image->pixel_count() * image->channels, 0.0f);
     }
 }
@@ -125,6 +135,12 @@ Bytes pack_proxy_records(const ProxyLayout& layout, const ProxyFrame& partial, s
             const float* channels = &image->pixels[pixel * I];
             std::copy(channels, channels + I, record.begin() + static_cast<std::ptrdiff_t>(next));
             next += static_cast<std::size_t>(I);
+        }
+        if (layout.interleaving) {
+            const std::size_t size = detail::kInterleavingHead + static_cast<std::size_t>(I);
+            const float* channels = &partial.interleaving.pixels[pixel * size];
+            std::copy(channels, channels + size,
+                      record.begin() + static_cast<std::ptrdiff_t>(next));
         }
         const auto index = static_cast<std::uint32_t>(pixel);
         append(bytes, &index, sizeof index);
@@ -218,6 +234,10 @@ void identity_outputs(const ProxyLayout& layout, float* out) {
     if (layout.entry_depth) {
         for (int j = 0; j < I; ++j) out[next++] = kInf;
     }
+    if (layout.interleaving) {
+        out[next++] = 0.0f;
+        out[next++] = 0.0f;
+    }
 }
 
 // Scratch memory of a fold, allocated once per tile.
@@ -237,6 +257,7 @@ void fold_proxy_pixel(const ProxyLayout& layout, const RecordRef* first, const R
     const int mean_at = attenuation_at + (layout.attenuation ? I : 0);
     const int optical_at = mean_at + (layout.mean_depth ? I : 0);
     const int entry_at = optical_at + (layout.optical_depth ? I : 0);
+    const int interleaving_at = entry_at + (layout.entry_depth ? I : 0);
     scratch.record.resize(static_cast<std::size_t>(layout.record()));
     float* const record = scratch.record.data();
     load_record(*first, layout.record(), record);
@@ -249,6 +270,8 @@ void fold_proxy_pixel(const ProxyLayout& layout, const RecordRef* first, const R
         const float a = out[attenuation_at + j];
         weighted[j] = a > 0.0f ? static_cast<double>(a) * out[mean_at + j] : 0.0;
     }
+    detail::InterleavingFold interleaving;
+    if (layout.interleaving) interleaving.start(f + kFragmentChannels + interleaving_at);
     double transmittance = f[kTransmittance];
     float last_index = f[kLastIndex];
     float last_value = f[kLastValue];
@@ -281,6 +304,10 @@ void fold_proxy_pixel(const ProxyLayout& layout, const RecordRef* first, const R
         // The whole pass stops accumulating once 1 - T rounds to 1 in float (its early
         // termination at opacity 1): nothing behind a front that saturated counts.
         if (1.0f - static_cast<float>(transmittance) < 1.0f) {
+            // Before the back's light joins the front's a_j: what its runs re-enter.
+            if (layout.interleaving) {
+                interleaving.add(b_out + interleaving_at, I, out + attenuation_at, transmittance);
+            }
             for (int j = 0; j < I; ++j) {
                 const float a_back = layout.attenuation ? b_out[attenuation_at + j] : 0.0f;
                 if (layout.attenuation) {
@@ -310,6 +337,10 @@ void fold_proxy_pixel(const ProxyLayout& layout, const RecordRef* first, const R
             const float a = out[attenuation_at + j];
             out[mean_at + j] = a > 0.0f ? static_cast<float>(weighted[j] / a) : kInf;
         }
+    }
+    if (layout.interleaving) {
+        out[interleaving_at] = static_cast<float>(interleaving.reentries);
+        out[interleaving_at + 1] = static_cast<float>(interleaving.reentered);
     }
 }
 
@@ -350,6 +381,8 @@ void unpack_proxy_outputs(const ProxyLayout& layout, const float* values, std::i
             std::copy(in + next, in + next + I, &image->pixels[pixel * I]);
             next += I;
         }
+        if (layout.interleaving)
+            std::copy(in + next, in + next + 2, &frame.interleaving.pixels[pixel * 2]);
     }
 }
 
@@ -363,12 +396,18 @@ void check_partial(const ProxyLayout& layout, const ProxyFrame& shell, const Pro
     const auto same = [](const Image& a, const Image& b) {
         return a.width == b.width && a.height == b.height && a.channels == b.channels;
     };
-    bool matches = static_cast<int>(partial.depth_layers.size()) == layout.layers &&
-                   partial.distortion_layers.size() == shell.distortion_layers.size() &&
-                   same(partial.attenuation, shell.attenuation) &&
-                   same(partial.mean_depth, shell.mean_depth) &&
-                   same(partial.optical_depth, shell.optical_depth) &&
-                   same(partial.entry_depth, shell.entry_depth);
+    bool matches =
+        static_cast<int>(partial.depth_layers.size()) == layout.layers &&
+        partial.distortion_layers.size() == shell.distortion_layers.size() &&
+        same(partial.attenuation, shell.attenuation) &&
+        same(partial.mean_depth, shell.mean_depth) &&
+        same(partial.optical_depth, shell.optical_depth) &&
+        same(partial.entry_depth, shell.entry_depth) &&
+        (layout.interleaving
+             ? partial.interleaving.width == shell.interleaving.width &&
+                   partial.interleaving.height == shell.interleaving.height &&
+                   partial.interleaving.channels == detail::kInterleavingHead + layout.intervals
+             : partial.interleaving.pixels.empty());
     for (std::size_t l = 0; matches && l < shell.depth_layers.size(); ++l) {
         matches = same(partial.depth_layers[l], shell.depth_layers[l]);
     }
@@ -465,6 +504,7 @@ ProxyFrame frame_shell(const Camera& camera, double tilt_deg, bool multi_perspec
         if (request.mean_depth) frame.mean_depth = sized(width, height, I);
         if (request.optical_depth) frame.optical_depth = sized(width, height, I);
         if (request.entry_depth) frame.entry_depth = sized(width, height, I);
+        if (request.interleaving) frame.interleaving = sized(width, height, 2);
     }
     return frame;
 }

@@ -1,5 +1,6 @@
 #include "parallel/reduced_field_statistics.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -55,21 +56,31 @@ void ReducedFieldStatistics::reduce_range() {
             local.max = volume.range.max;
         }
     });
+    // The agreement carries every rank's range: one collective, not one per reduction (each
+    // costs the ranks a wake-up; bench/RESULTS.md, "Compositing cost under MPI"). Min, max and
+    // sums of integer counts do not depend on the order they are taken in.
     const auto start = SteadyClock::now();
-    agree(ranks_, failure_);
-    std::vector<double> low{local.min};
-    std::vector<double> high{local.max};
-    std::vector<double> counts{static_cast<double>(local.finite_count),
-                               static_cast<double>(local.nonfinite_count)};
-    ranks_.all_reduce(low, Reduction::min);
-    ranks_.all_reduce(high, Reduction::max);
-    ranks_.all_reduce(counts, Reduction::sum);
+    const std::vector<Bytes> ranges =
+        agree(ranks_, failure_,
+              doubles_bytes({local.min, local.max, static_cast<double>(local.finite_count),
+                             static_cast<double>(local.nonfinite_count)}));
     collective_seconds_ += seconds_since(start);
+    double low = std::numeric_limits<double>::infinity();
+    double high = -low;
+    double counts[2] = {0.0, 0.0};
+    for (const Bytes& bytes : ranges) {
+        const std::vector<double> values = bytes_doubles(bytes);
+        if (values.size() != 4) fail<Error>("value range of a rank cut short");
+        low = std::min(low, values[0]);
+        high = std::max(high, values[1]);
+        counts[0] += values[2];
+        counts[1] += values[3];
+    }
     range_.finite_count = static_cast<std::int64_t>(counts[0]);
     range_.nonfinite_count = static_cast<std::int64_t>(counts[1]);
     if (!range_.empty()) {
-        range_.min = low[0];
-        range_.max = high[0];
+        range_.min = low;
+        range_.max = high;
     }
 }
 

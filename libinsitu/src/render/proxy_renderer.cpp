@@ -72,12 +72,6 @@ struct PassPlan {
 /// Refuses the outputs that partial frames cannot composite: a block sees its own part of each
 /// ray only.
 void check_partial_request(const ProxyRequest& request, bool want_segments) {
-    // A run that the block's neighbour interrupts is not a re-entry it can count.
-    if (request.interleaving) {
-        fail<InvalidArgument>(
-            "interleaving counts are not composited across blocks: a block of a distributed "
-            "run cannot know which intervals the ray met in front of it");
-    }
     // A segment's and the first hit's opacity thresholds depend on the opacity in front of
     // the block: the caller finds it (parallel/light_field_compositing.cpp).
     if (want_segments && request.front.pixels.empty()) {
@@ -306,7 +300,9 @@ PassOutputs ProxyRenderer::DeviceState::outputs(detail::OpenClDevice& opencl,
     out.mean_depth = output_buffer(opencl, mean_depth_out, request.mean_depth, pixels, intervals);
     out.optical_depth =
         output_buffer(opencl, optical_depth_out, request.optical_depth, pixels, intervals);
-    out.interleaving = output_buffer(opencl, interleaving_out, request.interleaving, pixels, 2);
+    // A block records what folding its counts with the front's needs (interleaving_fold.hpp).
+    out.interleaving = output_buffer(opencl, interleaving_out, request.interleaving, pixels,
+                                     plan.partial ? detail::kInterleavingHead + intervals : 2);
     out.entry_depth =
         output_buffer(opencl, entry_depth_out, request.entry_depth, pixels, intervals);
     out.segment_rgba =
@@ -397,7 +393,8 @@ void download_outputs(detail::OpenClDevice& opencl, const ProxyRequest& request,
         frame.segment_depth = planes_to_images(planar, width, height, segments);
     }
     if (request.interleaving) {
-        frame.interleaving = Image(width, height, 2);
+        frame.interleaving = Image(
+            width, height, plan.partial ? detail::kInterleavingHead + plan.interval_count : 2);
         opencl.download(outputs.interleaving, frame.interleaving.pixels.data(),
                         frame.interleaving.pixels.size() * sizeof(float), "interleaving");
     }

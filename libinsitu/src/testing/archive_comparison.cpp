@@ -125,6 +125,11 @@ std::vector<ProxyMeasurement> compare_frames(ProxyFrame& one, ProxyFrame& other,
         compare_images("optical_depth", {one.optical_depth}, {other.optical_depth}, true,
                        stored_depth),
         compare_images("entry_depth", {one.entry_depth}, {other.entry_depth}, true, stored_depth),
+        // Re-entry counts (relative: one re-entry more is a difference of 1 / count) and their
+        // light (a fraction, absolute), stored at the archive's precision.
+        compare_images("interleaving", {one.interleaving}, {other.interleaving}, true,
+                       tolerances.attenuation + std::max(tolerances.stored_step_absolute,
+                                                         tolerances.stored_step_relative)),
     };
     if (one.multi_perspective || other.multi_perspective) {
         measurements.push_back(compare_images("distortion", one.distortion_layers,

@@ -11,6 +11,8 @@
 //  * mean depth: the attenuation-weighted mean of the two; optical depth: the sum;
 //  * entry depth (per interval, the first sample that gave it light): the front's; else the
 //    back's where it got light through the front (T_front a_back > 0);
+//  * interleaving: the front's re-entries plus the back's, plus the back's first runs of
+//    intervals that hold light in front (parallel/interleaving_fold.hpp);
 //  * depth layers: the front's crossing; else the crossing between the front's last and the
 //    back's first sample (the pair the whole pass compares there, refined the same way), so a
 //    crossing on a block boundary is found once; else the back's;

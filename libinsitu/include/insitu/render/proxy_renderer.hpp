@@ -46,8 +46,9 @@ struct ProxyRequest {
     bool mean_depth = true;
     bool optical_depth = false;
     /// Per pixel, how many times the ray re-entered an interval it had already left
-    /// (ProxyFrame::interleaving); needs intervals, and is refused for a block of a distributed
-    /// run (a block cannot know what the ray met in front of it).
+    /// (ProxyFrame::interleaving); needs intervals. A block of a distributed run gives the
+    /// record that compositing folds with the intervals in front of it
+    /// (parallel/interleaving_fold.hpp).
     bool interleaving = false;
     /// Per pixel and interval, the depth where the interval first took light
     /// (ProxyFrame::entry_depth); needs intervals. A block of a distributed run gives its own,
@@ -112,7 +113,8 @@ struct ProxyFrame {
     /// interval that already held light after another interval's (a run j, k, j counts 1), and
     /// the attenuation those re-entered runs added (part of sum_j a_j). Where the count is 0
     /// every interval is one contiguous run along the ray, the case in which opacity edits are
-    /// exact (estimate_attenuation); the edit's trust reads both.
+    /// exact (estimate_attenuation); the edit's trust reads both. A block's partial frame holds
+    /// its record instead (5 + L channels, parallel/interleaving_fold.hpp).
     Image interleaving;
     /// L channels: the depth of the first sample that gave interval j light, the front of its
     /// first run; +inf where a_j = 0. With the mean depth it says where an interval that the ray
