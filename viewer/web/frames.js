@@ -6,7 +6,7 @@
 // engine's PNG. The confidence overlay of a frame drawn here is the page's own (its source's
 // confidence, an edit's trust on top); of any other, the engine's mask of the frame shown.
 import {
-  $, FPS_WINDOW_MS, errorText, noteFrameDone, session, showError, state, viewer,
+  $, FPS_WINDOW_MS, errorText, noteFrameDone, session, setHidden, showError, state, viewer,
 } from './page.js';
 import { currentOptions, sameOptions } from './explore_options.js';
 import { baseTf } from './transfer_function.js';
@@ -299,8 +299,8 @@ function countFrame() {
 }
 
 function showCanvas(canvas) {
-  $('frame').hidden = canvas;
-  $('gpu-frame').hidden = !canvas;
+  setHidden($('frame'), canvas);
+  setHidden($('gpu-frame'), !canvas);
 }
 
 // A frame from the step's light field; with a `recipe` (/api/recipe, light_field), edited, lit,
@@ -408,8 +408,8 @@ function unedited(options) {
 
 export async function updateMask() {
   const canvas = $('mask-overlay');
-  canvas.hidden = !state.mask;
-  $('overlay-legend').hidden = !state.mask;
+  setHidden(canvas, !state.mask);
+  setHidden($('overlay-legend'), !state.mask);
   if (!state.mask || !viewer.displayed) return;
   const displayed = viewer.displayed;
   // A preview keeps the overlay it has: the full frame follows once the pointer rests.

@@ -1,6 +1,9 @@
 // Orbit: the drag and the angle inputs, and the trusted range around the stored view
 // (/api/trust), drawn as a map of offsets.
-import { $, DEGREES_PER_PIXEL, REST_MS, getJson, short, state, svg, viewer } from './page.js';
+import {
+  $, DEGREES_PER_PIXEL, REST_MS, getJson, setHidden, setText, short, state, svg, viewer,
+} from './page.js';
+import { drawCaption } from './annotations.js';
 import { reorbit } from './camera.js';
 import { askedStep } from './timeline.js';
 import { requestFrame } from './frames.js';
@@ -43,6 +46,7 @@ export function syncOrbitInputs() {
   const [az, el] = storedAngles();
   $('azimuth').value = (state.azimuth ?? az).toFixed(2);
   $('elevation').value = (state.elevation ?? el).toFixed(2);
+  drawCaption();
   drawTrustMap();
 }
 
@@ -100,11 +104,11 @@ export function trustWords(t) {
 // Near the picture: whether the view shown lies outside the trusted range, and what that means.
 function showViewNote(inside, da, de) {
   const note = $('view-note');
-  note.hidden = inside;
+  setHidden(note, inside);
   if (inside) return;
-  note.textContent = `outside the trusted range (Δazimuth ${da.toFixed(0)}°, Δelevation ` +
+  setText(note, `outside the trusted range (Δazimuth ${da.toFixed(0)}°, Δelevation ` +
     `${de.toFixed(0)}°): this view is made from the stored one and may miss what it did not ` +
-    'see. Double-click to go back.';
+    'see. Double-click to go back.');
 }
 
 /// Orbit offsets from the stored view: +-90 deg azimuth across, +-90 deg elevation up and down.
