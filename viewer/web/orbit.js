@@ -22,27 +22,34 @@ function normaliseAzimuth(degrees) {
   return a;
 }
 
-// While a pointer drags, the angle inputs and the trust map (an SVG rebuilt each time) follow
-// every INPUTS_EVERY_MS, not every event (a pointer moves up to a few hundred times a second):
-// each change is laid out and rastered again, on the same GPU as the frames.
+// While a pointer drags, the angle inputs, the trust map (an SVG rebuilt each time) and the
+// caption follow every INPUTS_EVERY_MS, not every event (a pointer moves up to a few hundred
+// times a second), and only as a frame is drawn (frames.js followDragChrome): each change is laid
+// out, rastered and painted again, on the same GPU as the frames, and a paint of its own costs
+// as much as a frame's.
 const INPUTS_EVERY_MS = 100;
-let inputsTimer = null;
+let inputsStale = false;
+let inputsAt = 0;
 
 export function setOrbit(azimuth, elevation) {
   state.azimuth = normaliseAzimuth(azimuth);
   state.elevation = Math.max(-89, Math.min(89, elevation));
-  if (!state.dragging) {
+  if (state.dragging) {
+    inputsStale = true;
+  } else {
     syncOrbitInputs();
-  } else if (inputsTimer === null) {
-    inputsTimer = setTimeout(() => {
-      inputsTimer = null;
-      syncOrbitInputs();
-    }, INPUTS_EVERY_MS);
   }
   requestFrame();
 }
 
+/// The inputs, trust map and caption caught up with a drag, at most every INPUTS_EVERY_MS.
+export function followDrag() {
+  if (inputsStale && performance.now() - inputsAt >= INPUTS_EVERY_MS) syncOrbitInputs();
+}
+
 export function syncOrbitInputs() {
+  inputsStale = false;
+  inputsAt = performance.now();
   const [az, el] = storedAngles();
   $('azimuth').value = (state.azimuth ?? az).toFixed(2);
   $('elevation').value = (state.elevation ?? el).toFixed(2);
@@ -184,6 +191,7 @@ export function installOrbitDrag(viewport = $('viewport')) {
     clearTimeout(rest);
     rest = setTimeout(() => {
       state.dragging = false;
+      if (inputsStale) syncOrbitInputs();
       requestFrame();
     }, REST_MS);
     // Grab-and-turn: dragging right turns the object right (the camera moves left), dragging
@@ -197,6 +205,7 @@ export function installOrbitDrag(viewport = $('viewport')) {
     clearTimeout(rest);
     if (state.dragging) {
       state.dragging = false;
+      if (inputsStale) syncOrbitInputs();
       requestFrame();
     }
   };
