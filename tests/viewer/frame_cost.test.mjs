@@ -65,6 +65,14 @@ test('frames that march samples thin them before their previews drop under 128 p
   cost.record(true, 1e4, 128 * 128, 8);
   const slow = cost.dragPlan(512, 512, BUDGET_MS, factors);
   assert.deepEqual(slow, { divisor: Math.floor(512 / 48), factor: 8 });
+  // With a floor of 128 pixels (a volume's previews), the most thinning at 128 pixels instead.
+  const floored = new FrameCost();
+  floored.dragPlan(512, 512, BUDGET_MS, factors, 128, 128);
+  floored.record(true, 1e4, 128 * 128, 8);
+  assert.deepEqual(floored.dragPlan(512, 512, BUDGET_MS, factors, 128, 128),
+    { divisor: 4, factor: 8 });
+  // A view under two floors a side: half the view, not the full frame.
+  assert.deepEqual(new FrameCost().dragPlan(200, 200, 0, factors, 128, 128).divisor, 2);
   // Frames without samples to thin (proxies) keep dragDivisor's sizes.
   assert.equal(new FrameCost().dragPlan(512, 512, BUDGET_MS, [1], 48).factor, 1);
 });

@@ -96,6 +96,64 @@ test('caption, colour bar and box & axes say what the picture shows', async () =
   await page.close();
 });
 
+// A drag's pointer moves (120 a second, in the page) with the page's writes to its elements
+// counted: {moves, caption: writes of the caption's text, unchanged: attribute writes that kept
+// the value}.
+function dragWrites(page, moves) {
+  return page.evaluate(async (n) => {
+    const viewport = document.getElementById('viewport');
+    const box = viewport.getBoundingClientRect();
+    const writes = { moves: n, caption: 0, unchanged: [] };
+    const observer = new MutationObserver((records) => {
+      for (const r of records) {
+        if (r.target.id === 'caption' || r.target.parentElement?.id === 'caption') {
+          writes.caption += 1;
+        } else if (r.type === 'attributes' &&
+          r.oldValue === r.target.getAttribute(r.attributeName)) {
+          writes.unchanged.push(`${r.target.id || r.target.tagName} ${r.attributeName}`);
+        }
+      }
+    });
+    observer.observe(document.body, { subtree: true, childList: true, attributes: true,
+      attributeOldValue: true, characterData: true });
+    for (let i = 1; i <= n; ++i) {
+      viewport.dispatchEvent(new PointerEvent('pointermove', { pointerId: 1, pointerType: 'mouse',
+        isPrimary: true, bubbles: true, clientX: box.left + 100 + i, clientY: box.top + 120,
+        buttons: 1 }));
+      await new Promise((resolve) => setTimeout(resolve, 8));
+    }
+    observer.disconnect();
+    return writes;
+  }, moves);
+}
+
+test('a drag writes the page\'s text only as it changes; the caption follows', async () => {
+  // Each write is laid out and rastered again, on the GPU the drag's frames are drawn with:
+  // the caption written at each pointer move, and hidden flags set to what they were, took a
+  // third of a SwiftShader drag's frames (bench/RESULTS.md, "The page's chrome while dragging").
+  const { server, browser } = session;
+  const errors = [];
+  const page = await openViewerPage(browser, `${server.url}?gpu=off`, errors);
+  await waitForSettledFrame(page);
+  const box = await page.locator('#viewport').boundingBox();
+  await page.mouse.move(box.x + 100, box.y + 120);
+  await page.mouse.down();
+  const count = await page.evaluate(() => window.insituViewer.frameCount);
+  const writes = await dragWrites(page, 80);
+  await page.mouse.up();
+  // The caption follows with the angle inputs, every 100 ms: at most one write in 8 moves.
+  assert.ok(writes.caption >= 1, 'the caption follows the drag');
+  assert.ok(writes.caption <= writes.moves / 8, `the caption was written ${writes.caption} ` +
+    `times in ${writes.moves} moves`);
+  assert.deepEqual(writes.unchanged, [], 'no attribute is written with the value it has');
+  await waitForSettledFrame(page, count);
+  const { azimuth, elevation } = await page.evaluate(() => window.insituViewer.state());
+  assert.equal(await page.locator('#caption').textContent(), `v · step 10 · t = 10 · view 0 ` +
+    `(azimuth ${azimuth.toFixed(0)}°, elevation ${elevation.toFixed(0)}°)`);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
 test('a link reopens the whole view; the PNG says it in its name', async () => {
   const { server, browser } = session;
   const errors = [];

@@ -3,7 +3,7 @@
 // its value range, and the step's data range under it), and on request the world axes' triad and
 // the field's bounds (its grid's box where the step's compressed field gives the grid, else the
 // bounding sphere that the stored camera frames), projected with the frame's camera.
-import { $, short, state, svg, viewer } from './page.js';
+import { $, setText, short, state, svg, viewer } from './page.js';
 import { reorbit, storedCamera } from './camera.js';
 import { linearToSrgb } from './colour.js';
 import { baseTf, editedTf, evaluateTf, isEditable } from './transfer_function.js';
@@ -55,13 +55,13 @@ export function drawCaption() {
   const info = state.info;
   const caption = $('caption');
   if (!info) {
-    caption.textContent = '';
+    setText(caption, '');
     return;
   }
   const angles = state.azimuth === null ? 'stored view'
     : `azimuth ${state.azimuth.toFixed(0)}°, elevation ${state.elevation.toFixed(0)}°`;
-  caption.textContent = `${fieldLabel(info.field)} · step ${info.step} · t = ${short(info.time)}` +
-    ` · view ${info.view} (${angles})`;
+  setText(caption, `${fieldLabel(info.field)} · step ${info.step} · t = ${short(info.time)}` +
+    ` · view ${info.view} (${angles})`);
 }
 
 let barKey = null;
@@ -187,10 +187,11 @@ export async function drawAxes() {
   overlay.dataset.bounds = box ? 'box' : 'sphere';
 }
 
-/// Everything here, for the step, angles and function the page asks for now.
+/// Everything here, for the step, angles and function the page asks for now; during a drag the
+/// caption follows with the angle inputs (orbit.js), not at every pointer move.
 export function drawAnnotations() {
   if (!state.info) return;
-  drawCaption();
+  if (!state.dragging) drawCaption();
   drawScalarBar();
   drawAxes().catch(() => {});
 }

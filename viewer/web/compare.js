@@ -4,7 +4,7 @@
 // frame the page asks for asks for the comparison's too. The comparison is the server's frame
 // (its own session, so the two do not cancel each other); it keeps the first picture's opacity
 // edits by interval number.
-import { $, errorText, session, short, state, viewer } from './page.js';
+import { $, errorText, session, setHidden, short, state, viewer } from './page.js';
 import { currentOptions, sameOptions } from './explore_options.js';
 import { fieldLabel } from './annotations.js';
 import { fetchFrame } from './source.js';
@@ -42,7 +42,7 @@ function captionOf(options) {
 export function requestCompare() {
   const pane = $('compare-pane');
   const options = compareOptions();
-  pane.hidden = !options;
+  setHidden(pane, !options);
   document.body.classList.toggle('side-by-side', Boolean(options));
   if (!options || inFlight || sameOptions(viewer.compare.options, options)) return;
   inFlight = true;

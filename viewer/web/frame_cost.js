@@ -44,11 +44,14 @@ export class FrameCost {
   /// A drag frame's {divisor, factor}: the view scaled down by `divisor` and its samples per
   /// pixel thinned by `factor` (one of `factors`, increasing; 1 for the full frame) to keep within
   /// `budgetMs`: the largest preview first, down to `keepSide` pixels a side with any factor,
-  /// below that (to MIN_PREVIEW_SIDE) with the largest factor only. Kept while its cost stays
-  /// between half the budget and the budget.
-  dragPlan(width, height, budgetMs, factors, keepSide = SAMPLED_PREVIEW_SIDE) {
+  /// below that (to `minSide`) with the largest factor only. Kept while its cost stays between
+  /// half the budget and the budget.
+  dragPlan(width, height, budgetMs, factors, keepSide = SAMPLED_PREVIEW_SIDE,
+    minSide = MIN_PREVIEW_SIDE) {
     const side = Math.max(width, height);
     const largest = Math.max(1, Math.floor(side / MIN_PREVIEW_SIDE));
+    // The largest divisor a plan takes: previews of `minSide` or more (at least halved).
+    const deepest = Math.min(largest, Math.max(2, Math.floor(side / minSide)));
     const full = this.full ?? (this.preview === null ? null : this.preview * this.fullFactor);
     if (largest === 1 || (full !== null && full * width * height <= budgetMs)) {
       this.divisor = 1;
@@ -66,7 +69,7 @@ export class FrameCost {
       at(this.divisor, this.factor) < 0.5 * budgetMs) {
       const kept = Math.max(2, Math.floor(side / keepSide));
       const plans = [];
-      for (let divisor = 2; divisor <= largest; ++divisor) {
+      for (let divisor = 2; divisor <= deepest; ++divisor) {
         for (const factor of divisor <= kept ? factors : factors.slice(-1)) {
           plans.push({ divisor, factor });
         }
@@ -76,6 +79,6 @@ export class FrameCost {
       this.divisor = plan.divisor;
       this.factor = plan.factor;
     }
-    return { divisor: Math.min(this.divisor, largest), factor: this.factor };
+    return { divisor: Math.min(this.divisor, deepest), factor: this.factor };
   }
 }

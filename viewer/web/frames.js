@@ -6,7 +6,8 @@
 // engine's PNG. The confidence overlay of a frame drawn here is the page's own (its source's
 // confidence, an edit's trust on top); of any other, the engine's mask of the frame shown.
 import {
-  $, FPS_WINDOW_MS, errorText, noteFrameDone, session, showError, state, viewer,
+  $, FPS_WINDOW_MS, errorText, noteFrameDone, session, setHidden, setText, showError, state,
+  viewer,
 } from './page.js';
 import { currentOptions, sameOptions } from './explore_options.js';
 import { baseTf } from './transfer_function.js';
@@ -15,11 +16,25 @@ import { drawAnnotations } from './annotations.js';
 import { writeViewQuery } from './view_state.js';
 import { requestCompare } from './compare.js';
 import { askedStep, schedulePlay } from './timeline.js';
+import { followDrag } from './orbit.js';
 import { fetchFrame, fetchRecipe } from './source.js';
 
 let inFlight = false;
 const READOUT_EVERY_MS = 250;
 let readoutShownAt = 0;
+// During a drag the readout's text waits for the next frame's draw, so the two make one paint:
+// headless chromium on a software GPU reads the whole window back at every paint (30-100 ms
+// here), and a paint of the text alone cost as much as one of a frame (bench/RESULTS.md, "The
+// page's chrome while dragging").
+let pendingReadout = null;
+
+// The chrome a drag changed (the readout, the angle inputs, trust map and caption), written in
+// the task that draws the next frame.
+function followDragChrome() {
+  if (pendingReadout !== null) setText($('readout'), pendingReadout);
+  pendingReadout = null;
+  followDrag();
+}
 
 // Whether the browser draws this frame from the light field without asking for its recipe: an
 // orbit view (the stored view is the archive's own proxies, exact) of a step with a light field,
@@ -117,6 +132,7 @@ export function requestFrame() {
     viewer.displayed.toggle === drawingToggle()) return;
   inFlight = true;
   requestedToggle = drawingToggle();
+  if (state.dragging) followDragChrome();
   if (drawnInBrowser(options)) {
     drawInBrowser(options, dragging);
   } else if (proxiesInBrowser()) {
@@ -299,8 +315,8 @@ function countFrame() {
 }
 
 function showCanvas(canvas) {
-  $('frame').hidden = canvas;
-  $('gpu-frame').hidden = !canvas;
+  setHidden($('frame'), canvas);
+  setHidden($('gpu-frame'), !canvas);
 }
 
 // A frame from the step's light field; with a `recipe` (/api/recipe, light_field), edited, lit,
@@ -356,12 +372,18 @@ function showGpuFrame(options, timing, what, colourSource) {
   const now = performance.now();
   if (state.dragging && now - readoutShownAt < READOUT_EVERY_MS) return updateMask();
   readoutShownAt = now;
-  $('readout').textContent =
+  const readout =
     `frame ${timing.milliseconds.toFixed(1)} ms (WebGL2, ${what}` +
     `${preview ? `, preview ${timing.size[0]}x${timing.size[1]}` : ''}` +
     `${timing.partial ? `, ${timing.cameras} of ${timing.rigCameras} cameras, the rest coming` : ''})` +
     ` · ${fps.toFixed(1)} fps · step opened in ${(open.downloadMs + open.uploadMs).toFixed(0)} ms` +
     ` (${(open.bytes / 1e6).toFixed(1)} MB)` + ` · ${colourWords(what, colourSource)}`;
+  if (state.dragging) {
+    pendingReadout = readout;
+  } else {
+    pendingReadout = null;
+    setText($('readout'), readout);
+  }
   showError('');
   return updateMask();
 }
@@ -408,8 +430,8 @@ function unedited(options) {
 
 export async function updateMask() {
   const canvas = $('mask-overlay');
-  canvas.hidden = !state.mask;
-  $('overlay-legend').hidden = !state.mask;
+  setHidden(canvas, !state.mask);
+  setHidden($('overlay-legend'), !state.mask);
   if (!state.mask || !viewer.displayed) return;
   const displayed = viewer.displayed;
   // A preview keeps the overlay it has: the full frame follows once the pointer rests.

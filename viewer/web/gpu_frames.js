@@ -13,7 +13,7 @@
 // Frames of the colour model are drawn here too: the recipe carries its table.
 
 import { reorbit, storedCamera } from './camera.js';
-import { DRAG_FRAME_MS, FrameCost } from './frame_cost.js';
+import { DRAG_FRAME_MS, FrameCost, SAMPLED_PREVIEW_SIDE } from './frame_cost.js';
 import { fetchLightField, streamsLightField } from './light_field_data.js';
 import { LightFieldRenderer, webgl2Available } from './light_field_renderer.js';
 import { coarserProxies, fetchProxies } from './proxy_data.js';
@@ -35,7 +35,10 @@ const FULL_SEARCH_STEPS = 64;  // LightFieldReconstructionSettings::search_steps
 // where fewer steps fit the budget (frame_cost.js dragPlan).
 const PREVIEW_SEARCH_FACTORS = [4, 8];
 // A volume's preview marches this many times the recipe's step (its table corrected for that
-// step, so the picture keeps its opacity), as few as the budget allows at 128 pixels a side.
+// step, so the picture keeps its opacity), as few as the budget allows at 128 pixels a side;
+// its previews are never smaller (or else half the view): a smaller one saves little, as a
+// software GPU's drag frame is mostly the page's compositing, not the march (bench/RESULTS.md,
+// "The page's chrome while dragging").
 const PREVIEW_STEP_FACTORS = [2, 3, 4, 6, 8, 12, 16];
 const FULL_FRAME = Object.freeze({ divisor: 1, factor: 1 });
 const WHOLE_TRIES = 3;  // downloads of a whole light field after its nearest cameras
@@ -208,7 +211,8 @@ export class GpuFrames {
     const [width, height] = stored.size;
     const cost = this.cost(`volume/${Boolean(recipe.shading)}`);
     const { divisor, factor } = dragging
-      ? cost.dragPlan(width, height, this.dragFrameMs, PREVIEW_STEP_FACTORS) : FULL_FRAME;
+      ? cost.dragPlan(width, height, this.dragFrameMs, PREVIEW_STEP_FACTORS, SAMPLED_PREVIEW_SIDE,
+        SAMPLED_PREVIEW_SIDE) : FULL_FRAME;
     const preview = divisor > 1;
     const size = [Math.max(1, Math.round(width / divisor)),
       Math.max(1, Math.round(height / divisor))];

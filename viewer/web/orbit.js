@@ -1,6 +1,9 @@
 // Orbit: the drag and the angle inputs, and the trusted range around the stored view
 // (/api/trust), drawn as a map of offsets.
-import { $, DEGREES_PER_PIXEL, REST_MS, getJson, short, state, svg, viewer } from './page.js';
+import {
+  $, DEGREES_PER_PIXEL, REST_MS, getJson, setHidden, setText, short, state, svg, viewer,
+} from './page.js';
+import { drawCaption } from './annotations.js';
 import { reorbit } from './camera.js';
 import { askedStep } from './timeline.js';
 import { requestFrame } from './frames.js';
@@ -19,30 +22,38 @@ function normaliseAzimuth(degrees) {
   return a;
 }
 
-// While a pointer drags, the angle inputs and the trust map (an SVG rebuilt each time) follow
-// every INPUTS_EVERY_MS, not every event (a pointer moves up to a few hundred times a second):
-// each change is laid out and rastered again, on the same GPU as the frames.
+// While a pointer drags, the angle inputs, the trust map (an SVG rebuilt each time) and the
+// caption follow every INPUTS_EVERY_MS, not every event (a pointer moves up to a few hundred
+// times a second), and only as a frame is drawn (frames.js followDragChrome): each change is laid
+// out, rastered and painted again, on the same GPU as the frames, and a paint of its own costs
+// as much as a frame's.
 const INPUTS_EVERY_MS = 100;
-let inputsTimer = null;
+let inputsStale = false;
+let inputsAt = 0;
 
 export function setOrbit(azimuth, elevation) {
   state.azimuth = normaliseAzimuth(azimuth);
   state.elevation = Math.max(-89, Math.min(89, elevation));
-  if (!state.dragging) {
+  if (state.dragging) {
+    inputsStale = true;
+  } else {
     syncOrbitInputs();
-  } else if (inputsTimer === null) {
-    inputsTimer = setTimeout(() => {
-      inputsTimer = null;
-      syncOrbitInputs();
-    }, INPUTS_EVERY_MS);
   }
   requestFrame();
 }
 
+/// The inputs, trust map and caption caught up with a drag, at most every INPUTS_EVERY_MS.
+export function followDrag() {
+  if (inputsStale && performance.now() - inputsAt >= INPUTS_EVERY_MS) syncOrbitInputs();
+}
+
 export function syncOrbitInputs() {
+  inputsStale = false;
+  inputsAt = performance.now();
   const [az, el] = storedAngles();
   $('azimuth').value = (state.azimuth ?? az).toFixed(2);
   $('elevation').value = (state.elevation ?? el).toFixed(2);
+  drawCaption();
   drawTrustMap();
 }
 
@@ -100,11 +111,11 @@ export function trustWords(t) {
 // Near the picture: whether the view shown lies outside the trusted range, and what that means.
 function showViewNote(inside, da, de) {
   const note = $('view-note');
-  note.hidden = inside;
+  setHidden(note, inside);
   if (inside) return;
-  note.textContent = `outside the trusted range (Δazimuth ${da.toFixed(0)}°, Δelevation ` +
+  setText(note, `outside the trusted range (Δazimuth ${da.toFixed(0)}°, Δelevation ` +
     `${de.toFixed(0)}°): this view is made from the stored one and may miss what it did not ` +
-    'see. Double-click to go back.';
+    'see. Double-click to go back.');
 }
 
 /// Orbit offsets from the stored view: +-90 deg azimuth across, +-90 deg elevation up and down.
@@ -180,6 +191,7 @@ export function installOrbitDrag(viewport = $('viewport')) {
     clearTimeout(rest);
     rest = setTimeout(() => {
       state.dragging = false;
+      if (inputsStale) syncOrbitInputs();
       requestFrame();
     }, REST_MS);
     // Grab-and-turn: dragging right turns the object right (the camera moves left), dragging
@@ -193,6 +205,7 @@ export function installOrbitDrag(viewport = $('viewport')) {
     clearTimeout(rest);
     if (state.dragging) {
       state.dragging = false;
+      if (inputsStale) syncOrbitInputs();
       requestFrame();
     }
   };

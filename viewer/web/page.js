@@ -71,9 +71,20 @@ export function short(x) {
   return Number(x.toPrecision(6)).toString();
 }
 
+/// An element's `hidden` and text, written only where they change: every write is laid out and
+/// rastered again, and with a software GPU that raster shares the GPU process with the frames a
+/// drag draws (bench/RESULTS.md, "The page's chrome while dragging").
+export function setHidden(element, hidden) {
+  if (element.hidden !== hidden) element.hidden = hidden;
+}
+
+export function setText(element, text) {
+  if (element.textContent !== text) element.textContent = text;
+}
+
 export function showError(message) {
-  $('error').hidden = !message;
-  $('error').textContent = message || '';
+  setHidden($('error'), !message);
+  setText($('error'), message || '');
 }
 
 export async function errorText(response) {
