@@ -149,12 +149,12 @@ viewer_browser_test(streaming lf_attenuation)
 set_tests_properties(viewer.webgl viewer.light_field_edits viewer.streaming PROPERTIES TIMEOUT 300)
 
 # Per-segment fades (issue 15): the same run with its light field split at opacity 0.5 into two
-# segments, depth in half floats; segments.test.mjs moves the page's faders and compares the
-# canvas with `insitu-view render --source lightfield --segment-opacity`, checks the refusals of
-# bad segment-opacity values, and that the faders are hidden for the archives above (no light
-# field; one segment).
+# segments, depth in half floats, the rims' depth; segments.test.mjs moves the page's faders and
+# compares the canvas with `insitu-view render --source lightfield --segment-opacity`, checks the
+# refusals of bad segment-opacity values, and that the faders are hidden for the archives above
+# (no light field; one segment).
 viewer_light_field_archive(lf_segments [=[{"cameras": 42, "size": 128, "attenuation": false,]=]
-                           [=[ "segments": [0.5], "depth_bits": 16}]=])
+                           [=[ "segments": [0.5], "depth_bits": 16, "rim_threshold": 0.05}]=])
 viewer_browser_test(segments lf_segments
                     ENVIRONMENT ARCHIVE_ONE_SEGMENT=${viewer_lf_archive}
                                 ARCHIVE_NO_LIGHT_FIELD=${viewer_archive}

@@ -102,6 +102,9 @@ std::vector<int> present_cameras(const LightField& light_field, int intervals) {
             check_plane(rgba, n, 4, images.camera, "segment_rgba");
         }
         check_plane(images.depth, n, 1, images.camera, "depth");
+        if (light_field.settings.rim_threshold > 0.0) {
+            check_plane(images.rim_depth, n, 1, images.camera, "rim_depth");
+        }
         for (const Image& depth : images.segment_depth) {
             check_plane(depth, n, 1, images.camera, "segment_depth");
         }
@@ -119,7 +122,7 @@ std::vector<int> present_cameras(const LightField& light_field, int intervals) {
 struct PlaneLayout {
     std::size_t rgba_bytes = 0;
     std::size_t first_hit_bytes = 0;
-    /// End of the depth planes (first hit, then each segment's).
+    /// End of the depth planes (first hit, then each segment's, then the rims').
     std::size_t depth_end = 0;
     std::vector<float> attenuation;
     std::vector<float> mean_depth;
@@ -139,8 +142,9 @@ PlaneLayout plane_layout(const LightField& light_field, std::size_t slots, int i
     const std::size_t depth_bytes = light_field.settings.depth_bits == 8 ? 1 : 2;
     layout.rgba_bytes = slots * segments * pixels * 4 * 2;
     layout.first_hit_bytes = slots * pixels * depth_bytes;
-    layout.depth_end =
-        layout.rgba_bytes + layout.first_hit_bytes * (segments > 1 ? segments + 1 : 1);
+    const bool rim = light_field.settings.rim_threshold > 0.0;
+    layout.depth_end = layout.rgba_bytes +
+                       layout.first_hit_bytes * ((segments > 1 ? segments + 1 : 1) + (rim ? 1 : 0));
     for (const LightFieldImages& images : light_field.cameras) {
         if (intervals == 0) break;
         append_groups(layout.attenuation, images.attenuation, groups, 0.0f);
@@ -189,11 +193,16 @@ void add_rig(json& header, const LightFieldRig& rig) {
 }
 
 /// The byte offset of each kind of plane, as the header's "planes" gives them.
-json planes_header(const PlaneLayout& layout, int segments, int depth_bits, int intervals) {
+json planes_header(const PlaneLayout& layout, int segments, int depth_bits, int intervals,
+                   bool rim) {
     json planes{{"rgba", 0},
                 {"depth", layout.rgba_bytes},
                 {"segment_depth", segments > 1 ? layout.rgba_bytes + layout.first_hit_bytes : 0},
                 {"depth_type", depth_bits == 8 ? "uint8 code" : "half"}};
+    if (rim) {
+        planes["rim_depth"] =
+            layout.rgba_bytes + layout.first_hit_bytes * (segments > 1 ? segments + 1 : 1);
+    }
     if (intervals > 0) {
         planes["attenuation"] = {{"offset", layout.attenuation_at},
                                  {"type", layout.attenuation_half ? "half" : "float"}};
@@ -203,7 +212,8 @@ json planes_header(const PlaneLayout& layout, int segments, int depth_bits, int 
     return planes;
 }
 
-/// The first-hit depth of each slot, then with several segments each segment's depth.
+/// The first-hit depth of each slot, then with several segments each segment's depth, then
+/// with a rim threshold each slot's rim depth.
 void append_depth_planes(std::string& out, const LightField& light_field) {
     const auto append_depth = [&](const Image& depth, int camera) {
         if (light_field.settings.depth_bits == 8) {
@@ -218,6 +228,11 @@ void append_depth_planes(std::string& out, const LightField& light_field) {
     if (light_field.segment_count() > 1) {
         for (const LightFieldImages& images : light_field.cameras) {
             for (const Image& depth : images.segment_depth) append_depth(depth, images.camera);
+        }
+    }
+    if (light_field.settings.rim_threshold > 0.0) {
+        for (const LightFieldImages& images : light_field.cameras) {
+            append_depth(images.rim_depth, images.camera);
         }
     }
 }
@@ -247,9 +262,11 @@ std::string light_field_payload(const LightField& light_field, std::int64_t step
                 {"segment_rule", to_string(light_field.settings.segments)},
                 {"depth_bits", depth_bits},
                 {"depth_threshold", light_field.settings.depth_threshold},
+                {"rim_threshold", light_field.settings.rim_threshold},
                 {"intervals", intervals},
                 {"present", present},
-                {"planes", planes_header(layout, segments, depth_bits, intervals)}};
+                {"planes", planes_header(layout, segments, depth_bits, intervals,
+                                         light_field.settings.rim_threshold > 0.0)}};
     add_rig(header, light_field.rig);
     std::string out = payload_opening("insituLF", kLightFieldPayloadVersion, header);
     const std::size_t data_start = out.size();

@@ -14,10 +14,12 @@
 //   planes       per present camera (slot i) and segment s, RGBA premultiplied as IEEE half
 //                (N x N x 4, rows from the top, the map's pixel order), plane i * S + s; then the
 //                first-hit depth of each slot; then, with S > 1, segment s's depth of slot i at
-//                i * S + s. Depth is seed 001's secant fraction (Eq. 3): 8-bit light fields send
-//                the archive's code (round(f * 254), 255 = no hit) as uint8, 16-bit ones the half
-//                (+inf = no hit). Attenuation light fields then hold, at byte offsets 4-aligned
-//                (planes "attenuation" and "mean_depth", each with its "type", half or float),
+//                i * S + s; then, where the settings have a rim threshold (planes "rim_depth"),
+//                the rim depth of each slot. Depth is seed 001's secant fraction (Eq. 3): 8-bit
+//                light fields send the archive's code (round(f * 254), 255 = no hit) as uint8,
+//                16-bit ones the half (+inf = no hit). Attenuation light fields then hold, at
+//                byte offsets 4-aligned (planes "attenuation" and "mean_depth", each with its
+//                "type", half or float),
 //                per slot i and group g of four intervals (G = ceil(L / 4) groups), an N x N x 4
 //                plane i * G + g: a_j, then the mean depth (source camera depth, +inf where
 //                a_j = 0), of intervals 4g .. 4g + 3 (a 0 and depth +inf past the last).

@@ -167,6 +167,8 @@ void section_light_field_cracks(const std::vector<const Scene*>& scenes, bool sm
         request.settings.cameras = 42;
         request.settings.size = map;
         request.settings.attenuation = false;
+        // The rims' own depth (bench/RESULTS.md, "Light-field rims").
+        request.settings.rim_threshold = 0.05;
         request.transfer_function = tf;
         request.intervals = scene_intervals(*scene, 16);
         const fs::path archive = scratch / ("cracks_" + scene->name + std::to_string(map));

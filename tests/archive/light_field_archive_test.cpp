@@ -121,6 +121,7 @@ LightField hand_made(const LightFieldSettings& with, std::vector<double> isovalu
             if (segments > 1) images.segment_depth.push_back(depth_pattern(with.size, k, s + 1));
         }
         images.depth = depth_pattern(with.size, k, 0);
+        if (with.rim_threshold > 0.0) images.rim_depth = depth_pattern(with.size, k, 7);
         if (with.attenuation) {
             images.attenuation = pattern(with.size, 5, k, 0.1f, false);
             images.mean_depth = pattern(with.size, 5, k, 2.0f, true);
@@ -214,6 +215,7 @@ void expect_light_fields_match(const LightField& expected, const LightField& act
                                 camera + " segment depth " + std::to_string(s));
         }
         expect_images_match(e.depth, a.depth, depth, camera + " depth");
+        expect_images_match(e.rim_depth, a.rim_depth, depth, camera + " rim depth");
         expect_images_match(e.attenuation, a.attenuation, compact, camera + " attenuation");
         expect_images_match(e.mean_depth, a.mean_depth, compact, camera + " mean depth");
     }
@@ -282,6 +284,28 @@ TEST_F(LightFieldArchive, EightBitDepthIsWithinHalfACodeAndKeepsNoHit) {
         EXPECT_EQ(read.cameras[0].depth.at(1, 0, 0), 0.0f);
         EXPECT_EQ(read.cameras[0].depth.at(2, 0, 0), 1.0f);
     }
+}
+
+// The rim's depth (LightFieldSettings::rim_threshold) is a channel of its own, stored as the
+// first hit's (8-bit codes here, half at 16 bits); light fields without it have no such channel.
+TEST_F(LightFieldArchive, RimDepthRoundTripsAsTheFirstHitsDepth) {
+    for (const int bits : {8, 16}) {
+        SCOPED_TRACE(bits);
+        config_.on_existing = OnExisting::replace;
+        LightFieldSettings with = settings(bits, false);
+        with.rim_threshold = 0.05;
+        const LightField field = hand_made(with);
+        const LightField read = write_and_load(field);
+        expect_light_fields_match(field, read, Stored::exact,
+                                  bits == 8 ? Stored::eight_bit : Stored::half);
+        Imf::MultiPartInputFile file(light_field_file(10).c_str());
+        EXPECT_NE(file.header(0).channels().findChannel("camera0.rim.depth"), nullptr);
+    }
+    config_.on_existing = OnExisting::replace;
+    const LightField without = write_and_load(hand_made(settings(8, false)));
+    EXPECT_TRUE(without.cameras[0].rim_depth.pixels.empty());
+    Imf::MultiPartInputFile file(light_field_file(10).c_str());
+    EXPECT_EQ(file.header(0).channels().findChannel("camera0.rim.depth"), nullptr);
 }
 
 TEST_F(LightFieldArchive, LoadsOnlyTheCamerasAskedFor) {

@@ -488,6 +488,12 @@ TEST(LightFieldSettings, JsonRoundTrips) {
     const LightFieldSettings back = LightFieldSettings::from_json(written, &unknown);
     EXPECT_TRUE(unknown.empty());
     EXPECT_EQ(back.to_json(), written);
+    // A rim threshold is written only where there is one: headers without it read as before.
+    LightFieldSettings rims;
+    rims.rim_threshold = 0.05;
+    EXPECT_EQ(rims.to_json().at("rim_threshold"), 0.05);
+    EXPECT_EQ(LightFieldSettings::from_json(rims.to_json(), &unknown).rim_threshold, 0.05);
+    EXPECT_EQ(LightFieldSettings::from_json(written, &unknown).rim_threshold, 0.0);
 
     const json opacity = json::parse(R"({"cameras": 642, "size": 64, "segments": [0.3, 0.7],
         "attenuation": false, "depth_bits": 16, "depth_threshold": 0.25})");
@@ -561,6 +567,12 @@ TEST(LightFieldSettings, ErrorsNameTheKeyAndValue) {
                                          "\"light_field.depth_threshold\" = 0.0");
     expect_error_naming<InvalidArgument>([&] { parse(R"({"depth_threshold": 1.5})"); },
                                          "\"light_field.depth_threshold\" = 1.5");
+    expect_error_naming<InvalidArgument>([&] { parse(R"({"rim_threshold": -0.1})"); },
+                                         "\"light_field.rim_threshold\" = -0.1");
+    expect_error_naming<InvalidArgument>(
+        [&] { parse(R"({"rim_threshold": 0.3, "depth_threshold": 0.3})"); },
+        "\"light_field.rim_threshold\" = 0.3 (opacity of the rim's depth, must be 0 (none) or in "
+        "(0, depth_threshold = 0.3)");
     expect_error_naming<ParseError>([&] { parse(R"([42])"); },
                                     "\"light_field\" = [42] (expected an object)");
 

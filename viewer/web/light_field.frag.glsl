@@ -15,6 +15,8 @@
 //     is read instead, with their weight; cameras without a hit read the ray where the others
 //     found it (else at its point nearest the centre), and pass by (hold nothing of the ray)
 //     where they recorded a surface there;
+//  3b. rims: where no camera read sees a first hit, cameras with a rim depth (uRimAt) search it
+//     as the first hit, and every camera reads the ray at its own rim hit, else at their blend;
 //  4. per segment (its own depth search where there are several), RGBA read bilinearly where
 //     each camera sees the hit; the cameras that hold something of the ray blend with
 //     renormalised weights; segments composite front to back, segment s with its opacity
@@ -42,7 +44,8 @@ precision highp usampler2DArray;
 
 // Layer slot * S + s: RGBA (half) of segment s of the camera in that slot.
 uniform sampler2DArray uRgba;
-// Layer slot: the first-hit depth; layer P + slot * S + s: segment s's depth (S > 1).
+// Layer slot: the first-hit depth; layer P + slot * S + s: segment s's depth (S > 1); layer
+// uRimAt + slot: the rim's depth, where the light field has one (uRimAt >= 0).
 #ifdef DEPTH_CODES
 uniform usampler2DArray uDepth;  // seed 001's 8-bit codes, 255 = no hit
 #else
@@ -69,6 +72,7 @@ uniform int uMapSize;
 uniform float uMapHalfExtent;   // tan 45 degrees as the C++ rig computes it
 uniform int uSegments;
 uniform int uSlotCount;
+uniform int uRimAt;            // the first rim depth layer, -1: none
 uniform int uDepthBits;
 uniform int uSearchSteps;
 uniform float uScales[MAX_SEGMENTS];
@@ -424,6 +428,7 @@ float gWeight[MAX_READ];  // renormalised over the cameras around; a substitute 
 RigCamera gCamera[MAX_READ];
 float gHit[MAX_READ];     // whole-ray first hit along the ray, -1 none
 float gReadT[MAX_READ];   // where it reads the ray: its hit, or the others' (tRead)
+float gRim[MAX_READ];     // its rim hit along the ray where no camera sees a first hit, -1 none
 bool gPassesBy[MAX_READ]; // no hit, yet a surface recorded where it reads: nothing of this ray
 vec3 gOrigin, gDirection;
 float gT0, gT1;
@@ -466,6 +471,7 @@ void placeCameras(float presentWeight, float tCentre) {
     gCamera[i] = rigCamera(gIndex[i]);
     gHit[i] = firstHit(gCamera[i], gSlot[i], gOrigin, gDirection, gT0, gT1);
     gReadT[i] = gHit[i] >= 0.0 ? gHit[i] : tCentre;
+    gRim[i] = -1.0;
     gPassesBy[i] = gHit[i] < 0.0 && recordsAt(i, gSlot[i], gReadT[i]);
   }
 }
@@ -535,10 +541,36 @@ void substitute() {
     gCamera[gCount] = camera;
     gHit[gCount] = hit;
     gReadT[gCount] = hit;
+    gRim[gCount] = -1.0;
     gPassesBy[gCount] = false;
     ++gCount;
     return;
   }
+}
+
+// Where no camera read sees a first hit, the ray may cross a faint rim (read_rims): cameras
+// with a rim depth search it as the first hit, and every camera around reads the ray at its own
+// rim hit, else at their blend (returned; tCentre where none found one). The rims occlude
+// nothing: no other test reads them.
+float readRims(float tCentre) {
+  for (int i = 0; i < gCount; ++i) {
+    if (gHit[i] >= 0.0) return tCentre;
+  }
+  if (uRimAt < 0) return tCentre;
+  float rimT = 0.0, weight = 0.0;
+  for (int i = 0; i < gAround; ++i) {
+    gRim[i] = firstHit(gCamera[i], uRimAt + gSlot[i], gOrigin, gDirection, gT0, gT1);
+    if (gRim[i] < 0.0) continue;
+    rimT += gWeight[i] * gRim[i];
+    weight += gWeight[i];
+  }
+  if (!(weight > 0.0)) return tCentre;
+  float tRead = rimT / weight;
+  for (int i = 0; i < gAround; ++i) {
+    gReadT[i] = gRim[i] >= 0.0 ? gRim[i] : tRead;
+    gPassesBy[i] = recordsAt(i, gSlot[i], gReadT[i]);
+  }
+  return tRead;
 }
 
 // Cameras without a hit read the ray where the others found its hit (read_without_hits); one
@@ -646,7 +678,7 @@ void main() {
   if (gCount == 0) return;
   placeCameras(presentWeight, tCentre);
   substitute();
-  float tRead = readWithoutHits(tCentre);
+  float tRead = readWithoutHits(readRims(tCentre));
 
   vec3 colour = vec3(0.0);
   float transmittance = 1.0;
@@ -661,7 +693,7 @@ void main() {
       int layer = uSegments > 1 ? uSlotCount + gSlot[i] * uSegments + s : gSlot[i];
       float hit = uSegments > 1 ? firstHit(gCamera[i], layer, gOrigin, gDirection, gT0, gT1)
                                 : gHit[i];
-      vec2 map = project(gCamera[i], rayAt(hit >= 0.0 ? hit : tRead));
+      vec2 map = project(gCamera[i], rayAt(hit >= 0.0 ? hit : gRim[i] >= 0.0 ? gRim[i] : tRead));
       if (hit < 0.0 && recorded(storedDistance(layer, map))) continue;  // passes it by
       vec4 read = bilinear(gSlot[i] * uSegments + s, map);
       blended += gWeight[i] * read;

@@ -11,7 +11,7 @@ const MAGIC = 'insituLF';
 const VERSION = 2;
 
 /// Parses a payload (ArrayBuffer): {header, rgba: Uint16Array, depth: Uint8Array | Uint16Array,
-/// segmentDepth: same type or null, attenuation and meanDepth: {type: 'half' | 'float', values:
+/// segmentDepth and rimDepth: same type or null, attenuation and meanDepth: {type: 'half' | 'float', values:
 /// Uint16Array | Float32Array} or null, bytes}.
 export function parseLightField(buffer) {
   const { header, start } = readPayloadHeader(buffer, MAGIC, VERSION, 'light-field payload');
@@ -25,6 +25,8 @@ export function parseLightField(buffer) {
   const depth = new DepthArray(buffer, start + planes.depth, slots * pixels);
   const segmentDepth = segments > 1
     ? new DepthArray(buffer, start + planes.segment_depth, slots * segments * pixels) : null;
+  const rimDepth = planes.rim_depth !== undefined
+    ? new DepthArray(buffer, start + planes.rim_depth, slots * pixels) : null;
   const groups = Math.ceil((header.intervals || 0) / 4);
   const grouped = (plane) => {
     if (!plane || groups === 0) return null;
@@ -33,7 +35,7 @@ export function parseLightField(buffer) {
     return { type: plane.type,
       values: new (half ? Uint16Array : Float32Array)(buffer, start + plane.offset, count) };
   };
-  return { header, rgba, depth, segmentDepth, attenuation: grouped(planes.attenuation),
+  return { header, rgba, depth, segmentDepth, rimDepth, attenuation: grouped(planes.attenuation),
     meanDepth: grouped(planes.mean_depth), bytes: buffer.byteLength };
 }
 

@@ -119,7 +119,9 @@ export class LightFieldRenderer {
     const slots = header.present.length;
     const segments = header.segments;
     const layers = slots * segments;
-    const depthLayers = slots * (segments > 1 ? segments + 1 : 1);
+    // The rims' depth (where the light field has them) after the first hit's and segments'.
+    const rimAt = lightField.rimDepth ? slots * (segments > 1 ? segments + 1 : 1) : -1;
+    const depthLayers = slots * (segments > 1 ? segments + 1 : 1) + (rimAt >= 0 ? slots : 0);
     const maxLayers = gl.getParameter(gl.MAX_ARRAY_TEXTURE_LAYERS);
     if (Math.max(layers, depthLayers) > maxLayers) {
       throw new Error(`the light field needs ${Math.max(layers, depthLayers)} texture layers, ` +
@@ -137,6 +139,7 @@ export class LightFieldRenderer {
     const depth = new (codes ? Uint8Array : Uint16Array)(depthLayers * n * n);
     depth.set(lightField.depth, 0);
     if (lightField.segmentDepth) depth.set(lightField.segmentDepth, lightField.depth.length);
+    if (rimAt >= 0) depth.set(lightField.rimDepth, rimAt * n * n);
     gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, codes ? gl.R8UI : gl.R16F, n, n, depthLayers, 0,
       codes ? gl.RED_INTEGER : gl.RED, codes ? gl.UNSIGNED_BYTE : gl.HALF_FLOAT, depth);
 
@@ -219,6 +222,7 @@ export class LightFieldRenderer {
       gl.uniform1f(uniform('uMapHalfExtent'), header.map_half_extent);
       gl.uniform1i(uniform('uSegments'), segments);
       gl.uniform1i(uniform('uSlotCount'), slots);
+      gl.uniform1i(uniform('uRimAt'), rimAt);
       gl.uniform1i(uniform('uDepthBits'), header.depth_bits);
       gl.uniform3fv(uniform('uCenter'), header.center);
       gl.uniform1f(uniform('uBoundingRadius'), header.bounding_radius);

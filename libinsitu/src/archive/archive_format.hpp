@@ -122,6 +122,8 @@ inline constexpr const char* kLightFieldsKey = "light_fields";
 inline constexpr const char* kCameraPartPrefix = "camera";
 inline constexpr const char* kSegmentChannel = ".segment";
 inline constexpr const char* kDepthChannel = ".depth";
+/// The rim's depth (LightFieldSettings::rim_threshold), encoded as the first hit's depth.
+inline constexpr const char* kRimDepthChannel = ".rim.depth";
 inline constexpr const char* kLightFieldAttribute = "libinsitu.light_field";    // settings JSON
 inline constexpr const char* kRigAttribute = "libinsitu.rig";                   // first part only
 inline constexpr const char* kCameraIndexAttribute = "libinsitu.camera_index";  // int

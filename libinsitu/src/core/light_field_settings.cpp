@@ -75,7 +75,8 @@ constexpr const char* kSettingsKeys[] = {"cameras",
                                          "attenuation",
                                          "depth_bits",
                                          "depth_threshold",
-                                         "attenuation_subsampling"};
+                                         "attenuation_subsampling",
+                                         "rim_threshold"};
 
 }  // namespace
 
@@ -134,6 +135,12 @@ void LightFieldSettings::validate() const {
         settings_out_of_range(settings_key("attenuation_subsampling"), attenuation_subsampling,
                               "expected 1, 2 or 4");
     }
+    if (!(rim_threshold >= 0.0 && rim_threshold < depth_threshold)) {
+        settings_out_of_range(settings_key("rim_threshold"), rim_threshold,
+                              "opacity of the rim's depth, must be 0 (none) or in (0, "
+                              "depth_threshold = ",
+                              depth_threshold, ")");
+    }
     if (size % attenuation_subsampling != 0) {
         settings_out_of_range(settings_key("attenuation_subsampling"), attenuation_subsampling,
                               "must divide the map size ", size);
@@ -149,6 +156,7 @@ json LightFieldSettings::to_json() const {
                    {"depth_threshold", depth_threshold}};
     // Only where it is not 1: full-size maps keep the header that readers before it take.
     if (attenuation_subsampling != 1) object["attenuation_subsampling"] = attenuation_subsampling;
+    if (rim_threshold != 0.0) object["rim_threshold"] = rim_threshold;
     return object;
 }
 
@@ -216,6 +224,9 @@ LightFieldSettings LightFieldSettings::from_json(const json& object,
     });
     read("attenuation_subsampling", [&](const json& v, const std::string& k) {
         settings.attenuation_subsampling = settings_integer(v, k);
+    });
+    read("rim_threshold", [&](const json& v, const std::string& k) {
+        settings.rim_threshold = settings_number(v, k);
     });
     settings.validate();
     return settings;

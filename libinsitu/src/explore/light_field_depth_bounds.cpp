@@ -100,6 +100,7 @@ DepthBoundsTable depth_bounds(const LightFieldRig& rig,
         if (images == nullptr) continue;
         bounds.emplace(&images->depth, DepthBounds{});
         for (const Image& depth : images->segment_depth) bounds.emplace(&depth, DepthBounds{});
+        if (!images->rim_depth.pixels.empty()) bounds.emplace(&images->rim_depth, DepthBounds{});
     }
     std::vector<std::pair<const Image* const, DepthBounds>*> maps;
     for (auto& entry : bounds) maps.push_back(&entry);

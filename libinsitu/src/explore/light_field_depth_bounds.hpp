@@ -36,7 +36,7 @@ private:
     std::vector<std::vector<float>> nearest_, farthest_;
 };
 
-/// Of each depth map (whole ray and segments) of the cameras in `table` (null: missing), built
+/// Of each depth map (whole ray, segments and rim) of the cameras in `table` (null: missing), built
 /// by the reconstruction's row workers.
 using DepthBoundsTable = std::unordered_map<const Image*, DepthBounds>;
 DepthBoundsTable depth_bounds(const LightFieldRig& rig,

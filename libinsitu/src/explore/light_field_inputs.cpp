@@ -66,6 +66,8 @@ std::vector<const LightFieldImages*> camera_table(const LightField& light_field,
         }
         for (const Image& rgba : images.segment_rgba) check_image(rgba, n, 4, k, "segment_rgba");
         check_image(images.depth, n, 1, k, "depth");
+        // The rim depth is optional (light fields before it, or without a rim threshold).
+        if (!images.rim_depth.pixels.empty()) check_image(images.rim_depth, n, 1, k, "rim_depth");
         if (segments > 1) {
             if (images.segment_depth.size() != static_cast<std::size_t>(segments)) {
                 fail<InvalidArgument>("light field camera ", k, ": ", images.segment_depth.size(),

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "explore/light_field_attenuation.hpp"
 #include "explore/light_field_depth_bounds.hpp"
 #include "explore/light_field_inputs.hpp"
 #include "explore/light_field_rays.hpp"
@@ -238,12 +239,15 @@ private:
         }
         const int around = present;
         present = substitute(samples, present, span);
+        read_rims(samples, around, span);
         read_without_hits(samples, around, span);
         blend_segments(samples, present, span, scratch);
         const double unscaled_transmittance = composite_segments(scratch, p);
         double hit_t = 0.0;
         const double hit_weight = blended_first_hit(samples, present, span, p, hit_t);
-        if (intervals_ > 0) attenuation(samples, present, p);
+        if (intervals_ > 0) {
+            detail::blend_attenuation(rig_, target_, samples, present, intervals_, p, result_);
+        }
         result_.confidence.pixels[p] =
             static_cast<float>(confidence(samples, present, present_weight, hit_weight, hit_t,
                                           1.0 - unscaled_transmittance, ray.direction));
@@ -346,6 +350,36 @@ private:
         return present;
     }
 
+    // Where no camera around the ray records a first hit (nor a substitute), the ray may cross
+    // a faint rim: cameras that stored the rim's depth search it as they search the first hit,
+    // and every camera reads the ray at its own rim hit or else the blended one (t_read). The
+    // rims occlude nothing: no other test reads them (bench/RESULTS.md, "Light-field rims").
+    void read_rims(Samples& samples, int around, RaySpan& span) const {
+        if (std::any_of(samples.begin(), samples.end(),
+                        [](const CameraSample& s) { return s.hit_t.has_value(); })) {
+            return;
+        }
+        double rim_t = 0.0, weight = 0.0;
+        for (int i = 0; i < around; ++i) {
+            CameraSample& sample = samples[static_cast<std::size_t>(i)];
+            const Image& rim = sample.images->rim_depth;
+            if (rim.pixels.empty()) continue;
+            sample.rim_t = first_hit(rig_.camera(sample.camera), rim, span.ray, span.t0, span.t1);
+            if (!sample.rim_t) continue;
+            rim_t += sample.weight * *sample.rim_t;
+            weight += sample.weight;
+        }
+        if (!(weight > 0.0)) return;
+        span.t_read = rim_t / weight;
+        for (int i = 0; i < around; ++i) {
+            CameraSample& sample = samples[static_cast<std::size_t>(i)];
+            sample.read_point = span.at(sample.rim_t.value_or(span.t_read));
+            sample.read_map = rig_.camera(sample.camera).project(sample.read_point);
+            sample.passes_by =
+                std::isfinite(stored_distance(sample.images->depth, sample.read_map));
+        }
+    }
+
     // Cameras without a hit read the ray where the others found its hit (t_read); one that
     // recorded a surface there is occluded at the hit and passes by (read, it mixed the
     // occluder's colour or nothing into the blend: cracks).
@@ -385,7 +419,8 @@ private:
                 const auto hit = segments_ > 1
                                      ? first_hit(camera, depth, span.ray, span.t0, span.t1)
                                      : sample.hit_t;
-                const glm::dvec2 map = camera.project(span.at(hit.value_or(span.t_read)));
+                const glm::dvec2 map =
+                    camera.project(span.at(hit.value_or(sample.rim_t.value_or(span.t_read))));
                 // No hit: what the camera saw there is either faint (no first hit recorded:
                 // read it, it lies somewhere along the ray) or a surface the ray passes by
                 // (recorded, yet the ray never reached it): nothing of it is on this ray.
@@ -454,58 +489,6 @@ private:
             result_.depth.pixels[p] = static_cast<float>(target_.depth_of(span.at(hit_t)));
         }
         return hit_weight;
-    }
-
-    // a_j of each camera at its whole-ray hit (or where the colour was read without one), blended
-    // with the weights of the cameras that see the ray (renormalised over them, as the colour
-    // is); the mean depth carried into the target camera (the point at the
-    // stored mean depth along the source camera's ray, seen from the target) and blended with
-    // the weights w_k a_jk.
-    void attenuation(const Samples& samples, int present, std::size_t p) {
-        const int n = rig_.map_size();
-        double seeing_weight = 0.0;
-        for (int i = 0; i < present; ++i) {
-            if (!samples[static_cast<std::size_t>(i)].passes_by) {
-                seeing_weight += samples[static_cast<std::size_t>(i)].weight;
-            }
-        }
-        if (!(seeing_weight > 0.0)) return;  // a_j = 0, mean depth +inf
-        for (int j = 0; j < intervals_; ++j) {
-            double a_sum = 0.0, weighted_depth = 0.0, depth_weight = 0.0;
-            for (int i = 0; i < present; ++i) {
-                const CameraSample& sample = samples[static_cast<std::size_t>(i)];
-                if (sample.passes_by) continue;
-                const Camera& camera = rig_.camera(sample.camera);
-                const Taps taps = bilinear_taps(n, sample.read_map);
-                // Mean depth is interpolated with the weights w a_j over the taps where it is
-                // defined (+inf where a_j = 0), so that empty texels do not pull it to +inf.
-                double a = 0.0, z_sum = 0.0, z_weight = 0.0;
-                for (int t = 0; t < 4; ++t) {
-                    const std::size_t texel = taps.pixel[t] * intervals_ + j;
-                    const double a_texel = sample.images->attenuation.pixels[texel];
-                    const double z_texel = sample.images->mean_depth.pixels[texel];
-                    a += taps.weight[t] * a_texel;
-                    if (a_texel > 0.0 && std::isfinite(z_texel)) {
-                        z_sum += taps.weight[t] * a_texel * z_texel;
-                        z_weight += taps.weight[t] * a_texel;
-                    }
-                }
-                a_sum += sample.weight * a;
-                if (!(z_weight > 0.0)) continue;
-                const Ray source = camera.ray(sample.read_map.x, sample.read_map.y);
-                const double along =
-                    (z_sum / z_weight) / glm::dot(source.direction, camera.forward());
-                const double z_target = target_.depth_of(source.origin + along * source.direction);
-                weighted_depth += sample.weight * a * z_target;
-                depth_weight += sample.weight * a;
-            }
-            const std::size_t out = p * intervals_ + j;
-            a_sum /= seeing_weight;
-            result_.attenuation.pixels[out] = static_cast<float>(a_sum);
-            if (a_sum > 0.0 && depth_weight > 0.0) {
-                result_.mean_depth.pixels[out] = static_cast<float>(weighted_depth / depth_weight);
-            }
-        }
     }
 
     // The header's confidence: present weight x consensus x depth agreement x angular closeness.

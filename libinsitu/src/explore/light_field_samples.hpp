@@ -29,8 +29,11 @@ struct CameraSample {
     const LightFieldImages* images = nullptr;
     double weight = 0.0;          ///< renormalised over the cameras present
     std::optional<double> hit_t;  ///< whole-ray first hit along the target ray
-    glm::dvec3 read_point{0.0};   ///< the hit, or the ray's point nearest the centre
-    glm::dvec2 read_map{0.0};     ///< read_point in this camera's map (pixels)
+    /// Where no camera around records a first hit: this camera's rim (its faint surface) along
+    /// the target ray.
+    std::optional<double> rim_t;
+    glm::dvec3 read_point{0.0};  ///< the hit, or the ray's point nearest the centre
+    glm::dvec2 read_map{0.0};    ///< read_point in this camera's map (pixels)
     /// This camera's own colour of the ray: its segments read and composited, unscaled.
     std::array<double, 4> rgba{0.0, 0.0, 0.0, 0.0};
     /// No hit, yet a first hit recorded at read_map: a surface the ray passes by, none of whose

@@ -226,9 +226,14 @@ ProxyFrame segment_frame(const Camera& camera, const ProxyRequest& request, int 
 }  // namespace
 
 ProxyFrame composite_light_field_pass(Communicator& communicator, const Camera& camera,
-                                      const ProxyRequest& request, const BlockPass& march, int root,
+                                      const ProxyRequest& asked, const BlockPass& march, int root,
                                       double* exchange_seconds) {
-    validate(request);
+    validate(asked);
+    // A block cannot stop early (it does not know the opacity in front of it), so it marches to
+    // its end: a request that stops once its first hit is found (the light field's rim pass)
+    // gets the same first hit.
+    ProxyRequest request = asked;
+    request.march.early_termination_opacity = 1.0;
     const int segments = segment_count(request);
     Exchanges exchanges{communicator, static_cast<std::int64_t>(camera.width()) * camera.height(),
                         root, 0.0, nullptr};

@@ -1,7 +1,9 @@
 #include "insitu/render/light_field_capture.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
+#include <limits>
 #include <utility>
 
 #include "insitu/core/check.hpp"
@@ -33,6 +35,35 @@ ProxyRequest proxy_request(const LightFieldRequest& request, int segment_count) 
     proxies.skip_empty_space = request.skip_empty_space;
     proxies.march = request.march;
     return proxies;
+}
+
+// The pass that records the rim's depth: the first hit at the rim threshold, nothing else, the
+// march stopped once it is found (a distributed run's blocks march to their end: the same hit).
+// A pass of its own keeps the proxy kernels' marching as it is (bench/RESULTS.md, "Light-field
+// rims").
+ProxyRequest rim_request(const ProxyRequest& proxies, double rim_threshold) {
+    ProxyRequest rim = proxies;
+    rim.attenuation = rim.mean_depth = false;
+    rim.segment_rgba = rim.segment_depth = false;
+    rim.segments = SegmentRule::whole_ray;
+    rim.segment_thresholds.clear();
+    rim.isovalues.clear();
+    rim.intervals.reset();
+    rim.first_hit_threshold = rim_threshold;
+    rim.march.early_termination_opacity = rim_threshold;
+    return rim;
+}
+
+// The rim's depth only where no first hit is recorded: elsewhere the first hit says where the
+// ray's material is, and +inf codes compress to little. (A rank of a distributed run that holds
+// no results has empty images.)
+void keep_rim_without_hit(const Image& first_hit, Image& rim) {
+    if (rim.pixels.size() != first_hit.pixels.size()) return;
+    for (std::size_t i = 0; i < rim.pixels.size(); ++i) {
+        if (std::isfinite(first_hit.pixels[i])) {
+            rim.pixels[i] = std::numeric_limits<float>::infinity();
+        }
+    }
 }
 
 // Camera depth (world units along forward) -> secant fraction (seed 001 Eq. 3), in place.
@@ -103,6 +134,7 @@ LightField capture_light_field(const CameraPass& pass, const LightFieldRig& rig,
     const ProxyRequest proxies = proxy_request(request, segments);
     validate(proxies);  // names a bad isovalue or interval set before the first camera
     INSITU_CHECK_EQ(segment_count(proxies), segments);
+    const ProxyRequest rim = rim_request(proxies, settings.rim_threshold);
 
     std::vector<int> cameras = request.cameras;
     if (cameras.empty()) {
@@ -127,6 +159,11 @@ LightField capture_light_field(const CameraPass& pass, const LightFieldRig& rig,
         }
         images.depth = std::move(frame.first_hit_depth);
         to_secant_fractions(rig, images.depth);
+        if (settings.rim_threshold > 0.0) {
+            images.rim_depth = std::move(pass(rig.camera(k), rim).first_hit_depth);
+            to_secant_fractions(rig, images.rim_depth);
+            keep_rim_without_hit(images.depth, images.rim_depth);
+        }
         if (settings.attenuation) {
             images.attenuation = std::move(frame.attenuation);
             images.mean_depth = std::move(frame.mean_depth);

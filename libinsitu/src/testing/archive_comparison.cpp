@@ -187,6 +187,8 @@ std::vector<ProxyMeasurement> compare_light_field_camera(const LightFieldImages&
         compare_images("segment_depth", a.segment_depth, b.segment_depth, true,
                        tolerances.depth + depth_step),
         compare_images("first_hit", {a.depth}, {b.depth}, true, tolerances.depth + depth_step),
+        compare_images("rim_depth", {a.rim_depth}, {b.rim_depth}, true,
+                       tolerances.depth + depth_step),
         compare_images("attenuation", {one.attenuation}, {other.attenuation}, false,
                        tolerances.attenuation + tolerances.stored_step_absolute),
         compare_images("mean_depth", {one.mean_depth}, {other.mean_depth}, true,

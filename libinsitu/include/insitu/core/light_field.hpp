@@ -72,6 +72,11 @@ struct LightFieldSettings {
     /// They only matter for edits, whose error is the view synthesis' more than theirs, and they
     /// are most of an attenuation light field's bytes (bench/RESULTS.md, "Light-field bytes").
     int attenuation_subsampling = 1;
+    /// "rim_threshold": where the ray's opacity never reaches depth_threshold (a blob's faint
+    /// rim), the depth where it first reaches this, stored apart from the first hit (so that it
+    /// occludes nothing) and read where no camera around a ray records a first hit; 0 = none.
+    /// In [0, depth_threshold).
+    double rim_threshold = 0.0;
 
     /// InvalidArgument naming the "light_field" key and value of the first bad member.
     void validate() const;

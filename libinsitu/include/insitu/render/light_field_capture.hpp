@@ -37,8 +37,11 @@ struct LightFieldImages {
     std::vector<Image> segment_rgba;   ///< S images, RGBA premultiplied
     std::vector<Image> segment_depth;  ///< S images, 1 channel, secant fractions; empty if S = 1
     Image depth;                       ///< 1 channel: first hit, secant fraction (+inf none)
-    Image attenuation;                 ///< L channels, when the settings ask for it
-    Image mean_depth;                  ///< L channels, when the settings ask for it
+    /// 1 channel when settings.rim_threshold > 0: where `depth` is +inf, the secant fraction at
+    /// which the ray's opacity reaches the rim threshold (+inf elsewhere and where it never does).
+    Image rim_depth;
+    Image attenuation;  ///< L channels, when the settings ask for it
+    Image mean_depth;   ///< L channels, when the settings ask for it
 };
 
 /// One step's light field of one field.

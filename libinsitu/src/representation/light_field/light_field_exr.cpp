@@ -37,14 +37,15 @@ namespace insitu::archive_format {
 
 namespace {
 
-/// RGBA and depth per segment, first-hit depth, a_j and mean depth per interval.
-constexpr long long kMaxCameraChannels = 5ll * kMaxLightFieldSegments + 1 + 2ll * kMaxIntervals;
+/// RGBA and depth per segment, first-hit and rim depth, a_j and mean depth per interval.
+constexpr long long kMaxCameraChannels = 5ll * kMaxLightFieldSegments + 2 + 2ll * kMaxIntervals;
 
 /// The channel names of one camera's part, grouped as its images are.
 struct CameraChannels {
     std::vector<std::string> rgba;           ///< 4 per segment
     std::vector<std::string> segment_depth;  ///< one per segment when there are several
     std::string depth;
+    std::string rim;                       ///< empty without a rim threshold
     std::vector<std::string> attenuation;  ///< L
     std::vector<std::string> mean_depth;   ///< L
 
@@ -53,13 +54,14 @@ struct CameraChannels {
         std::vector<std::string> names = rgba;
         names.insert(names.end(), segment_depth.begin(), segment_depth.end());
         names.push_back(depth);
+        if (!rim.empty()) names.push_back(rim);
         names.insert(names.end(), attenuation.begin(), attenuation.end());
         names.insert(names.end(), mean_depth.begin(), mean_depth.end());
         return names;
     }
 };
 
-CameraChannels camera_channels(int camera, int segments, int intervals) {
+CameraChannels camera_channels(int camera, int segments, int intervals, bool rim) {
     const std::string part = camera_part(camera);
     CameraChannels names;
     for (int s = 0; s < segments; ++s) {
@@ -69,6 +71,7 @@ CameraChannels camera_channels(int camera, int segments, int intervals) {
         if (segments > 1) names.segment_depth.push_back(prefix + kDepthChannel);
     }
     names.depth = part + kDepthChannel;
+    if (rim) names.rim = part + kRimDepthChannel;
     for (int j = 0; j < intervals; ++j) {
         names.attenuation.push_back(interval_channel(part, kAttenuationChannel, j));
         names.mean_depth.push_back(interval_channel(part, kMeanDepthChannel, j));
@@ -110,11 +113,13 @@ Imf::Header camera_header(const StepRecord& record, const LightFieldRecord& sour
 
     const int segments = light_field.segment_count();
     const int intervals = light_field.settings.attenuation ? light_field.intervals->count() : 0;
-    const CameraChannels names = camera_channels(images.camera, segments, intervals);
+    const CameraChannels names = camera_channels(images.camera, segments, intervals,
+                                                 light_field.settings.rim_threshold > 0.0);
     const Imf::PixelType depth = depth_type(encoding, light_field.settings.depth_bits);
     for (const std::string& name : names.rgba) header.channels().insert(name, encoding.compact);
     for (const std::string& name : names.segment_depth) header.channels().insert(name, depth);
     header.channels().insert(names.depth, depth);
+    if (!names.rim.empty()) header.channels().insert(names.rim, depth);
     const int factor = light_field.settings.attenuation_subsampling;
     for (const std::string& name : names.attenuation) {
         header.channels().insert(name, Imf::Channel(encoding.compact, factor, factor));
@@ -159,7 +164,8 @@ public:
         : size_(light_field.rig.map_size()) {
         const int segments = light_field.segment_count();
         const int intervals = light_field.settings.attenuation ? light_field.intervals->count() : 0;
-        const CameraChannels names = camera_channels(images.camera, segments, intervals);
+        const CameraChannels names = camera_channels(images.camera, segments, intervals,
+                                                     light_field.settings.rim_threshold > 0.0);
         halves_.reserve(names.all().size());
         codes_.reserve(names.all().size());
         for (int s = 0; s < segments; ++s) {
@@ -173,6 +179,7 @@ public:
             add_depth(names.segment_depth[s], images.segment_depth[s], depth_bits, depth, where);
         }
         add_depth(names.depth, images.depth, depth_bits, depth, where);
+        if (!names.rim.empty()) add_depth(names.rim, images.rim_depth, depth_bits, depth, where);
         if (intervals == 0) return;
         const int factor = light_field.settings.attenuation_subsampling;
         if (factor > 1) {
@@ -348,7 +355,8 @@ LightFieldImages read_camera(Imf::InputPart& part, int camera, const LightField&
                              const PartContext& where) {
     const int segments = light_field.segment_count();
     const int intervals = light_field.settings.attenuation ? light_field.intervals->count() : 0;
-    const CameraChannels names = camera_channels(camera, segments, intervals);
+    const CameraChannels names =
+        camera_channels(camera, segments, intervals, light_field.settings.rim_threshold > 0.0);
     // Attenuation maps subsampled by the settings' factor are read in a pass of their own.
     const int factor = light_field.settings.attenuation_subsampling;
     std::vector<std::string> all_names = names.all();
@@ -391,6 +399,11 @@ LightFieldImages read_camera(Imf::InputPart& part, int camera, const LightField&
     }
     images.depth = channel_range(all, first++, 1);
     decode_depth(images.depth, *channels.findChannel(names.depth), depth_bits, names.depth, where);
+    if (!names.rim.empty()) {
+        images.rim_depth = channel_range(all, first++, 1);
+        decode_depth(images.rim_depth, *channels.findChannel(names.rim), depth_bits, names.rim,
+                     where);
+    }
     if (intervals > 0 && factor == 1) {
         images.attenuation = channel_range(all, first, intervals);
         images.mean_depth = channel_range(all, first + intervals, intervals);

@@ -43,6 +43,12 @@ void check_camera(const LightFieldImages& images, const LightField& light_field,
         }
     }
     check_image(images.depth, 1, size, where, camera + " depth");
+    if (light_field.settings.rim_threshold > 0.0) {
+        check_image(images.rim_depth, 1, size, where, camera + " rim depth");
+    } else if (!images.rim_depth.pixels.empty()) {
+        fail<InvalidArgument>(where, ": ", camera,
+                              " has a rim depth image but the settings have no \"rim_threshold\"");
+    }
     const int intervals = light_field.settings.attenuation ? light_field.intervals->count() : 0;
     if (intervals == 0) {
         if (!images.attenuation.pixels.empty() || !images.mean_depth.pixels.empty()) {
