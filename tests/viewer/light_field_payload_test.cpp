@@ -163,6 +163,52 @@ TEST(LightFieldPayload, HoldsTheRigAndEveryPlaneExactly) {
     }
 }
 
+// A rim threshold adds each camera's rim depth after every other depth plane, coded as they are;
+// without one the header names no rim plane and the payload holds none.
+TEST(LightFieldPayload, HoldsEachCamerasRimDepthAfterTheOtherDepths) {
+    for (const int depth_bits : {8, 16}) {
+        for (const int segments : {1, 2}) {
+            SCOPED_TRACE(::testing::Message()
+                         << "depth bits " << depth_bits << ", segments " << segments);
+            LightField light_field = small_light_field(segments, depth_bits);
+            const std::string without = light_field_payload(light_field, 40, "v");
+            EXPECT_FALSE(decode(without).header.at("planes").contains("rim_depth"));
+            light_field.settings.rim_threshold = 0.05;
+            for (LightFieldImages& images : light_field.cameras) {
+                images.rim_depth = Image(8, 8, 1, 0.0f);
+                for (int p = 0; p < 64; ++p) {
+                    const int value = (p * 11 + images.camera * 3 + 1) % 256;
+                    images.rim_depth.pixels[p] = value == 255 ? kInf : value / 254.0f;
+                }
+            }
+            const Decoded decoded = decode(light_field_payload(light_field, 40, "v"));
+            const nlohmann::json& planes = decoded.header.at("planes");
+            const std::size_t depth_bytes = depth_bits == 8 ? 1 : 2;
+            const std::size_t slots = 2, pixels = 64;
+            const std::size_t depth_planes = segments > 1 ? segments + 1 : 1;
+            const std::size_t rim_at = planes.at("rim_depth");
+            EXPECT_EQ(rim_at, planes.at("depth").get<std::size_t>() +
+                                  slots * pixels * depth_bytes * depth_planes);
+            EXPECT_EQ(decoded.data.size(), rim_at + slots * pixels * depth_bytes);
+            EXPECT_EQ(decoded.data.size(),
+                      decode(without).data.size() + slots * pixels * depth_bytes);
+            for (std::size_t slot = 0; slot < slots; ++slot) {
+                for (std::size_t p = 0; p < pixels; ++p) {
+                    const float expected = light_field.cameras[slot].rim_depth.pixels[p];
+                    const std::size_t byte = rim_at + (slot * pixels + p) * depth_bytes;
+                    if (depth_bits == 16) {
+                        ASSERT_EQ(half_at(decoded.data, byte),
+                                  static_cast<float>(Imath::half(expected)));
+                    } else {
+                        const auto code = static_cast<unsigned char>(decoded.data[byte]);
+                        ASSERT_EQ(code == 255 ? kInf : code / 254.0f, expected);
+                    }
+                }
+            }
+        }
+    }
+}
+
 // Attenuation light fields add a_j and mean depth per camera in groups of four intervals (the
 // last padded with a = 0, depth +inf): half where every value is one, else float.
 TEST(LightFieldPayload, HoldsTheAttenuationInGroupsOfFourIntervals) {
