@@ -47,15 +47,22 @@ const quiet = args.includes('--quiet');
 const sleep = (seconds) => new Promise((resolve) => { setTimeout(resolve, seconds * 1000); });
 
 // Observes long tasks from the page's start (an init script runs before the page's own).
-// And the paints of #frame's images (Element Timing: the page's img has elementtiming="frame").
+// And the paints of #frame's images (Element Timing, for the elementtiming attribute this script
+// gives #frame as the parser inserts it, whatever the page's version).
 const OBSERVE = `window.__longTasks = [];
+new MutationObserver((records, observer) => {
+  const frame = document.getElementById('frame');
+  if (!frame) return;
+  frame.setAttribute('elementtiming', 'frame');
+  observer.disconnect();
+}).observe(document, { childList: true, subtree: true });
 window.__framePaints = [];
 new PerformanceObserver((list) => {
   for (const e of list.getEntries()) window.__longTasks.push([e.startTime, e.duration]);
 }).observe({ type: 'longtask', buffered: true });
 new PerformanceObserver((list) => {
   for (const e of list.getEntries()) {
-    if (e.identifier === 'frame') window.__framePaints.push(e.renderTime || e.loadTime);
+    if (e.identifier === 'frame' && e.url) window.__framePaints.push(e.renderTime || e.loadTime);
   }
 }).observe({ type: 'element', buffered: true });`;
 

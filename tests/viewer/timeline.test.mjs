@@ -179,12 +179,11 @@ test('the stored view is shown before any of the page\'s modules has run', async
   await page.goto(`${session.server.url}?step=${steps[1]}&gpu=off`, { waitUntil: 'commit' });
   const heldShown = await page.waitForFunction(() => {
     const image = document.getElementById('frame');
-    return image.complete && image.naturalWidth > 0 && window.insituViewer === undefined &&
+    return image.complete && image.naturalWidth > 0 && !('displayed' in window.insituViewer) &&
       performance.now();
   }, null, { timeout: 30000 }).then((handle) => handle.jsonValue());
   const whileHeld = asked.slice();
   release();
-  await page.waitForFunction(() => window.insituViewer !== undefined, null, { timeout: 30000 });
   await waitForSettledFrame(page);
   const v = await page.evaluate(() => ({ first: window.insituViewer.firstFrameAt,
     options: window.insituViewer.displayed.options }));
