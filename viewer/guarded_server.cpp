@@ -140,8 +140,8 @@ httplib::Server::HandlerResponse without_brotli(const httplib::Request& request,
     for (auto header = begin; header != end; ++header) {
         std::size_t start = 0;
         while (start <= header->second.size()) {
-            const std::size_t comma = std::min(header->second.find(',', start),
-                                               header->second.size());
+            const std::size_t comma =
+                std::min(header->second.find(',', start), header->second.size());
             const std::string coding = trimmed(header->second.substr(start, comma - start));
             if (!coding.empty() && trimmed(coding.substr(0, coding.find(';'))) != "br") {
                 kept += (kept.empty() ? "" : ", ") + coding;
