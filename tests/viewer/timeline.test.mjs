@@ -153,6 +153,9 @@ test('the first frame is shown before the page creates its WebGL2 context', asyn
   assert.ok(at.firstFrame < at.webgl2,
     `first frame at ${at.firstFrame.toFixed(0)} ms, WebGL2 context at ${at.webgl2.toFixed(0)} ms`);
   assert.equal(at.drawnFrom, 'stored view', 'then the browser draws the stored view');
+  // The readout says what the frame and the step's opening took.
+  assert.match(await page.locator('#readout').textContent(),
+    /^frame \d+\.\d ms \(WebGL2, stored view\) · .* · step opened in \d+ ms \(\d+\.\d MB\)/);
   assert.deepEqual(errors, []);
   await page.close();
 });
@@ -193,6 +196,9 @@ test('the stored view is shown before any of the page\'s modules has run', async
   assert.ok(v.first <= heldShown, `the page's first frame (${v.first.toFixed(0)} ms) is the one ` +
     `shown while its modules were held (by ${heldShown.toFixed(0)} ms)`);
   assert.deepEqual(v.options, { step: String(steps[1]), view: '0' });
+  assert.match(await page.locator('#readout').textContent(),
+    /^frame \d+\.\d ms \(engine\) \+ \d+\.\d ms \(PNG\) · \d+\.\d ms \(round trip\)/,
+    'the readout says what the server\'s frame took');
   assert.deepEqual(errors, []);
   await page.close();
 });

@@ -17,7 +17,7 @@ import { writeViewQuery } from './view_state.js';
 import { requestCompare } from './compare.js';
 import { askedStep, schedulePlay } from './timeline.js';
 import { followDrag } from './orbit.js';
-import { fetchFrame, fetchRecipe } from './source.js';
+import { fetchFrame, fetchRecipe, isExported } from './source.js';
 import { takeEarlyFrame } from './early_frame.js';
 
 let inFlight = false;
@@ -189,8 +189,12 @@ function serverFrame(options, provisional = false, extra = {}, then = () => {}) 
       if (response.status === 409) return;  // a newer request of ours replaced it
       if (!response.ok) {
         showError(await errorText(response));
-        // Do not ask again for what was refused: remember it as displayed.
+        // Do not ask again for what was refused: remember it as displayed (a stand-in's, as
+        // one the browser's frame replaces once it can draw it).
         if (viewer.displayed) viewer.displayed.options = options;
+        if (viewer.displayed && provisional === 'light field') {
+          viewer.displayed.provisional = provisional;
+        }
         return;
       }
       const png = new Uint8Array(await response.arrayBuffer());
@@ -345,7 +349,7 @@ function showCanvas(canvas) {
 // GPU without what that takes), the server's frame.
 function drawInBrowser(options, dragging, recipe = null) {
   const entry = state.timeline[state.stepIndex];
-  if (!viewer.gpu.lightFieldWarm) {
+  if (!viewer.gpu.lightFieldWarm && !isExported()) {  // a gallery has no server to ask
     standInFrame(options, recipe);
     return;
   }
