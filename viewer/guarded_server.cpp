@@ -118,6 +118,42 @@ private:
     std::size_t end_ = 0;
 };
 
+/// `text` without the spaces and tabs around it.
+std::string trimmed(const std::string& text) {
+    const auto first = text.find_first_not_of(" \t");
+    if (first == std::string::npos) return "";
+    return text.substr(first, text.find_last_not_of(" \t") - first + 1);
+}
+
+/// Takes Brotli out of what a request accepts, before httplib answers it: httplib compresses
+/// every text, JavaScript and JSON answer per request, with Brotli where the client accepts it
+/// (every browser does), at Brotli's default quality, 11, the slowest: 90 ms for one of the
+/// page's 24 KB modules and 1.3 s for a 12,000-step run's 400 KB index on a 2-core machine, 31
+/// modules and the index before every page's first frame. gzip at zlib's default level takes
+/// about 1 % of that, for an answer about 10 % larger (bench/RESULTS.md, "The first frame").
+/// The request is httplib's own object, not const: its handlers see it as const only.
+httplib::Server::HandlerResponse without_brotli(const httplib::Request& request,
+                                                httplib::Response&) {
+    auto& headers = const_cast<httplib::Headers&>(request.headers);
+    const auto [begin, end] = headers.equal_range("Accept-Encoding");
+    std::string kept;
+    for (auto header = begin; header != end; ++header) {
+        std::size_t start = 0;
+        while (start <= header->second.size()) {
+            const std::size_t comma =
+                std::min(header->second.find(',', start), header->second.size());
+            const std::string coding = trimmed(header->second.substr(start, comma - start));
+            if (!coding.empty() && trimmed(coding.substr(0, coding.find(';'))) != "br") {
+                kept += (kept.empty() ? "" : ", ") + coding;
+            }
+            start = comma + 1;
+        }
+    }
+    headers.erase(begin, end);
+    if (!kept.empty()) headers.emplace("Accept-Encoding", kept);
+    return httplib::Server::HandlerResponse::Unhandled;
+}
+
 /// Answers a connection over the limit with 503 and drops it.
 void refuse(int sock, const std::string& client) {
     const std::string message = "too many connections from " + client + " (at most " +
@@ -147,6 +183,7 @@ GuardedServer::GuardedServer() {
     set_keep_alive_timeout(kKeepAliveTimeoutSeconds);
     set_read_timeout(kReadTimeoutSeconds);
     set_write_timeout(kWriteTimeoutSeconds);
+    set_pre_routing_handler(without_brotli);
 }
 
 bool GuardedServer::process_and_close_socket(socket_t sock) {

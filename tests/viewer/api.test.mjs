@@ -30,16 +30,18 @@ after(async () => {
   if (server) assert.equal(await stopServer(server), 0, 'serve exits 0 on SIGTERM');
 });
 
-/// A raw GET whose path goes to the server exactly as written (fetch would normalise "..").
-function rawGet(base, rawPath) {
+/// A raw GET whose path goes to the server exactly as written (fetch would normalise ".."), with
+/// `headers`; resolves to its status, body (not decoded) and headers.
+function rawGet(base, rawPath, headers = {}) {
   const url = new URL(base);
   return new Promise((resolve, reject) => {
-    const request = http.request({ host: url.hostname, port: url.port, path: rawPath, method: 'GET' },
-      (response) => {
+    const request = http.request({ host: url.hostname, port: url.port, path: rawPath, method: 'GET',
+      headers }, (response) => {
         let body = '';
         response.setEncoding('latin1');
         response.on('data', (chunk) => { body += chunk; });
-        response.on('end', () => resolve({ status: response.statusCode, body }));
+        response.on('end', () => resolve({ status: response.statusCode, body,
+          headers: response.headers }));
       });
     request.on('error', reject);
     request.end();
@@ -88,6 +90,22 @@ test('the page and its scripts are served from the binary', async () => {
     assert.equal(response.status, 200, route);
     assert.ok(response.headers.get('content-type').startsWith(type), route);
   }
+});
+
+// httplib answers Brotli at quality 11 where a client accepts it: 90 ms a module, 1.3 s for a
+// long run's index (bench/RESULTS.md, "The first frame"); serve takes Brotli out of what a
+// request accepts, so a browser's answers are gzip.
+test('the page and the API answer a browser in gzip, not Brotli', async () => {
+  const browser = { 'Accept-Encoding': 'gzip, deflate, br, zstd' };
+  for (const route of ['/', '/frames.js', '/style.css', '/api/archive']) {
+    const answer = await rawGet(server.url, route, browser);
+    assert.equal(answer.status, 200, route);
+    assert.equal(answer.headers['content-encoding'], 'gzip', route);
+  }
+  const onlyBrotli = await rawGet(server.url, '/frames.js', { 'Accept-Encoding': 'br;q=1' });
+  assert.equal(onlyBrotli.headers['content-encoding'], undefined, 'sent as it is');
+  assert.equal(onlyBrotli.body, readFileSync(path.join(import.meta.dirname, '../../viewer/web/frames.js'),
+    'latin1'));
 });
 
 test('a step without a light field has no segments: the page shows no faders', async () => {

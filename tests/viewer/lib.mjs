@@ -178,6 +178,28 @@ export async function openViewerPage(context, url, errors) {
   return page;
 }
 
+/// The pages a measuring script (first_frame_profile.mjs, page_waits.mjs) opens, 1280x900, as
+/// `openIn` says: 'tab' as a user opens a link in a browser already running, a new tab of the one
+/// browser context every run shares (its HTTP cache emptied first unless `warmCache`: the
+/// user's first visit); 'window' a new browser context per page (playwright's browser.newPage: a
+/// new window, whose own chrome the browser builds each time). Resolves to a function that
+/// opens the next page.
+export async function measuredPages(browser, openIn, warmCache = false) {
+  const viewport = { width: 1280, height: 900 };
+  if (openIn === 'window') return () => browser.newPage({ viewport });
+  if (openIn !== 'tab') throw new Error(`--open=${openIn}: tab or window`);
+  const shared = await browser.newContext({ viewport });
+  const first = await shared.newPage();  // the tab the user has open
+  return async () => {
+    if (!warmCache) {
+      const cdp = await shared.newCDPSession(first);
+      await cdp.send('Network.clearBrowserCache');
+      await cdp.detach();
+    }
+    return shared.newPage();
+  };
+}
+
 /// Waits until `page` shows a whole frame (not a drag's preview) newer than frame number `count`
 /// whose options are the page's current ones: nothing is left to request or redraw, and the page
 /// is ready (it draws in the browser where it can; its first frame may come before, the

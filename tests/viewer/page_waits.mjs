@@ -7,15 +7,20 @@
 //    data not downloaded before: each run opens a new page);
 //  * opacity edit: from setting an interval's opacity scale to the edited frame shown, and of
 //    that the frame's drawing (the GPU's, or the server's engine);
-//  * orbit: from turning the view 20 degrees to its first frame (of a light field: drawn from
-//    the cameras around the view), and to its settled frame (from the whole rig).
+//  * orbit: from turning the view 20 degrees to its first frame (of a light field in a page
+//    that has drawn none: the server's, while the page builds its program), to the first frame
+//    the browser drew (from the cameras around the view), and to its settled frame (from the
+//    whole rig).
+// Pages open as --open says (lib.mjs measuredPages): `tab` (the default), a new tab of one
+// browser context with an empty cache; `window`, a new window each (the figures before
+// 2026-12-07).
 //
-//   node tests/viewer/page_waits.mjs INSITU_VIEW ARCHIVE [RUNS] [--gpu=off]
-import { cpus } from 'node:os';
+//   node tests/viewer/page_waits.mjs INSITU_VIEW ARCHIVE [RUNS] [--gpu=off] [--open=tab|window]
+import { cpus, loadavg } from 'node:os';
 
 import {
-  CHROMIUM, CHROMIUM_ARGS, loadPlaywright, startServer, stopServer, waitForSettledFrame,
-  WEBGL_ARGS,
+  CHROMIUM, CHROMIUM_ARGS, loadPlaywright, measuredPages, startServer, stopServer,
+  waitForSettledFrame, WEBGL_ARGS,
 } from './lib.mjs';
 
 const args = process.argv.slice(2);
@@ -26,6 +31,8 @@ if (!binary || !archive) {
   process.exit(2);
 }
 const runs = Number(runsText || 5);
+const openArg = args.find((a) => a.startsWith('--open='));
+const openIn = openArg ? openArg.slice('--open='.length) : 'tab';
 
 // The page's clock: the time from `start` (performance.now() in the page) until a settled frame
 // newer than `count` is shown.
@@ -34,8 +41,8 @@ async function settledAfter(page, count) {
   return page.evaluate(() => performance.now());
 }
 
-async function oneRun(browser, url) {
-  const page = await browser.newPage({ viewport: { width: 1280, height: 900 } });
+async function oneRun(openPage, url) {
+  const page = await openPage();
   await page.goto(url);
   await page.waitForFunction(() => window.insituViewer.frameCount > 0, null, { timeout: 120000 });
   const first = await page.evaluate(() => window.insituViewer.firstFrameAt);  // from navigation
@@ -90,6 +97,13 @@ async function oneRun(browser, url) {
     return v.frameCount > n && v.displayed.options.azimuth !== undefined;
   }, count, { timeout: 120000 });
   waits['orbit frame'] = await page.evaluate(() => performance.now()) - start;
+  if (!gpuOff) {
+    await page.waitForFunction((n) => {
+      const v = window.insituViewer;
+      return v.frameCount > n && v.displayed.options.azimuth !== undefined && v.displayed.gpu;
+    }, count, { timeout: 120000 });
+    waits['  browser\'s'] = await page.evaluate(() => performance.now()) - start;
+  }
   waits['orbit settled'] = await settledAfter(page, count) - start;
   const drawn = await page.evaluate(() => window.insituViewer.displayed.drawnFrom || 'server');
   await page.close();
@@ -102,17 +116,21 @@ const browser = await loadPlaywright().chromium.launch({ executablePath: CHROMIU
   args: gpuOff ? CHROMIUM_ARGS : WEBGL_ARGS });
 try {
   const url = server.url + (gpuOff ? '?gpu=off' : '');
-  await oneRun(browser, url);  // warm-up: kernels built, files in the page cache
+  const openPage = await measuredPages(browser, openIn);
+  await oneRun(openPage, url);  // warm-up: kernels built, files in the page cache
+  const loads = [];
   const all = {};
   let drawn = '';
   for (let r = 0; r < runs; ++r) {
-    const run = await oneRun(browser, url);
+    loads.push(loadavg()[0]);
+    const run = await oneRun(openPage, url);
     drawn = run.drawn;
     for (const [what, ms] of Object.entries(run.waits)) (all[what] ||= []).push(ms);
   }
   console.log(`${archive}: ${runs} runs after one warm-up, ${gpuOff ? 'server frames' :
-    'WebGL2 (SwiftShader)'}, edited frame drawn from: ${drawn}; CPU ${cpu} (${cpus().length} ` +
-    'threads)');
+    'WebGL2 (SwiftShader)'}, edited frame drawn from: ${drawn}; each page a new ${openIn}; ` +
+    `CPU ${cpu} (${cpus().length} threads); load ${Math.min(...loads).toFixed(1)}–` +
+    `${Math.max(...loads).toFixed(1)}`);
   console.log('wait            best ms   median ms   spread (max-min) ms');
   for (const [what, values] of Object.entries(all)) {
     const sorted = values.slice().sort((a, b) => a - b);

@@ -1,8 +1,9 @@
 // A step's light field is downloaded by need and streamed (issues 41 and 42), on an archive whose
 // steps hold an attenuation light field beside the stored view's proxies: a step change and an
 // opacity edit at the stored view draw from the view's proxies and ask for no light field; the
-// first orbit frame draws from the cameras around the view (/api/lightfield?toward=...), shown
-// while the whole rig downloads, and the frame is redrawn from the whole rig once it comes,
+// first orbit frame is the server's frame of the light field while the page builds its program,
+// then the page's, drawn from the cameras around the view (/api/lightfield?toward=...) while the
+// whole rig downloads, and the frame is redrawn from the whole rig once it comes,
 // matching `insitu-view render --source lightfield`.
 //
 //   INSITU_VIEW=build/viewer/insitu-view ARCHIVE=viewer_lf_attenuation.cdb WORK_DIR=dir \
@@ -11,8 +12,8 @@ import assert from 'node:assert/strict';
 import { test } from 'node:test';
 
 import {
-  env, lightFieldFrameMatches, makeWorkDir, openViewerPage, serverAndBrowser,
-  waitForSettledFrame,
+  decodePng, differingSamples, env, lightFieldFrameMatches, makeWorkDir, openViewerPage,
+  renderWithCli, serverAndBrowser, waitForSettledFrame,
 } from './lib.mjs';
 
 const binary = env('INSITU_VIEW');
@@ -56,11 +57,29 @@ test('the light field is fetched by need and streamed from the cameras around th
     assert.equal(edited.drawnFrom, 'stored view', 'the stored view is drawn from its proxies');
     assert.deepEqual(asked, [], 'no light field is asked for before the view leaves the stored view');
 
-    // 20 degrees of orbit: first the cameras around the view.
+    // 20 degrees of orbit. The page has drawn no light-field frame yet: first the server's frame
+    // of the light field stands in, while the page builds its program (seconds on a software
+    // GPU); then the browser's, from the cameras around the view.
     count = await page.evaluate(() => window.insituViewer.frameCount);
     await page.fill('#azimuth', String(Math.round(info.azimuth + 20)));
     await page.fill('#elevation', String(Math.round(info.elevation)));
     await page.dispatchEvent('#elevation', 'change');
+    await page.waitForFunction((n) => window.insituViewer.frameCount > n, count,
+      { timeout: 60000 });
+    const standIn = await page.evaluate(() => {
+      const d = window.insituViewer.displayed;
+      return { gpu: Boolean(d.gpu), provisional: d.provisional, options: d.options,
+        extra: d.extra, png: Array.from(d.png || []) };
+    });
+    // The edit is still on: the engine's frame of these options, which its recipe makes from the
+    // light field, as the browser's will be.
+    assert.deepEqual([standIn.gpu, standIn.provisional, standIn.extra],
+      [false, 'light field', {}], 'the orbit\'s first frame is the server\'s');
+    assert.equal(standIn.options.azimuth, (Math.round(info.azimuth + 20)).toFixed(2));
+    assert.ok(standIn.options['opacity-scale'], 'edited');
+    const rendered = renderWithCli(binary, archive, standIn.options, workDir);
+    assert.equal(differingSamples(decodePng(Buffer.from(standIn.png)),
+      decodePng(rendered.colour)), 0, 'the frame render makes');
     await page.waitForFunction((n) => {
       const v = window.insituViewer;
       return v.frameCount > n && v.displayed.drawnFrom === 'light field' && !v.busy();

@@ -153,6 +153,52 @@ test('the first frame is shown before the page creates its WebGL2 context', asyn
   assert.ok(at.firstFrame < at.webgl2,
     `first frame at ${at.firstFrame.toFixed(0)} ms, WebGL2 context at ${at.webgl2.toFixed(0)} ms`);
   assert.equal(at.drawnFrom, 'stored view', 'then the browser draws the stored view');
+  // The readout says what the frame and the step's opening took.
+  assert.match(await page.locator('#readout').textContent(),
+    /^frame \d+\.\d ms \(WebGL2, stored view\) · .* · step opened in \d+ ms \(\d+\.\d MB\)/);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('the stored view is shown before any of the page\'s modules has run', async () => {
+  // app.js is held: what shows meanwhile is index.html's own doing (early_frame.js).
+  const steps = await timeline();
+  const page = await session.browser.newPage({ viewport: { width: 1280, height: 900 } });
+  const errors = [];
+  page.on('pageerror', (error) => errors.push(error.message));
+  let release;
+  const released = new Promise((resolve) => { release = resolve; });
+  await page.route((url) => url.pathname.endsWith('/app.js'), async (route) => {
+    await released;
+    await route.continue();
+  });
+  const asked = [];
+  page.on('request', (request) => {
+    const url = new URL(request.url());
+    if (url.pathname.startsWith('/api/') && url.pathname !== '/api/archive') {
+      asked.push(`${url.pathname} ${request.postData() || url.search}`);
+    }
+  });
+  await page.goto(`${session.server.url}?step=${steps[1]}&gpu=off`, { waitUntil: 'commit' });
+  const heldShown = await page.waitForFunction(() => {
+    const image = document.getElementById('frame');
+    return image.complete && image.naturalWidth > 0 && !('displayed' in window.insituViewer) &&
+      performance.now();
+  }, null, { timeout: 30000 }).then((handle) => handle.jsonValue());
+  const whileHeld = asked.slice();
+  release();
+  await waitForSettledFrame(page);
+  const v = await page.evaluate(() => ({ first: window.insituViewer.firstFrameAt,
+    options: window.insituViewer.displayed.options }));
+  assert.equal(whileHeld.length, 1, `one request before the modules: ${whileHeld}`);
+  assert.match(whileHeld[0], new RegExp(`^/api/frame step=${steps[1]}&view=0&session=page-`),
+    'the stored view of the step the address names');
+  assert.ok(v.first <= heldShown, `the page's first frame (${v.first.toFixed(0)} ms) is the one ` +
+    `shown while its modules were held (by ${heldShown.toFixed(0)} ms)`);
+  assert.deepEqual(v.options, { step: String(steps[1]), view: '0' });
+  assert.match(await page.locator('#readout').textContent(),
+    /^frame \d+\.\d ms \(engine\) \+ \d+\.\d ms \(PNG\) · \d+\.\d ms \(round trip\)/,
+    'the readout says what the server\'s frame took');
   assert.deepEqual(errors, []);
   await page.close();
 });

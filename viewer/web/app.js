@@ -8,7 +8,7 @@
 // (the view in the address), export_png.js, compare.js (side by side); the WebGL2 side: gpu_frames.js,
 // light_field_data.js, light_field_renderer.js, camera.js and the shaders beside them.
 import {
-  $, ARCHIVE_POLL_MS, firstFrameDone, showError, state, viewer, viewHasAttenuation,
+  $, ARCHIVE_POLL_MS, firstFrameDone, painted, showError, state, viewer, viewHasAttenuation,
 } from './page.js';
 import { currentOptions } from './explore_options.js';
 import { redrawUpgradable, requestFrame, updateMask } from './frames.js';
@@ -93,16 +93,6 @@ function installControls() {
 // How long the page waits for its first frame before creating its WebGL2 context anyway (an
 // archive of a run that has written no step yet shows no frame).
 const FIRST_FRAME_WAIT_MS = 5000;
-
-// Resolves once the browser has painted what the page shows now: a frame shown is painted only
-// after the task that showed it ends, so a long task started in it (creating the WebGL2 context)
-// would hold the picture back.
-function painted() {
-  return new Promise((resolve) => {
-    requestAnimationFrame(() => setTimeout(resolve, 0));
-    setTimeout(resolve, 100);  // a hidden page paints nothing and runs no animation frames
-  });
-}
 
 // The page asks for the archive and the stored view's exact frame (the server's) first, and
 // creates its WebGL2 context once that frame is done: creating it blocks the page (0.1–1.7 s on

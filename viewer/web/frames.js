@@ -6,8 +6,8 @@
 // engine's PNG. The confidence overlay of a frame drawn here is the page's own (its source's
 // confidence, an edit's trust on top); of any other, the engine's mask of the frame shown.
 import {
-  $, FPS_WINDOW_MS, errorText, noteFrameDone, session, setHidden, setText, showError, state,
-  viewer,
+  $, FPS_WINDOW_MS, errorText, noteFrameDone, painted, session, setHidden, setText, showError,
+  state, viewer,
 } from './page.js';
 import { currentOptions, sameOptions } from './explore_options.js';
 import { baseTf } from './transfer_function.js';
@@ -17,7 +17,8 @@ import { writeViewQuery } from './view_state.js';
 import { requestCompare } from './compare.js';
 import { askedStep, schedulePlay } from './timeline.js';
 import { followDrag } from './orbit.js';
-import { fetchFrame, fetchRecipe } from './source.js';
+import { fetchFrame, fetchRecipe, isExported } from './source.js';
+import { takeEarlyFrame } from './early_frame.js';
 
 let inFlight = false;
 const READOUT_EVERY_MS = 250;
@@ -154,7 +155,8 @@ function upgradable() {
   const d = viewer.displayed;
   if (!d || !viewer.gpu) return false;
   const [step, view] = [Number(d.options.step), Number(d.options.view)];
-  return Boolean((d.provisional && viewer.gpu.proxiesArrived(step, view)) ||
+  return Boolean((d.provisional === true && viewer.gpu.proxiesArrived(step, view)) ||
+    (d.provisional === 'light field' && viewer.gpu.lightFieldWarm) ||
     (d.partial && viewer.gpu.lightFieldArrived(step, view)));
 }
 
@@ -164,24 +166,48 @@ export function redrawUpgradable() {
   if (!inFlight && upgradable()) requestFrame();
 }
 
-function serverFrame(options, provisional = false) {
+// The server's frame of `options` (with `extra` added to the request: the frame the browser
+// would draw, where that is not the engine's choice); `provisional`: true while the step's
+// proxies download, 'light field' while the page builds its light-field program; `then` runs
+// once it is shown (or refused).
+function serverFrame(options, provisional = false, extra = {}, then = () => {}) {
+  const early = takeEarlyFrame(options);
+  if (early) {
+    // Awaited even when it is another frame: it must not be shown after this one.
+    early.then((frame) => {
+      if (!frame) return serverFrame(options, provisional, extra, then);
+      return display(options, frame.png, frame.headers, frame.roundTripMs, provisional, frame)
+        .then(() => showError(''))
+        .catch((error) => showError(String(error)))
+        .finally(frameDone);
+    });
+    return;
+  }
   const sent = performance.now();
-  fetchFrame('frame', { ...options, session })
+  fetchFrame('frame', { ...options, ...extra, session })
     .then(async (response) => {
       if (response.status === 409) return;  // a newer request of ours replaced it
       if (!response.ok) {
         showError(await errorText(response));
-        // Do not ask again for what was refused: remember it as displayed.
+        // Do not ask again for what was refused: remember it as displayed (a stand-in's, as
+        // one the browser's frame replaces once it can draw it).
         if (viewer.displayed) viewer.displayed.options = options;
+        if (viewer.displayed && provisional === 'light field') {
+          viewer.displayed.provisional = provisional;
+        }
         return;
       }
       const png = new Uint8Array(await response.arrayBuffer());
       if (!asked(options)) return;  // late: the page asks for another step now
-      await display(options, png, response.headers, performance.now() - sent, provisional);
+      await display(options, png, response.headers, performance.now() - sent, provisional, null,
+        extra);
       showError('');
     })
     .catch((error) => showError(String(error)))
-    .finally(frameDone);
+    .finally(() => {
+      frameDone();
+      then();
+    });
 }
 
 // A frame from the view's proxies, where the recipe allows; else (or when the server refuses
@@ -304,9 +330,8 @@ function frameDone() {
 }
 
 // Frames per second over the last FPS_WINDOW_MS, counting this one.
-function countFrame() {
+function countFrame(now = performance.now()) {
   viewer.frameCount += 1;
-  const now = performance.now();
   if (viewer.frameCount === 1) viewer.firstFrameAt = now;
   viewer.frameTimes.push(now);
   while (viewer.frameTimes.length && viewer.frameTimes[0] < now - FPS_WINDOW_MS) viewer.frameTimes.shift();
@@ -324,6 +349,10 @@ function showCanvas(canvas) {
 // GPU without what that takes), the server's frame.
 function drawInBrowser(options, dragging, recipe = null) {
   const entry = state.timeline[state.stepIndex];
+  if (!viewer.gpu.lightFieldWarm && !isExported()) {  // a gallery has no server to ask
+    standInFrame(options, recipe);
+    return;
+  }
   viewer.gpu.draw(entry.step, state.view, state.info.camera, Number(options.azimuth),
     Number(options.elevation), state.segmentScales.slice(), dragging, recipe, !unedited(options))
     .then((timing) => {
@@ -338,6 +367,22 @@ function drawInBrowser(options, dragging, recipe = null) {
       showError(String(error));
       frameDone();
     });
+}
+
+// An orbit's frame from the light field while this page has drawn none: the server's frame
+// stands in (exact: the light field's where the browser would draw it unedited, else the
+// engine's of the recipe's options; 1-3 s), while the page builds its light-field program
+// unseen (GpuFrames.warmLightField: SwiftShader takes 5-10 s to build and first draw it,
+// bench/RESULTS.md, "An orbit's first light-field frame"). The build starts once the stand-in is
+// painted (the GPU process that builds it also paints the page); the browser's frame replaces
+// the stand-in when it is done (upgradable), and draws the orbit from then on.
+function standInFrame(options, recipe) {
+  const entry = state.timeline[state.stepIndex];
+  const warm = () => viewer.gpu.warmLightField(entry.step, state.view, state.info.camera,
+    Number(options.azimuth), Number(options.elevation), state.segmentScales.slice(), recipe)
+    .then(redrawUpgradable);
+  serverFrame(options, 'light field', recipe ? {} : { source: 'lightfield' },
+    () => painted().then(warm));
 }
 
 // Where a frame's colour comes from, in words: a frame from the compressed field is classified
@@ -388,14 +433,19 @@ function showGpuFrame(options, timing, what, colourSource) {
   return updateMask();
 }
 
-async function display(options, png, headers, roundTripMs, provisional) {
-  const url = URL.createObjectURL(new Blob([png], { type: 'image/png' }));
+// Shows a PNG of the server's; `early`: the frame index.html showed already (early_frame.js),
+// kept as it is; `extra`: what the request added to the options (its mask is asked with it).
+async function display(options, png, headers, roundTripMs, provisional, early = null,
+  extra = {}) {
+  const url = early ? early.url : URL.createObjectURL(new Blob([png], { type: 'image/png' }));
   const image = $('frame');
-  await new Promise((resolve, reject) => {
-    image.onload = resolve;
-    image.onerror = () => reject(new Error('the frame is not a readable PNG'));
-    image.src = url;
-  });
+  if (!early) {
+    await new Promise((resolve, reject) => {
+      image.onload = resolve;
+      image.onerror = () => reject(new Error('the frame is not a readable PNG'));
+      image.src = url;
+    });
+  }
   if (viewer.displayed && viewer.displayed.url) URL.revokeObjectURL(viewer.displayed.url);
   showCanvas(false);
   const header = (name) => headers.get(name);
@@ -411,8 +461,9 @@ async function display(options, png, headers, roundTripMs, provisional) {
     proxySource: header('X-Insitu-Proxy-Source'),
     synthesised: header('X-Insitu-Synthesised') === '1',
     provisional,
+    extra,
   };
-  const fps = countFrame();
+  const fps = countFrame(early ? early.shownAt : performance.now());
   const d = viewer.displayed;
   $('readout').textContent =
     `frame ${d.milliseconds.toFixed(1)} ms (engine) + ${d.encodeMilliseconds.toFixed(1)} ms (PNG)` +
@@ -463,7 +514,8 @@ export async function updateMask() {
   if (!confidence) {
     // Else (a GPU that could not) the engine's mask of the frame shown; a frame drawn here from
     // the light field has the light field's confidence.
-    const source = displayed.drawnFrom === 'light field' ? { source: 'lightfield' } : {};
+    const source = displayed.drawnFrom === 'light field' ? { source: 'lightfield' }
+      : displayed.extra || {};
     const response = await fetchFrame('mask', { ...options, ...source, session });
     if (!response.ok) return;
     const bitmap = await createImageBitmap(await response.blob());

@@ -44,6 +44,9 @@ const FULL_FRAME = Object.freeze({ divisor: 1, factor: 1 });
 const WHOLE_TRIES = 3;  // downloads of a whole light field after its nearest cameras
 const RETRY_MS = 500;
 const DROPPED = Object.freeze({ dropped: true });  // a draw's answer for data no longer wanted
+// The side of the frame that builds the light field's program unseen (warmLightField): SwiftShader
+// builds a program's code at its first draw, whatever its size.
+const WARM_SIDE = 8;
 
 export class GpuFrames {
   /// null when this browser has no WebGL2 (the page then uses the server's frames only).
@@ -97,6 +100,31 @@ export class GpuFrames {
     // Called when the whole light field of (step, view) has come after its nearest cameras (the
     // page redraws the frame drawn from those).
     this.onLightField = () => {};
+    // Whether a light-field frame has been drawn in this page (its program built: until then
+    // an orbit's frame is the server's, frames.js), and the warm-up drawing one unseen.
+    this.lightFieldWarm = false;
+    this.warming = null;
+  }
+
+  /// Builds the light field's program for `recipe` (null: unedited) by drawing a WARM_SIDE-pixel
+  /// frame of (step, view) at the angles unseen, downloading the cameras around them first:
+  /// seconds on a software GPU (bench/RESULTS.md, "An orbit's first light-field frame"), which
+  /// the page spends showing the server's frame of the light field instead. One at a time;
+  /// resolves once lightFieldWarm (also where the GPU cannot draw it: the page then asks the
+  /// server, as it would have).
+  warmLightField(step, view, storedCamera, azimuthDeg, elevationDeg, segmentScales, recipe) {
+    if (!this.warming) {
+      const small = { ...storedCamera, size: [WARM_SIDE, WARM_SIDE] };
+      this.warming = this.draw(step, view, small, azimuthDeg, elevationDeg, segmentScales, false,
+        recipe, false, false)
+        .catch((error) => console.warn(`light-field program not warmed up: ${error.message}`))
+        .then((timing) => {
+          // Drawn (or nothing to draw from): the page's next orbit frame is drawn here.
+          if (!timing || !timing.dropped) this.lightFieldWarm = true;
+          this.warming = null;
+        });
+    }
+    return this.warming;
   }
 
   cost(kind, fullFactor = 1) {
@@ -317,9 +345,9 @@ export class GpuFrames {
   /// lights, occlusion and enhancement; while `dragging`, at the size the frame budget allows; a
   /// full edited frame `withTrust` keeps its confidence for lightFieldTrust (that takes one more
   /// reconstruction, of the confidence). Resolves to the frame's timing, or null without a light
-  /// field.
+  /// field. A frame not `recorded` (the warm-up's) leaves the frame budget's costs as they are.
   async draw(step, view, storedCamera, azimuthDeg, elevationDeg, segmentScales, dragging = false,
-    recipe = null, withTrust = false) {
+    recipe = null, withTrust = false, recorded = true) {
     const target = reorbit(storedCamera, azimuthDeg, elevationDeg);
     const { lightField, downloadMs, partial, key } = await this.streamedLightField(step, view,
       target.forward.map((c) => -c));
@@ -355,7 +383,10 @@ export class GpuFrames {
       withTrust && !preview);
     await this.renderer.finish();
     const milliseconds = performance.now() - started;
-    cost.record(preview, milliseconds, size[0] * size[1], factor);
+    if (recorded) {
+      cost.record(preview, milliseconds, size[0] * size[1], factor);
+      this.lightFieldWarm = true;
+    }
     return { milliseconds, uploadMs, preview, size, partial,
       cameras: lightField.header.present.length, rigCameras: lightField.header.cameras };
   }

@@ -12,7 +12,8 @@ export const FPS_WINDOW_MS = 2000;     // frames per second averaged over this w
 export const REST_MS = 150;      // a drag that has not moved for this long gets its full frame
 
 export const $ = (id) => document.getElementById(id);
-export const session = 'page-' + Math.random().toString(36).slice(2, 12);
+// index.html's (its early frame is this session's), else made here.
+export const session = window.insituSession || 'page-' + Math.random().toString(36).slice(2, 12);
 
 export const state = {
   archive: null,          // /api/archive
@@ -57,6 +58,16 @@ let firstFrameSettles;
 export const firstFrameDone = new Promise((resolve) => { firstFrameSettles = resolve; });
 export function noteFrameDone() {
   firstFrameSettles();
+}
+
+/// Resolves once the browser has painted what the page shows now: a frame shown is painted only
+/// after the task that showed it ends, so a long task started in it (creating the WebGL2 context,
+/// building a program) would hold the picture back.
+export function painted() {
+  return new Promise((resolve) => {
+    requestAnimationFrame(() => setTimeout(resolve, 0));
+    setTimeout(resolve, 100);  // a hidden page paints nothing and runs no animation frames
+  });
 }
 
 /// Whether `view`'s stored proxies hold attenuation, the proxies the browser draws from (the

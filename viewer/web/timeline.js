@@ -11,12 +11,15 @@ import { applyValueEdits } from './value_edits.js';
 import { exportedViews, noteIndex, stepUrl } from './source.js';
 
 // The index that index.html asked for while the modules loaded: the first loadArchive's answer
-// (one round trip less before the first frame); asked again where it failed, for its error.
+// (one round trip less before the first frame), read there already where it showed the early
+// frame; asked again where it failed, for its error.
 let earlyIndex = window.insituEarlyIndex || null;
+let earlyArchive = window.insituEarlyArchive || null;
 
 async function fetchIndex() {
-  const early = earlyIndex;
-  earlyIndex = null;
+  const [early, read] = [earlyIndex, earlyArchive];
+  earlyIndex = earlyArchive = null;
+  if (read) return (await read) || getJson('api/archive');
   const response = early && await early.catch(() => null);
   if (!response || !response.ok) return getJson('api/archive');
   return response.json();
