@@ -121,7 +121,8 @@ Options parse(int argc, char** argv) {
             options.radix = cli::parse_integer<int>(flag, value, 2, 64);
         } else if (flag == "--compositing") {
             if (value != "direct_send" && value != "radix_k" && value != "auto") {
-                throw cli::UsageError(flag + " " + value + ": must be direct_send, radix_k or auto");
+                throw cli::UsageError(flag + " " + value +
+                                      ": must be direct_send, radix_k or auto");
             }
             options.compositing = value;
         } else if (flag == "--archive") {
@@ -189,7 +190,7 @@ insitu::InstrumentConfig make_config(const Options& options) {
     config.archive = options.archive;
     config.compositing = options.compositing == "radix_k" ? insitu::CompositingSchedule::radix_k
                          : options.compositing == "auto"  ? insitu::CompositingSchedule::automatic
-                                                          : insitu::CompositingSchedule::direct_send;
+                                                         : insitu::CompositingSchedule::direct_send;
     config.compositing_radix = options.radix;
     if (options.light_field_cameras > 0) {
         insitu::LightFieldSettings light_field;

@@ -1,17 +1,17 @@
 // insitu::Communicator on an MPI communicator (insitu/mpi.hpp).
 //
-// Every exchange of byte arrays takes two steps (rounds of messages, each a wake-up of every
-// waiting rank: bench/RESULTS.md, "Compositing cost under MPI"), and one where it can: the sizes
+// Every exchange of byte arrays takes two rounds of messages, and one where it can (each round
+// is a wake-up of every waiting rank: bench/RESULTS.md, "Compositing cost under MPI"): the sizes
 // first (as 64-bit counts, so that every rank that needs them knows them before anything is
-// allocated; all_gather sends the first bytes of each message with its size, all_to_all what
-// the ranks must agree on before anything moves, and gather_known_sizes skips them), then the
-// bytes: with the
-// v-variant of the collective (all_gather), or, where each message has its own destination
-// (all_to_all, gather: the compositing's partial and folded tiles, megabytes each), point to
-// point straight from and into each message's own buffer, skipping empty ones, so that nothing
-// is packed into or copied out of one contiguous buffer. MPI counts are int; the checks that a
-// call fits are made where every rank sees the same numbers, or agreed over the ranks, so that
-// an oversized call throws on every rank instead of throwing on one while the others wait.
+// allocated), then the bytes: with the v-variant of the collective (all_gather), or, where each
+// message has its own destination (all_to_all, gather, exchange_within: the compositing's
+// partial and folded tiles, megabytes each), point to point straight from and into each
+// message's own buffer, skipping empty ones, so that nothing is packed into or copied out of one
+// contiguous buffer. all_gather sends each message's first bytes with its size (an agreement's
+// say then needs no second round), all_to_all the checks every rank must agree on with its
+// sizes, and gather_known_sizes no sizes at all. MPI counts are int; the checks that a call fits
+// are made where every rank sees the same numbers, or agreed over the ranks, so that an
+// oversized call throws on every rank instead of throwing on one while the others wait.
 //
 // Every wait is polite (wait_for): the collectives are their non-blocking forms, tested in a
 // loop that spins for a few microseconds and then sleeps. A blocking MPI wait busy-polls a core
@@ -27,7 +27,6 @@
 #include <limits>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "insitu/error.hpp"
@@ -322,7 +321,9 @@ public:
         // Within the group only: the sizes, each with the sender's largest message, so that the
         // members agree that every message fits an int count before any moves.
         std::uint64_t largest = 0;
-        for (const Bytes& bytes : to_group) largest = std::max<std::uint64_t>(largest, bytes.size());
+        for (const Bytes& bytes : to_group) {
+            largest = std::max<std::uint64_t>(largest, bytes.size());
+        }
         std::vector<std::uint64_t> send_info(2 * members);
         std::vector<std::uint64_t> receive_info(2 * members, 0);
         std::vector<MPI_Request> requests;
@@ -331,8 +332,8 @@ public:
             send_info[2 * j + 1] = largest;
             if (j == me) continue;
             requests.emplace_back();
-            check(MPI_Irecv(&receive_info[2 * j], 2, MPI_UINT64_T, group[j], kGroupSizesTag,
-                            comm_, &requests.back()),
+            check(MPI_Irecv(&receive_info[2 * j], 2, MPI_UINT64_T, group[j], kGroupSizesTag, comm_,
+                            &requests.back()),
                   "exchange_within", "MPI_Irecv");
             requests.emplace_back();
             check(MPI_Isend(&send_info[2 * j], 2, MPI_UINT64_T, group[j], kGroupSizesTag, comm_,
@@ -436,8 +437,8 @@ public:
         }
         exchange(comm_, rank_, received, sends, kGatherTag, "gather");
         if (sent != &mine) {
-            fail<InvalidArgument>("MPI communicator: gather: rank ", rank_, " passed ",
-                                  mine.size(), " bytes, not the ", expected, " its sizes say");
+            fail<InvalidArgument>("MPI communicator: gather: rank ", rank_, " passed ", mine.size(),
+                                  " bytes, not the ", expected, " its sizes say");
         }
         if (!is_root) {
             counters_.bytes_sent += expected;

@@ -426,9 +426,9 @@ void Instrument::Impl::capture(const FieldPlan& plan, StepRecord& record,
     const FieldRecipe recipe = field_recipe(config, plan);
     std::unique_ptr<StepPasses> passes;
     if (communicator) {
-        passes = std::make_unique<CompositedPasses>(
-            *communicator, *renderer, plan.has_block, composite_seconds, representations().size(),
-            config.compositing, config.compositing_radix);
+        passes = std::make_unique<CompositedPasses>(*communicator, *renderer, plan.has_block,
+                                                    composite_seconds, representations().size(),
+                                                    config.compositing, config.compositing_radix);
     } else {
         passes = std::make_unique<LocalPasses>(*renderer);
     }

@@ -124,8 +124,11 @@ TEST_F(MpiCommunicatorTest, AllGatherOfEmptyMessagesOnly) {
 // where some rank's message is longer (248 bytes at these ranks): all short, some just over, one
 // long among empty ones.
 TEST_F(MpiCommunicatorTest, AllGatherAroundTheSlotOfShortMessages) {
-    const std::vector<std::vector<std::size_t>> cases = {
-        {248, 247, 1, 0}, {247, 248, 249, 250}, {0, 5000, 0, 0}, {248, 248, 248, 248}};
+    const std::vector<std::vector<std::size_t>> cases = {{248, 247, 1, 0},
+                                                         {249, 248, 247, 0},
+                                                         {1, 250, 0, 249},
+                                                         {0, 5000, 0, 0},
+                                                         {248, 248, 248, 248}};
     for (const std::vector<std::size_t>& counts : cases) {
         const auto count_of = [&](int r) { return counts[static_cast<std::size_t>(r) % 4]; };
         const std::vector<Bytes> all = communicator->all_gather(pattern(rank, 0, count_of(rank)));

@@ -254,7 +254,8 @@ TEST(InstrumentMpi, RadixKWritesTheArchiveDirectSendWrites) {
             text["compositing_radix"] = 2;
             auto instrument = mpi::instrument_from_json_text(text.dump(), MPI_COMM_WORLD);
             for (int step = 0; step < 2; ++step) {
-                const std::vector<VolumeBlock> blocks = my_blocks(field_at(step), decompositions[d]);
+                const std::vector<VolumeBlock> blocks =
+                    my_blocks(field_at(step), decompositions[d]);
                 EXPECT_EQ(instrument->execute(step, 0.5 * step, views_of(blocks)), Status::ok);
             }
             EXPECT_EQ(instrument->finalize(), Status::ok);

@@ -2,6 +2,8 @@
 // (support/thread_communicator.hpp), the serial twin of the MPI tests. Both fold the same records
 // at the same pixels, so the images are equal bit for bit, at power-of-two and other rank counts,
 // with a rank that owns nothing; and radix-k sends fewer messages.
+#include "parallel/radix_k.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,7 +14,6 @@
 
 #include "insitu/parallel/compositing.hpp"
 #include "insitu/parallel/compositing_schedule.hpp"
-#include "parallel/radix_k.hpp"
 #include "support/thread_communicator.hpp"
 
 namespace insitu {
@@ -33,7 +34,9 @@ float noise(std::uint32_t a, std::uint32_t b, std::uint32_t c) {
 
 // Rank r's place along pixel p's ray (a different order at every pixel), and whether it has a
 // fragment there; the last rank owns nothing where `last_owns_nothing`.
-int order_of(int rank, int pixel, int ranks) { return (rank + pixel) % ranks; }
+int order_of(int rank, int pixel, int ranks) {
+    return (rank + pixel) % ranks;
+}
 bool covers(int rank, int pixel, int ranks, bool last_owns_nothing) {
     if (last_owns_nothing && rank == ranks - 1) return false;
     return noise(static_cast<std::uint32_t>(pixel), static_cast<std::uint32_t>(rank), 7) > 0.2f;
@@ -99,9 +102,10 @@ ProxyFrame partial_proxies(int rank, int ranks, bool last_owns_nothing) {
             continue;
         }
         const float order = static_cast<float>(order_of(rank, p, ranks));
-        const float fragment[9] = {100.0f * order,      100.0f * order + 99.0f, noise(u, r, 1),
-                                   noise(u, r, 2),      order + 0.1f,           order + 0.9f,
-                                   2.0f * order + 0.1f, 2.0f * order + 1.8f,    0.3f + 0.7f * noise(u, r, 3)};
+        const float fragment[9] = {
+            100.0f * order,      100.0f * order + 99.0f, noise(u, r, 1),
+            noise(u, r, 2),      order + 0.1f,           order + 0.9f,
+            2.0f * order + 0.1f, 2.0f * order + 1.8f,    0.3f + 0.7f * noise(u, r, 3)};
         std::copy(fragment, fragment + 9, f);
         for (Image& layer : partial.depth_layers) {
             if (noise(u, r, 4) > 0.5f) layer.pixels[p] = order + 0.5f * noise(u, r, 5);
@@ -213,9 +217,9 @@ TEST(RadixK, ProxiesEqualDirectSendWithARankThatOwnsNothing) {
         EXPECT_EQ(radix_k.optical_depth.pixels, direct.optical_depth.pixels) << where;
         EXPECT_EQ(radix_k.entry_depth.pixels, direct.entry_depth.pixels) << where;
         // Something was composited: light in some pixel, a layer found in some pixel.
-        EXPECT_GT(*std::max_element(direct.attenuation.pixels.begin(),
-                                    direct.attenuation.pixels.end()),
-                  0.0f);
+        EXPECT_GT(
+            *std::max_element(direct.attenuation.pixels.begin(), direct.attenuation.pixels.end()),
+            0.0f);
     }
 }
 

@@ -10,8 +10,8 @@
 #include "insitu/core/check.hpp"
 #include "insitu/error.hpp"
 #include "parallel/compositing_exchange.hpp"
-#include "parallel/record_index.hpp"
 #include "parallel/interleaving_fold.hpp"
+#include "parallel/record_index.hpp"
 
 namespace insitu {
 

@@ -62,8 +62,8 @@ inline std::vector<Bytes> split_records(const std::vector<Bytes>& messages,
         for (std::size_t at = 0; at < message.size(); at += record_bytes) {
             std::uint32_t pixel = 0;
             std::memcpy(&pixel, &message[at], sizeof pixel);
-            const auto after = std::upper_bound(bounds.begin(), bounds.end(),
-                                                 static_cast<std::int64_t>(pixel));
+            const auto after =
+                std::upper_bound(bounds.begin(), bounds.end(), static_cast<std::int64_t>(pixel));
             if (after == bounds.begin() || after == bounds.end()) {
                 fail<Error>("compositing: a record for pixel ", pixel, " outside [", bounds.front(),
                             ", ", bounds.back(), ")");

@@ -15,8 +15,7 @@ void append(Bytes& bytes, const void* data, std::size_t size);
 
 /// How many of the pixels [begin, end) have a fragment (first index >= 0) in a fragment image
 /// of `channels` floats per pixel: messages are sized once, not grown.
-std::size_t fragments_in(const Image& fragment, int channels, std::int64_t begin,
-                         std::int64_t end);
+std::size_t fragments_in(const Image& fragment, int channels, std::int64_t begin, std::int64_t end);
 
 /// One received record: its pixel, the index of its first sample, and where its floats are in
 /// the message (read with memcpy: floats are not read through a byte pointer).

@@ -50,7 +50,9 @@ public:
         }
         const std::vector<Bytes> received = all_to_all(to_each);
         std::vector<Bytes> from_group;
-        for (const int member : group) from_group.push_back(received.at(static_cast<std::size_t>(member)));
+        for (const int member : group) {
+            from_group.push_back(received.at(static_cast<std::size_t>(member)));
+        }
         return from_group;
     }
     /// Every rank's `mine`, indexed by rank, at `root`; an empty list elsewhere.
