@@ -3,6 +3,7 @@
 //
 //   mpirun -np N bench_mpi [--size 128] [--image 256] [--steps 5] [--layers 4] [--intervals 16]
 //                          [--archive DIR] [--latency-us A --bandwidth-gbs B] [--radix K]
+//                          [--compositing direct_send|radix_k|auto]
 //                          [--light-field CAMERAS --light-field-size S --segments none|layers]
 //                          [--budget PSNR]
 //
@@ -21,6 +22,8 @@
 //                 waits for other ranks; the rest of composite ms is packing and folding);
 //   execute ms    execute_seconds: the time the simulation waited in execute();
 //   MB sent, MB received: payload bytes between ranks.
+// --compositing picks the exchange ("compositing"; direct send by default, as before the key),
+// radix-k in groups of --radix ranks (which the model below uses too).
 // --light-field adds a light field of CAMERAS cameras and S^2 maps (segments split at the layers
 // or none) to every step: each rank then marches each camera up to three times, and the three
 // exchanges of insitu/parallel/light_field_compositing.hpp count as composite ms.
@@ -95,6 +98,7 @@ struct Options {
     int light_field_size = 64;
     std::string segments = "none";
     double budget_psnr_db = 0.0;  ///< 0: no budget
+    std::string compositing = "direct_send";
 };
 
 Options parse(int argc, char** argv) {
@@ -115,6 +119,12 @@ Options parse(int argc, char** argv) {
             options.intervals = cli::parse_integer<int>(flag, value, 1, 64);
         } else if (flag == "--radix") {
             options.radix = cli::parse_integer<int>(flag, value, 2, 64);
+        } else if (flag == "--compositing") {
+            if (value != "direct_send" && value != "radix_k" && value != "auto") {
+                throw cli::UsageError(flag + " " + value +
+                                      ": must be direct_send, radix_k or auto");
+            }
+            options.compositing = value;
         } else if (flag == "--archive") {
             options.archive = value;
         } else if (flag == "--light-field") {
@@ -178,6 +188,10 @@ insitu::InstrumentConfig make_config(const Options& options) {
     config.every = 1;
     config.precision = insitu::StoragePrecision::single;
     config.archive = options.archive;
+    config.compositing = options.compositing == "radix_k" ? insitu::CompositingSchedule::radix_k
+                         : options.compositing == "auto"  ? insitu::CompositingSchedule::automatic
+                                                         : insitu::CompositingSchedule::direct_send;
+    config.compositing_radix = options.radix;
     if (options.light_field_cameras > 0) {
         insitu::LightFieldSettings light_field;
         light_field.cameras = options.light_field_cameras;
@@ -339,6 +353,41 @@ void print_model(const Options& options, int ranks, const Link& link, double mea
         "on 64K cores of Intrepid (Blue Gene/P); see the paper for its times\n");
 }
 
+/// Compositing's share of `execute`, two ways. Plain: composite ms / execute ms of each rank,
+/// waits for the other ranks' marches included. Critical path: per step, the rank that waited
+/// least (the least composite ms: the one whose marches ended last, which no other rank's march
+/// holds up), its composite ms and share; what is left there is the compositing work, the
+/// transfers and the wake-ups of the collectives, not load imbalance. `everyone` is every rank's
+/// flattened figures (march, composite, execute first), rank by rank.
+void print_shares(const std::vector<double>& everyone, int ranks, int steps, int figures) {
+    const auto at = [&](int rank, int step, int figure) {
+        return everyone[(static_cast<std::size_t>(rank) * steps + step) * figures + figure];
+    };
+    std::printf("  composite / execute, plain, median over the steps:");
+    for (int r = 0; r < ranks; ++r) {
+        std::vector<double> shares;
+        for (int s = 0; s < steps; ++s) shares.push_back(at(r, s, 1) / at(r, s, 2));
+        std::printf(" rank %d %.0f %%", r, 100.0 * insitu::bench::median(shares));
+    }
+    std::vector<double> critical_ms;
+    std::vector<double> critical_shares;
+    for (int s = 0; s < steps; ++s) {
+        int least = 0;
+        for (int r = 1; r < ranks; ++r) {
+            if (at(r, s, 1) < at(least, s, 1)) least = r;
+        }
+        critical_ms.push_back(at(least, s, 1));
+        critical_shares.push_back(at(least, s, 1) / at(least, s, 2));
+    }
+    const Summary ms = summarize(critical_ms);
+    const Summary share = summarize(critical_shares);
+    std::printf(
+        "\n  critical path (per step the rank that waited least): composite best / median / "
+        "spread %.2f / %.2f / %.2f ms, of its execute %.0f / %.0f / %.0f %%\n",
+        ms.best, ms.median, ms.spread, 100.0 * share.best, 100.0 * share.median,
+        100.0 * share.spread);
+}
+
 int run(const Options& options) {
     gray_scott::Parameters parameters;
     parameters.size = options.size;
@@ -386,6 +435,7 @@ int run(const Options& options) {
         if (options.budget_psnr_db > 0.0) {
             std::printf("budget: %g dB, checked at every step\n", options.budget_psnr_db);
         }
+        std::printf("compositing: %s, radix %d\n", options.compositing.c_str(), options.radix);
     }
 
     simulation.step();
@@ -486,6 +536,7 @@ int run(const Options& options) {
                 insitu::bench::median(columns[4]) / 1e6, insitu::bench::median(columns[5]),
                 insitu::bench::median(columns[6]));
         }
+        print_shares(everyone, ranks, options.steps, kFigures);
         const double pixels = static_cast<double>(options.image) * options.image;
         double sent_total = 0.0;
         for (int s = 0; s < options.steps; ++s) {

@@ -1,13 +1,17 @@
 // insitu::Communicator on an MPI communicator (insitu/mpi.hpp).
 //
-// Every exchange of byte arrays takes two steps: the sizes first (as 64-bit counts, so that every
-// rank that needs them knows them before anything is allocated), then the bytes: with the
-// v-variant of the collective (all_gather), or, where each message has its own destination
-// (all_to_all, gather: the compositing's partial and folded tiles, megabytes each), point to
-// point straight from and into each message's own buffer, skipping empty ones, so that nothing
-// is packed into or copied out of one contiguous buffer. MPI counts are int; the checks that a
-// call fits are made where every rank sees the same numbers, or agreed over the ranks, so that
-// an oversized call throws on every rank instead of throwing on one while the others wait.
+// Every exchange of byte arrays takes two rounds of messages, and one where it can (each round
+// is a wake-up of every waiting rank: bench/RESULTS.md, "Compositing cost under MPI"): the sizes
+// first (as 64-bit counts, so that every rank that needs them knows them before anything is
+// allocated), then the bytes: with the v-variant of the collective (all_gather), or, where each
+// message has its own destination (all_to_all, gather, exchange_within: the compositing's
+// partial and folded tiles, megabytes each), point to point straight from and into each
+// message's own buffer, skipping empty ones, so that nothing is packed into or copied out of one
+// contiguous buffer. all_gather sends each message's first bytes with its size (an agreement's
+// say then needs no second round), all_to_all the checks every rank must agree on with its
+// sizes, and gather_known_sizes no sizes at all. MPI counts are int; the checks that a call fits
+// are made where every rank sees the same numbers, or agreed over the ranks, so that an
+// oversized call throws on every rank instead of throwing on one while the others wait.
 //
 // Every wait is polite (wait_for): the collectives are their non-blocking forms, tested in a
 // loop that spins for a few microseconds and then sleeps. A blocking MPI wait busy-polls a core
@@ -19,14 +23,15 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "insitu/error.hpp"
 #include "insitu/mpi.hpp"
+#include "mpi_calls.hpp"
 
 namespace insitu::mpi {
 
@@ -35,93 +40,12 @@ namespace {
 // The most bytes one MPI call may address with its int counts and displacements.
 constexpr std::uint64_t max_count_bytes = std::numeric_limits<int>::max();
 
-std::string error_text(int code) {
-    char text[MPI_MAX_ERROR_STRING];
-    int length = 0;
-    if (MPI_Error_string(code, text, &length) != MPI_SUCCESS) {
-        return "MPI error code " + std::to_string(code);
-    }
-    return std::string(text, static_cast<std::size_t>(length));
-}
-
-// Throws IoError naming the communicator call, the MPI function and MPI's own message.
-void check(int code, const char* operation, const char* mpi_function) {
-    if (code != MPI_SUCCESS) {
-        fail<IoError>("MPI communicator: ", operation, ": ", mpi_function,
-                      " failed: ", error_text(code));
-    }
-}
-
-// Some MPI implementations check buffer pointers against NULL even for a count of 0, and an
-// empty vector's data() may be NULL: an empty message points here instead (never read or
-// written, its count being 0).
-std::uint8_t no_bytes[1] = {0};
-
-const void* send_data(const Bytes& bytes) {
-    return bytes.empty() ? no_bytes : bytes.data();
-}
-
-void* receive_data(Bytes& bytes) {
-    return bytes.empty() ? no_bytes : bytes.data();
-}
-
-// Waits until `requests` complete: MPI_Testall in a loop, spinning for the first 50 us (a
-// message in flight completes within that), then sleeping an eighth of the time waited so far
-// (between 20 and 500 us), so that a long wait for another rank leaves the core to this
-// process's other threads and oversleeps by at most about 1/8 of it.
-void wait_for(int count, MPI_Request* requests, const char* operation, const char* mpi_function) {
-    using Clock = std::chrono::steady_clock;
-    constexpr auto kSpin = std::chrono::microseconds(50);
-    constexpr auto kShortest = std::chrono::microseconds(20);
-    constexpr auto kLongest = std::chrono::microseconds(500);
-    const Clock::time_point start = Clock::now();
-    for (;;) {
-        int done = 0;
-        check(MPI_Testall(count, requests, &done, MPI_STATUSES_IGNORE), operation, mpi_function);
-        if (done != 0) return;
-        const auto waited = Clock::now() - start;
-        if (waited < kSpin) continue;
-        std::this_thread::sleep_for(
-            std::clamp(std::chrono::duration_cast<std::chrono::microseconds>(waited / 8), kShortest,
-                       kLongest));
-    }
-}
-
-// One non-blocking collective started by `start` (which fills the request), waited for politely.
-template <typename Start>
-void collective(Start start, const char* operation, const char* mpi_function) {
-    MPI_Request request = MPI_REQUEST_NULL;
-    check(start(&request), operation, mpi_function);
-    wait_for(1, &request, operation, mpi_function);
-}
-
 // Tags of the point-to-point messages on the duplicate, which carries nothing else: each call
 // completes all its messages before it returns, so the calls' messages never mix.
 constexpr int kAllToAllTag = 1;
 constexpr int kGatherTag = 2;
-
-// Posts the receives and sends of one exchange and waits for all: `receive[r]` (sized) from
-// rank r, `send[r]` to rank r, empty ones and those to this rank skipped.
-void exchange(MPI_Comm comm, int me, std::vector<Bytes>& receive,
-              const std::vector<const Bytes*>& send, int tag, const char* operation) {
-    std::vector<MPI_Request> requests;
-    requests.reserve(receive.size() + send.size());
-    for (std::size_t r = 0; r < receive.size(); ++r) {
-        if (static_cast<int>(r) == me || receive[r].empty()) continue;
-        requests.emplace_back();
-        check(MPI_Irecv(receive[r].data(), static_cast<int>(receive[r].size()), MPI_BYTE,
-                        static_cast<int>(r), tag, comm, &requests.back()),
-              operation, "MPI_Irecv");
-    }
-    for (std::size_t r = 0; r < send.size(); ++r) {
-        if (static_cast<int>(r) == me || send[r] == nullptr || send[r]->empty()) continue;
-        requests.emplace_back();
-        check(MPI_Isend(send[r]->data(), static_cast<int>(send[r]->size()), MPI_BYTE,
-                        static_cast<int>(r), tag, comm, &requests.back()),
-              operation, "MPI_Isend");
-    }
-    wait_for(static_cast<int>(requests.size()), requests.data(), operation, "MPI_Testall");
-}
+constexpr int kGroupSizesTag = 3;
+constexpr int kGroupTag = 4;
 
 std::uint64_t total_of(const std::vector<std::uint64_t>& sizes) {
     std::uint64_t total = 0;
@@ -157,15 +81,6 @@ void require_int_count(std::uint64_t bytes, const char* operation, const char* w
                               " bytes, more than the ", max_count_bytes,
                               " that MPI's int counts address in one call");
     }
-}
-
-std::vector<Bytes> unpacked(const Bytes& buffer, const Layout& layout) {
-    std::vector<Bytes> messages(layout.counts.size());
-    for (std::size_t i = 0; i < messages.size(); ++i) {
-        const auto begin = buffer.begin() + layout.displacements[i];
-        messages[i].assign(begin, begin + layout.counts[i]);
-    }
-    return messages;
 }
 
 MPI_Op operation_of(Reduction reduction) {
@@ -267,63 +182,103 @@ public:
 
     std::vector<Bytes> all_gather(const Bytes& mine) override {
         CallTimer timer(counters_.seconds);
+        // One round where every message is short (an agreement's say): each rank's size and
+        // first bytes travel in a slot of fixed size; only the rest of longer ones in a second.
+        const std::size_t slot = slot_bytes();
+        const std::size_t head = slot - sizeof(std::uint64_t);
         const std::uint64_t my_bytes = mine.size();
-        std::vector<std::uint64_t> sizes(static_cast<std::size_t>(size_));
+        Bytes my_slot(slot, 0);
+        std::memcpy(my_slot.data(), &my_bytes, sizeof my_bytes);
+        if (!mine.empty()) {
+            std::memcpy(my_slot.data() + sizeof my_bytes, mine.data(),
+                        std::min<std::size_t>(head, mine.size()));
+        }
+        Bytes slots(slot * static_cast<std::size_t>(size_));
         collective(
             [&](MPI_Request* r) {
-                return MPI_Iallgather(&my_bytes, 1, MPI_UINT64_T, sizes.data(), 1, MPI_UINT64_T,
-                                      comm_, r);
+                return MPI_Iallgather(my_slot.data(), static_cast<int>(slot), MPI_BYTE,
+                                      slots.data(), static_cast<int>(slot), MPI_BYTE, comm_, r);
             },
             "all_gather", "MPI_Iallgather");
+        std::vector<std::uint64_t> sizes(static_cast<std::size_t>(size_));
+        std::vector<std::uint64_t> rests(sizes.size(), 0);
+        for (std::size_t r = 0; r < sizes.size(); ++r) {
+            std::memcpy(&sizes[r], slots.data() + r * slot, sizeof sizes[r]);
+            if (sizes[r] > head) rests[r] = sizes[r] - head;
+        }
         // The same total on every rank.
         require_int_count(total_of(sizes), "all_gather", "the ranks' messages total");
-        const Layout layout = layout_of(sizes);
-        Bytes received(layout.total_bytes);
-        collective(
-            [&](MPI_Request* r) {
-                return MPI_Iallgatherv(send_data(mine), static_cast<int>(my_bytes), MPI_BYTE,
-                                       receive_data(received), layout.counts.data(),
-                                       layout.displacements.data(), MPI_BYTE, comm_, r);
-            },
-            "all_gather", "MPI_Iallgatherv");
+        std::vector<Bytes> messages(sizes.size());
+        for (std::size_t r = 0; r < sizes.size(); ++r) {
+            messages[r].resize(static_cast<std::size_t>(sizes[r]));
+            const std::size_t first = std::min<std::size_t>(head, messages[r].size());
+            if (first > 0) {
+                std::memcpy(messages[r].data(), slots.data() + r * slot + sizeof(std::uint64_t),
+                            first);
+            }
+        }
+        if (total_of(rests) > 0) {
+            const Layout layout = layout_of(rests);
+            Bytes received(layout.total_bytes);
+            const std::uint64_t my_rest = rests[static_cast<std::size_t>(rank_)];
+            collective(
+                [&](MPI_Request* r) {
+                    return MPI_Iallgatherv(my_rest > 0 ? mine.data() + head : no_bytes,
+                                           static_cast<int>(my_rest), MPI_BYTE,
+                                           receive_data(received), layout.counts.data(),
+                                           layout.displacements.data(), MPI_BYTE, comm_, r);
+                },
+                "all_gather", "MPI_Iallgatherv");
+            for (std::size_t r = 0; r < sizes.size(); ++r) {
+                if (rests[r] == 0) continue;
+                std::memcpy(messages[r].data() + head, received.data() + layout.displacements[r],
+                            static_cast<std::size_t>(rests[r]));
+            }
+        }
         if (size_ > 1) {
             counters_.bytes_sent += my_bytes;
-            counters_.bytes_received += layout.total_bytes - my_bytes;
+            counters_.bytes_received += total_of(sizes) - my_bytes;
             counters_.messages_sent += my_bytes > 0 ? 1 : 0;
         }
-        return unpacked(received, layout);
+        return messages;
     }
 
     std::vector<Bytes> all_to_all(const std::vector<Bytes>& to_each) override {
         CallTimer timer(counters_.seconds);
         const auto ranks = static_cast<std::size_t>(size_);
-        // A rank with a wrong list still takes part in the exchange of sizes (sending none) and
-        // in the agreement below, so that every rank throws rather than waits for it.
+        // A rank with a wrong list still takes part in the exchange of sizes (sending none,
+        // and saying so), so that every rank throws rather than waits for it.
         const bool wrong_list = to_each.size() != ranks;
         std::vector<std::uint64_t> send_sizes(ranks, 0);
         if (!wrong_list) {
             for (std::size_t r = 0; r < ranks; ++r) send_sizes[r] = to_each[r].size();
         }
-        std::vector<std::uint64_t> receive_sizes(ranks, 0);
+        // Each message is one point-to-point call: its own size must fit an int count. With
+        // each size goes what every rank must know before any message moves: whether this
+        // rank's list is wrong (its rank + 1) and its largest message, so that one exchange
+        // tells every rank every rank's problems (no agreement of its own: a round fewer).
+        const std::uint64_t my_largest = *std::max_element(send_sizes.begin(), send_sizes.end());
+        std::vector<std::uint64_t> send_info(3 * ranks);
+        for (std::size_t r = 0; r < ranks; ++r) {
+            send_info[3 * r] = send_sizes[r];
+            send_info[3 * r + 1] = wrong_list ? static_cast<std::uint64_t>(rank_) + 1 : 0;
+            send_info[3 * r + 2] = my_largest;
+        }
+        std::vector<std::uint64_t> receive_info(3 * ranks, 0);
         collective(
             [&](MPI_Request* r) {
-                return MPI_Ialltoall(send_sizes.data(), 1, MPI_UINT64_T, receive_sizes.data(), 1,
+                return MPI_Ialltoall(send_info.data(), 3, MPI_UINT64_T, receive_info.data(), 3,
                                      MPI_UINT64_T, comm_, r);
             },
             "all_to_all", "MPI_Ialltoall");
-        // Each message is one point-to-point call: its own size must fit an int count.
-        const std::uint64_t largest =
-            std::max(*std::max_element(send_sizes.begin(), send_sizes.end()),
-                     *std::max_element(receive_sizes.begin(), receive_sizes.end()));
-        // Agreed over the ranks (largest wins): the highest rank with a wrong list, plus one,
-        // and the largest message that does not fit MPI's counts.
-        long long problems[2] = {wrong_list ? rank_ + 1LL : 0LL,
-                                 largest > max_count_bytes ? static_cast<long long>(largest) : 0};
-        collective(
-            [&](MPI_Request* r) {
-                return MPI_Iallreduce(MPI_IN_PLACE, problems, 2, MPI_LONG_LONG, MPI_MAX, comm_, r);
-            },
-            "all_to_all", "MPI_Iallreduce");
+        std::vector<std::uint64_t> receive_sizes(ranks, 0);
+        // The highest rank with a wrong list, plus one, and the largest message of any rank.
+        std::uint64_t problems[2] = {0, 0};
+        for (std::size_t r = 0; r < ranks; ++r) {
+            receive_sizes[r] = receive_info[3 * r];
+            problems[0] = std::max(problems[0], receive_info[3 * r + 1]);
+            problems[1] = std::max(problems[1], receive_info[3 * r + 2]);
+        }
         if (wrong_list) {
             fail<InvalidArgument>("MPI communicator: all_to_all: ", to_each.size(),
                                   " messages for ", size_, " ranks");
@@ -333,10 +288,7 @@ public:
                                   " passed a message list whose length is not ", size_,
                                   " (one per rank)");
         }
-        if (problems[1] != 0) {
-            require_int_count(static_cast<std::uint64_t>(problems[1]), "all_to_all",
-                              "a message of");
-        }
+        require_int_count(problems[1], "all_to_all", "a message of");
         std::vector<Bytes> received(ranks);
         std::vector<const Bytes*> sends(ranks, nullptr);
         for (std::size_t r = 0; r < ranks; ++r) {
@@ -352,6 +304,69 @@ public:
             counters_.messages_sent += send_sizes[r] > 0 ? 1 : 0;
         }
         return received;
+    }
+
+    std::vector<Bytes> exchange_within(const std::vector<int>& group,
+                                       const std::vector<Bytes>& to_group) override {
+        CallTimer timer(counters_.seconds);
+        const std::size_t members = group.size();
+        const auto me_at = std::find(group.begin(), group.end(), rank_);
+        // Whom to wait for is the group: a call outside it cannot be answered (a caller's bug).
+        if (me_at == group.end() || to_group.size() != members) {
+            fail<InvalidArgument>("MPI communicator: exchange_within: rank ", rank_, " passed ",
+                                  to_group.size(), " messages for a group of ", members,
+                                  me_at == group.end() ? " without it" : "");
+        }
+        const auto me = static_cast<std::size_t>(me_at - group.begin());
+        // Within the group only: the sizes, each with the sender's largest message, so that the
+        // members agree that every message fits an int count before any moves.
+        std::uint64_t largest = 0;
+        for (const Bytes& bytes : to_group) {
+            largest = std::max<std::uint64_t>(largest, bytes.size());
+        }
+        std::vector<std::uint64_t> send_info(2 * members);
+        std::vector<std::uint64_t> receive_info(2 * members, 0);
+        std::vector<MPI_Request> requests;
+        for (std::size_t j = 0; j < members; ++j) {
+            send_info[2 * j] = to_group[j].size();
+            send_info[2 * j + 1] = largest;
+            if (j == me) continue;
+            requests.emplace_back();
+            check(MPI_Irecv(&receive_info[2 * j], 2, MPI_UINT64_T, group[j], kGroupSizesTag, comm_,
+                            &requests.back()),
+                  "exchange_within", "MPI_Irecv");
+            requests.emplace_back();
+            check(MPI_Isend(&send_info[2 * j], 2, MPI_UINT64_T, group[j], kGroupSizesTag, comm_,
+                            &requests.back()),
+                  "exchange_within", "MPI_Isend");
+        }
+        wait_for(static_cast<int>(requests.size()), requests.data(), "exchange_within",
+                 "MPI_Testall");
+        for (std::size_t j = 0; j < members; ++j) {
+            largest = std::max(largest, receive_info[2 * j + 1]);
+        }
+        require_int_count(largest, "exchange_within", "a message of");  // alike in the group
+        std::vector<Bytes> received(static_cast<std::size_t>(size_));
+        std::vector<const Bytes*> sends(static_cast<std::size_t>(size_), nullptr);
+        for (std::size_t j = 0; j < members; ++j) {
+            if (j == me) continue;
+            received[static_cast<std::size_t>(group[j])].resize(
+                static_cast<std::size_t>(receive_info[2 * j]));
+            sends[static_cast<std::size_t>(group[j])] = &to_group[j];
+        }
+        exchange(comm_, rank_, received, sends, kGroupTag, "exchange_within");
+        std::vector<Bytes> from_group(members);
+        for (std::size_t j = 0; j < members; ++j) {
+            if (j == me) {
+                from_group[j] = to_group[j];
+                continue;
+            }
+            from_group[j] = std::move(received[static_cast<std::size_t>(group[j])]);
+            counters_.bytes_sent += to_group[j].size();
+            counters_.bytes_received += from_group[j].size();
+            counters_.messages_sent += to_group[j].empty() ? 0 : 1;
+        }
+        return from_group;
     }
 
     std::vector<Bytes> gather(const Bytes& mine, int root) override {
@@ -389,6 +404,52 @@ public:
         return received;
     }
 
+    std::vector<Bytes> gather_known_sizes(const Bytes& mine, int root,
+                                          const std::vector<std::uint64_t>& sizes) override {
+        CallTimer timer(counters_.seconds);
+        require_root(root, "gather");
+        // Checks on what every rank passes alike: every rank throws, none waits.
+        if (sizes.size() != static_cast<std::size_t>(size_)) {
+            fail<InvalidArgument>("MPI communicator: gather: ", sizes.size(), " sizes for ", size_,
+                                  " ranks");
+        }
+        require_int_count(*std::max_element(sizes.begin(), sizes.end()), "gather", "a message of");
+        // The sizes are known: one round, the messages alone. A rank passing another size
+        // sends the size its list says all the same (the root waits for that many bytes), then
+        // throws.
+        const std::uint64_t expected = sizes[static_cast<std::size_t>(rank_)];
+        Bytes resized;
+        const Bytes* sent = &mine;
+        if (mine.size() != expected) {
+            resized = mine;
+            resized.resize(static_cast<std::size_t>(expected));
+            sent = &resized;
+        }
+        const bool is_root = rank_ == root;
+        std::vector<Bytes> received(is_root ? sizes.size() : 0);
+        std::vector<const Bytes*> sends(sizes.size(), nullptr);
+        if (is_root) {
+            for (std::size_t r = 0; r < sizes.size(); ++r) {
+                received[r].resize(static_cast<std::size_t>(sizes[r]));
+            }
+        } else {
+            sends[static_cast<std::size_t>(root)] = sent;
+        }
+        exchange(comm_, rank_, received, sends, kGatherTag, "gather");
+        if (sent != &mine) {
+            fail<InvalidArgument>("MPI communicator: gather: rank ", rank_, " passed ", mine.size(),
+                                  " bytes, not the ", expected, " its sizes say");
+        }
+        if (!is_root) {
+            counters_.bytes_sent += expected;
+            counters_.messages_sent += expected > 0 ? 1 : 0;
+            return {};
+        }
+        received[static_cast<std::size_t>(root)] = mine;
+        counters_.bytes_received += total_of(sizes) - expected;
+        return received;
+    }
+
     void broadcast(Bytes& bytes, int root) override {
         CallTimer timer(counters_.seconds);
         require_root(root, "broadcast");
@@ -417,6 +478,15 @@ public:
     CommunicationCounters counters() const override { return counters_; }
 
 private:
+    // all_gather's slot per rank: a size and the first bytes of the message, as many as an
+    // agreement's say holds at a few ranks, fewer at many (the slots of all ranks reach every
+    // rank: about 64 KiB in all, and never less than the size itself).
+    std::size_t slot_bytes() const {
+        const std::size_t share = std::size_t{65536} / static_cast<std::size_t>(size_);
+        return std::clamp<std::size_t>(share, sizeof(std::uint64_t), 256) &
+               ~(sizeof(std::uint64_t) - 1);
+    }
+
     // Local, like the single-process communicator's: every rank passes the same root.
     void require_root(int root, const char* operation) const {
         if (root < 0 || root >= size_) {

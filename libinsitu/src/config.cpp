@@ -159,6 +159,10 @@ constexpr Choice<OnExisting> kOnExisting[] = {
     {"append", OnExisting::append}, {"replace", OnExisting::replace}, {"fail", OnExisting::fail}};
 constexpr Choice<HaloCheck> kHaloCheck[] = {
     {"first", HaloCheck::first}, {"every", HaloCheck::every}, {"off", HaloCheck::off}};
+constexpr Choice<CompositingSchedule> kCompositing[] = {
+    {"auto", CompositingSchedule::automatic},
+    {"direct_send", CompositingSchedule::direct_send},
+    {"radix_k", CompositingSchedule::radix_k}};
 
 const Key<InstrumentConfig> kTopLevelKeys[] = {
     {"fields",
@@ -337,6 +341,18 @@ const Key<InstrumentConfig> kTopLevelKeys[] = {
          config.halo_check = choose(value, key, kHaloCheck);
      },
      [](const InstrumentConfig& config) { return json(name_of(config.halo_check, kHaloCheck)); }},
+    {"compositing",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.compositing = choose(value, key, kCompositing);
+     },
+     [](const InstrumentConfig& config) {
+         return json(name_of(config.compositing, kCompositing));
+     }},
+    {"compositing_radix",
+     [](const json& value, const std::string& key, InstrumentConfig& config, Unknown&) {
+         config.compositing_radix = small_integer(value, key);
+     },
+     [](const InstrumentConfig& config) { return json(config.compositing_radix); }},
     {"light_field",
      [](const json& value, const std::string& key, InstrumentConfig& config, Unknown& unknown) {
          require_object(value, key);

@@ -170,6 +170,9 @@ void InstrumentConfig::validate() const {
         out_of_range("colour_model.clusters", text_of(colour_model.clusters), "must be in [1, ",
                      kMaxColourModelClusters, "]");
     }
+    if (compositing_radix < 2 || compositing_radix > 64) {
+        out_of_range("compositing_radix", text_of(compositing_radix), "must be in [2, 64]");
+    }
     check_cost(*this);
 }
 

@@ -275,11 +275,11 @@ Status Instrument::Impl::execute_distributed(std::int64_t step, double time,
             });
         }
     });
-    // Every rank returns rank 0's status: a step dropped there is dropped for all.
-    Bytes verdict{static_cast<std::uint8_t>(status)};
-    communicator->broadcast(verdict, 0);
-    agree(*communicator, failure_to_queue);
-    return static_cast<Status>(verdict.at(0));
+    // Every rank returns rank 0's status (a step dropped there is dropped for all), told in
+    // the agreement on the queueing's failure: one collective.
+    const std::vector<Bytes> said =
+        agree(*communicator, failure_to_queue, Bytes{static_cast<std::uint8_t>(status)});
+    return static_cast<Status>(said.at(0).at(0));
 }
 
 bool Instrument::Impl::skips(std::int64_t step) {
@@ -427,7 +427,8 @@ void Instrument::Impl::capture(const FieldPlan& plan, StepRecord& record,
     std::unique_ptr<StepPasses> passes;
     if (communicator) {
         passes = std::make_unique<CompositedPasses>(*communicator, *renderer, plan.has_block,
-                                                    composite_seconds);
+                                                    composite_seconds, representations().size(),
+                                                    config.compositing, config.compositing_radix);
     } else {
         passes = std::make_unique<LocalPasses>(*renderer);
     }

@@ -120,6 +120,25 @@ TEST_F(MpiCommunicatorTest, AllGatherOfEmptyMessagesOnly) {
     for (const Bytes& bytes : all) EXPECT_TRUE(bytes.empty());
 }
 
+// all_gather sends each message's first bytes with its size, the rest in a second round only
+// where some rank's message is longer (248 bytes at these ranks): all short, some just over, one
+// long among empty ones.
+TEST_F(MpiCommunicatorTest, AllGatherAroundTheSlotOfShortMessages) {
+    const std::vector<std::vector<std::size_t>> cases = {{248, 247, 1, 0},
+                                                         {249, 248, 247, 0},
+                                                         {1, 250, 0, 249},
+                                                         {0, 5000, 0, 0},
+                                                         {248, 248, 248, 248}};
+    for (const std::vector<std::size_t>& counts : cases) {
+        const auto count_of = [&](int r) { return counts[static_cast<std::size_t>(r) % 4]; };
+        const std::vector<Bytes> all = communicator->all_gather(pattern(rank, 0, count_of(rank)));
+        ASSERT_EQ(static_cast<int>(all.size()), size);
+        for (int r = 0; r < size; ++r) {
+            EXPECT_EQ(all[r], pattern(r, 0, count_of(r))) << "rank " << r << ", " << count_of(r);
+        }
+    }
+}
+
 TEST_F(MpiCommunicatorTest, AllToAllDeliversEachMessageToItsRank) {
     std::vector<Bytes> to_each;
     for (int d = 0; d < size; ++d) to_each.push_back(pattern(rank, d, uneven_count(rank, d)));
@@ -160,6 +179,45 @@ TEST_F(MpiCommunicatorTest, GatherAtEveryRoot) {
             EXPECT_EQ(all[r], pattern(r, root, uneven_count(r, root))) << "root " << root;
         }
     }
+}
+
+// The folded tiles' gather: every rank knows every size, which do not travel.
+TEST_F(MpiCommunicatorTest, GatherOfKnownSizesAtEveryRoot) {
+    for (int root = 0; root < size; ++root) {
+        std::vector<std::uint64_t> sizes;
+        for (int r = 0; r < size; ++r) sizes.push_back(uneven_count(r, root) + 3u * r);
+        const std::vector<Bytes> all = communicator->gather_known_sizes(
+            pattern(rank, root, sizes[static_cast<std::size_t>(rank)]), root, sizes);
+        if (rank != root) {
+            EXPECT_TRUE(all.empty()) << "root " << root;
+            continue;
+        }
+        ASSERT_EQ(static_cast<int>(all.size()), size);
+        for (int r = 0; r < size; ++r) {
+            EXPECT_EQ(all[r], pattern(r, root, sizes[static_cast<std::size_t>(r)]))
+                << "root " << root;
+        }
+    }
+}
+
+// A rank passing another size than the list says throws, and no rank waits: the root gets the
+// size it expects (the message cut or zero-filled).
+TEST_F(MpiCommunicatorTest, GatherOfKnownSizesWithAWrongSizeFailsThere) {
+    if (size == 1) GTEST_SKIP() << "the root's own message does not travel";
+    const std::vector<std::uint64_t> sizes(static_cast<std::size_t>(size), 10u);
+    const bool wrong = rank == size - 1;
+    const Bytes mine = pattern(rank, 0, wrong ? 4u : 10u);
+    if (wrong) {
+        expect_error_naming<insitu::InvalidArgument>(
+            [&] { communicator->gather_known_sizes(mine, 0, sizes); },
+            "rank " + std::to_string(rank) + " passed 4 bytes, not the 10");
+        return;
+    }
+    const std::vector<Bytes> all = communicator->gather_known_sizes(mine, 0, sizes);
+    if (rank != 0) return;
+    Bytes cut = pattern(size - 1, 0, 4u);
+    cut.resize(10u, 0);
+    EXPECT_EQ(all.back(), cut);
 }
 
 TEST_F(MpiCommunicatorTest, GatherOrBroadcastToARootOutsideFails) {

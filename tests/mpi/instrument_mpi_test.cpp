@@ -13,6 +13,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <iterator>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -233,6 +235,48 @@ TEST(InstrumentMpi, GridWithAutoLayersAndHistogramIntervals) {
     MPI_Dims_create(world_size(), 3, dims);
     expect_same_archive_as_one_process("grid", {dims[0], dims[1], dims[2]}, "\"auto\"",
                                        "histogram");
+}
+
+// "compositing": "radix_k" in groups of 2 (two rounds at 4 ranks; at 2 and 3 ranks one round,
+// which is direct send) writes the archive direct send writes, to the bit: the same records are
+// folded at the same pixels. On a 3D grid, and on slabs with a rank that owns nothing.
+TEST(InstrumentMpi, RadixKWritesTheArchiveDirectSendWrites) {
+    int dims[3] = {0, 0, 0};
+    MPI_Dims_create(world_size(), 3, dims);
+    const std::vector<Index3> decompositions = {{dims[0], dims[1], dims[2]},
+                                                {std::max(world_size() - 1, 1), 1, 1}};
+    for (std::size_t d = 0; d < decompositions.size(); ++d) {
+        const std::string directory = shared_directory("radix_k" + std::to_string(d));
+        const auto run = [&](const std::string& archive, const std::string& schedule) {
+            nlohmann::json text =
+                nlohmann::json::parse(configuration(archive, "[0.35, 0.6]", "uniform"));
+            text["compositing"] = schedule;
+            text["compositing_radix"] = 2;
+            auto instrument = mpi::instrument_from_json_text(text.dump(), MPI_COMM_WORLD);
+            for (int step = 0; step < 2; ++step) {
+                const std::vector<VolumeBlock> blocks =
+                    my_blocks(field_at(step), decompositions[d]);
+                EXPECT_EQ(instrument->execute(step, 0.5 * step, views_of(blocks)), Status::ok);
+            }
+            EXPECT_EQ(instrument->finalize(), Status::ok);
+        };
+        run(directory + "/direct.cdb", "direct_send");
+        run(directory + "/radix.cdb", "radix_k");
+        bool same = true;
+        if (world_rank() == 0) {
+            ArchiveTolerances exact;
+            exact.attenuation = 0.0;
+            exact.depth = 0.0;
+            exact.preview = 0.0;
+            exact.value = 0.0;
+            const ArchiveComparison comparison =
+                compare_archives(directory + "/direct.cdb", directory + "/radix.cdb", exact);
+            same = comparison.passed();
+            EXPECT_TRUE(same) << "decomposition " << d << ": " << comparison;
+            EXPECT_EQ(comparison.frames.size(), 12u);  // 2 steps x 2 views x 3 frames
+        }
+        EXPECT_TRUE(on_every_rank(same));
+    }
 }
 
 // "transfer_function": "auto": every rank colours by the percentiles of the whole grid.
@@ -554,6 +598,69 @@ TEST(InstrumentMpi, ARankThatCannotReachTheArchiveKeepsNoCompressedField) {
         }
     }
     std::filesystem::current_path(here);
+}
+
+// The files in the archive's folder of the compressed field, with their bytes.
+std::map<std::string, std::string> volume_files(const std::filesystem::path& archive) {
+    std::map<std::string, std::string> files;
+    for (const auto& entry : std::filesystem::directory_iterator(archive / "volumes")) {
+        std::ifstream in(entry.path(), std::ios::binary);
+        files[entry.path().filename().string()] =
+            std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    return files;
+}
+
+// A run killed inside a step leaves the blocks its ranks placed for that step, which rank 0 never
+// committed (issue 43). Simulated here: after steps 0 and 1, every rank places a block file of
+// step 2 (and one of another block count) and the run ends without it. Reopened ("append"),
+// rank 0 removes them before any rank of the new run writes: the new run's step 3 is whole, the
+// archive verifies, and the blocks of steps 0 and 1 are unchanged, byte for byte.
+TEST(InstrumentMpi, AReopenedArchiveHoldsNoOrphanBlocks) {
+    const std::filesystem::path archive =
+        std::filesystem::path(shared_directory("orphans")) / "run.cdb";
+    std::string text = configuration(archive.string(), "[0.35]", "uniform");
+    text.insert(text.size() - 1, R"(, "volume": {"relative_tolerance": 0.01})");
+    InstrumentOptions quiet;
+    quiet.log = false;
+    const auto run = [&](const std::vector<int>& steps) {
+        auto instrument = mpi::instrument_from_json_text(text, MPI_COMM_WORLD, quiet);
+        for (const int step : steps) {
+            const std::vector<VolumeBlock> blocks = my_blocks(field_at(step), {world_size(), 1, 1});
+            EXPECT_EQ(instrument->execute(step, 0.5 * step, views_of(blocks)), Status::ok);
+        }
+        EXPECT_EQ(instrument->finalize(), Status::ok);
+    };
+    run({0, 1});
+    std::map<std::string, std::string> before;
+    if (world_rank() == 0) before = volume_files(archive);
+    MPI_Barrier(MPI_COMM_WORLD);  // the orphans are placed after rank 0 has seen the archive
+    const std::string rank = std::to_string(world_rank());
+    const std::vector<std::string> orphans = {"step000002_field0_block" + rank + ".zfp",
+                                              "step000002_field0_block" + rank + ".mask",
+                                              "step000001_field0_block" + rank + "7.zfp"};
+    for (const std::string& orphan : orphans) {
+        std::ofstream(archive / "volumes" / orphan, std::ios::binary) << "placed, never committed";
+    }
+    MPI_Barrier(MPI_COMM_WORLD);
+    text.replace(text.find(R"("on_existing": "replace")"), 24, R"("on_existing": "append" )");
+    run({3});
+    if (world_rank() == 0) {
+        const ArchiveReader reader(archive.string());
+        EXPECT_EQ(reader.steps(), (std::vector<std::int64_t>{0, 1, 3}));
+        const std::vector<std::string> problems = reader.verify();
+        EXPECT_TRUE(problems.empty()) << problems.front();
+        const std::map<std::string, std::string> after = volume_files(archive);
+        for (const auto& [name, bytes] : before) {
+            ASSERT_EQ(after.count(name), 1u) << name << " of steps 0 and 1 is gone";
+            EXPECT_EQ(after.at(name), bytes) << name << " of steps 0 and 1 changed";
+        }
+        for (const auto& [name, bytes] : after) {
+            EXPECT_TRUE(before.count(name) != 0 || name.rfind("step000003_", 0) == 0)
+                << name << " is in the reopened archive and not listed";
+        }
+        EXPECT_FALSE(before.empty());
+    }
 }
 
 // Two budget records alike: the choice and every figure the check measured on the whole field

@@ -48,6 +48,7 @@
 #include "insitu/core/light_field.hpp"
 #include "insitu/core/transfer_function.hpp"
 #include "insitu/core/volume_settings.hpp"
+#include "insitu/parallel/compositing_schedule.hpp"
 
 namespace insitu {
 
@@ -240,6 +241,10 @@ struct InstrumentConfig {
     bool strict = true;
     OnExisting on_existing = OnExisting::append;  ///< "on_existing"
     HaloCheck halo_check = HaloCheck::first;      ///< "halo_check": "first" | "every" | "off"
+    /// "compositing": "direct_send" | "radix_k" | "auto" (the default), a distributed run's
+    /// exchange of partial images (insitu/parallel/compositing_schedule.hpp).
+    CompositingSchedule compositing = CompositingSchedule::automatic;
+    int compositing_radix = kCompositingRadix;  ///< "compositing_radix": radix-k's groups, 2-64
     /// "light_field": per step and field, a light field (seed 001) from an icosphere of cameras
     /// (insitu/core/light_field.hpp), captured in the proxy pass; none by default.
     std::optional<LightFieldSettings> light_field;

@@ -256,6 +256,31 @@ void remove_archive_files(const fs::path& archive) {
         }
     }
 }
+// At open: removes the files in the archive's own folders that the index does not list, which a
+// killed run left of a step it never committed (a distributed run's ranks place their blocks of
+// the compressed field before rank 0 commits the step: issue 43). Nothing else writes there
+// now: this writer holds the lock, and the other ranks of a distributed run place files only
+// in execute(), after the Instrument's opening agreement, which rank 0 joins once this
+// constructor returns. A file that a malformed step kept aside names is kept for whoever
+// repairs it. Best effort: a file that cannot be removed is only clutter.
+void remove_unlisted_files(const fs::path& archive, const nlohmann::json& manifest) {
+    std::set<fs::path> listed;
+    for (const af::ListedFile& file : af::listed_files(archive.string(), manifest)) {
+        listed.insert(fs::path(file.absolute_path).lexically_normal());
+    }
+    const std::string kept_aside =
+        manifest.contains(af::kMalformedKey) ? manifest.at(af::kMalformedKey).dump() : "";
+    for (const std::string& folder : archive_folders()) {
+        std::error_code error;
+        for (const fs::directory_entry& entry : fs::directory_iterator(archive / folder, error)) {
+            if (!entry.is_regular_file(error)) continue;
+            const fs::path path = entry.path().lexically_normal();
+            const std::string relative = (fs::path(folder) / path.filename()).generic_string();
+            if (listed.count(path) != 0 || kept_aside.find(relative) != std::string::npos) continue;
+            fs::remove(path, error);
+        }
+    }
+}
 }  // namespace
 
 ArchiveWriter::ArchiveWriter(const InstrumentConfig& config)
@@ -309,6 +334,7 @@ ArchiveWriter::ArchiveWriter(const InstrumentConfig& config)
     manifest["producer"] = std::string("libinsitu ") + INSITU_VERSION;
     manifest["configuration"] = std::move(configuration);
     for (const fs::path& folder : folders) af::remove_temp_files(folder);
+    remove_unlisted_files(archive, manifest);
     // Writing both indexes whole now makes a fresh archive open (with no steps), catches an
     // unwritable directory at start-up, folds in the journal a killed run left and repairs a
     // data.csv it left behind or torn. The journal goes only once manifest.json holds its steps.

@@ -61,6 +61,15 @@ std::vector<Bytes> agree(Communicator& communicator, const LocalFailure& failure
     return payloads;
 }
 
+void agree_on_sum(Communicator& communicator, const LocalFailure& failure,
+                  std::vector<double>& values) {
+    values.push_back(failure.failed() ? 1.0 : 0.0);
+    communicator.all_reduce(values, Reduction::sum);
+    const bool any_failed = values.back() > 0.0;
+    values.pop_back();
+    if (any_failed) agree(communicator, failure);  // every rank saw the sum: all call it
+}
+
 Bytes doubles_bytes(const std::vector<double>& values) {
     Bytes bytes(values.size() * sizeof(double));
     if (!values.empty()) std::memcpy(bytes.data(), values.data(), bytes.size());

@@ -53,6 +53,12 @@ struct LocalFailure {
 std::vector<Bytes> agree(Communicator& communicator, const LocalFailure& failure,
                          const Bytes& payload = {});
 
+/// Sums `values` over the ranks in place (every rank passes as many) and raises on every rank
+/// the first failure any rank said, as agree() does: one collective where nothing failed (the
+/// failure travels as one more summed value; only then does agree() fetch its message).
+void agree_on_sum(Communicator& communicator, const LocalFailure& failure,
+                  std::vector<double>& values);
+
 /// The ranks (", "-separated, by rank; empty: none) that do not see `folder` as a directory: a
 /// collective, so every rank learns the same list.
 std::string ranks_that_cannot_reach(Communicator& communicator,

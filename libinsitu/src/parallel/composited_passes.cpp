@@ -33,7 +33,7 @@ Image CompositedPasses::truth(const Camera& camera, const TransferFunction& tf,
     failure_.always([&] {
         composited = timed(composite_seconds_, [&] {
             return composite_rendering(ranks_, camera.width(), camera.height(),
-                                       partial ? &*partial : nullptr, 0);
+                                       partial ? &*partial : nullptr, 0, schedule_, radix_);
         });
     });
     return composited.rgba;
@@ -58,7 +58,8 @@ ProxyFrame CompositedPasses::proxies(const OrbitView& orbit, const Bounds& bound
             const ProxyFrame shell = multi_perspective
                                          ? frame_shell(distortion.base(), tilt_deg, true, march)
                                          : frame_shell(camera, 0.0, false, march);
-            return composite_proxies(ranks_, shell, partial ? &*partial : nullptr, 0);
+            return composite_proxies(ranks_, shell, partial ? &*partial : nullptr, 0, schedule_,
+                                     radix_);
         });
     });
     for (const TransferFunction& tf : request.training_transfer_functions) {
@@ -88,6 +89,16 @@ std::vector<Bytes> CompositedPasses::gather(const Bytes& payload) {
 }
 
 void CompositedPasses::finish() {
+    // Only the field's last finish agrees, before the step is queued: each collective costs
+    // every rank a wake-up (bench/RESULTS.md, "Compositing cost under MPI"), and an earlier
+    // one is not needed to keep the ranks in step. Every composite and gather is taken by
+    // every rank whether or not it failed (failure_.always), so a representation after a
+    // failure makes the same collectives on every rank, and the failure is raised here (or by
+    // a gather's agreement before) on all of them.
+    if (finishes_left_ > 1) {
+        --finishes_left_;
+        return;
+    }
     const auto start = SteadyClock::now();
     agree(ranks_, failure_);
     composite_seconds_ += seconds_since(start);

@@ -9,12 +9,20 @@
 #include "device/kernel_constants.hpp"
 #include "insitu/core/check.hpp"
 #include "insitu/error.hpp"
-#include "parallel/direct_send.hpp"
+#include "parallel/compositing_exchange.hpp"
 #include "parallel/interleaving_fold.hpp"
+#include "parallel/record_index.hpp"
 
 namespace insitu {
 
 namespace {
+
+using detail::append;
+using detail::fragments_in;
+using detail::index_records;
+using detail::load_record;
+using detail::RecordIndex;
+using detail::RecordRef;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
@@ -98,22 +106,6 @@ void allocate_images(ProxyFrame& frame) {
     }
 }
 
-void append(Bytes& bytes, const void* data, std::size_t size) {
-    const auto* begin = static_cast<const std::uint8_t*>(data);
-    bytes.insert(bytes.end(), begin, begin + size);
-}
-
-// How many of the pixels [begin, end) have a fragment (first index >= 0) in a fragment image
-// of `channels` floats per pixel: messages are sized once, not grown.
-std::size_t fragments_in(const Image& fragment, int channels, std::int64_t begin,
-                         std::int64_t end) {
-    std::size_t count = 0;
-    for (std::int64_t pixel = begin; pixel < end; ++pixel) {
-        if (fragment.pixels[pixel * channels] >= 0.0f) ++count;
-    }
-    return count;
-}
-
 // This rank's records of the pixels in [begin, end) it has a fragment for: (pixel, record)*.
 Bytes pack_proxy_records(const ProxyLayout& layout, const ProxyFrame& partial, std::int64_t begin,
                          std::int64_t end) {
@@ -147,74 +139,6 @@ Bytes pack_proxy_records(const ProxyLayout& layout, const ProxyFrame& partial, s
         append(bytes, record.data(), record.size() * sizeof(float));
     }
     return bytes;
-}
-
-// One received record: its pixel, the index of its first sample, and where its floats are in
-// the message (read with memcpy: floats are not read through a byte pointer).
-struct RecordRef {
-    std::uint32_t pixel;
-    float first_index;
-    const std::uint8_t* values;
-};
-
-void load_record(const RecordRef& ref, int record_floats, float* into) {
-    std::memcpy(into, ref.values, static_cast<std::size_t>(record_floats) * sizeof(float));
-}
-
-// The records of every message for the pixels [begin, end), grouped by pixel (a counting sort:
-// one pass, no allocation per record) and, within a pixel, in ray order: by the index of their
-// first sample. Pixel p's records are refs[starts[p - begin], starts[p - begin + 1]).
-struct RecordIndex {
-    std::vector<RecordRef> refs;
-    std::vector<std::uint32_t> starts;
-};
-
-RecordIndex index_records(const std::vector<Bytes>& messages, int record_floats, std::int64_t begin,
-                          std::int64_t end) {
-    const std::size_t stride = sizeof(std::uint32_t) + record_floats * sizeof(float);
-    RecordIndex index;
-    index.starts.assign(static_cast<std::size_t>(end - begin) + 1, 0);
-    std::size_t count = 0;
-    for (const Bytes& message : messages) {
-        if (message.size() % stride != 0) {
-            fail<Error>("compositing: a message of ", message.size(),
-                        " bytes is not a whole number of ", stride, "-byte records");
-        }
-        for (std::size_t at = 0; at < message.size(); at += stride) {
-            std::uint32_t pixel = 0;
-            std::memcpy(&pixel, &message[at], sizeof pixel);
-            if (pixel < begin || pixel >= end) {
-                fail<Error>("compositing: a record for pixel ", pixel, " outside the tile [", begin,
-                            ", ", end, ")");
-            }
-            ++index.starts[pixel - begin + 1];
-            ++count;
-        }
-    }
-    for (std::size_t p = 1; p < index.starts.size(); ++p) index.starts[p] += index.starts[p - 1];
-    index.refs.resize(count);
-    std::vector<std::uint32_t> next(index.starts.begin(), index.starts.end() - 1);
-    for (const Bytes& message : messages) {
-        for (std::size_t at = 0; at < message.size(); at += stride) {
-            RecordRef ref;
-            std::memcpy(&ref.pixel, &message[at], sizeof ref.pixel);
-            ref.values = &message[at + sizeof ref.pixel];
-            std::memcpy(&ref.first_index, ref.values, sizeof(float));
-            index.refs[next[ref.pixel - begin]++] = ref;
-        }
-    }
-    // A pixel has at most one record per rank: insertion sort of short runs.
-    for (std::size_t p = 0; p + 1 < index.starts.size(); ++p) {
-        RecordRef* first = index.refs.data() + index.starts[p];
-        RecordRef* last = index.refs.data() + index.starts[p + 1];
-        for (RecordRef* i = first + 1; i < last; ++i) {
-            const RecordRef moving = *i;
-            RecordRef* j = i;
-            for (; j > first && (j - 1)->first_index > moving.first_index; --j) *j = *(j - 1);
-            *j = moving;
-        }
-    }
-    return index;
 }
 
 // The identity of the fold: what a pass over nothing gives (a ray that misses the grid).
@@ -510,15 +434,18 @@ ProxyFrame frame_shell(const Camera& camera, double tilt_deg, bool multi_perspec
 }
 
 ProxyFrame composite_proxies(Communicator& communicator, const ProxyFrame& shell,
-                             const ProxyFrame* partial, int root) {
+                             const ProxyFrame* partial, int root, CompositingSchedule schedule,
+                             int radix) {
     const ProxyLayout layout = layout_of(shell);
     if (partial != nullptr) check_partial(layout, shell, *partial);
     const std::int64_t pixels =
         static_cast<std::int64_t>(shell.camera.width()) * shell.camera.height();
     ProxyFrame frame = shell;
     if (communicator.rank() == root) allocate_images(frame);
-    detail::direct_send(
-        communicator, pixels, layout.outputs(), root,
+    const std::size_t record_bytes =
+        sizeof(std::uint32_t) + static_cast<std::size_t>(layout.record()) * sizeof(float);
+    detail::composite_exchange(
+        communicator, schedule, radix, pixels, layout.outputs(), root, record_bytes,
         [&](std::int64_t begin, std::int64_t end) {
             return partial != nullptr ? pack_proxy_records(layout, *partial, begin, end) : Bytes{};
         },
@@ -532,7 +459,8 @@ ProxyFrame composite_proxies(Communicator& communicator, const ProxyFrame& shell
 }
 
 Rendering composite_rendering(Communicator& communicator, int width, int height,
-                              const Rendering* partial, int root) {
+                              const Rendering* partial, int root, CompositingSchedule schedule,
+                              int radix) {
     const std::int64_t pixels = static_cast<std::int64_t>(width) * height;
     if (partial != nullptr && partial->fragment.pixels.size() != static_cast<std::size_t>(pixels)) {
         fail<InvalidArgument>("compositing: the partial rendering has no fragment records for its ",
@@ -543,8 +471,9 @@ Rendering composite_rendering(Communicator& communicator, int width, int height,
         result.rgba = Image(width, height, 4);
         result.depth = Image(width, height, 1);
     }
-    detail::direct_send(
-        communicator, pixels, kRenderingOutputs, root,
+    detail::composite_exchange(
+        communicator, schedule, radix, pixels, kRenderingOutputs, root,
+        sizeof(std::uint32_t) + kRenderingRecord * sizeof(float),
         [&](std::int64_t begin, std::int64_t end) {
             return partial != nullptr ? pack_rendering_records(*partial, begin, end) : Bytes{};
         },

@@ -16,6 +16,20 @@ inline std::int64_t tile_begin(std::int64_t pixels, int tiles, int tile) {
     return pixels * tile / tiles;
 }
 
+/// The bytes of each rank's folded tile in the gather at `root` (none from the root itself):
+/// known to every rank, so they need not travel (Communicator::gather_known_sizes).
+inline std::vector<std::uint64_t> tile_sizes(std::int64_t pixels, int tiles, int outputs,
+                                             int root) {
+    std::vector<std::uint64_t> sizes(static_cast<std::size_t>(tiles), 0);
+    for (int k = 0; k < tiles; ++k) {
+        if (k == root) continue;
+        sizes[k] = static_cast<std::uint64_t>(tile_begin(pixels, tiles, k + 1) -
+                                              tile_begin(pixels, tiles, k)) *
+                   static_cast<std::uint64_t>(outputs) * sizeof(float);
+    }
+    return sizes;
+}
+
 // Runs local work and keeps the first failure: a rank whose own work fails (packing, folding,
 // unpacking) still takes part in every exchange, with nothing to send, and throws once they are
 // done: the others must not wait for it. (Its caller then agrees on the failure with them.)
@@ -70,7 +84,8 @@ void direct_send(Communicator& communicator, std::int64_t pixels, int outputs, i
         const auto* tile_bytes = reinterpret_cast<const std::uint8_t*>(tile.data());
         mine.assign(tile_bytes, tile_bytes + tile.size() * sizeof(float));
     }
-    const std::vector<Bytes> tiles = communicator.gather(mine, root);
+    const std::vector<Bytes> tiles =
+        communicator.gather_known_sizes(mine, root, tile_sizes(pixels, ranks, outputs, root));
     if (me == root) {
         local([&] {
             std::vector<float> values;

@@ -86,8 +86,7 @@ void ReducedFieldStatistics::reduce_range() {
 
 void ReducedFieldStatistics::sum_over_ranks(std::vector<double>& counts) {
     const auto start = SteadyClock::now();
-    ranks_.all_reduce(counts, Reduction::sum);
-    agree(ranks_, failure_);
+    agree_on_sum(ranks_, failure_, counts);
     collective_seconds_ += seconds_since(start);
 }
 

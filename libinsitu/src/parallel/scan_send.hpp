@@ -180,7 +180,8 @@ inline std::vector<float> scan_send(Communicator& communicator, std::int64_t pix
     if (shape.outputs > 0) {
         tile.resize(static_cast<std::size_t>(end - begin) * shape.outputs);
         const std::vector<Bytes> tiles =
-            communicator.gather(me == root ? Bytes{} : scan::float_bytes(tile), root);
+            communicator.gather_known_sizes(me == root ? Bytes{} : scan::float_bytes(tile), root,
+                                            tile_sizes(pixels, ranks, shape.outputs, root));
         if (me == root) {
             local([&] {
                 for (int k = 0; k < ranks; ++k) {

@@ -37,8 +37,34 @@ public:
     /// Personalised exchange (direct send): `to_each[r]` goes to rank r (size() entries, empty
     /// ones cost no message); returns what each rank sent to this one, indexed by source.
     virtual std::vector<Bytes> all_to_all(const std::vector<Bytes>& to_each) = 0;
+    /// A personalised exchange within groups (radix-k's rounds): every rank calls it at once,
+    /// each with its group (the ranks, ascending, this one among them; the groups partition
+    /// the ranks), `to_group[j]` going to group[j]. Returns what each member sent to this rank,
+    /// indexed as `group` (its own entry: to_group's). This default runs one all_to_all of all
+    /// ranks; a communicator may exchange within the group alone.
+    virtual std::vector<Bytes> exchange_within(const std::vector<int>& group,
+                                               const std::vector<Bytes>& to_group) {
+        std::vector<Bytes> to_each(static_cast<std::size_t>(size()));
+        for (std::size_t j = 0; j < group.size() && j < to_group.size(); ++j) {
+            to_each.at(static_cast<std::size_t>(group[j])) = to_group[j];
+        }
+        const std::vector<Bytes> received = all_to_all(to_each);
+        std::vector<Bytes> from_group;
+        for (const int member : group) {
+            from_group.push_back(received.at(static_cast<std::size_t>(member)));
+        }
+        return from_group;
+    }
     /// Every rank's `mine`, indexed by rank, at `root`; an empty list elsewhere.
     virtual std::vector<Bytes> gather(const Bytes& mine, int root) = 0;
+    /// gather() where every rank knows beforehand what each rank passes: `sizes[r]` bytes from
+    /// rank r, the same list on every rank (the compositing's folded tiles), so the sizes need
+    /// not travel and a communicator may save the round that exchanges them (this default does
+    /// not). A rank whose `mine` has another size throws, after taking part in the exchange.
+    virtual std::vector<Bytes> gather_known_sizes(const Bytes& mine, int root,
+                                                  const std::vector<std::uint64_t>& /*sizes*/) {
+        return gather(mine, root);
+    }
     /// `bytes` of `root`, on every rank (resized there).
     virtual void broadcast(Bytes& bytes, int root) = 0;
 

@@ -26,7 +26,9 @@
 // less than 1e-6 of attenuation, are of samples no view can see and may differ.
 //
 // Over a communicator the fold runs by direct send over image tiles (Hsu's and IceT's
-// direct-send): the image is cut into size() tiles of consecutive pixels, every rank sends the
+// direct-send), or by radix-k (parallel/radix_k.hpp: the same records folded at the same
+// pixels, in rounds of fewer messages and more bytes; "compositing" in the configuration):
+// the image is cut into size() tiles of consecutive pixels, every rank sends the
 // pixels of tile k that it has fragments for to rank k, rank k folds its tile, and the folded
 // tiles are gathered at the root, which alone writes. A rank receives at most one record per
 // rank for each pixel of its own tile and sends each of its pixels once: bytes per rank are
@@ -34,6 +36,7 @@
 #include <vector>
 
 #include "insitu/parallel/communicator.hpp"
+#include "insitu/parallel/compositing_schedule.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 
 namespace insitu {
@@ -46,11 +49,16 @@ ProxyFrame frame_shell(const Camera& camera, double tilt_deg, bool multi_perspec
 /// Composites the ranks' partial frames of one pass into `shell`'s images at `root` (the shell
 /// with its images filled there, the shell as it is elsewhere). `partial` is this rank's pass
 /// (fragment set) or null for a rank without a block. Collective.
+/// `schedule` and `radix`: the exchange (the images are the same with either).
 ProxyFrame composite_proxies(Communicator& communicator, const ProxyFrame& shell,
-                             const ProxyFrame* partial, int root);
+                             const ProxyFrame* partial, int root,
+                             CompositingSchedule schedule = CompositingSchedule::direct_send,
+                             int radix = kCompositingRadix);
 /// The same for ground-truth renderings of `width` x `height` pixels (rgba, depth).
 Rendering composite_rendering(Communicator& communicator, int width, int height,
-                              const Rendering* partial, int root);
+                              const Rendering* partial, int root,
+                              CompositingSchedule schedule = CompositingSchedule::direct_send,
+                              int radix = kCompositingRadix);
 
 /// The fold in one process, for tests: the partial frames of every block, any order.
 ProxyFrame composite_proxies(const ProxyFrame& shell, const std::vector<ProxyFrame>& partials);
