@@ -317,7 +317,8 @@ ArchiveWriter::ArchiveWriter(const InstrumentConfig& config)
 
     nlohmann::json configuration = config_.to_json();
     nlohmann::json manifest;
-    if (fs::exists(archive / af::kManifestFile)) {
+    const bool indexed = fs::exists(archive / af::kManifestFile);
+    if (indexed) {
         // A restarted run appends. A manifest whose top level is corrupt throws here and is never
         // overwritten; malformed step entries are kept aside, verbatim (manifest.hpp).
         af::Index index = af::read_index(path_);
@@ -334,7 +335,9 @@ ArchiveWriter::ArchiveWriter(const InstrumentConfig& config)
     manifest["producer"] = std::string("libinsitu ") + INSITU_VERSION;
     manifest["configuration"] = std::move(configuration);
     for (const fs::path& folder : folders) af::remove_temp_files(folder);
-    remove_unlisted_files(archive, manifest);
+    // Only against an index read whole (manifest.json and the journal replayed into it): a folder
+    // whose manifest.json is gone still holds the steps its journal lists, and they stay.
+    if (indexed) remove_unlisted_files(archive, manifest);
     // Writing both indexes whole now makes a fresh archive open (with no steps), catches an
     // unwritable directory at start-up, folds in the journal a killed run left and repairs a
     // data.csv it left behind or torn. The journal goes only once manifest.json holds its steps.
