@@ -281,10 +281,17 @@ private:
         const Camera& camera = rig_.camera(sample.camera);
         sample.weight /= present_weight;
         sample.hit_t = first_hit(camera, sample.images->depth, span.ray, span.t0, span.t1);
-        sample.read_point = span.at(sample.hit_t.value_or(span.t_centre));
-        sample.read_map = camera.project(sample.read_point);
-        sample.passes_by =
-            !sample.hit_t && std::isfinite(stored_distance(sample.images->depth, sample.read_map));
+        read_at(sample, span, sample.hit_t.value_or(span.t_centre));
+        sample.passes_by = sample.passes_by && !sample.hit_t;
+    }
+
+    // Where camera `sample` reads the ray at t (its point and map position), and whether it
+    // recorded a first hit there: without one of its own on the ray, a surface the ray passes
+    // by (recordsAt on the page).
+    void read_at(CameraSample& sample, const RaySpan& span, double t) const {
+        sample.read_point = span.at(t);
+        sample.read_map = rig_.camera(sample.camera).project(sample.read_point);
+        sample.passes_by = std::isfinite(stored_distance(sample.images->depth, sample.read_map));
     }
 
     // Whether camera k records no surface at `point`, or one behind it: it sees through it.
@@ -343,8 +350,8 @@ private:
             found.images = images;
             found.weight = hidden_weight;
             found.hit_t = hit;
-            found.read_point = point;
-            found.read_map = rig_.camera(k).project(point);
+            read_at(found, span, *hit);
+            found.passes_by = false;  // it sees the hit
             return present + 1;
         }
         return present;
@@ -373,10 +380,7 @@ private:
         span.t_read = rim_t / weight;
         for (int i = 0; i < around; ++i) {
             CameraSample& sample = samples[static_cast<std::size_t>(i)];
-            sample.read_point = span.at(sample.rim_t.value_or(span.t_read));
-            sample.read_map = rig_.camera(sample.camera).project(sample.read_point);
-            sample.passes_by =
-                std::isfinite(stored_distance(sample.images->depth, sample.read_map));
+            read_at(sample, span, sample.rim_t.value_or(span.t_read));
         }
     }
 
@@ -394,11 +398,7 @@ private:
         span.t_read = hit_t / weight;
         for (int i = 0; i < around; ++i) {
             CameraSample& sample = samples[static_cast<std::size_t>(i)];
-            if (sample.hit_t) continue;
-            sample.read_point = span.at(span.t_read);
-            sample.read_map = rig_.camera(sample.camera).project(sample.read_point);
-            sample.passes_by =
-                std::isfinite(stored_distance(sample.images->depth, sample.read_map));
+            if (!sample.hit_t) read_at(sample, span, span.t_read);
         }
     }
 
