@@ -381,6 +381,11 @@ private:
         for (int i = 0; i < around; ++i) {
             CameraSample& sample = samples[static_cast<std::size_t>(i)];
             read_at(sample, span, sample.rim_t.value_or(span.t_read));
+            // A camera on its own rim sees the ray there, as one with a hit does: its search
+            // ends on the edge of the rim's texel, whose neighbour often holds a first hit, and
+            // which side float or double rounding reads there decided whether it passed by
+            // (bench/RESULTS.md, "Light-field rims").
+            sample.passes_by = sample.passes_by && !sample.rim_t;
         }
     }
 
@@ -421,10 +426,11 @@ private:
                                      : sample.hit_t;
                 const glm::dvec2 map =
                     camera.project(span.at(hit.value_or(sample.rim_t.value_or(span.t_read))));
-                // No hit: what the camera saw there is either faint (no first hit recorded:
-                // read it, it lies somewhere along the ray) or a surface the ray passes by
-                // (recorded, yet the ray never reached it): nothing of it is on this ray.
-                if (!hit && std::isfinite(stored_distance(depth, map))) continue;
+                // No hit: what the camera saw there is either faint (no first hit recorded, or
+                // its own rim: read it, it lies somewhere along the ray) or a surface the ray
+                // passes by (recorded, yet the ray never reached it): nothing of it is on this
+                // ray.
+                if (!hit && !sample.rim_t && std::isfinite(stored_distance(depth, map))) continue;
                 std::array<double, 4> read{0.0, 0.0, 0.0, 0.0};
                 add_bilinear(sample.images->segment_rgba[static_cast<std::size_t>(s)], map, 1.0,
                              read);
