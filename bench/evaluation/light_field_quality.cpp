@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "harness.hpp"
@@ -92,14 +93,6 @@ std::uintmax_t write_archive(const Scene& scene, ProxyRenderer& renderer,
     return files.empty() ? 0 : fs::file_size(files.front().exr_path);
 }
 
-std::uintmax_t write_archive(const Scene& scene, ProxyRenderer& renderer,
-                             const LightFieldRequest& request, const std::string& path, int image) {
-    const LightFieldRig rig = LightFieldRig::around(
-        renderer.volume().bounds, request.settings.cameras, request.settings.size);
-    return write_archive(scene, renderer, request, capture_light_field(renderer, rig, request),
-                         path, image);
-}
-
 /// Means over views of one archive's frames against their truths.
 struct ViewScores {
     double mean_abs_percent = 0.0, psnr = 0.0, crack_percent = 0.0, worst_crack_percent = 0.0;
@@ -134,6 +127,41 @@ void write_orbit_pngs(const Scene& scene, ProxyRenderer& renderer, Explorer& exp
                   .rgba);
 }
 
+// The capture's cost per camera with the rims' pass (request's rim threshold) and without,
+// against the bound: a single-perspective proxy pass (layers, attenuation, mean depth)
+// of each rig camera, the same pixels, as the light_fields section times it. Interleaved after
+// a warm-up each, best of 3 rounds (1 in a smoke run): the machine is shared.
+struct CaptureCost {
+    LightField light_field;  ///< captured with `request`
+    double with_rims_ms = 0.0, without_rims_ms = 0.0, proxy_pass_ms = 0.0;
+};
+
+CaptureCost capture_cost(const Scene& scene, ProxyRenderer& renderer,
+                         const LightFieldRequest& request, bool smoke) {
+    const LightFieldRig rig = LightFieldRig::around(
+        renderer.volume().bounds, request.settings.cameras, request.settings.size);
+    LightFieldRequest without_rims = request;
+    without_rims.settings.rim_threshold = 0.0;
+    ProxyRequest pass;
+    pass.transfer_function = request.transfer_function;
+    pass.isovalues = scene_layers(scene, 4);
+    pass.intervals = request.intervals;
+    pass.march.tf_value_bins = truth_settings().tf_value_bins;
+    CaptureCost cost;
+    const std::vector<bench::Timing> timings = bench::interleaved_timings(
+        smoke ? 1 : 3, {[&] { cost.light_field = capture_light_field(renderer, rig, request); },
+                        [&] { capture_light_field(renderer, rig, without_rims); },
+                        [&] {
+                            for (int k = 0; k < rig.camera_count(); ++k)
+                                renderer.render(rig.camera(k), pass);
+                        }});
+    const double cameras = rig.camera_count();
+    cost.with_rims_ms = timings[0].best / cameras;
+    cost.without_rims_ms = timings[1].best / cameras;
+    cost.proxy_pass_ms = timings[2].best / cameras;
+    return cost;
+}
+
 }  // namespace
 
 void section_light_field_cracks(const std::vector<const Scene*>& scenes, bool smoke,
@@ -141,7 +169,8 @@ void section_light_field_cracks(const std::vector<const Scene*>& scenes, bool sm
     Csv csv(out / "light_field_cracks.csv",
             "scene,cameras,map,views,mean_abs_percent,psnr,worst_psnr,worst_view_azimuth,"
             "worst_view_elevation,crack_percent,worst_crack_percent,reconstruct_ms,stored_bytes,"
-            "payload_bytes,relit_psnr,relit_worst_psnr");
+            "payload_bytes,relit_psnr,relit_worst_psnr,capture_ms_per_camera,"
+            "capture_without_rims_ms_per_camera,proxy_pass_ms_per_camera");
     const int views = smoke ? 3 : 30;
     const std::vector<std::pair<double, double>> angles = random_views(views);
     // Relit: a headlight, against the ground truth's headlight Phong (what the Explorer's volume
@@ -172,8 +201,9 @@ void section_light_field_cracks(const std::vector<const Scene*>& scenes, bool sm
         request.transfer_function = tf;
         request.intervals = scene_intervals(*scene, 16);
         const fs::path archive = scratch / ("cracks_" + scene->name + std::to_string(map));
-        const std::uintmax_t stored_bytes =
-            write_archive(*scene, renderer, request, archive.string(), image);
+        CaptureCost cost = capture_cost(*scene, renderer, request, smoke);
+        const std::uintmax_t stored_bytes = write_archive(
+            *scene, renderer, request, std::move(cost.light_field), archive.string(), image);
         // What `insitu-view serve` sends the page for the step (uncompressed).
         const std::size_t payload_bytes =
             viewer::light_field_payload(
@@ -208,15 +238,16 @@ void section_light_field_cracks(const std::vector<const Scene*>& scenes, bool sm
         csv.row(scene->name, 42, map, views, unlit.mean_abs_percent, unlit.psnr, unlit.worst_psnr,
                 unlit.worst_view.first, unlit.worst_view.second, unlit.crack_percent,
                 unlit.worst_crack_percent, ms, stored_bytes, payload_bytes, relit.psnr,
-                relit.worst_psnr);
+                relit.worst_psnr, cost.with_rims_ms, cost.without_rims_ms, cost.proxy_pass_ms);
         std::printf(
             "light-field cracks: %s 42 cameras %d^2: mean error %.2f %%, PSNR %.1f dB, worst "
             "view %.1f dB (az %.0f el %.0f), cracks %.3f %% (worst view %.3f %%), %.0f ms/frame, "
-            "%.2f MB stored, %.2f MB to the page, relit %.1f dB (worst %.1f)\n",
+            "%.2f MB stored, %.2f MB to the page, relit %.1f dB (worst %.1f); capture per camera "
+            "%.2f ms with rims, %.2f without, proxy pass %.2f\n",
             scene->name.c_str(), map, unlit.mean_abs_percent, unlit.psnr, unlit.worst_psnr,
             unlit.worst_view.first, unlit.worst_view.second, unlit.crack_percent,
             unlit.worst_crack_percent, ms, stored_bytes / 1e6, payload_bytes / 1e6, relit.psnr,
-            relit.worst_psnr);
+            relit.worst_psnr, cost.with_rims_ms, cost.without_rims_ms, cost.proxy_pass_ms);
         fs::remove_all(archive);
     }
 }

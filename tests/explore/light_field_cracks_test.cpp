@@ -168,13 +168,11 @@ Scene spots() {
 // The same balls through a semi-transparent function as Gray-Scott's: a ray grazing a ball
 // gathers colour no camera recorded a first hit for. Base (e9ae600): 0.07-0.35 % cracked, every
 // view above the goal; occlusion-aware: 0.02-0.08 % (56 pixels over the 8 views), two views
-// above it; with the rims' own depth 0.006-0.055 % (33 pixels), one view above it. Held to
-// 0.06 % (which the light field without rims fails, 0.079 % at az 310) until the goal
-// is met here too (bench/RESULTS.md, "Light-field rims").
+// above it; with the rims' own depth 0.006-0.055 % (33 pixels), one view above it; with a
+// camera on its own rim never passing by 0.006-0.043 % (30 pixels): the goal in every
+// view, which the two before fail (bench/RESULTS.md, "Light-field rims").
 Scene translucent_spots() {
-    Scene scene{"translucent spots", spots_volume(), kSpotViews, translucent_tf()};
-    scene.max_crack_share = 0.0006;
-    return scene;
+    return Scene{"translucent spots", spots_volume(), kSpotViews, translucent_tf()};
 }
 
 // Without the rims' depth, the occlusion-aware reconstruction alone (held to its figures).

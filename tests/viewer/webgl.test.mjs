@@ -1,10 +1,10 @@
 // The page's own frames in a real browser: headless Debian chromium with WebGL2 through its
-// software rasteriser (SwiftShader), on an archive with a light field. Orbit views drawn by the
-// page's WebGL2 light-field renderer must match `insitu-view render --source lightfield` (the
-// C++ reference) for the same angles, also relit by a headlight and occluded; the page must fall
-// back to the server's frames when WebGL is disabled.
+// software rasteriser (SwiftShader), on an archive with a light field (8-bit depth, the rims'
+// depth). Orbit views drawn by the page's WebGL2 light-field renderer must match `insitu-view
+// render --source lightfield` (the C++ reference) for the same angles, also relit by a headlight
+// and occluded; the page must fall back to the server's frames when WebGL is disabled.
 //
-//   INSITU_VIEW=build/viewer/insitu-view ARCHIVE=viewer_lf.cdb WORK_DIR=dir node webgl.test.mjs
+//   INSITU_VIEW=build/viewer/insitu-view ARCHIVE=viewer_lf_rims.cdb WORK_DIR=dir node webgl.test.mjs
 import assert from 'node:assert/strict';
 import { after, before, test } from 'node:test';
 
@@ -100,7 +100,8 @@ test('orbit views drawn with WebGL2 match insitu-view render --source lightfield
     () => window.insituViewer.maskConfidence.filter((c) => c < 128).length);
   results.push(`confidence: ${differing} bytes differ from render --mask, by at most ${worst}`);
   assert.ok(untrusted > 0, 'some pixels are not trusted');
-  // Measured: 8 of 25,600 bytes, by 1 of 255 (float against double, then 8 bits).
+  // Measured: 17 of 25,600 bytes, by 1 of 255 (float against double, then 8 bits); 81 by up
+  // to 236 while the page and the reference read a rim hit on a texel's edge from either side.
   assert.ok(worst <= 2 && differing <= 0.01 * 160 * 160,
     `confidence against render --mask: ${differing} bytes differ, by at most ${worst}`);
   console.log(`WebGL2 light field vs insitu-view render: ${results.join(', ')}`);

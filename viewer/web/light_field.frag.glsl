@@ -16,7 +16,8 @@
 //     found it (else at its point nearest the centre), and pass by (hold nothing of the ray)
 //     where they recorded a surface there;
 //  3b. rims: where no camera read sees a first hit, cameras with a rim depth (uRimAt) search it
-//     as the first hit, and every camera reads the ray at its own rim hit, else at their blend;
+//     as the first hit, and every camera reads the ray at its own rim hit (where it never passes
+//     by), else at their blend;
 //  4. per segment (its own depth search where there are several), RGBA read bilinearly where
 //     each camera sees the hit; the cameras that hold something of the ray blend with
 //     renormalised weights; segments composite front to back, segment s with its opacity
@@ -568,7 +569,9 @@ float readRims(float tCentre) {
   float tRead = rimT / weight;
   for (int i = 0; i < gAround; ++i) {
     gReadT[i] = gRim[i] >= 0.0 ? gRim[i] : tRead;
-    gPassesBy[i] = recordsAt(i, gSlot[i], gReadT[i]);
+    // On its own rim a camera sees the ray (its search ends on the rim texel's edge, where
+    // float and double would read different sides of a neighbouring first hit).
+    gPassesBy[i] = gRim[i] < 0.0 && recordsAt(i, gSlot[i], gReadT[i]);
   }
   return tRead;
 }
@@ -694,7 +697,8 @@ void main() {
       float hit = uSegments > 1 ? firstHit(gCamera[i], layer, gOrigin, gDirection, gT0, gT1)
                                 : gHit[i];
       vec2 map = project(gCamera[i], rayAt(hit >= 0.0 ? hit : gRim[i] >= 0.0 ? gRim[i] : tRead));
-      if (hit < 0.0 && recorded(storedDistance(layer, map))) continue;  // passes it by
+      bool passesBy = hit < 0.0 && gRim[i] < 0.0 && recorded(storedDistance(layer, map));
+      if (passesBy) continue;
       vec4 read = bilinear(gSlot[i] * uSegments + s, map);
       blended += gWeight[i] * read;
       segmentWeight += gWeight[i];

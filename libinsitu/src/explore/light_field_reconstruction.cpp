@@ -281,10 +281,17 @@ private:
         const Camera& camera = rig_.camera(sample.camera);
         sample.weight /= present_weight;
         sample.hit_t = first_hit(camera, sample.images->depth, span.ray, span.t0, span.t1);
-        sample.read_point = span.at(sample.hit_t.value_or(span.t_centre));
-        sample.read_map = camera.project(sample.read_point);
-        sample.passes_by =
-            !sample.hit_t && std::isfinite(stored_distance(sample.images->depth, sample.read_map));
+        read_at(sample, span, sample.hit_t.value_or(span.t_centre));
+        sample.passes_by = sample.passes_by && !sample.hit_t;
+    }
+
+    // Where camera `sample` reads the ray at t (its point and map position), and whether it
+    // recorded a first hit there: without one of its own on the ray, a surface the ray passes
+    // by (recordsAt on the page).
+    void read_at(CameraSample& sample, const RaySpan& span, double t) const {
+        sample.read_point = span.at(t);
+        sample.read_map = rig_.camera(sample.camera).project(sample.read_point);
+        sample.passes_by = std::isfinite(stored_distance(sample.images->depth, sample.read_map));
     }
 
     // Whether camera k records no surface at `point`, or one behind it: it sees through it.
@@ -343,8 +350,8 @@ private:
             found.images = images;
             found.weight = hidden_weight;
             found.hit_t = hit;
-            found.read_point = point;
-            found.read_map = rig_.camera(k).project(point);
+            read_at(found, span, *hit);
+            found.passes_by = false;  // it sees the hit
             return present + 1;
         }
         return present;
@@ -373,10 +380,12 @@ private:
         span.t_read = rim_t / weight;
         for (int i = 0; i < around; ++i) {
             CameraSample& sample = samples[static_cast<std::size_t>(i)];
-            sample.read_point = span.at(sample.rim_t.value_or(span.t_read));
-            sample.read_map = rig_.camera(sample.camera).project(sample.read_point);
-            sample.passes_by =
-                std::isfinite(stored_distance(sample.images->depth, sample.read_map));
+            read_at(sample, span, sample.rim_t.value_or(span.t_read));
+            // A camera on its own rim sees the ray there, as one with a hit does: its search
+            // ends on the edge of the rim's texel, whose neighbour often holds a first hit, and
+            // which side float or double rounding reads there decided whether it passed by
+            // (bench/RESULTS.md, "Light-field rims").
+            sample.passes_by = sample.passes_by && !sample.rim_t;
         }
     }
 
@@ -394,11 +403,7 @@ private:
         span.t_read = hit_t / weight;
         for (int i = 0; i < around; ++i) {
             CameraSample& sample = samples[static_cast<std::size_t>(i)];
-            if (sample.hit_t) continue;
-            sample.read_point = span.at(span.t_read);
-            sample.read_map = rig_.camera(sample.camera).project(sample.read_point);
-            sample.passes_by =
-                std::isfinite(stored_distance(sample.images->depth, sample.read_map));
+            if (!sample.hit_t) read_at(sample, span, span.t_read);
         }
     }
 
@@ -421,10 +426,11 @@ private:
                                      : sample.hit_t;
                 const glm::dvec2 map =
                     camera.project(span.at(hit.value_or(sample.rim_t.value_or(span.t_read))));
-                // No hit: what the camera saw there is either faint (no first hit recorded:
-                // read it, it lies somewhere along the ray) or a surface the ray passes by
-                // (recorded, yet the ray never reached it): nothing of it is on this ray.
-                if (!hit && std::isfinite(stored_distance(depth, map))) continue;
+                // No hit: what the camera saw there is either faint (no first hit recorded, or
+                // its own rim: read it, it lies somewhere along the ray) or a surface the ray
+                // passes by (recorded, yet the ray never reached it): nothing of it is on this
+                // ray.
+                if (!hit && !sample.rim_t && std::isfinite(stored_distance(depth, map))) continue;
                 std::array<double, 4> read{0.0, 0.0, 0.0, 0.0};
                 add_bilinear(sample.images->segment_rgba[static_cast<std::size_t>(s)], map, 1.0,
                              read);
