@@ -383,25 +383,7 @@ public:
             },
             "gather", "MPI_Iallgather");
         require_int_count(*std::max_element(sizes.begin(), sizes.end()), "gather", "a message of");
-        const bool is_root = rank_ == root;
-        std::vector<Bytes> received(is_root ? sizes.size() : 0);
-        std::vector<const Bytes*> sends(sizes.size(), nullptr);
-        if (is_root) {
-            for (std::size_t r = 0; r < sizes.size(); ++r) {
-                received[r].resize(static_cast<std::size_t>(sizes[r]));
-            }
-        } else {
-            sends[static_cast<std::size_t>(root)] = &mine;
-        }
-        exchange(comm_, rank_, received, sends, kGatherTag, "gather");
-        if (!is_root) {
-            counters_.bytes_sent += my_bytes;
-            counters_.messages_sent += my_bytes > 0 ? 1 : 0;
-            return {};
-        }
-        received[static_cast<std::size_t>(root)] = mine;
-        counters_.bytes_received += total_of(sizes) - my_bytes;
-        return received;
+        return gather_sized(mine, mine, root, sizes);
     }
 
     std::vector<Bytes> gather_known_sizes(const Bytes& mine, int root,
@@ -425,28 +407,11 @@ public:
             resized.resize(static_cast<std::size_t>(expected));
             sent = &resized;
         }
-        const bool is_root = rank_ == root;
-        std::vector<Bytes> received(is_root ? sizes.size() : 0);
-        std::vector<const Bytes*> sends(sizes.size(), nullptr);
-        if (is_root) {
-            for (std::size_t r = 0; r < sizes.size(); ++r) {
-                received[r].resize(static_cast<std::size_t>(sizes[r]));
-            }
-        } else {
-            sends[static_cast<std::size_t>(root)] = sent;
-        }
-        exchange(comm_, rank_, received, sends, kGatherTag, "gather");
+        std::vector<Bytes> received = gather_sized(*sent, mine, root, sizes);
         if (sent != &mine) {
             fail<InvalidArgument>("MPI communicator: gather: rank ", rank_, " passed ", mine.size(),
                                   " bytes, not the ", expected, " its sizes say");
         }
-        if (!is_root) {
-            counters_.bytes_sent += expected;
-            counters_.messages_sent += expected > 0 ? 1 : 0;
-            return {};
-        }
-        received[static_cast<std::size_t>(root)] = mine;
-        counters_.bytes_received += total_of(sizes) - expected;
         return received;
     }
 
@@ -478,6 +443,31 @@ public:
     CommunicationCounters counters() const override { return counters_; }
 
 private:
+    /// The gather's one round once every rank knows every size: `sent` (sizes[rank] bytes) to
+    /// the root, which receives the others' and keeps `mine` as its own.
+    std::vector<Bytes> gather_sized(const Bytes& sent, const Bytes& mine, int root,
+                                    const std::vector<std::uint64_t>& sizes) {
+        const bool is_root = rank_ == root;
+        std::vector<Bytes> received(is_root ? sizes.size() : 0);
+        std::vector<const Bytes*> sends(sizes.size(), nullptr);
+        if (is_root) {
+            for (std::size_t r = 0; r < sizes.size(); ++r) {
+                received[r].resize(static_cast<std::size_t>(sizes[r]));
+            }
+        } else {
+            sends[static_cast<std::size_t>(root)] = &sent;
+        }
+        exchange(comm_, rank_, received, sends, kGatherTag, "gather");
+        if (!is_root) {
+            counters_.bytes_sent += sent.size();
+            counters_.messages_sent += sent.empty() ? 0 : 1;
+            return {};
+        }
+        received[static_cast<std::size_t>(root)] = mine;
+        counters_.bytes_received += total_of(sizes) - sizes[static_cast<std::size_t>(root)];
+        return received;
+    }
+
     // all_gather's slot per rank: a size and the first bytes of the message, as many as an
     // agreement's say holds at a few ranks, fewer at many (the slots of all ranks reach every
     // rank: about 64 KiB in all, and never less than the size itself).
