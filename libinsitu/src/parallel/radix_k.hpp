@@ -23,6 +23,7 @@
 #include "insitu/error.hpp"
 #include "insitu/parallel/communicator.hpp"
 #include "parallel/direct_send.hpp"
+#include "parallel/record_index.hpp"
 
 namespace insitu::detail {
 
@@ -55,13 +56,7 @@ inline std::vector<Bytes> split_records(const std::vector<Bytes>& messages,
                                         const std::vector<std::int64_t>& bounds) {
     std::vector<Bytes> parts(bounds.size() - 1);
     for (const Bytes& message : messages) {
-        if (message.size() % record_bytes != 0) {
-            fail<Error>("compositing: a message of ", message.size(),
-                        " bytes is not a whole number of ", record_bytes, "-byte records");
-        }
-        for (std::size_t at = 0; at < message.size(); at += record_bytes) {
-            std::uint32_t pixel = 0;
-            std::memcpy(&pixel, &message[at], sizeof pixel);
+        for_each_record(message, record_bytes, [&](std::uint32_t pixel, std::size_t at) {
             const auto after =
                 std::upper_bound(bounds.begin(), bounds.end(), static_cast<std::int64_t>(pixel));
             if (after == bounds.begin() || after == bounds.end()) {
@@ -71,7 +66,7 @@ inline std::vector<Bytes> split_records(const std::vector<Bytes>& messages,
             Bytes& part = parts[static_cast<std::size_t>(after - bounds.begin() - 1)];
             part.insert(part.end(), message.begin() + static_cast<std::ptrdiff_t>(at),
                         message.begin() + static_cast<std::ptrdiff_t>(at + record_bytes));
-        }
+        });
     }
     return parts;
 }

@@ -25,20 +25,14 @@ RecordIndex index_records(const std::vector<Bytes>& messages, int record_floats,
     index.starts.assign(static_cast<std::size_t>(end - begin) + 1, 0);
     std::size_t count = 0;
     for (const Bytes& message : messages) {
-        if (message.size() % stride != 0) {
-            fail<Error>("compositing: a message of ", message.size(),
-                        " bytes is not a whole number of ", stride, "-byte records");
-        }
-        for (std::size_t at = 0; at < message.size(); at += stride) {
-            std::uint32_t pixel = 0;
-            std::memcpy(&pixel, &message[at], sizeof pixel);
+        for_each_record(message, stride, [&](std::uint32_t pixel, std::size_t) {
             if (pixel < begin || pixel >= end) {
                 fail<Error>("compositing: a record for pixel ", pixel, " outside the tile [", begin,
                             ", ", end, ")");
             }
             ++index.starts[pixel - begin + 1];
             ++count;
-        }
+        });
     }
     for (std::size_t p = 1; p < index.starts.size(); ++p) index.starts[p] += index.starts[p - 1];
     index.refs.resize(count);

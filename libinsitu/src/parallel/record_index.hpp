@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "insitu/core/image.hpp"
+#include "insitu/error.hpp"
 #include "insitu/parallel/communicator.hpp"
 
 namespace insitu::detail {
@@ -16,6 +17,21 @@ void append(Bytes& bytes, const void* data, std::size_t size);
 /// How many of the pixels [begin, end) have a fragment (first index >= 0) in a fragment image
 /// of `channels` floats per pixel: messages are sized once, not grown.
 std::size_t fragments_in(const Image& fragment, int channels, std::int64_t begin, std::int64_t end);
+
+/// Calls visit(pixel, at) for each record of `message` (each `record_bytes`, its pixel's uint32
+/// index first; `at` its offset in the message), after checking the message holds whole records.
+template <typename Visit>
+void for_each_record(const Bytes& message, std::size_t record_bytes, Visit visit) {
+    if (message.size() % record_bytes != 0) {
+        fail<Error>("compositing: a message of ", message.size(),
+                    " bytes is not a whole number of ", record_bytes, "-byte records");
+    }
+    for (std::size_t at = 0; at < message.size(); at += record_bytes) {
+        std::uint32_t pixel = 0;
+        std::memcpy(&pixel, &message[at], sizeof pixel);
+        visit(pixel, at);
+    }
+}
 
 /// One received record: its pixel, the index of its first sample, and where its floats are in
 /// the message (read with memcpy: floats are not read through a byte pointer).
