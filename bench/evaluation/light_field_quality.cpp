@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -252,16 +253,42 @@ void section_light_field_cracks(const std::vector<const Scene*>& scenes, bool sm
     }
 }
 
+namespace {
+
+/// One way of storing the section's light field: attenuation maps subsampled per side, and the
+/// colour's DWA level (0: lossless).
+struct StoredForm {
+    int subsampling = 1;
+    double colour_dwa_level = 0.0;
+};
+
+/// `captured` without its attenuation maps: what a light field with "attenuation": false
+/// stores of the same capture.
+LightField without_attenuation(LightField captured) {
+    captured.settings.attenuation = false;
+    for (LightFieldImages& images : captured.cameras) {
+        images.attenuation = Image();
+        images.mean_depth = Image();
+    }
+    return captured;
+}
+
+}  // namespace
+
 void section_light_field_bytes(const std::vector<const Scene*>& scenes, bool smoke,
                                const fs::path& out, const fs::path& scratch, int image) {
     Csv csv(out / "light_field_bytes.csv",
-            "scene,cameras,map,attenuation_subsampling,stored_bytes,edit,views,mean_abs_percent,"
-            "psnr,worst_psnr,worst_view_azimuth,worst_view_elevation,crack_percent,"
-            "worst_crack_percent");
+            "scene,cameras,map,attenuation_subsampling,colour_dwa_level,stored_bytes,"
+            "stored_bytes_without_attenuation,edit,views,mean_abs_percent,psnr,worst_psnr,"
+            "worst_view_azimuth,worst_view_elevation,crack_percent,worst_crack_percent");
     const int views = smoke ? 3 : 30;
     const int map = smoke ? 64 : 256;
     const std::vector<std::pair<double, double>> angles = random_views(views);
     const std::vector<TfSpec> edits = held_out_edits(views);
+    const std::vector<StoredForm> forms =
+        smoke ? std::vector<StoredForm>{{1, 0.0}, {2, 0.0}, {1, 45.0}}
+              : std::vector<StoredForm>{{1, 0.0},  {2, 0.0},  {4, 0.0},
+                                        {1, 45.0}, {2, 45.0}, {1, 100.0}};
     for (const Scene* scene : scenes) {
         ProxyRenderer renderer;
         renderer.upload(scene->volume.field());
@@ -283,10 +310,21 @@ void section_light_field_bytes(const std::vector<const Scene*>& scenes, bool smo
                 renderer.render_ground_truth(view, make_tf(*scene, edits[v]), truth_settings())
                     .rgba);
         }
-        Image unedited_first;  // the full-size archive's first view, unedited
-        for (const int subsampling : smoke ? std::vector<int>{1, 2} : std::vector<int>{1, 2, 4}) {
-            request.settings.attenuation_subsampling = subsampling;
+        // Per colour level, the full-size archive's first view unedited.
+        std::map<double, Image> unedited_first;
+        for (const StoredForm& form : forms) {
+            request.settings.attenuation_subsampling = form.subsampling;
+            request.settings.colour_dwa_level = form.colour_dwa_level;
             const fs::path archive = scratch / ("bytes_" + scene->name);
+            std::uintmax_t bytes_without_attenuation = 0;
+            if (form.subsampling == 1) {
+                LightFieldRequest plain = request;
+                plain.settings.attenuation = false;
+                bytes_without_attenuation =
+                    write_archive(*scene, renderer, plain, without_attenuation(captured),
+                                  archive.string(), image);
+                fs::remove_all(archive);
+            }
             const std::uintmax_t bytes =
                 write_archive(*scene, renderer, request, captured, archive.string(), image);
             Explorer explorer(archive.string());
@@ -300,29 +338,34 @@ void section_light_field_bytes(const std::vector<const Scene*>& scenes, bool smo
                     if (edit) explore.transfer_function = make_tf(*scene, edits[v]);
                     const Image frame = explorer.render(explore).colour;
                     // Unedited frames read colour and depth, which subsampling leaves as they
-                    // are: measured once, checked to be the same frame where the maps are smaller.
-                    if (!edit && subsampling == 1 && v == 0) unedited_first = frame;
-                    if (!edit && subsampling > 1) {
-                        if (frame.pixels != unedited_first.pixels) {
+                    // are: measured once per colour level, checked to be the same frame where
+                    // the maps are smaller.
+                    if (!edit && form.subsampling == 1 && v == 0) {
+                        unedited_first[form.colour_dwa_level] = frame;
+                    }
+                    if (!edit && form.subsampling > 1) {
+                        if (frame.pixels != unedited_first.at(form.colour_dwa_level).pixels) {
                             fail<Error>("an unedited frame changed with the attenuation maps");
                         }
                         break;
                     }
                     scores.add(edit ? edited_truths[v] : truths[v], frame, angles[v], views);
                 }
-                if (!edit && subsampling > 1) continue;
-                csv.row(scene->name, 42, map, subsampling, bytes, edit ? 1 : 0, views,
-                        scores.mean_abs_percent, scores.psnr, scores.worst_psnr,
-                        scores.worst_view.first, scores.worst_view.second, scores.crack_percent,
-                        scores.worst_crack_percent);
+                if (!edit && form.subsampling > 1) continue;
+                csv.row(scene->name, 42, map, form.subsampling, form.colour_dwa_level, bytes,
+                        bytes_without_attenuation, edit ? 1 : 0, views, scores.mean_abs_percent,
+                        scores.psnr, scores.worst_psnr, scores.worst_view.first,
+                        scores.worst_view.second, scores.crack_percent, scores.worst_crack_percent);
                 std::printf(
-                    "light-field bytes: %s 42 cameras %d^2, attenuation maps / %d: %.2f MB, %s: "
-                    "mean error %.2f %%, PSNR %.1f dB, worst view %.1f dB (az %.0f el %.0f), "
-                    "cracks %.3f %% (worst %.3f %%)\n",
-                    scene->name.c_str(), map, subsampling, bytes / 1e6,
-                    edit ? "held-out edits" : "unedited", scores.mean_abs_percent, scores.psnr,
-                    scores.worst_psnr, scores.worst_view.first, scores.worst_view.second,
-                    scores.crack_percent, scores.worst_crack_percent);
+                    "light-field bytes: %s 42 cameras %d^2, attenuation maps / %d, colour DWA "
+                    "%.0f: %.2f MB (%.2f MB without attenuation), %s: mean error %.2f %%, PSNR "
+                    "%.1f dB, worst view %.1f dB (az %.0f el %.0f), cracks %.3f %% (worst %.3f "
+                    "%%)\n",
+                    scene->name.c_str(), map, form.subsampling, form.colour_dwa_level, bytes / 1e6,
+                    bytes_without_attenuation / 1e6, edit ? "held-out edits" : "unedited",
+                    scores.mean_abs_percent, scores.psnr, scores.worst_psnr,
+                    scores.worst_view.first, scores.worst_view.second, scores.crack_percent,
+                    scores.worst_crack_percent);
             }
             fs::remove_all(archive);
         }

@@ -17,9 +17,10 @@ void section_light_field_cracks(const std::vector<const Scene*>& scenes, bool sm
                                 const std::filesystem::path& scratch, int image);
 
 /// Bytes against accuracy (issue 41 item 3): one attenuation light field of 42 cameras at 256^2
-/// stored with its attenuation maps at full size and subsampled by 2 and 4, each through the
-/// archive and the Explorer from the same 30 random views, unedited and with held-out opacity
-/// edits, against the ground truth. Writes light_field_bytes.csv.
+/// stored with its attenuation maps at full size and subsampled by 2 and 4, and its colour
+/// lossless or lossy (DWA levels 45 and 100), each through the archive and the Explorer from the
+/// same 30 random views, unedited and with held-out opacity edits, against the ground truth;
+/// with the bytes of the same capture stored without attenuation. Writes light_field_bytes.csv.
 void section_light_field_bytes(const std::vector<const Scene*>& scenes, bool smoke,
                                const std::filesystem::path& out,
                                const std::filesystem::path& scratch, int image);

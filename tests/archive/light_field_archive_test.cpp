@@ -661,9 +661,13 @@ TEST_F(LightFieldArchive, DepthCodeTypeIsTheSmallerUnderEachCompression) {
         field.cameras.push_back(std::move(images));
     }
     const StepRecord record = step_with(10, field);
-    for (const char* compression : {"none", "rle", "zips", "zip", "piz", "pxr24"}) {
-        const archive_format::LightFieldEncoding chosen =
-            archive_format::light_field_encoding(StoragePrecision::half, compression);
+    // "dwab": a light field's own "colour_dwa_level" over the archive's zip.
+    for (const char* compression : {"none", "rle", "zips", "zip", "piz", "pxr24", "dwab"}) {
+        const bool dwab = std::string(compression) == "dwab";
+        const archive_format::LightFieldEncoding chosen = archive_format::with_colour_dwa_level(
+            archive_format::light_field_encoding(StoragePrecision::half,
+                                                 dwab ? "zip" : compression),
+            dwab ? 45.0 : 0.0);
         archive_format::LightFieldEncoding other = chosen;
         other.depth_code_type = chosen.depth_code_type == Imf::UINT ? Imf::HALF : Imf::UINT;
         const auto bytes = [&](const archive_format::LightFieldEncoding& encoding) {

@@ -76,7 +76,8 @@ constexpr const char* kSettingsKeys[] = {"cameras",
                                          "depth_bits",
                                          "depth_threshold",
                                          "attenuation_subsampling",
-                                         "rim_threshold"};
+                                         "rim_threshold",
+                                         "colour_dwa_level"};
 
 }  // namespace
 
@@ -141,6 +142,11 @@ void LightFieldSettings::validate() const {
                               "depth_threshold = ",
                               depth_threshold, ")");
     }
+    if (!(colour_dwa_level >= 0.0 && colour_dwa_level <= kMaxColourDwaLevel)) {
+        settings_out_of_range(settings_key("colour_dwa_level"), colour_dwa_level,
+                              "must be 0 (lossless colour) or an OpenEXR DWA level in (0, ",
+                              kMaxColourDwaLevel, "]");
+    }
     if (size % attenuation_subsampling != 0) {
         settings_out_of_range(settings_key("attenuation_subsampling"), attenuation_subsampling,
                               "must divide the map size ", size);
@@ -157,6 +163,7 @@ json LightFieldSettings::to_json() const {
     // Only where it is not 1: full-size maps keep the header that readers before it take.
     if (attenuation_subsampling != 1) object["attenuation_subsampling"] = attenuation_subsampling;
     if (rim_threshold != 0.0) object["rim_threshold"] = rim_threshold;
+    if (colour_dwa_level != 0.0) object["colour_dwa_level"] = colour_dwa_level;
     return object;
 }
 
@@ -227,6 +234,9 @@ LightFieldSettings LightFieldSettings::from_json(const json& object,
     });
     read("rim_threshold", [&](const json& v, const std::string& k) {
         settings.rim_threshold = settings_number(v, k);
+    });
+    read("colour_dwa_level", [&](const json& v, const std::string& k) {
+        settings.colour_dwa_level = settings_number(v, k);
     });
     settings.validate();
     return settings;

@@ -54,6 +54,10 @@ enum class SegmentRule {
 };
 
 /// "light_field" in the configuration: what each captured light field holds.
+/// The largest "colour_dwa_level": OpenEXR's default is 45; at 500 a colour map's error is
+/// several codes.
+constexpr double kMaxColourDwaLevel = 500.0;
+
 struct LightFieldSettings {
     int cameras = 42;  ///< "cameras": one of kLightFieldCameraCounts
     int size = 256;    ///< "size": map pixels per side
@@ -77,6 +81,13 @@ struct LightFieldSettings {
     /// occludes nothing) and read where no camera around a ray records a first hit; 0 = none.
     /// In [0, depth_threshold).
     double rim_threshold = 0.0;
+    /// "colour_dwa_level": 0 stores the colour as the archive stores everything, lossless; > 0
+    /// stores each camera with OpenEXR's DWAB compression at this level, which compresses the
+    /// R, G and B channels lossily (a DCT of 8x8 blocks) and every other channel (alpha, depths,
+    /// attenuation) without loss. The colour maps are then about 40 % of the stored bytes for a
+    /// fraction of a code of error, far below the reconstruction's (bench/RESULTS.md, "Light-field
+    /// bytes"). In [0, kMaxColourDwaLevel].
+    double colour_dwa_level = 0.0;
 
     /// InvalidArgument naming the "light_field" key and value of the first bad member.
     void validate() const;

@@ -110,6 +110,9 @@ Imf::Header camera_header(const StepRecord& record, const LightFieldRecord& sour
     header.setType(Imf::SCANLINEIMAGE);
     header.compression() = encoding.compression;
     header.zipCompressionLevel() = kZipCompressionLevel;
+    if (encoding.compression == Imf::DWAB_COMPRESSION) {
+        header.dwaCompressionLevel() = encoding.dwa_level;
+    }
 
     const int segments = light_field.segment_count();
     const int intervals = light_field.settings.attenuation ? light_field.intervals->count() : 0;
@@ -351,6 +354,22 @@ void decode_depth(Image& depth, const Imf::Channel& channel, int depth_bits,
     }
 }
 
+/// A lossy (DWA) part's colour back into what premultiplied colour is, 0 <= R, G, B <= A: the
+/// DCT leaves errors of a fraction of a code either way, which where alpha is 0 would add light
+/// to a transparent ray.
+void restore_premultiplied(Image& rgba) {
+    for (std::size_t p = 0; p < rgba.pixel_count(); ++p) {
+        float* pixel = &rgba.pixels[4 * p];
+        // min/max, not std::clamp: a damaged file may hold alpha < 0 or NaN.
+        for (int c = 0; c < 3; ++c) pixel[c] = std::min(std::max(pixel[c], 0.0f), pixel[3]);
+    }
+}
+
+bool lossy_colour(const Imf::Header& header) {
+    return header.compression() == Imf::DWAA_COMPRESSION ||
+           header.compression() == Imf::DWAB_COMPRESSION;
+}
+
 LightFieldImages read_camera(Imf::InputPart& part, int camera, const LightField& light_field,
                              const PartContext& where) {
     const int segments = light_field.segment_count();
@@ -391,6 +410,7 @@ LightFieldImages read_camera(Imf::InputPart& part, int camera, const LightField&
     int first = 0;
     for (int s = 0; s < segments; ++s, first += 4) {
         images.segment_rgba.push_back(channel_range(all, first, 4));
+        if (lossy_colour(part.header())) restore_premultiplied(images.segment_rgba.back());
     }
     const int depth_bits = light_field.settings.depth_bits;
     for (const std::string& name : names.segment_depth) {
@@ -449,13 +469,25 @@ LightFieldEncoding light_field_encoding(StoragePrecision precision,
     return encoding;
 }
 
+LightFieldEncoding with_colour_dwa_level(const LightFieldEncoding& archive, double level) {
+    if (level <= 0.0) return archive;
+    LightFieldEncoding encoding = archive;
+    encoding.compression = Imf::DWAB_COMPRESSION;
+    encoding.dwa_level = static_cast<float>(level);
+    // DWA deflates the channels it keeps lossless as the zip family does (two byte streams).
+    encoding.depth_code_type = Imf::HALF;
+    return encoding;
+}
+
 EncodedLightField encode_light_field(const StepRecord& record, const LightFieldRecord& source,
-                                     const LightFieldEncoding& encoding,
+                                     const LightFieldEncoding& archive_encoding,
                                      const std::string& relative_path) {
     const std::string where = "step " + std::to_string(record.step) + " light field of \"" +
                               source.field + "\" (" + relative_path + ")";
     const LightField& light_field = source.light_field;
     check_light_field(light_field, where);
+    const LightFieldEncoding encoding =
+        with_colour_dwa_level(archive_encoding, light_field.settings.colour_dwa_level);
 
     // Parts in camera order, whatever order the capture listed them in.
     std::vector<const LightFieldImages*> cameras;

@@ -24,10 +24,15 @@ struct LightFieldEncoding {
     /// 8-bit depth codes: UINT codes, or HALF code / 254 (light_field_exr.cpp says which is
     /// smaller under which compression).
     Imf::PixelType depth_code_type = Imf::HALF;
+    /// OpenEXR's DWA level where `compression` is DWAB (LightFieldSettings::colour_dwa_level).
+    float dwa_level = 0.0f;
 };
 /// The encoding the archive uses for "precision" and "compression" (InvalidArgument naming an
 /// unknown compression).
 LightFieldEncoding light_field_encoding(StoragePrecision precision, const std::string& compression);
+/// `archive` as a light field whose settings ask "colour_dwa_level" stores it: DWAB at that level
+/// (lossy R, G, B; lossless alpha, depths and attenuation) where it is > 0, else unchanged.
+LightFieldEncoding with_colour_dwa_level(const LightFieldEncoding& archive, double level);
 
 struct EncodedLightField {
     std::string bytes;         ///< the EXR file

@@ -1,0 +1,162 @@
+// Light-field colour stored lossily ("colour_dwa_level", LightFieldSettings): each camera's part
+// with OpenEXR's DWAB compression, which compresses R, G and B by a DCT and keeps every other
+// channel without loss. Checked on rendered maps (a renderer's colour against empty space, as a
+// capture records it): alpha and depth read back as the lossless codec reads them, colour
+// within a small error, still premultiplied (0 <= R, G, B <= A), in fewer bytes; the setting's
+// key, its checks and the part's header.
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfMultiPartInputFile.h>
+#include <OpenEXR/ImfStdIO.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "insitu/error.hpp"
+#include "insitu/render/proxy_renderer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
+#include "representation/light_field/light_field_exr.hpp"
+#include "support/expect_error.hpp"
+
+namespace insitu {
+namespace {
+
+using insitu::testing::expect_error_naming;
+
+constexpr int kMapSize = 64;
+constexpr int kStoredCameras = 4;
+
+// Four cameras of a 12-camera rig around two nested shells (the outer one faint), their ground
+// truth's colour and first-hit depth as a capture stores them.
+LightField rendered_light_field() {
+    const SampledVolume volume = make_nested_shells({32, 32, 32}, {9.0, 15.0}, {1.0, 0.6}, 1.5);
+    ProxyRenderer renderer;
+    renderer.upload(volume.field());
+    const TransferFunction tf({{0.0, {0, 0, 1, 0}}, {0.3, {0, 1, 0, 0.05f}}, {1.0, {1, 0, 0, 1}}});
+    LightField field;
+    field.settings.cameras = 12;
+    field.settings.size = kMapSize;
+    field.settings.attenuation = false;
+    field.rig = LightFieldRig::around(renderer.volume().bounds, 12, kMapSize);
+    field.transfer_function = tf;
+    for (int k = 0; k < kStoredCameras; ++k) {
+        const Rendering rendering = renderer.render_ground_truth(field.rig.camera(k), tf, {});
+        LightFieldImages images;
+        images.camera = k;
+        images.segment_rgba = {rendering.rgba};
+        images.depth = Image(kMapSize, kMapSize, 1);
+        for (int y = 0; y < kMapSize; ++y) {
+            for (int x = 0; x < kMapSize; ++x) {
+                images.depth.at(x, y, 0) = static_cast<float>(
+                    field.rig.depth_fraction(x + 0.5, y + 0.5, rendering.depth.at(x, y, 0)));
+            }
+        }
+        field.cameras.push_back(std::move(images));
+    }
+    return field;
+}
+
+struct Stored {
+    std::string bytes;
+    LightField read;
+};
+
+Stored store(LightField field, double colour_dwa_level) {
+    field.settings.colour_dwa_level = colour_dwa_level;
+    StepRecord record;
+    record.step = 7;
+    record.field = "v";
+    record.light_fields.push_back({"v", std::move(field)});
+    const archive_format::EncodedLightField encoded = archive_format::encode_light_field(
+        record, record.light_fields[0],
+        archive_format::light_field_encoding(StoragePrecision::half, "zip"), "test.exr");
+    const std::vector<char> bytes(encoded.bytes.begin(), encoded.bytes.end());
+    return {encoded.bytes, archive_format::decode_light_field(bytes, "test.exr", {}, kMapSize)};
+}
+
+TEST(LightFieldLossyColour, KeepsAlphaAndDepthLosslessAndColourPremultipliedInFewerBytes) {
+    const LightField field = rendered_light_field();
+    const Stored lossless = store(field, 0.0);
+    const Stored lossy = store(field, 45.0);
+    ASSERT_EQ(lossy.read.cameras.size(), static_cast<std::size_t>(kStoredCameras));
+    EXPECT_DOUBLE_EQ(lossy.read.settings.colour_dwa_level, 45.0);
+
+    double colour_error = 0.0, largest = 0.0;
+    std::size_t colours = 0, outside = 0, covered = 0;
+    for (int k = 0; k < kStoredCameras; ++k) {
+        const Image& exact = lossless.read.cameras[k].segment_rgba[0];
+        const Image& read = lossy.read.cameras[k].segment_rgba[0];
+        EXPECT_EQ(lossy.read.cameras[k].depth.pixels, lossless.read.cameras[k].depth.pixels)
+            << "camera " << k << ": depth must stay lossless";
+        for (std::size_t p = 0; p < exact.pixel_count(); ++p) {
+            const float alpha = read.pixels[4 * p + 3];
+            ASSERT_EQ(alpha, exact.pixels[4 * p + 3]) << "camera " << k << " pixel " << p;
+            covered += alpha > 0.1f ? 1 : 0;
+            for (int c = 0; c < 3; ++c) {
+                const float value = read.pixels[4 * p + c];
+                outside += (value < 0.0f || value > alpha) ? 1 : 0;
+                const double error = std::abs(value - exact.pixels[4 * p + c]);
+                colour_error += error;
+                largest = std::max(largest, error);
+                ++colours;
+            }
+        }
+    }
+    ASSERT_GT(covered, static_cast<std::size_t>(kStoredCameras * kMapSize * kMapSize / 16))
+        << "the shells should fill the maps";
+    EXPECT_EQ(outside, 0u) << "colour read back must stay premultiplied: 0 <= R, G, B <= A";
+    // A light field's reconstruction errs by about 6 codes of 255 on average (bench/RESULTS.md,
+    // "Light fields"); the DCT's error must stay a small part of that.
+    EXPECT_GT(largest, 0.0) << "DWA should be lossy on R, G, B";
+    EXPECT_LT(colour_error / static_cast<double>(colours), 0.5 / 255.0);
+    EXPECT_LT(largest, 16.0 / 255.0);
+    // 83 % here (64^2 maps of smooth shells); bench/RESULTS.md measures real scenes' bytes.
+    EXPECT_LT(static_cast<double>(lossy.bytes.size()), 0.9 * lossless.bytes.size())
+        << lossy.bytes.size() << " bytes lossy, " << lossless.bytes.size() << " lossless";
+}
+
+TEST(LightFieldLossyColour, PartsSayDwabAndAHigherLevelStoresFewerBytes) {
+    const Stored lossy = store(rendered_light_field(), 100.0);
+    Imf::StdISStream stream;
+    stream.str(lossy.bytes);
+    Imf::MultiPartInputFile file(stream);
+    ASSERT_EQ(file.parts(), kStoredCameras);
+    for (int p = 0; p < file.parts(); ++p) {
+        EXPECT_EQ(file.header(p).compression(), Imf::DWAB_COMPRESSION) << "part " << p;
+    }
+    // OpenEXR does not store the level (a writer's parameter); the settings' JSON does, and the
+    // bytes show it was applied.
+    EXPECT_DOUBLE_EQ(lossy.read.settings.colour_dwa_level, 100.0);
+    EXPECT_LT(lossy.bytes.size(), store(rendered_light_field(), 45.0).bytes.size());
+    const Stored lossless = store(rendered_light_field(), 0.0);
+    Imf::StdISStream plain;
+    plain.str(lossless.bytes);
+    EXPECT_EQ(Imf::MultiPartInputFile(plain).header(0).compression(), Imf::ZIP_COMPRESSION);
+}
+
+TEST(LightFieldLossyColour, SettingWritesItsKeyOnlyWhenSetAndNamesABadValue) {
+    std::vector<std::string> unknown;
+    LightFieldSettings settings;
+    EXPECT_FALSE(settings.to_json().contains("colour_dwa_level"));
+    settings.colour_dwa_level = 45.0;
+    EXPECT_EQ(settings.to_json().at("colour_dwa_level"), 45.0);
+    EXPECT_EQ(LightFieldSettings::from_json(settings.to_json(), &unknown).colour_dwa_level, 45.0);
+    EXPECT_TRUE(unknown.empty());
+    for (const char* bad : {R"({"colour_dwa_level": -1})", R"({"colour_dwa_level": 501})"}) {
+        expect_error_naming<InvalidArgument>(
+            [&] { LightFieldSettings::from_json(nlohmann::json::parse(bad), &unknown); },
+            "light_field.colour_dwa_level");
+    }
+    expect_error_naming<ParseError>(
+        [&] {
+            LightFieldSettings::from_json(nlohmann::json::parse(R"({"colour_dwa_level": "high"})"),
+                                          &unknown);
+        },
+        "light_field.colour_dwa_level\" = \"high\" (expected a number)");
+}
+
+}  // namespace
+}  // namespace insitu
