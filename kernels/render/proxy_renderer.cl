@@ -398,54 +398,121 @@ __kernel void render_proxies(
     }
 }
 
-// render_proxies' interleaving state, per lane of a packet.
+// render_proxies' per-interval accumulation for the lanes of a packet, each lane's current
+// interval held in registers. A lane's consecutive contributing samples mostly fall in one
+// interval (the field is smooth at the step), so a lane reads the interleaved outputs of an
+// interval when it enters it and writes them back when it leaves it, not at every sample: adding
+// to the outputs in memory sample by sample, one lane at a time, took a third of the packet
+// kernel's time (bench/RESULTS.md, "Where the proxy packets' time goes"). The held values are
+// the outputs' own, added to with the same float operations in the same order, so the outputs
+// are the same floats. Interleaving as render_proxies counts it: `interval` is the interval of
+// the lane's last contributing sample (-1 before any), `reentering` whether the lane's run there
+// re-entered an interval that already held light.
 typedef struct {
-    intp last_interval;
+    intp interval;
+    floatp attenuation, weighted_depth, optical_depth, entry_depth;
     intp reentering;
-    floatp reentries;
-    floatp reentered;
-} PacketInterleaving;
+    floatp reentries, reentered;
+} PacketIntervals;
 
-// Adds one sample's contribution to the interleaved per-interval outputs of the lanes in
-// `contributes`, one lane at a time (a lane's interval is data-dependent, and its pixel's
-// intervals share one or two cache lines, as in render_proxies).
-PACKET_INLINE void accumulate_lanes(intp contributes, floatp value, floatp weight, floatp depth,
-                                    floatp alpha, int gx, int gy, int2 size, int interval_count,
-                                    float uniform_interval_scale,
-                                    __global const float* interval_edges, bool want_mean_depth,
-                                    bool want_optical_depth, bool want_entry_depth,
-                                    __global float* attenuation_out, __global float* mean_depth_out,
-                                    __global float* optical_depth_out,
-                                    __global float* entry_depth_out,
-                                    PacketInterleaving* interleaving) {
+// The per-interval outputs of one packet and what of them the pass wants.
+typedef struct {
+    __global float* attenuation;
+    __global float* mean_depth;
+    __global float* optical_depth;
+    __global float* entry_depth;
+    bool want_mean_depth, want_optical_depth, want_entry_depth;
+    int interval_count;
+} IntervalOutputs;
+
+PACKET_INLINE int interval_output_index(int gx, int gy, int2 size, int interval_count, int lane,
+                                        int interval) {
+    const int2 pixel_xy = packet_pixel(gx, gy, lane);
+    return (pixel_xy.y * size.x + pixel_xy.x) * interval_count + interval;
+}
+
+// Writes the held interval of each lane of `lanes` that holds one back to the outputs.
+PACKET_INLINE void store_held_intervals(intp lanes, const PacketIntervals* held, int gx, int gy,
+                                        int2 size, const IntervalOutputs* out) {
     for (int lane = 0; lane < PACKET_LANES; ++lane) {
-        if (!LANE_INT(contributes, lane)) continue;
-        const int2 pixel_xy = packet_pixel(gx, gy, lane);
-        const int pixel = pixel_xy.y * size.x + pixel_xy.x;
-        const float v = LANE(value, lane);
-        const int j = uniform_interval_scale > 0.0f
-                          ? clamp((int)((v - interval_edges[0]) * uniform_interval_scale), 0,
-                                  interval_count - 1)
-                          : interval_of(interval_edges, interval_count, v);
-        const int index = pixel * interval_count + j;
-        // Interleaving, as render_proxies counts it.
-        if (j != LANE_INT(interleaving->last_interval, lane)) {
-            const bool reentering = attenuation_out[index] > 0.0f;
-            LANE_INT(interleaving->reentering, lane) = reentering ? -1 : 0;
-            if (reentering) LANE(interleaving->reentries, lane) += 1.0f;
-            LANE_INT(interleaving->last_interval, lane) = j;
+        const int j = LANE_INT(held->interval, lane);
+        if (!LANE_INT(lanes, lane) || j < 0) continue;
+        const int index = interval_output_index(gx, gy, size, out->interval_count, lane, j);
+        out->attenuation[index] = LANE(held->attenuation, lane);
+        if (out->want_mean_depth) out->mean_depth[index] = LANE(held->weighted_depth, lane);
+        if (out->want_optical_depth) out->optical_depth[index] = LANE(held->optical_depth, lane);
+        if (out->want_entry_depth) out->entry_depth[index] = LANE(held->entry_depth, lane);
+    }
+}
+
+// Reads interval j of each lane of `lanes` from the outputs into the held state; a lane re-enters
+// the interval when it already holds light.
+PACKET_INLINE void load_held_intervals(intp lanes, intp j, PacketIntervals* held, int gx, int gy,
+                                       int2 size, const IntervalOutputs* out) {
+    for (int lane = 0; lane < PACKET_LANES; ++lane) {
+        if (!LANE_INT(lanes, lane)) continue;
+        const int index =
+            interval_output_index(gx, gy, size, out->interval_count, lane, LANE_INT(j, lane));
+        const float a = out->attenuation[index];
+        LANE(held->attenuation, lane) = a;
+        if (out->want_mean_depth) LANE(held->weighted_depth, lane) = out->mean_depth[index];
+        if (out->want_optical_depth) LANE(held->optical_depth, lane) = out->optical_depth[index];
+        if (out->want_entry_depth) LANE(held->entry_depth, lane) = out->entry_depth[index];
+        const bool reentering = a > 0.0f;
+        LANE_INT(held->reentering, lane) = reentering ? -1 : 0;
+        if (reentering) LANE(held->reentries, lane) += 1.0f;
+        LANE_INT(held->interval, lane) = LANE_INT(j, lane);
+    }
+}
+
+// Adds one sample's contribution (weight, depth, alpha) to the intervals of the lanes in
+// `contributes`, as render_proxies adds its ray's.
+PACKET_INLINE void accumulate_intervals(intp contributes, floatp value, floatp weight, floatp depth,
+                                        floatp alpha, float uniform_interval_scale,
+                                        __global const float* interval_edges, int gx, int gy,
+                                        int2 size, const IntervalOutputs* out,
+                                        PacketIntervals* held) {
+    const int count = out->interval_count;
+    intp j;
+    if (uniform_interval_scale > 0.0f) {
+        // Uniform intervals (the default) need no search: L / (max - min) > 0.
+        j = clamp(convert_intp((value - interval_edges[0]) * uniform_interval_scale), 0, count - 1);
+    } else {
+        j = held->interval;
+        for (int lane = 0; lane < PACKET_LANES; ++lane) {
+            if (LANE_INT(contributes, lane))
+                LANE_INT(j, lane) = interval_of(interval_edges, count, LANE(value, lane));
         }
-        const float w = LANE(weight, lane);
-        if (want_entry_depth && w > 0.0f && !(attenuation_out[index] > 0.0f)) {
-            entry_depth_out[index] = LANE(depth, lane);
-        }
-        if (LANE_INT(interleaving->reentering, lane)) LANE(interleaving->reentered, lane) += w;
-        attenuation_out[index] += w;
-        if (want_mean_depth) mean_depth_out[index] += w * LANE(depth, lane);
-        if (want_optical_depth) {
+    }
+    const intp enters = contributes & (j != held->interval);
+    if (any(enters)) {
+        store_held_intervals(enters, held, gx, gy, size, out);
+        load_held_intervals(enters, j, held, gx, gy, size, out);
+    }
+    // Entry depth: where the interval first took light (none where T has underflowed and the
+    // weight is 0).
+    if (out->want_entry_depth) {
+        held->entry_depth = select(held->entry_depth, depth,
+                                   contributes & (weight > 0.0f) & ~(held->attenuation > 0.0f));
+    }
+    held->reentered =
+        select(held->reentered, held->reentered + weight, contributes & held->reentering);
+    held->attenuation = select(held->attenuation, held->attenuation + weight, contributes);
+    if (out->want_mean_depth) {
+        held->weighted_depth =
+            select(held->weighted_depth, held->weighted_depth + weight * depth, contributes);
+    }
+    if (out->want_optical_depth) {
+        // alpha = 1 would be infinite optical depth; clamp to float's largest. One lane at a
+        // time: the scalar log render_proxies takes.
+        floatp optical = 0.0f;
+        for (int lane = 0; lane < PACKET_LANES; ++lane) {
+            if (!LANE_INT(contributes, lane)) continue;
             const float a = LANE(alpha, lane);
-            optical_depth_out[index] += a < 1.0f ? -log(1.0f - a) : FLT_MAX;
+            LANE(optical, lane) = a < 1.0f ? -log(1.0f - a) : FLT_MAX;
         }
+        held->optical_depth =
+            select(held->optical_depth, held->optical_depth + optical, contributes);
     }
 }
 
@@ -536,7 +603,11 @@ __kernel void render_proxies_packets(
     intp layers_found = 0;
     floatp transmittance = 1.0f;
     intp accumulating = accumulate ? (intp)(-1) : (intp)(0);
-    PacketInterleaving interleaving = {(intp)(-1), (intp)(0), (floatp)(0.0f), (floatp)(0.0f)};
+    PacketIntervals held = {(intp)(-1),         (floatp)(0.0f), (floatp)(0.0f), (floatp)(0.0f),
+                            (floatp)(INFINITY), (intp)(0),      (floatp)(0.0f), (floatp)(0.0f)};
+    const IntervalOutputs interval_outputs = {attenuation_out,  mean_depth_out,  optical_depth_out,
+                                              entry_depth_out,  want_mean_depth, want_optical_depth,
+                                              want_entry_depth, interval_count};
     intp compositing = want_segments ? (intp)(-1) : (intp)(0);
     floatp red = 0.0f, green = 0.0f, blue = 0.0f, ray_transmittance = 1.0f;
     floatp first_hit = INFINITY;
@@ -619,10 +690,8 @@ __kernel void render_proxies_packets(
                 const floatp a = select((floatp)0.0f, alpha, contributes);
                 const floatp weight = transmittance * a;  // seed 000 Eq. 7
                 transmittance *= 1.0f - a;
-                accumulate_lanes(contributes, value, weight, depth, a, gx, gy, size, interval_count,
-                                 uniform_interval_scale, interval_edges, want_mean_depth,
-                                 want_optical_depth, want_entry_depth, attenuation_out,
-                                 mean_depth_out, optical_depth_out, entry_depth_out, &interleaving);
+                accumulate_intervals(contributes, value, weight, depth, a, uniform_interval_scale,
+                                     interval_edges, gx, gy, size, &interval_outputs, &held);
                 accumulating &= ~(contributes & (1.0f - transmittance >= stop_opacity));
             }
             // The whole ray, then the opacity segment (none unless asked for).
@@ -652,6 +721,7 @@ __kernel void render_proxies_packets(
         sample += advance;
     }
 
+    if (accumulate) store_held_intervals(in_image, &held, gx, gy, size, &interval_outputs);
     for (int lane = 0; lane < PACKET_LANES; ++lane) {
         if (!LANE_INT(in_image, lane)) continue;
         const int2 pixel_xy = packet_pixel(gx, gy, lane);
@@ -683,9 +753,8 @@ __kernel void render_proxies_packets(
         }
         if ((wanted & WANT_FIRST_HIT_DEPTH) != 0) first_hit_out[pixel] = LANE(first_hit, lane);
         if (want_interleaving) {
-            vstore2(
-                (float2)(LANE(interleaving.reentries, lane), LANE(interleaving.reentered, lane)),
-                pixel, interleaving_out);
+            vstore2((float2)(LANE(held.reentries, lane), LANE(held.reentered, lane)), pixel,
+                    interleaving_out);
         }
         if (want_mean_depth) {
             const int base = pixel * interval_count;
