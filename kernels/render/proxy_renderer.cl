@@ -617,6 +617,7 @@ __kernel void render_proxies_packets(
     floatp segment_red = 0.0f, segment_green = 0.0f, segment_blue = 0.0f;
     floatp segment_transmittance = 1.0f, segment_depth = INFINITY;
     floatp previous_value = NAN;
+    intp previous_below = 0;  // isovalues at or below previous_value
     floatp previous_t = 0.0f;
     floatp next_block_t = -INFINITY;
     intp sample = 0;  // each lane's sample index
@@ -632,8 +633,14 @@ __kernel void render_proxies_packets(
         const floatp value = select((floatp)tf_domain.x, sampled, usable);
 
         if (want_layers) {
-            const intp bracketed = usable & ~isnan(previous_value);
-            for (int l = 0; l < layer_count; ++l) {
+            // How many isovalues lie at or below each lane's value: it grows with the value, so
+            // it changes between two samples exactly where one isovalue or more lies between
+            // them, and the samples where it does not (most) skip the refinement of every layer.
+            intp below = 0;
+            for (int l = 0; l < layer_count; ++l) below -= value >= isovalues[l];  // true is -1
+            const intp bracketed = usable & ~isnan(previous_value) & (below != previous_below);
+            previous_below = below;
+            for (int l = 0; l < layer_count && any(bracketed); ++l) {
                 const float iso = isovalues[l];
                 const intp crossed =
                     bracketed & isinf(layer_t[l]) & ((previous_value >= iso) ^ (value >= iso));
