@@ -431,38 +431,32 @@ PACKET_INLINE int interval_output_index(int gx, int gy, int2 size, int interval_
     return (pixel_xy.y * size.x + pixel_xy.x) * interval_count + interval;
 }
 
-// Writes the held interval of each lane of `lanes` that holds one back to the outputs.
-PACKET_INLINE void store_held_intervals(intp lanes, const PacketIntervals* held, int gx, int gy,
-                                        int2 size, const IntervalOutputs* out) {
-    for (int lane = 0; lane < PACKET_LANES; ++lane) {
-        const int j = LANE_INT(held->interval, lane);
-        if (!LANE_INT(lanes, lane) || j < 0) continue;
-        const int index = interval_output_index(gx, gy, size, out->interval_count, lane, j);
-        out->attenuation[index] = LANE(held->attenuation, lane);
-        if (out->want_mean_depth) out->mean_depth[index] = LANE(held->weighted_depth, lane);
-        if (out->want_optical_depth) out->optical_depth[index] = LANE(held->optical_depth, lane);
-        if (out->want_entry_depth) out->entry_depth[index] = LANE(held->entry_depth, lane);
-    }
+// Writes a lane's held interval, if it holds one, back to the outputs.
+PACKET_INLINE void store_held_lane(int lane, const PacketIntervals* held, int gx, int gy,
+                                   int2 size, const IntervalOutputs* out) {
+    const int j = LANE_INT(held->interval, lane);
+    if (j < 0) return;
+    const int index = interval_output_index(gx, gy, size, out->interval_count, lane, j);
+    out->attenuation[index] = LANE(held->attenuation, lane);
+    if (out->want_mean_depth) out->mean_depth[index] = LANE(held->weighted_depth, lane);
+    if (out->want_optical_depth) out->optical_depth[index] = LANE(held->optical_depth, lane);
+    if (out->want_entry_depth) out->entry_depth[index] = LANE(held->entry_depth, lane);
 }
 
-// Reads interval j of each lane of `lanes` from the outputs into the held state; a lane re-enters
-// the interval when it already holds light.
-PACKET_INLINE void load_held_intervals(intp lanes, intp j, PacketIntervals* held, int gx, int gy,
-                                       int2 size, const IntervalOutputs* out) {
-    for (int lane = 0; lane < PACKET_LANES; ++lane) {
-        if (!LANE_INT(lanes, lane)) continue;
-        const int index =
-            interval_output_index(gx, gy, size, out->interval_count, lane, LANE_INT(j, lane));
-        const float a = out->attenuation[index];
-        LANE(held->attenuation, lane) = a;
-        if (out->want_mean_depth) LANE(held->weighted_depth, lane) = out->mean_depth[index];
-        if (out->want_optical_depth) LANE(held->optical_depth, lane) = out->optical_depth[index];
-        if (out->want_entry_depth) LANE(held->entry_depth, lane) = out->entry_depth[index];
-        const bool reentering = a > 0.0f;
-        LANE_INT(held->reentering, lane) = reentering ? -1 : 0;
-        if (reentering) LANE(held->reentries, lane) += 1.0f;
-        LANE_INT(held->interval, lane) = LANE_INT(j, lane);
-    }
+// Reads interval j of a lane from the outputs into the held state; the lane re-enters the
+// interval when it already holds light.
+PACKET_INLINE void load_held_lane(int lane, int j, PacketIntervals* held, int gx, int gy,
+                                  int2 size, const IntervalOutputs* out) {
+    const int index = interval_output_index(gx, gy, size, out->interval_count, lane, j);
+    const float a = out->attenuation[index];
+    LANE(held->attenuation, lane) = a;
+    if (out->want_mean_depth) LANE(held->weighted_depth, lane) = out->mean_depth[index];
+    if (out->want_optical_depth) LANE(held->optical_depth, lane) = out->optical_depth[index];
+    if (out->want_entry_depth) LANE(held->entry_depth, lane) = out->entry_depth[index];
+    const bool reentering = a > 0.0f;
+    LANE_INT(held->reentering, lane) = reentering ? -1 : 0;
+    if (reentering) LANE(held->reentries, lane) += 1.0f;
+    LANE_INT(held->interval, lane) = j;
 }
 
 // Adds one sample's contribution (weight, depth, alpha) to the intervals of the lanes in
@@ -486,8 +480,11 @@ PACKET_INLINE void accumulate_intervals(intp contributes, floatp value, floatp w
     }
     const intp enters = contributes & (j != held->interval);
     if (any(enters)) {
-        store_held_intervals(enters, held, gx, gy, size, out);
-        load_held_intervals(enters, j, held, gx, gy, size, out);
+        for (int lane = 0; lane < PACKET_LANES; ++lane) {
+            if (!LANE_INT(enters, lane)) continue;
+            store_held_lane(lane, held, gx, gy, size, out);
+            load_held_lane(lane, LANE_INT(j, lane), held, gx, gy, size, out);
+        }
     }
     // Entry depth: where the interval first took light (none where T has underflowed and the
     // weight is 0).
@@ -728,11 +725,11 @@ __kernel void render_proxies_packets(
         sample += advance;
     }
 
-    if (accumulate) store_held_intervals(in_image, &held, gx, gy, size, &interval_outputs);
     for (int lane = 0; lane < PACKET_LANES; ++lane) {
         if (!LANE_INT(in_image, lane)) continue;
         const int2 pixel_xy = packet_pixel(gx, gy, lane);
         const int pixel = pixel_xy.y * size.x + pixel_xy.x;
+        if (accumulate) store_held_lane(lane, &held, gx, gy, size, &interval_outputs);
         if (want_layers) {
             for (int l = 0; l < layer_count; ++l) {
                 const float t = LANE(layer_t[l], lane);
