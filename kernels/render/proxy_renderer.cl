@@ -432,8 +432,8 @@ PACKET_INLINE int interval_output_index(int gx, int gy, int2 size, int interval_
 }
 
 // Writes a lane's held interval, if it holds one, back to the outputs.
-PACKET_INLINE void store_held_lane(int lane, const PacketIntervals* held, int gx, int gy,
-                                   int2 size, const IntervalOutputs* out) {
+PACKET_INLINE void store_held_lane(int lane, const PacketIntervals* held, int gx, int gy, int2 size,
+                                   const IntervalOutputs* out) {
     const int j = LANE_INT(held->interval, lane);
     if (j < 0) return;
     const int index = interval_output_index(gx, gy, size, out->interval_count, lane, j);
@@ -445,8 +445,8 @@ PACKET_INLINE void store_held_lane(int lane, const PacketIntervals* held, int gx
 
 // Reads interval j of a lane from the outputs into the held state; the lane re-enters the
 // interval when it already holds light.
-PACKET_INLINE void load_held_lane(int lane, int j, PacketIntervals* held, int gx, int gy,
-                                  int2 size, const IntervalOutputs* out) {
+PACKET_INLINE void load_held_lane(int lane, int j, PacketIntervals* held, int gx, int gy, int2 size,
+                                  const IntervalOutputs* out) {
     const int index = interval_output_index(gx, gy, size, out->interval_count, lane, j);
     const float a = out->attenuation[index];
     LANE(held->attenuation, lane) = a;
@@ -685,9 +685,14 @@ __kernel void render_proxies_packets(
 
         const intp classify = usable & (accumulating | compositing | compositing_segment);
         if (any(classify)) {
-            floatp sample_red, sample_green, sample_blue, alpha;
-            packet_lookup_transfer(tf_table, tf_bins, tf_domain, value, 0.0f, &sample_red,
-                                   &sample_green, &sample_blue, &alpha);
+            // Colour only where segments composite; the accumulation reads the opacity alone.
+            floatp sample_red = 0.0f, sample_green = 0.0f, sample_blue = 0.0f, alpha;
+            if (want_segments) {
+                packet_lookup_transfer(tf_table, tf_bins, tf_domain, value, 0.0f, &sample_red,
+                                       &sample_green, &sample_blue, &alpha);
+            } else {
+                alpha = packet_lookup_opacity(tf_table, tf_bins, tf_domain, value);
+            }
             const floatp depth = rays.depth_origin + t * rays.depth_per_t;
             const intp contributes = usable & accumulating & (alpha > 0.0f);
             if (any(contributes)) {

@@ -518,3 +518,21 @@ PACKET_INLINE void packet_lookup_transfer(__global const float4* table4, int2 bi
     *b = mix(mix(b0, b1, fx), mix(b2, b3, fx), fy);
     *a = mix(mix(a0, a1, fx), mix(a2, a3, fx), fy);
 }
+
+// packet_lookup_transfer's opacity alone, with a gradient magnitude of 0 (unshaded): the same
+// floats where only the opacity is read (the proxies' accumulation), from two gathers of the
+// alpha column of a 1D table instead of four paired gathers of whole entries.
+PACKET_INLINE floatp packet_lookup_opacity(__global const float4* table4, int2 bins, float4 domain,
+                                           floatp value) {
+    if (bins.y != 1) {
+        floatp r, g, b, a;
+        packet_lookup_transfer(table4, bins, domain, value, 0.0f, &r, &g, &b, &a);
+        return a;
+    }
+    __global const float* table = (__global const float*)table4;
+    const floatp x = clamp((value - domain.x) * domain.y, 0.0f, 1.0f) * (float)(bins.x - 1);
+    const intp ix = min(convert_intp(x), bins.x - 2);
+    const floatp fx = x - convert_floatp(ix);
+    const intp alpha0 = 4 * ix + 3;
+    return mix(GATHER(table, alpha0), GATHER(table, alpha0 + 4), fx);
+}
