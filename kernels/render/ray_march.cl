@@ -213,8 +213,8 @@ inline float absorb(float* transmittance, float alpha) {
 // the trilinear corners and the transfer table. Every lane computes what march_ray(),
 // sample_trilinear() and lookup_transfer() compute for its ray, with the same formulas, so a
 // packet pass takes the same samples as the one-ray-per-work-item pass (tests compare the two).
-// 16 lanes ran faster than 8, both well ahead of one ray per work-item (bench/RESULTS.md, "Ray
-// packets on CPU devices, 16 lanes").
+// 16 lanes ran faster than 8, both well ahead of one ray per work-item, on AVX-512 and on AVX2
+// (bench/RESULTS.md, "Ray packets on CPU devices, 16 lanes").
 #define PACKET_LANES 16
 // The packet helpers are inlined by force: PoCL (3.1, LLVM 15) otherwise compiled packet_cell,
 // packet_cell_gradient and packet_lookup_transfer as calls, each packet of 16 lanes passed and
