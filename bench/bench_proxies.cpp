@@ -90,17 +90,23 @@ void report(const char* label, double ms, double reference_ms) {
     std::printf("  %-46s %9.1f ms  %6.2fx the ground truth\n", label, ms, ms / reference_ms);
 }
 
+// Every timed camera: 30 degrees around, 20 up, the image's size.
+OrbitView bench_view(const Options& options) {
+    OrbitView view;
+    view.azimuth_deg = 30.0;
+    view.elevation_deg = 20.0;
+    view.width = options.image;
+    view.height = options.image;
+    return view;
+}
+
 void run_scene(const char* name, const SampledVolume& volume, const TransferFunction& tf,
                const Options& options) {
     ProxyRenderer proxies;
     proxies.upload(volume.field());
     VolumeRenderer ground_truth;
     ground_truth.upload(volume.field());
-    OrbitView view;
-    view.azimuth_deg = 30.0;
-    view.elevation_deg = 20.0;
-    view.width = options.image;
-    view.height = options.image;
+    const OrbitView view = bench_view(options);
     const Camera camera = Camera::orbit(view, proxies.volume().bounds);
     const DistortionCamera distortion =
         DistortionCamera::orbit(view, proxies.volume().bounds, 45.0);
@@ -173,11 +179,7 @@ void time_single_proxies(const SampledVolume& volume, const TransferFunction& tf
                          const Options& options) {
     ProxyRenderer proxies;
     proxies.upload(volume.field());
-    OrbitView view;
-    view.azimuth_deg = 30.0;
-    view.elevation_deg = 20.0;
-    view.width = options.image;
-    view.height = options.image;
+    const OrbitView view = bench_view(options);
     const Camera camera = Camera::orbit(view, proxies.volume().bounds);
     const ProxyRequest request = default_request(proxies.volume().range, tf);
     const bench::Timing timing =
