@@ -232,6 +232,12 @@ typedef int16 intp;
               buf[(index).s5], buf[(index).s6], buf[(index).s7], buf[(index).s8], buf[(index).s9], \
               buf[(index).sa], buf[(index).sb], buf[(index).sc], buf[(index).sd], buf[(index).se], \
               buf[(index).sf]))
+// Lane k is the byte buf[index.sk], as an int.
+#define GATHER_BYTES(buf, index)                                                                 \
+    ((intp)(buf[(index).s0], buf[(index).s1], buf[(index).s2], buf[(index).s3], buf[(index).s4], \
+            buf[(index).s5], buf[(index).s6], buf[(index).s7], buf[(index).s8], buf[(index).s9], \
+            buf[(index).sa], buf[(index).sb], buf[(index).sc], buf[(index).sd], buf[(index).se], \
+            buf[(index).sf]))
 // Lanes k of two packets read as pairs: first.sk = buf[index.sk], second.sk = buf[index.sk + 1],
 // with one 8-byte element per lane where GATHER takes two 4-byte ones (index even, buf 8-byte
 // aligned). The same floats, half the gathered elements: AMD's Zen cores gather an element at a
@@ -346,12 +352,9 @@ PACKET_INLINE intp packet_block_skip(const MarchPacket* rays, floatp t, floatp x
                               rays->direction_z == 0.0f);
     *next_block_t = select(*next_block_t, fmin(fmin(t_x, t_y), t_z), look_up);
     const intp block_index = (bz * block_counts.y + by) * block_counts.x + bx;
-    intp skippable = 0;
-    for (int lane = 0; lane < PACKET_LANES; ++lane) {
-        if (LANE_INT(look_up, lane) && skippable_blocks[LANE_INT(block_index, lane)]) {
-            LANE_INT(skippable, lane) = -1;
-        }
-    }
+    // Every lane's block index is clamped into the grid of blocks, so all lanes read without a
+    // branch per lane, and those not looking up are masked after.
+    const intp skippable = look_up & (GATHER_BYTES(skippable_blocks, block_index) != 0);
     const intp last = convert_intp(ceil((*next_block_t - rays->t_near) / step - 0.5f)) - 1;
     const intp jump = skippable & (last > sample + 1);
     return select(advance, last - sample, jump);
