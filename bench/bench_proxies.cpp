@@ -3,6 +3,11 @@
 // skipping and exact early termination save. Prints figures; never a test.
 //
 //   bench_proxies [--size N] [--image P] [--repeats R] [--gray-scott-size N] [--gray-scott-steps S]
+//                 [--frames F]
+//
+// --frames F: only the single-perspective proxies of the blobs with the defaults, F frames, and
+// the CPU time of each (what compares on a machine other processes load; bench/RESULTS.md,
+// "Where the proxy packets' time goes").
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -17,6 +22,7 @@
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "machine.hpp"
+#include "median_time.hpp"
 #include "sample_count.hpp"
 
 namespace {
@@ -29,6 +35,7 @@ struct Options {
     int repeats = 3;
     int gray_scott_size = 128;
     int gray_scott_steps = 400;
+    int frames = 0;
 };
 
 Options parse(int argc, char** argv) {
@@ -46,6 +53,8 @@ Options parse(int argc, char** argv) {
             options.gray_scott_size = value;
         else if (flag == "--gray-scott-steps")
             options.gray_scott_steps = value;
+        else if (flag == "--frames")
+            options.frames = value;
         else
             throw cli::UsageError("unknown flag " + flag);
     }
@@ -81,17 +90,23 @@ void report(const char* label, double ms, double reference_ms) {
     std::printf("  %-46s %9.1f ms  %6.2fx the ground truth\n", label, ms, ms / reference_ms);
 }
 
+// Every timed camera: 30 degrees around, 20 up, the image's size.
+OrbitView bench_view(const Options& options) {
+    OrbitView view;
+    view.azimuth_deg = 30.0;
+    view.elevation_deg = 20.0;
+    view.width = options.image;
+    view.height = options.image;
+    return view;
+}
+
 void run_scene(const char* name, const SampledVolume& volume, const TransferFunction& tf,
                const Options& options) {
     ProxyRenderer proxies;
     proxies.upload(volume.field());
     VolumeRenderer ground_truth;
     ground_truth.upload(volume.field());
-    OrbitView view;
-    view.azimuth_deg = 30.0;
-    view.elevation_deg = 20.0;
-    view.width = options.image;
-    view.height = options.image;
+    const OrbitView view = bench_view(options);
     const Camera camera = Camera::orbit(view, proxies.volume().bounds);
     const DistortionCamera distortion =
         DistortionCamera::orbit(view, proxies.volume().bounds, 45.0);
@@ -159,6 +174,26 @@ void run_scene(const char* name, const SampledVolume& volume, const TransferFunc
     }
 }
 
+// --frames: the single-perspective proxies of `camera` with the defaults, timed frame by frame.
+void time_single_proxies(const SampledVolume& volume, const TransferFunction& tf,
+                         const Options& options) {
+    ProxyRenderer proxies;
+    proxies.upload(volume.field());
+    const OrbitView view = bench_view(options);
+    const Camera camera = Camera::orbit(view, proxies.volume().bounds);
+    const ProxyRequest request = default_request(proxies.volume().range, tf);
+    const bench::Timing timing =
+        bench::interleaved_timings(options.frames, {[&] { proxies.render(camera, request); }})
+            .front();
+    const double cpu_least = *std::min_element(timing.cpu_rounds.begin(), timing.cpu_rounds.end());
+    const double cpu_most = *std::max_element(timing.cpu_rounds.begin(), timing.cpu_rounds.end());
+    std::printf(
+        "single-perspective proxies, %lld^3, %d^2, %d frames: wall %.1f ms best, %.1f median, "
+        "%.1f slowest; CPU %.1f ms least, %.1f most\n",
+        static_cast<long long>(volume.dims[0]), options.image, options.frames, timing.best,
+        timing.median, timing.worst, cpu_least, cpu_most);
+}
+
 SampledVolume gray_scott_field(int size, int steps) {
     gray_scott::Parameters parameters;
     parameters.size = size;
@@ -180,6 +215,11 @@ int main(int argc, char** argv) {
                                         {0.3, {0, 1, 0, 0.02}},
                                         {0.6, {1, 1, 0, 0.05}},
                                         {1.0, {1, 0, 0, 0.1}}});
+        if (options.frames > 0) {
+            time_single_proxies(blobs, blob_tf, options);
+            insitu::bench::print_machine("end");
+            return 0;
+        }
         run_scene("Gaussian blobs", blobs, blob_tf, options);
 
         const auto start = std::chrono::steady_clock::now();

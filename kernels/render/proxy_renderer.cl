@@ -398,54 +398,118 @@ __kernel void render_proxies(
     }
 }
 
-// render_proxies' interleaving state, per lane of a packet.
+// render_proxies' per-interval accumulation for the lanes of a packet, each lane's current
+// interval held in registers. A lane's consecutive contributing samples mostly fall in one
+// interval (the field is smooth at the step), so a lane reads the interleaved outputs of an
+// interval when it enters it and writes them back when it leaves it, not at every sample: adding
+// to the outputs in memory sample by sample, one lane at a time, took a third of the packet
+// kernel's time (bench/RESULTS.md, "Where the proxy packets' time goes"). The held values are
+// the outputs' own, added to with the same float operations in the same order, so the outputs
+// are the same floats. Interleaving as render_proxies counts it: `interval` is the interval of
+// the lane's last contributing sample (-1 before any), `reentering` whether the lane's run there
+// re-entered an interval that already held light.
 typedef struct {
-    intp last_interval;
+    intp interval;
+    floatp attenuation, weighted_depth, optical_depth, entry_depth;
     intp reentering;
-    floatp reentries;
-    floatp reentered;
-} PacketInterleaving;
+    floatp reentries, reentered;
+} PacketIntervals;
 
-// Adds one sample's contribution to the interleaved per-interval outputs of the lanes in
-// `contributes`, one lane at a time (a lane's interval is data-dependent, and its pixel's
-// intervals share one or two cache lines, as in render_proxies).
-PACKET_INLINE void accumulate_lanes(intp contributes, floatp value, floatp weight, floatp depth,
-                                    floatp alpha, int gx, int gy, int2 size, int interval_count,
-                                    float uniform_interval_scale,
-                                    __global const float* interval_edges, bool want_mean_depth,
-                                    bool want_optical_depth, bool want_entry_depth,
-                                    __global float* attenuation_out, __global float* mean_depth_out,
-                                    __global float* optical_depth_out,
-                                    __global float* entry_depth_out,
-                                    PacketInterleaving* interleaving) {
-    for (int lane = 0; lane < PACKET_LANES; ++lane) {
-        if (!LANE_INT(contributes, lane)) continue;
-        const int2 pixel_xy = packet_pixel(gx, gy, lane);
-        const int pixel = pixel_xy.y * size.x + pixel_xy.x;
-        const float v = LANE(value, lane);
-        const int j = uniform_interval_scale > 0.0f
-                          ? clamp((int)((v - interval_edges[0]) * uniform_interval_scale), 0,
-                                  interval_count - 1)
-                          : interval_of(interval_edges, interval_count, v);
-        const int index = pixel * interval_count + j;
-        // Interleaving, as render_proxies counts it.
-        if (j != LANE_INT(interleaving->last_interval, lane)) {
-            const bool reentering = attenuation_out[index] > 0.0f;
-            LANE_INT(interleaving->reentering, lane) = reentering ? -1 : 0;
-            if (reentering) LANE(interleaving->reentries, lane) += 1.0f;
-            LANE_INT(interleaving->last_interval, lane) = j;
+// The per-interval outputs of one packet and what of them the pass wants.
+typedef struct {
+    __global float* attenuation;
+    __global float* mean_depth;
+    __global float* optical_depth;
+    __global float* entry_depth;
+    bool want_mean_depth, want_optical_depth, want_entry_depth;
+    int interval_count;
+} IntervalOutputs;
+
+PACKET_INLINE int interval_output_index(int gx, int gy, int2 size, int interval_count, int lane,
+                                        int interval) {
+    const int2 pixel_xy = packet_pixel(gx, gy, lane);
+    return (pixel_xy.y * size.x + pixel_xy.x) * interval_count + interval;
+}
+
+// Writes a lane's held interval, if it holds one, back to the outputs.
+PACKET_INLINE void store_held_lane(int lane, const PacketIntervals* held, int gx, int gy, int2 size,
+                                   const IntervalOutputs* out) {
+    const int j = LANE_INT(held->interval, lane);
+    if (j < 0) return;
+    const int index = interval_output_index(gx, gy, size, out->interval_count, lane, j);
+    out->attenuation[index] = LANE(held->attenuation, lane);
+    if (out->want_mean_depth) out->mean_depth[index] = LANE(held->weighted_depth, lane);
+    if (out->want_optical_depth) out->optical_depth[index] = LANE(held->optical_depth, lane);
+    if (out->want_entry_depth) out->entry_depth[index] = LANE(held->entry_depth, lane);
+}
+
+// Reads interval j of a lane from the outputs into the held state; the lane re-enters the
+// interval when it already holds light.
+PACKET_INLINE void load_held_lane(int lane, int j, PacketIntervals* held, int gx, int gy, int2 size,
+                                  const IntervalOutputs* out) {
+    const int index = interval_output_index(gx, gy, size, out->interval_count, lane, j);
+    const float a = out->attenuation[index];
+    LANE(held->attenuation, lane) = a;
+    if (out->want_mean_depth) LANE(held->weighted_depth, lane) = out->mean_depth[index];
+    if (out->want_optical_depth) LANE(held->optical_depth, lane) = out->optical_depth[index];
+    if (out->want_entry_depth) LANE(held->entry_depth, lane) = out->entry_depth[index];
+    const bool reentering = a > 0.0f;
+    LANE_INT(held->reentering, lane) = reentering ? -1 : 0;
+    if (reentering) LANE(held->reentries, lane) += 1.0f;
+    LANE_INT(held->interval, lane) = j;
+}
+
+// Adds one sample's contribution (weight, depth, alpha) to the intervals of the lanes in
+// `contributes`, as render_proxies adds its ray's.
+PACKET_INLINE void accumulate_intervals(intp contributes, floatp value, floatp weight, floatp depth,
+                                        floatp alpha, float uniform_interval_scale,
+                                        __global const float* interval_edges, int gx, int gy,
+                                        int2 size, const IntervalOutputs* out,
+                                        PacketIntervals* held) {
+    const int count = out->interval_count;
+    intp j;
+    if (uniform_interval_scale > 0.0f) {
+        // Uniform intervals (the default) need no search: L / (max - min) > 0.
+        j = clamp(convert_intp((value - interval_edges[0]) * uniform_interval_scale), 0, count - 1);
+    } else {
+        j = held->interval;
+        for (int lane = 0; lane < PACKET_LANES; ++lane) {
+            if (LANE_INT(contributes, lane))
+                LANE_INT(j, lane) = interval_of(interval_edges, count, LANE(value, lane));
         }
-        const float w = LANE(weight, lane);
-        if (want_entry_depth && w > 0.0f && !(attenuation_out[index] > 0.0f)) {
-            entry_depth_out[index] = LANE(depth, lane);
+    }
+    const intp enters = contributes & (j != held->interval);
+    if (any(enters)) {
+        for (int lane = 0; lane < PACKET_LANES; ++lane) {
+            if (!LANE_INT(enters, lane)) continue;
+            store_held_lane(lane, held, gx, gy, size, out);
+            load_held_lane(lane, LANE_INT(j, lane), held, gx, gy, size, out);
         }
-        if (LANE_INT(interleaving->reentering, lane)) LANE(interleaving->reentered, lane) += w;
-        attenuation_out[index] += w;
-        if (want_mean_depth) mean_depth_out[index] += w * LANE(depth, lane);
-        if (want_optical_depth) {
+    }
+    // Entry depth: where the interval first took light (none where T has underflowed and the
+    // weight is 0).
+    if (out->want_entry_depth) {
+        held->entry_depth = select(held->entry_depth, depth,
+                                   contributes & (weight > 0.0f) & ~(held->attenuation > 0.0f));
+    }
+    held->reentered =
+        select(held->reentered, held->reentered + weight, contributes & held->reentering);
+    held->attenuation = select(held->attenuation, held->attenuation + weight, contributes);
+    if (out->want_mean_depth) {
+        held->weighted_depth =
+            select(held->weighted_depth, held->weighted_depth + weight * depth, contributes);
+    }
+    if (out->want_optical_depth) {
+        // alpha = 1 would be infinite optical depth; clamp to float's largest. One lane at a
+        // time: the scalar log render_proxies takes.
+        floatp optical = 0.0f;
+        for (int lane = 0; lane < PACKET_LANES; ++lane) {
+            if (!LANE_INT(contributes, lane)) continue;
             const float a = LANE(alpha, lane);
-            optical_depth_out[index] += a < 1.0f ? -log(1.0f - a) : FLT_MAX;
+            LANE(optical, lane) = a < 1.0f ? -log(1.0f - a) : FLT_MAX;
         }
+        held->optical_depth =
+            select(held->optical_depth, held->optical_depth + optical, contributes);
     }
 }
 
@@ -536,7 +600,11 @@ __kernel void render_proxies_packets(
     intp layers_found = 0;
     floatp transmittance = 1.0f;
     intp accumulating = accumulate ? (intp)(-1) : (intp)(0);
-    PacketInterleaving interleaving = {(intp)(-1), (intp)(0), (floatp)(0.0f), (floatp)(0.0f)};
+    PacketIntervals held = {(intp)(-1),         (floatp)(0.0f), (floatp)(0.0f), (floatp)(0.0f),
+                            (floatp)(INFINITY), (intp)(0),      (floatp)(0.0f), (floatp)(0.0f)};
+    const IntervalOutputs interval_outputs = {attenuation_out,  mean_depth_out,  optical_depth_out,
+                                              entry_depth_out,  want_mean_depth, want_optical_depth,
+                                              want_entry_depth, interval_count};
     intp compositing = want_segments ? (intp)(-1) : (intp)(0);
     floatp red = 0.0f, green = 0.0f, blue = 0.0f, ray_transmittance = 1.0f;
     floatp first_hit = INFINITY;
@@ -546,6 +614,7 @@ __kernel void render_proxies_packets(
     floatp segment_red = 0.0f, segment_green = 0.0f, segment_blue = 0.0f;
     floatp segment_transmittance = 1.0f, segment_depth = INFINITY;
     floatp previous_value = NAN;
+    intp previous_below = 0;  // isovalues at or below previous_value
     floatp previous_t = 0.0f;
     floatp next_block_t = -INFINITY;
     intp sample = 0;  // each lane's sample index
@@ -561,8 +630,14 @@ __kernel void render_proxies_packets(
         const floatp value = select((floatp)tf_domain.x, sampled, usable);
 
         if (want_layers) {
-            const intp bracketed = usable & ~isnan(previous_value);
-            for (int l = 0; l < layer_count; ++l) {
+            // How many isovalues lie at or below each lane's value: it grows with the value, so
+            // it changes between two samples exactly where one isovalue or more lies between
+            // them, and the samples where it does not (most) skip the refinement of every layer.
+            intp below = 0;
+            for (int l = 0; l < layer_count; ++l) below -= value >= isovalues[l];  // true is -1
+            const intp bracketed = usable & ~isnan(previous_value) & (below != previous_below);
+            previous_below = below;
+            for (int l = 0; l < layer_count && any(bracketed); ++l) {
                 const float iso = isovalues[l];
                 const intp crossed =
                     bracketed & isinf(layer_t[l]) & ((previous_value >= iso) ^ (value >= iso));
@@ -610,19 +685,22 @@ __kernel void render_proxies_packets(
 
         const intp classify = usable & (accumulating | compositing | compositing_segment);
         if (any(classify)) {
-            floatp sample_red, sample_green, sample_blue, alpha;
-            packet_lookup_transfer(tf_table, tf_bins, tf_domain, value, 0.0f, &sample_red,
-                                   &sample_green, &sample_blue, &alpha);
+            // Colour only where segments composite; the accumulation reads the opacity alone.
+            floatp sample_red = 0.0f, sample_green = 0.0f, sample_blue = 0.0f, alpha;
+            if (want_segments) {
+                packet_lookup_transfer(tf_table, tf_bins, tf_domain, value, 0.0f, &sample_red,
+                                       &sample_green, &sample_blue, &alpha);
+            } else {
+                alpha = packet_lookup_opacity(tf_table, tf_bins, tf_domain, value);
+            }
             const floatp depth = rays.depth_origin + t * rays.depth_per_t;
             const intp contributes = usable & accumulating & (alpha > 0.0f);
             if (any(contributes)) {
                 const floatp a = select((floatp)0.0f, alpha, contributes);
                 const floatp weight = transmittance * a;  // seed 000 Eq. 7
                 transmittance *= 1.0f - a;
-                accumulate_lanes(contributes, value, weight, depth, a, gx, gy, size, interval_count,
-                                 uniform_interval_scale, interval_edges, want_mean_depth,
-                                 want_optical_depth, want_entry_depth, attenuation_out,
-                                 mean_depth_out, optical_depth_out, entry_depth_out, &interleaving);
+                accumulate_intervals(contributes, value, weight, depth, a, uniform_interval_scale,
+                                     interval_edges, gx, gy, size, &interval_outputs, &held);
                 accumulating &= ~(contributes & (1.0f - transmittance >= stop_opacity));
             }
             // The whole ray, then the opacity segment (none unless asked for).
@@ -656,6 +734,7 @@ __kernel void render_proxies_packets(
         if (!LANE_INT(in_image, lane)) continue;
         const int2 pixel_xy = packet_pixel(gx, gy, lane);
         const int pixel = pixel_xy.y * size.x + pixel_xy.x;
+        if (accumulate) store_held_lane(lane, &held, gx, gy, size, &interval_outputs);
         if (want_layers) {
             for (int l = 0; l < layer_count; ++l) {
                 const float t = LANE(layer_t[l], lane);
@@ -683,9 +762,8 @@ __kernel void render_proxies_packets(
         }
         if ((wanted & WANT_FIRST_HIT_DEPTH) != 0) first_hit_out[pixel] = LANE(first_hit, lane);
         if (want_interleaving) {
-            vstore2(
-                (float2)(LANE(interleaving.reentries, lane), LANE(interleaving.reentered, lane)),
-                pixel, interleaving_out);
+            vstore2((float2)(LANE(held.reentries, lane), LANE(held.reentered, lane)), pixel,
+                    interleaving_out);
         }
         if (want_mean_depth) {
             const int base = pixel * interval_count;

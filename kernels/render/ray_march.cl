@@ -213,8 +213,8 @@ inline float absorb(float* transmittance, float alpha) {
 // the trilinear corners and the transfer table. Every lane computes what march_ray(),
 // sample_trilinear() and lookup_transfer() compute for its ray, with the same formulas, so a
 // packet pass takes the same samples as the one-ray-per-work-item pass (tests compare the two).
-// 16 lanes ran faster than 8, both well ahead of one ray per work-item (bench/RESULTS.md, "Ray
-// packets on CPU devices, 16 lanes").
+// 16 lanes ran faster than 8, both well ahead of one ray per work-item, on AVX-512 and on AVX2
+// (bench/RESULTS.md, "Ray packets on CPU devices, 16 lanes").
 #define PACKET_LANES 16
 // The packet helpers are inlined by force: PoCL (3.1, LLVM 15) otherwise compiled packet_cell,
 // packet_cell_gradient and packet_lookup_transfer as calls, each packet of 16 lanes passed and
@@ -232,6 +232,12 @@ typedef int16 intp;
               buf[(index).s5], buf[(index).s6], buf[(index).s7], buf[(index).s8], buf[(index).s9], \
               buf[(index).sa], buf[(index).sb], buf[(index).sc], buf[(index).sd], buf[(index).se], \
               buf[(index).sf]))
+// Lane k is the byte buf[index.sk], as an int.
+#define GATHER_BYTES(buf, index)                                                                 \
+    ((intp)(buf[(index).s0], buf[(index).s1], buf[(index).s2], buf[(index).s3], buf[(index).s4], \
+            buf[(index).s5], buf[(index).s6], buf[(index).s7], buf[(index).s8], buf[(index).s9], \
+            buf[(index).sa], buf[(index).sb], buf[(index).sc], buf[(index).sd], buf[(index).se], \
+            buf[(index).sf]))
 // Lanes k of two packets read as pairs: first.sk = buf[index.sk], second.sk = buf[index.sk + 1],
 // with one 8-byte element per lane where GATHER takes two 4-byte ones (index even, buf 8-byte
 // aligned). The same floats, half the gathered elements: AMD's Zen cores gather an element at a
@@ -346,12 +352,9 @@ PACKET_INLINE intp packet_block_skip(const MarchPacket* rays, floatp t, floatp x
                               rays->direction_z == 0.0f);
     *next_block_t = select(*next_block_t, fmin(fmin(t_x, t_y), t_z), look_up);
     const intp block_index = (bz * block_counts.y + by) * block_counts.x + bx;
-    intp skippable = 0;
-    for (int lane = 0; lane < PACKET_LANES; ++lane) {
-        if (LANE_INT(look_up, lane) && skippable_blocks[LANE_INT(block_index, lane)]) {
-            LANE_INT(skippable, lane) = -1;
-        }
-    }
+    // Every lane's block index is clamped into the grid of blocks, so all lanes read without a
+    // branch per lane, and those not looking up are masked after.
+    const intp skippable = look_up & (GATHER_BYTES(skippable_blocks, block_index) != 0);
     const intp last = convert_intp(ceil((*next_block_t - rays->t_near) / step - 0.5f)) - 1;
     const intp jump = skippable & (last > sample + 1);
     return select(advance, last - sample, jump);
@@ -517,4 +520,22 @@ PACKET_INLINE void packet_lookup_transfer(__global const float4* table4, int2 bi
     *g = mix(mix(g0, g1, fx), mix(g2, g3, fx), fy);
     *b = mix(mix(b0, b1, fx), mix(b2, b3, fx), fy);
     *a = mix(mix(a0, a1, fx), mix(a2, a3, fx), fy);
+}
+
+// packet_lookup_transfer's opacity alone, with a gradient magnitude of 0 (unshaded): the same
+// floats where only the opacity is read (the proxies' accumulation), from two gathers of the
+// alpha column of a 1D table instead of four paired gathers of whole entries.
+PACKET_INLINE floatp packet_lookup_opacity(__global const float4* table4, int2 bins, float4 domain,
+                                           floatp value) {
+    if (bins.y != 1) {
+        floatp r, g, b, a;
+        packet_lookup_transfer(table4, bins, domain, value, 0.0f, &r, &g, &b, &a);
+        return a;
+    }
+    __global const float* table = (__global const float*)table4;
+    const floatp x = clamp((value - domain.x) * domain.y, 0.0f, 1.0f) * (float)(bins.x - 1);
+    const intp ix = min(convert_intp(x), bins.x - 2);
+    const floatp fx = x - convert_floatp(ix);
+    const intp alpha0 = 4 * ix + 3;
+    return mix(GATHER(table, alpha0), GATHER(table, alpha0 + 4), fx);
 }
