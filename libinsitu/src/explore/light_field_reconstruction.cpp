@@ -303,22 +303,16 @@ private:
                  distance + depth_tolerance(distance, map, kSurfaceFootprints));
     }
 
-    // Occlusion: where no camera around the ray recorded its hit and some recorded a surface in
-    // front of it, a camera further out may see the ray's surface: their icosphere neighbours,
-    // nearest the ray's direction first. Its hit counts where no camera around sees through it;
-    // it takes the weight of those that passed by (the blend's weights stay the barycentric
-    // ones). Returns the samples now present.
-    int substitute(Samples& samples, int present, const RaySpan& span) const {
-        double hidden_weight = 0.0;
-        for (int i = 0; i < present; ++i) {
-            const CameraSample& sample = samples[static_cast<std::size_t>(i)];
-            if (sample.hit_t) return present;
-            if (sample.passes_by) hidden_weight += sample.weight;
-        }
-        if (!(hidden_weight > 0.0)) return present;
+    // The cameras further out than those around the ray, as substitute() searches them: their
+    // icosphere neighbours, then the neighbours' neighbours (two rings: up to 60 degrees from the
+    // ray with 42 cameras), each ring nearest the ray's direction first. A second ring finds the
+    // ray's surface where the whole first ring is occluded too (bench/RESULTS.md, "Light-field
+    // cracks: a second ring of substitutes").
+    std::vector<int> substitute_candidates(const Samples& samples, int present,
+                                           const glm::dvec3& direction) const {
         std::vector<int> candidates;
-        for (int i = 0; i < present; ++i) {
-            for (const int k : neighbours_[static_cast<std::size_t>(samples[i].camera)]) {
+        const auto add_neighbours = [&](int camera) {
+            for (const int k : neighbours_[static_cast<std::size_t>(camera)]) {
                 const bool around =
                     std::any_of(samples.begin(), samples.begin() + present,
                                 [k](const CameraSample& s) { return s.camera == k; });
@@ -327,13 +321,38 @@ private:
                     candidates.push_back(k);
                 }
             }
-        }
-        const glm::dvec3 towards_eye = -span.ray.direction;
+        };
         const auto& vertices = rig_.icosphere().vertices;
-        std::sort(candidates.begin(), candidates.end(), [&](int a, int b) {
-            return glm::dot(vertices[static_cast<std::size_t>(a)], towards_eye) >
-                   glm::dot(vertices[static_cast<std::size_t>(b)], towards_eye);
-        });
+        const auto sort_ring = [&](std::size_t first) {
+            std::sort(candidates.begin() + static_cast<std::ptrdiff_t>(first), candidates.end(),
+                      [&](int a, int b) {
+                          return glm::dot(vertices[static_cast<std::size_t>(a)], -direction) >
+                                 glm::dot(vertices[static_cast<std::size_t>(b)], -direction);
+                      });
+        };
+        for (int i = 0; i < present; ++i)
+            add_neighbours(samples[static_cast<std::size_t>(i)].camera);
+        sort_ring(0);
+        const std::size_t first_ring = candidates.size();
+        for (std::size_t c = 0; c < first_ring; ++c) add_neighbours(candidates[c]);
+        sort_ring(first_ring);
+        return candidates;
+    }
+
+    // Occlusion: where no camera around the ray recorded its hit and some recorded a surface in
+    // front of it, a camera further out may see the ray's surface (substitute_candidates()). Its
+    // hit counts where no camera around sees through it; it takes the weight of those that
+    // passed by (the blend's weights stay the barycentric ones). Returns the samples now present.
+    int substitute(Samples& samples, int present, const RaySpan& span) const {
+        double hidden_weight = 0.0;
+        for (int i = 0; i < present; ++i) {
+            const CameraSample& sample = samples[static_cast<std::size_t>(i)];
+            if (sample.hit_t) return present;
+            if (sample.passes_by) hidden_weight += sample.weight;
+        }
+        if (!(hidden_weight > 0.0)) return present;
+        const std::vector<int> candidates =
+            substitute_candidates(samples, present, span.ray.direction);
         for (const int k : candidates) {
             const LightFieldImages* images = table_[static_cast<std::size_t>(k)];
             const auto hit = first_hit(rig_.camera(k), images->depth, span.ray, span.t0, span.t1);
