@@ -71,6 +71,7 @@ public:
                   scales_.begin());
         spacing_rad_ = camera_spacing_rad(rig_.icosphere());
         neighbours_ = icosphere_neighbours(rig_);
+        for (const LightFieldImages* images : table_) held_.push_back(images != nullptr ? 1 : 0);
         bounds_ = detail::depth_bounds(rig_, table_);
 
         const int w = target.width(), h = target.height();
@@ -303,44 +304,8 @@ private:
                  distance + depth_tolerance(distance, map, kSurfaceFootprints));
     }
 
-    // The cameras further out than those around the ray, as substitute() searches them: their
-    // icosphere neighbours, then the neighbours' neighbours (two rings: up to 60 degrees from the
-    // ray with 42 cameras), each ring nearest the ray's direction first. A second ring finds the
-    // ray's surface where the whole first ring is occluded too (bench/RESULTS.md, "Light-field
-    // cracks: a second ring of substitutes").
-    std::vector<int> substitute_candidates(const Samples& samples, int present,
-                                           const glm::dvec3& direction) const {
-        std::vector<int> candidates;
-        const auto add_neighbours = [&](int camera) {
-            for (const int k : neighbours_[static_cast<std::size_t>(camera)]) {
-                const bool around =
-                    std::any_of(samples.begin(), samples.begin() + present,
-                                [k](const CameraSample& s) { return s.camera == k; });
-                if (!around && table_[static_cast<std::size_t>(k)] != nullptr &&
-                    std::find(candidates.begin(), candidates.end(), k) == candidates.end()) {
-                    candidates.push_back(k);
-                }
-            }
-        };
-        const auto& vertices = rig_.icosphere().vertices;
-        const auto sort_ring = [&](std::size_t first) {
-            std::sort(candidates.begin() + static_cast<std::ptrdiff_t>(first), candidates.end(),
-                      [&](int a, int b) {
-                          return glm::dot(vertices[static_cast<std::size_t>(a)], -direction) >
-                                 glm::dot(vertices[static_cast<std::size_t>(b)], -direction);
-                      });
-        };
-        for (int i = 0; i < present; ++i)
-            add_neighbours(samples[static_cast<std::size_t>(i)].camera);
-        sort_ring(0);
-        const std::size_t first_ring = candidates.size();
-        for (std::size_t c = 0; c < first_ring; ++c) add_neighbours(candidates[c]);
-        sort_ring(first_ring);
-        return candidates;
-    }
-
     // Occlusion: where no camera around the ray recorded its hit and some recorded a surface in
-    // front of it, a camera further out may see the ray's surface (substitute_candidates()). Its
+    // front of it, a camera further out may see the ray's surface (cameras_further_out()). Its
     // hit counts where no camera around sees through it; it takes the weight of those that
     // passed by (the blend's weights stay the barycentric ones). Returns the samples now present.
     int substitute(Samples& samples, int present, const RaySpan& span) const {
@@ -351,8 +316,10 @@ private:
             if (sample.passes_by) hidden_weight += sample.weight;
         }
         if (!(hidden_weight > 0.0)) return present;
+        std::vector<int> around;
+        for (int i = 0; i < present; ++i) around.push_back(samples[i].camera);
         const std::vector<int> candidates =
-            substitute_candidates(samples, present, span.ray.direction);
+            detail::cameras_further_out(rig_, neighbours_, around, held_, span.ray.direction);
         for (const int k : candidates) {
             const LightFieldImages* images = table_[static_cast<std::size_t>(k)];
             const auto hit = first_hit(rig_.camera(k), images->depth, span.ray, span.t0, span.t1);
@@ -579,6 +546,7 @@ private:
     detail::DepthBoundsTable bounds_;  ///< of each depth map first_hit reads
     std::vector<double> scales_;
     std::vector<std::vector<int>> neighbours_;  ///< by camera: its neighbours on the icosphere
+    std::vector<char> held_;                    ///< by camera: whether the light field holds it
     double spacing_rad_ = 1.0;
     // Rows are disjoint, so the workers write their pixels without locks.
     LightFieldReconstruction result_;
