@@ -493,10 +493,39 @@ bool isAround(int k) {
   return false;
 }
 
+// The cameras further out that substitute() searches, nearest the ray's direction first within
+// each ring: up to every camera but the three around.
+const int MAX_CANDIDATES = 40;
+int gCandidates[MAX_CANDIDATES];
+float gNearness[MAX_CANDIDATES];
+int gCandidateCount;
+
+// Camera k's icosphere neighbours that are neither around the ray, missing, nor listed yet,
+// added to the ring that starts at ringStart in order of nearness to the ray's direction
+// (std::sort's order).
+void addNeighbours(int k, int ringStart) {
+  int first = tableAt(uNeighboursAt + k), last = tableAt(uNeighboursAt + k + 1);
+  for (int e = first; e < last && gCandidateCount < MAX_CANDIDATES; ++e) {
+    int n = tableAt(e);
+    bool known = isAround(n) || tableAt(uSlotsAt + n) < 0;
+    for (int c = 0; c < gCandidateCount && !known; ++c) known = gCandidates[c] == n;
+    if (known) continue;
+    float score = dot(vertexAt(n), -gDirection);
+    int at = gCandidateCount++;
+    while (at > ringStart && gNearness[at - 1] < score) {
+      gCandidates[at] = gCandidates[at - 1];
+      gNearness[at] = gNearness[at - 1];
+      --at;
+    }
+    gCandidates[at] = n;
+    gNearness[at] = score;
+  }
+}
+
 // Occlusion (substitute()): where no camera around the ray recorded its hit and some recorded a
-// surface in front of it, their icosphere neighbours, nearest the ray's direction first, are
-// searched; the first whose hit no camera around sees through is read with the weight of those
-// that pass by.
+// surface in front of it, the cameras further out are searched, their icosphere neighbours
+// first, then the neighbours' neighbours, each ring nearest the ray's direction first; the first
+// whose hit no camera around sees through is read with the weight of those that pass by.
 void substitute() {
   float hiddenWeight = 0.0;
   for (int i = 0; i < gCount; ++i) {
@@ -504,31 +533,13 @@ void substitute() {
     if (gPassesBy[i]) hiddenWeight += gWeight[i];
   }
   if (!(hiddenWeight > 0.0)) return;
-  const int MAX_CANDIDATES = 24;
-  int candidates[MAX_CANDIDATES];
-  float nearness[MAX_CANDIDATES];
-  int count = 0;
-  for (int i = 0; i < gAround; ++i) {
-    int first = tableAt(uNeighboursAt + gIndex[i]), last = tableAt(uNeighboursAt + gIndex[i] + 1);
-    for (int e = first; e < last && count < MAX_CANDIDATES; ++e) {
-      int k = tableAt(e);
-      bool known = isAround(k) || tableAt(uSlotsAt + k) < 0;
-      for (int c = 0; c < count && !known; ++c) known = candidates[c] == k;
-      if (known) continue;
-      // Inserted in order of nearness to the ray's direction (std::sort's order).
-      float score = dot(vertexAt(k), -gDirection);
-      int at = count++;
-      while (at > 0 && nearness[at - 1] < score) {
-        candidates[at] = candidates[at - 1];
-        nearness[at] = nearness[at - 1];
-        --at;
-      }
-      candidates[at] = k;
-      nearness[at] = score;
-    }
-  }
+  gCandidateCount = 0;
+  for (int i = 0; i < gAround; ++i) addNeighbours(gIndex[i], 0);
+  int firstRing = gCandidateCount;
+  for (int c = 0; c < firstRing; ++c) addNeighbours(gCandidates[c], firstRing);
+  int count = gCandidateCount;
   for (int c = 0; c < count; ++c) {
-    int k = candidates[c];
+    int k = gCandidates[c];
     int slot = tableAt(uSlotsAt + k);
     RigCamera camera = rigCamera(k);
     float hit = firstHit(camera, slot, gOrigin, gDirection, gT0, gT1);

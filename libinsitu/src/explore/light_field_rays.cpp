@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <glm/geometric.hpp>
 #include <vector>
 
@@ -68,6 +69,36 @@ std::vector<std::vector<int>> icosphere_neighbours(const LightFieldRig& rig) {
         }
     }
     return neighbours;
+}
+
+std::vector<int> cameras_further_out(const LightFieldRig& rig,
+                                     const std::vector<std::vector<int>>& neighbours,
+                                     const std::vector<int>& around, const std::vector<char>& held,
+                                     const glm::dvec3& direction) {
+    std::vector<int> candidates;
+    const auto add_neighbours = [&](int camera) {
+        for (const int k : neighbours[static_cast<std::size_t>(camera)]) {
+            if (held[static_cast<std::size_t>(k)] != 0 &&
+                std::find(around.begin(), around.end(), k) == around.end() &&
+                std::find(candidates.begin(), candidates.end(), k) == candidates.end()) {
+                candidates.push_back(k);
+            }
+        }
+    };
+    const auto& vertices = rig.icosphere().vertices;
+    const auto sort_ring = [&](std::size_t first) {
+        std::sort(candidates.begin() + static_cast<std::ptrdiff_t>(first), candidates.end(),
+                  [&](int a, int b) {
+                      return glm::dot(vertices[static_cast<std::size_t>(a)], -direction) >
+                             glm::dot(vertices[static_cast<std::size_t>(b)], -direction);
+                  });
+    };
+    for (const int k : around) add_neighbours(k);
+    sort_ring(0);
+    const std::size_t first_ring = candidates.size();
+    for (std::size_t c = 0; c < first_ring; ++c) add_neighbours(candidates[c]);
+    sort_ring(first_ring);
+    return candidates;
 }
 
 }  // namespace insitu::detail

@@ -1,7 +1,7 @@
 #pragma once
 // Where a target ray meets a light field's rig (light_field_reconstruction.hpp, step 1): its
-// chord through the bounding sphere and the cameras around it, and the bilinear taps with which
-// a camera's map is read; the rig's camera spacing.
+// chord through the bounding sphere, the cameras around it and those further out, and the
+// bilinear taps with which a camera's map is read; the rig's camera spacing.
 #include <array>
 #include <cstddef>
 #include <glm/vec2.hpp>
@@ -40,6 +40,17 @@ Taps bilinear_taps(int size, const glm::dvec2& map_position);
 
 // Each camera's neighbours on the icosphere (the cameras it shares a triangle edge with).
 std::vector<std::vector<int>> icosphere_neighbours(const LightFieldRig& rig);
+
+// The cameras further out than those `around` a ray, in the order the reconstruction's
+// substitute() searches them: their icosphere neighbours, then the neighbours' neighbours (two
+// rings: up to about 60 degrees from the ray with 42 cameras), each ring nearest the ray's
+// direction first; only cameras the light field holds (`held`, by camera). A second ring finds
+// the ray's surface where the whole first ring is occluded too (bench/RESULTS.md, "Light-field
+// cracks: a second ring of substitutes").
+std::vector<int> cameras_further_out(const LightFieldRig& rig,
+                                     const std::vector<std::vector<int>>& neighbours,
+                                     const std::vector<int>& around, const std::vector<char>& held,
+                                     const glm::dvec3& direction);
 
 // Mean angle between neighbouring cameras, seen from the centre: the scale of the angular term.
 double camera_spacing_rad(const Icosphere& icosphere);

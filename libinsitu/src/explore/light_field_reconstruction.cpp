@@ -71,6 +71,7 @@ public:
                   scales_.begin());
         spacing_rad_ = camera_spacing_rad(rig_.icosphere());
         neighbours_ = icosphere_neighbours(rig_);
+        for (const LightFieldImages* images : table_) held_.push_back(images != nullptr ? 1 : 0);
         bounds_ = detail::depth_bounds(rig_, table_);
 
         const int w = target.width(), h = target.height();
@@ -304,10 +305,9 @@ private:
     }
 
     // Occlusion: where no camera around the ray recorded its hit and some recorded a surface in
-    // front of it, a camera further out may see the ray's surface: their icosphere neighbours,
-    // nearest the ray's direction first. Its hit counts where no camera around sees through it;
-    // it takes the weight of those that passed by (the blend's weights stay the barycentric
-    // ones). Returns the samples now present.
+    // front of it, a camera further out may see the ray's surface (cameras_further_out()). Its
+    // hit counts where no camera around sees through it; it takes the weight of those that
+    // passed by (the blend's weights stay the barycentric ones). Returns the samples now present.
     int substitute(Samples& samples, int present, const RaySpan& span) const {
         double hidden_weight = 0.0;
         for (int i = 0; i < present; ++i) {
@@ -316,24 +316,10 @@ private:
             if (sample.passes_by) hidden_weight += sample.weight;
         }
         if (!(hidden_weight > 0.0)) return present;
-        std::vector<int> candidates;
-        for (int i = 0; i < present; ++i) {
-            for (const int k : neighbours_[static_cast<std::size_t>(samples[i].camera)]) {
-                const bool around =
-                    std::any_of(samples.begin(), samples.begin() + present,
-                                [k](const CameraSample& s) { return s.camera == k; });
-                if (!around && table_[static_cast<std::size_t>(k)] != nullptr &&
-                    std::find(candidates.begin(), candidates.end(), k) == candidates.end()) {
-                    candidates.push_back(k);
-                }
-            }
-        }
-        const glm::dvec3 towards_eye = -span.ray.direction;
-        const auto& vertices = rig_.icosphere().vertices;
-        std::sort(candidates.begin(), candidates.end(), [&](int a, int b) {
-            return glm::dot(vertices[static_cast<std::size_t>(a)], towards_eye) >
-                   glm::dot(vertices[static_cast<std::size_t>(b)], towards_eye);
-        });
+        std::vector<int> around;
+        for (int i = 0; i < present; ++i) around.push_back(samples[i].camera);
+        const std::vector<int> candidates =
+            detail::cameras_further_out(rig_, neighbours_, around, held_, span.ray.direction);
         for (const int k : candidates) {
             const LightFieldImages* images = table_[static_cast<std::size_t>(k)];
             const auto hit = first_hit(rig_.camera(k), images->depth, span.ray, span.t0, span.t1);
@@ -560,6 +546,7 @@ private:
     detail::DepthBoundsTable bounds_;  ///< of each depth map first_hit reads
     std::vector<double> scales_;
     std::vector<std::vector<int>> neighbours_;  ///< by camera: its neighbours on the icosphere
+    std::vector<char> held_;                    ///< by camera: whether the light field holds it
     double spacing_rad_ = 1.0;
     // Rows are disjoint, so the workers write their pixels without locks.
     LightFieldReconstruction result_;
