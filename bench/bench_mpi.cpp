@@ -1,6 +1,5 @@
 // bench_mpi: what a distributed Instrument costs each rank (issue 16), and a model of its
 // compositing at 64 to 4096 ranks. Prints figures; never a test.
-//
 //   mpirun -np N bench_mpi [--size 128] [--image 256] [--steps 5] [--layers 4] [--intervals 16]
 //                          [--archive DIR] [--latency-us A --bandwidth-gbs B] [--radix K]
 //                          [--compositing direct_send|radix_k|auto]
@@ -30,8 +29,8 @@
 // --budget checks an error budget of PSNR dB at every step ("check_every": 1, everything it
 // may choose): rank 0 gathers the field and measures the candidates on it (the gather counts as
 // composite ms; the check as rank 0's march ms, and as the other ranks' wait in composite ms).
-// Rank 0 prints the steps (the slowest rank's times, the bytes of all ranks), then one row per
-// rank: best / median / spread (max - min) over the steps, the bench/median_time.hpp way.
+// Rank 0 prints each rank's binding (bench/mpi_binding.hpp), the steps (the slowest rank's
+// times, all ranks' bytes), one row per rank: best / median / spread over the steps.
 //
 // Then the model: Hockney's t = messages x latency + bytes / bandwidth per rank, with latency and
 // bandwidth measured here by a ping-pong between ranks 0 and 1 (or given), for
@@ -49,10 +48,9 @@
 // an upper bound for direct send: a rank sends only the pixels its block covers. The model
 // leaves out blending, contention and the compression IceT applies to empty pixels.
 //
-// Reference, as text (no figures of it are reproduced here): Moreland, Kendall, Peterka, Huang,
-// "An Image Compositing Solution at Scale", SC11 (doi:10.1145/2063384.2063417), compares binary
-// swap, radix-k and their optimisations inside IceT and demonstrates IceT's compositing on 64K
-// cores of the Intrepid Blue Gene/P; see the paper for its compositing times.
+// Reference, as text (no figures of it reproduced): Moreland, Kendall, Peterka, Huang, "An
+// Image Compositing Solution at Scale", SC11 (doi:10.1145/2063384.2063417): binary swap, radix-k
+// and their optimisations in IceT, on 64K cores of Intrepid (Blue Gene/P); see it for times.
 #include <mpi.h>
 
 #include <algorithm>
@@ -79,6 +77,7 @@
 #include "insitu/mpi.hpp"
 #include "machine.hpp"
 #include "median_time.hpp"
+#include "mpi_binding.hpp"
 
 namespace {
 
@@ -437,6 +436,7 @@ int run(const Options& options) {
         }
         std::printf("compositing: %s, radix %d\n", options.compositing.c_str(), options.radix);
     }
+    insitu::bench::print_binding(comm, rank, ranks);
 
     simulation.step();
     execute(1);  // builds the kernels, sizes the buffers: not counted

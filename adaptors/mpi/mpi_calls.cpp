@@ -38,6 +38,21 @@ void* receive_data(Bytes& bytes) {
     return bytes.empty() ? no_bytes : bytes.data();
 }
 
+// Which of the ranks of `comm` on this node this one is, and how many: a split by shared memory,
+// made and freed here (once, with the communicator: a blocking collective is fine there).
+NodeShare node_share(MPI_Comm comm) {
+    MPI_Comm node = MPI_COMM_NULL;
+    check(MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node), "communicator",
+          "MPI_Comm_split_type");
+    NodeShare share;
+    const int rank_status = MPI_Comm_rank(node, &share.index);
+    const int size_status = MPI_Comm_size(node, &share.count);
+    MPI_Comm_free(&node);
+    check(rank_status, "communicator", "MPI_Comm_rank");
+    check(size_status, "communicator", "MPI_Comm_size");
+    return share;
+}
+
 // Waits until `requests` complete: MPI_Testall in a loop, spinning for the first 50 us (a
 // message in flight completes within that), then sleeping an eighth of the time waited so far
 // (between 20 and 500 us), so that a long wait for another rank leaves the core to this

@@ -9,9 +9,14 @@
 #include <string>
 #include <vector>
 
+#include "insitu/device/compute_device.hpp"
 #include "insitu/parallel/communicator.hpp"
 
 namespace insitu::mpi {
+
+/// Which of the ranks of `comm` on this node (MPI_COMM_TYPE_SHARED) this one is, and how many
+/// there are: each takes that share of a CPU device (insitu/device/compute_device.hpp).
+NodeShare node_share(MPI_Comm comm);
 
 /// MPI's own message for an error code.
 std::string error_text(int code);

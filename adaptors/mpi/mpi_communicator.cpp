@@ -503,6 +503,9 @@ std::shared_ptr<Communicator> communicator(MPI_Comm comm) {
     check(MPI_Finalized(&finalized), "communicator", "MPI_Finalized");
     if (finalized != 0) fail<StateError>("MPI communicator: made after MPI_Finalize");
     if (comm == MPI_COMM_NULL) fail<InvalidArgument>("MPI communicator: comm is MPI_COMM_NULL");
+    // The ranks on one node each take their part of a CPU device (before the device is made:
+    // a device made earlier keeps what it took).
+    ComputeDevice::share_node(node_share(comm));
     return std::make_shared<MpiCommunicator>(comm);
 }
 

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
@@ -35,6 +36,30 @@ TEST(ComputeDevice, SharedDeviceExistsAndDescribesItself) {
     EXPECT_GT(device->description().size(), 4u);
     // The same object every time.
     EXPECT_EQ(ComputeDevice::shared().get(), device.get());
+}
+
+// Processes that share a node each take an equal part of a CPU device (at least one compute
+// unit); the part runs a kernel as the whole device does. INSITU_DEVICE_SHARE=off (the MPI tests
+// compare whole archives: tests/mpi/CMakeLists.txt, mpi_device_share) keeps the whole device.
+TEST(ComputeDevice, AProcessOfTwoOnANodeTakesHalfACpuDevice) {
+    ComputeDevice whole("");
+    if (!whole.opencl().is_cpu()) GTEST_SKIP() << "GPUs are never split: " << whole.description();
+    ComputeDevice half("", NodeShare{1, 2});
+    const unsigned units = whole.compute_units();
+    EXPECT_EQ(half.compute_units(), units >= 2 ? units / 2 : units) << half.description();
+    if (units >= 2) {
+        EXPECT_THAT(half.description(), HasSubstr("compute units, part 1"));
+    }
+    EXPECT_EQ(ComputeDevice("", NodeShare{0, 1}).compute_units(), units);
+    ::setenv("INSITU_DEVICE_SHARE", "off", 1);
+    EXPECT_EQ(ComputeDevice("", NodeShare{1, 2}).compute_units(), units);
+    ::setenv("INSITU_DEVICE_SHARE", "sometimes", 1);
+    insitu::testing::expect_error_naming<InvalidArgument>(
+        [] {
+            ComputeDevice("", NodeShare{1, 2});
+        },
+        "INSITU_DEVICE_SHARE = \"sometimes\"");
+    ::unsetenv("INSITU_DEVICE_SHARE");
 }
 
 TEST(ComputeDevice, EmbeddedFamiliesIncludeTheGroundTruthAndCommonHelpers) {

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <mpi.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <iostream>
 #include <memory>
@@ -13,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "insitu/device/compute_device.hpp"
 #include "insitu/error.hpp"
 #include "insitu/mpi.hpp"
 #include "insitu/parallel/communicator.hpp"
@@ -59,6 +61,22 @@ protected:
 TEST_F(MpiCommunicatorTest, RankAndSizeAreThoseOfTheCommunicator) {
     EXPECT_EQ(communicator->rank(), rank);
     EXPECT_EQ(communicator->size(), size);
+}
+
+// The ranks on one node (here every rank) each take an equal part of the CPU device's compute
+// units, at least one, when the communicator is made before the process's device
+// (INSITU_DEVICE_SHARE, insitu/device/compute_device.hpp); one rank keeps the whole device.
+TEST_F(MpiCommunicatorTest, TheRanksOfANodeShareTheCpuDevice) {
+    const std::shared_ptr<insitu::ComputeDevice> device = insitu::ComputeDevice::shared();
+    const insitu::ComputeDevice whole("");
+    const unsigned units = whole.compute_units();
+    const unsigned part = std::max(1u, units / static_cast<unsigned>(size));
+    if (size == 1 || part >= units) {
+        EXPECT_EQ(device->compute_units(), units) << device->description();
+    } else {
+        EXPECT_EQ(device->compute_units(), part) << device->description();
+        EXPECT_THAT(device->description(), HasSubstr(" compute units, part "));
+    }
 }
 
 TEST_F(MpiCommunicatorTest, RanksOfASubCommunicator) {

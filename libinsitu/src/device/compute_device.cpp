@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "device/device_share.hpp"
 #include "device/kernel_constants.hpp"
 #include "device/opencl_device.hpp"
 
@@ -137,13 +138,15 @@ std::string opencl_status_name(cl_int status) {
     }
 }
 
-OpenClDevice::OpenClDevice(const std::string& selector) {
+OpenClDevice::OpenClDevice(const std::string& selector, const NodeShare& share) {
     try {
         const Choice choice = choose_device(selector);
         platform_ = choice.platform;
-        device_ = choice.device;
-        description_ = describe(platform_, device_);
+        std::string note;
+        device_ = take_share(choice.device, share, note);
+        description_ = describe(platform_, device_) + (note.empty() ? "" : " (" + note + ")");
         is_cpu_ = (device_.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
+        compute_units_ = device_.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
         context_ = cl::Context(device_);
         queue_ = cl::CommandQueue(context_, device_);
     } catch (const cl::Error& error) {
@@ -329,19 +332,45 @@ void OpenClDevice::download(const cl::Buffer& buffer, void* host, std::size_t by
 
 }  // namespace detail
 
-std::shared_ptr<ComputeDevice> ComputeDevice::shared() {
-    static std::mutex mutex;
-    static std::shared_ptr<ComputeDevice> instance;
-    std::lock_guard<std::mutex> lock(mutex);
-    if (!instance) {
-        const char* selector = std::getenv("INSITU_OPENCL_DEVICE");
-        instance = std::make_shared<ComputeDevice>(selector ? selector : "");
-    }
-    return instance;
+namespace {
+
+// The process-wide device and the node share it is made with, under one lock.
+struct SharedDevice {
+    std::mutex mutex;
+    std::shared_ptr<ComputeDevice> instance;
+    NodeShare share;
+};
+
+SharedDevice& shared_device() {
+    static SharedDevice device;
+    return device;
 }
 
-ComputeDevice::ComputeDevice(const std::string& selector)
-    : opencl_(std::make_unique<detail::OpenClDevice>(selector)) {}
+}  // namespace
+
+std::shared_ptr<ComputeDevice> ComputeDevice::shared() {
+    SharedDevice& device = shared_device();
+    std::lock_guard<std::mutex> lock(device.mutex);
+    if (!device.instance) {
+        const char* selector = std::getenv("INSITU_OPENCL_DEVICE");
+        device.instance = std::make_shared<ComputeDevice>(selector ? selector : "", device.share);
+    }
+    return device.instance;
+}
+
+bool ComputeDevice::share_node(NodeShare share) {
+    SharedDevice& device = shared_device();
+    std::lock_guard<std::mutex> lock(device.mutex);
+    device.share = share;
+    return !device.instance;
+}
+
+ComputeDevice::ComputeDevice(const std::string& selector, NodeShare share)
+    : opencl_(std::make_unique<detail::OpenClDevice>(selector, share)) {}
+
+unsigned ComputeDevice::compute_units() const {
+    return opencl_->compute_units();
+}
 
 ComputeDevice::~ComputeDevice() = default;
 

@@ -51,7 +51,9 @@ struct ArgumentCount<ArgumentPack<Values...>> {
 
 class OpenClDevice {
 public:
-    explicit OpenClDevice(const std::string& selector);
+    /// The device `selector` picks, or this process's part of it where `share` says the node is
+    /// shared (device/device_share.hpp).
+    explicit OpenClDevice(const std::string& selector, const NodeShare& share = {});
 
     /// "platform name / device name".
     const std::string& description() const { return description_; }
@@ -62,6 +64,8 @@ public:
     /// where a work-group's work-items run one after another; a GPU runs work-items in SIMD lanes
     /// of its own, and 16 rays per work-item would only cut its parallelism.
     bool is_cpu() const { return is_cpu_; }
+    /// The compute units of the device taken (a part's where the node is shared).
+    unsigned compute_units() const { return compute_units_; }
 
     /// A kernel from the embedded source of `family` (kernels/<stage>/<family>.cl), building that
     /// family on first use with the shared constants of device/kernel_constants.hpp as -D options.
@@ -141,6 +145,7 @@ private:
     cl::CommandQueue queue_;
     std::string description_;
     bool is_cpu_ = false;  ///< asked once: every pass consults it
+    unsigned compute_units_ = 0;
     bool synchronous_launches_ = false;
     std::mutex program_mutex_;
     std::mutex launch_mutex_;
