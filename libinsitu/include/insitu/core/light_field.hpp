@@ -84,9 +84,8 @@ struct LightFieldSettings {
     /// "colour_dwa_level": 0 stores the colour as the archive stores everything, lossless; > 0
     /// stores each camera with OpenEXR's DWAB compression at this level, which compresses the
     /// R, G and B channels lossily (a DCT of 8x8 blocks) and every other channel (alpha, depths,
-    /// attenuation) without loss. The colour maps are then about 40 % of the stored bytes for a
-    /// fraction of a code of error, far below the reconstruction's (bench/RESULTS.md, "Light-field
-    /// bytes"). In [0, kMaxColourDwaLevel].
+    /// attenuation) without loss: fewer bytes for an error far below the reconstruction's
+    /// (bench/RESULTS.md, "Light-field colour stored lossily"). In [0, kMaxColourDwaLevel].
     double colour_dwa_level = 0.0;
 
     /// InvalidArgument naming the "light_field" key and value of the first bad member.
