@@ -335,15 +335,18 @@ ArchiveWriter::ArchiveWriter(const InstrumentConfig& config)
     manifest["producer"] = std::string("libinsitu ") + INSITU_VERSION;
     manifest["configuration"] = std::move(configuration);
     for (const fs::path& folder : folders) af::remove_temp_files(folder);
-    // Only against an index read whole (manifest.json and the journal replayed into it): a folder
-    // whose manifest.json is gone still holds the steps its journal lists, and they stay.
-    if (indexed) remove_unlisted_files(archive, manifest);
     // Writing both indexes whole now makes a fresh archive open (with no steps), catches an
     // unwritable directory at start-up, folds in the journal a killed run left and repairs a
     // data.csv it left behind or torn. The journal goes only once manifest.json holds its steps.
     af::write_manifest(path_, manifest);
     af::remove_file_durably(archive / af::kJournalFile);
     af::write_cinema_csv(path_, manifest);
+    // Only against an index read whole (manifest.json and the journal replayed into it): a folder
+    // whose manifest.json is gone still holds the steps its journal lists, and they stay. Only
+    // after data.csv is rewritten from the index: a killed run's rows can name a step the index
+    // never got, and a writer killed between removing its files and rewriting data.csv left rows
+    // naming files that were gone (ArchiveCrash.KilledWriterLeavesAnArchiveWithEveryCompletedStep).
+    if (indexed) remove_unlisted_files(archive, manifest);
     steps_ = af::manifest_steps(manifest);
     compacted_steps_ = steps_.size();
 }
