@@ -10,94 +10,13 @@
 #include <limits>
 
 #include "insitu/error.hpp"
+#include "insitu/testing/reference_grid.hpp"
 
 namespace insitu::reference {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-
-// Below this |gradient| (field units per world unit) a sample has no usable normal and stays
-// unshaded (the same threshold the definition states).
-constexpr double kMinShadingGradient = 1e-12;
-
-// The field as the definition sees it: voxel coordinates, non-finite input read as NaN (empty).
-class VoxelGrid {
-public:
-    explicit VoxelGrid(const Field& field) : field_(field), dims_(field.dims()) {}
-
-    double voxel(std::int64_t i, std::int64_t j, std::int64_t k) const {
-        const double value = field_.value(i, j, k);
-        return std::isfinite(value) ? value : kNaN;
-    }
-
-    // Trilinear interpolation at `p` (voxel coordinates), clamped to the grid. A sample that
-    // touches a NaN voxel is NaN: empty space has no value to blend with.
-    double trilinear(glm::dvec3 p) const {
-        std::int64_t base[3];
-        double fraction[3];
-        for (int axis = 0; axis < 3; ++axis) {
-            const double last = static_cast<double>(dims_[axis] - 1);
-            const double clamped = std::clamp(p[axis], 0.0, last);
-            // The cell's lower corner; the last grid point belongs to the last cell.
-            base[axis] = std::min(static_cast<std::int64_t>(std::floor(clamped)), dims_[axis] - 2);
-            fraction[axis] = clamped - static_cast<double>(base[axis]);
-        }
-        double sum = 0.0;
-        for (int corner = 0; corner < 8; ++corner) {
-            double weight = 1.0;
-            std::int64_t index[3];
-            for (int axis = 0; axis < 3; ++axis) {
-                const bool upper = (corner >> axis) & 1;
-                index[axis] = base[axis] + (upper ? 1 : 0);
-                weight *= upper ? fraction[axis] : 1.0 - fraction[axis];
-            }
-            const double value = voxel(index[0], index[1], index[2]);
-            if (std::isnan(value)) return kNaN;
-            sum += weight * value;
-        }
-        return sum;
-    }
-
-    // Central differences of trilinear samples one voxel apart, divided by 2 * spacing:
-    // field units per world unit.
-    glm::dvec3 gradient(glm::dvec3 p, glm::dvec3 spacing) const {
-        glm::dvec3 g;
-        for (int axis = 0; axis < 3; ++axis) {
-            glm::dvec3 offset(0.0);
-            offset[axis] = 1.0;
-            g[axis] = (trilinear(p + offset) - trilinear(p - offset)) / (2.0 * spacing[axis]);
-        }
-        return g;
-    }
-
-private:
-    const Field& field_;
-    Index3 dims_;
-};
-
-// Slab test against the world box. Returns false when the ray misses; t_near is clipped to 0 so
-// that a ray starting inside the box starts where it is.
-bool clip_to_box(const Ray& ray, const Bounds& box, double& t_near, double& t_far) {
-    t_near = 0.0;
-    t_far = kInfinity;
-    for (int axis = 0; axis < 3; ++axis) {
-        const double origin = ray.origin[axis];
-        const double direction = ray.direction[axis];
-        if (direction == 0.0) {
-            // Parallel to this slab: inside it for every t, or never.
-            if (origin < box.lower[axis] || origin > box.upper[axis]) return false;
-            continue;
-        }
-        double t0 = (box.lower[axis] - origin) / direction;
-        double t1 = (box.upper[axis] - origin) / direction;
-        if (t0 > t1) std::swap(t0, t1);
-        t_near = std::max(t_near, t0);
-        t_far = std::min(t_far, t1);
-    }
-    return t_near <= t_far;
-}
 
 struct PixelResult {
     glm::dvec3 colour{0.0};
@@ -147,8 +66,7 @@ PixelResult march(const Ray& ray, const VoxelGrid& grid, const Field& field, con
         if (settings.shading && gradient_magnitude > kMinShadingGradient) {
             // The normal turned to face the light: |n.l|. With a headlight h = l, so n.h = n.l.
             const double n_dot_l = std::abs(glm::dot(gradient / gradient_magnitude, light));
-            colour = colour * (phong.ambient + phong.diffuse * n_dot_l) +
-                     glm::dvec3(phong.specular * std::pow(n_dot_l, phong.shininess));
+            colour = headlight_phong(colour, 1.0, n_dot_l, phong);
         }
 
         // Front to back, premultiplied.
