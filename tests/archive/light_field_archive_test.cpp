@@ -14,6 +14,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -31,6 +32,7 @@
 #include "representation/light_field/light_field_exr.hpp"
 #include "support/expect_error.hpp"
 #include "support/half_precision.hpp"
+#include "support/light_field_images.hpp"
 #include "support/test_files.hpp"
 
 namespace insitu {
@@ -643,20 +645,10 @@ TEST_F(LightFieldArchive, DepthCodeTypeIsTheSmallerUnderEachCompression) {
     field.settings = with;
     field.transfer_function = tf;
     for (int k = 0; k < 4; ++k) {
-        const Rendering rendering = renderer.render_ground_truth(field.rig.camera(k), tf, {});
-        LightFieldImages images;
-        images.camera = k;
-        images.segment_rgba = {rendering.rgba};
-        images.depth = Image(with.size, with.size, 1);
-        int hits = 0;
-        for (int y = 0; y < with.size; ++y) {
-            for (int x = 0; x < with.size; ++x) {
-                const double fraction =
-                    field.rig.depth_fraction(x + 0.5, y + 0.5, rendering.depth.at(x, y, 0));
-                images.depth.at(x, y, 0) = static_cast<float>(fraction);
-                hits += std::isfinite(fraction) ? 1 : 0;
-            }
-        }
+        LightFieldImages images = testing::images_from_rendering(
+            field.rig, k, renderer.render_ground_truth(field.rig.camera(k), tf, {}));
+        const auto hits = std::count_if(images.depth.pixels.begin(), images.depth.pixels.end(),
+                                        [](float fraction) { return std::isfinite(fraction); });
         ASSERT_GT(hits, with.size * with.size / 8) << "the shells should fill the maps";
         field.cameras.push_back(std::move(images));
     }

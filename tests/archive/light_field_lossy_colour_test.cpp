@@ -20,6 +20,7 @@
 #include "insitu/testing/analytic_fields.hpp"
 #include "representation/light_field/light_field_exr.hpp"
 #include "support/expect_error.hpp"
+#include "support/light_field_images.hpp"
 
 namespace insitu {
 namespace {
@@ -43,18 +44,8 @@ LightField rendered_light_field() {
     field.rig = LightFieldRig::around(renderer.volume().bounds, 12, kMapSize);
     field.transfer_function = tf;
     for (int k = 0; k < kStoredCameras; ++k) {
-        const Rendering rendering = renderer.render_ground_truth(field.rig.camera(k), tf, {});
-        LightFieldImages images;
-        images.camera = k;
-        images.segment_rgba = {rendering.rgba};
-        images.depth = Image(kMapSize, kMapSize, 1);
-        for (int y = 0; y < kMapSize; ++y) {
-            for (int x = 0; x < kMapSize; ++x) {
-                images.depth.at(x, y, 0) = static_cast<float>(
-                    field.rig.depth_fraction(x + 0.5, y + 0.5, rendering.depth.at(x, y, 0)));
-            }
-        }
-        field.cameras.push_back(std::move(images));
+        field.cameras.push_back(testing::images_from_rendering(
+            field.rig, k, renderer.render_ground_truth(field.rig.camera(k), tf, {})));
     }
     return field;
 }

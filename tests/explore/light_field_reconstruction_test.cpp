@@ -25,6 +25,7 @@
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/metrics.hpp"
 #include "support/expect_error.hpp"
+#include "support/light_field_images.hpp"
 
 namespace insitu {
 namespace {
@@ -102,16 +103,7 @@ LightField build_light_field(ProxyRenderer& renderer, int cameras, int map_size,
     const LightFieldRig& rig = light_field.rig;
     for (int k = 0; k < cameras; ++k) {
         const Rendering truth = renderer.render_ground_truth(rig.camera(k), tf, exact_march());
-        LightFieldImages images;
-        images.camera = k;
-        images.segment_rgba = {truth.rgba};
-        images.depth = Image(map_size, map_size, 1);
-        for (int y = 0; y < map_size; ++y) {
-            for (int x = 0; x < map_size; ++x) {
-                images.depth.at(x, y, 0) = static_cast<float>(
-                    rig.depth_fraction(x + 0.5, y + 0.5, truth.depth.at(x, y, 0)));
-            }
-        }
+        LightFieldImages images = testing::images_from_rendering(rig, k, truth);
         if (intervals) {
             ProxyRequest request;
             request.depth_layers = false;
