@@ -103,6 +103,7 @@ LightFieldSettings settings(int depth_bits, bool attenuation,
     result.segments = segments;
     result.attenuation = attenuation;
     result.depth_bits = depth_bits;
+    result.rim_threshold = 0.0;  // hand-made light fields have rims only where a test adds them
     return result;
 }
 
@@ -304,10 +305,39 @@ TEST_F(LightFieldArchive, RimDepthRoundTripsAsTheFirstHitsDepth) {
         EXPECT_NE(file.header(0).channels().findChannel("camera0.rim.depth"), nullptr);
     }
     config_.on_existing = OnExisting::replace;
-    const LightField without = write_and_load(hand_made(settings(8, false)));
+    LightFieldSettings none = settings(8, false);
+    none.rim_threshold = 0.0;
+    const LightField without = write_and_load(hand_made(none));
     EXPECT_TRUE(without.cameras[0].rim_depth.pixels.empty());
     Imf::MultiPartInputFile file(light_field_file(10).c_str());
     EXPECT_EQ(file.header(0).channels().findChannel("camera0.rim.depth"), nullptr);
+}
+
+// Rims became a default (kDefaultRimThreshold) after archives were written whose light-field
+// header has no "rim_threshold" and no rim channel: those still read, as light fields without
+// rims. The old header is made by blanking the key in a new one (the same length, so the file
+// stays whole; the header's JSON is stored as written, keys sorted).
+TEST_F(LightFieldArchive, HeaderWithoutRimKeyReadsAsWithoutRims) {
+    LightFieldSettings none = settings(8, false);
+    none.rim_threshold = 0.0;
+    ArchiveWriter(config_).write(step_with(10, hand_made(none)));
+    std::string bytes = read_text(light_field_file(10));
+    const std::string key = "\"rim_threshold\":0.0,";
+    const std::size_t at = bytes.find(key);
+    ASSERT_NE(at, std::string::npos) << "the header should hold " << key;
+    const std::uint32_t crc = file_crc(light_field_file(10));
+    bytes.replace(at, key.size(), std::string(key.size(), ' '));
+    write_text(light_field_file(10), bytes);
+    // The manifest's CRC of the part follows, as the writer of such an archive recorded it.
+    std::string manifest = read_text(archive() / "manifest.json");
+    const std::size_t recorded = manifest.find(std::to_string(crc));
+    ASSERT_NE(recorded, std::string::npos);
+    manifest.replace(recorded, std::to_string(crc).size(),
+                     std::to_string(file_crc(light_field_file(10))));
+    write_text(archive() / "manifest.json", manifest);
+    const LightField read = ArchiveReader(archive().string()).load_light_field(10, "v");
+    EXPECT_EQ(read.settings.rim_threshold, 0.0);
+    EXPECT_TRUE(read.cameras[0].rim_depth.pixels.empty());
 }
 
 TEST_F(LightFieldArchive, LoadsOnlyTheCamerasAskedFor) {

@@ -40,6 +40,7 @@ LightField rendered_light_field() {
     LightField field;
     field.settings.cameras = 12;
     field.settings.size = kMapSize;
+    field.settings.rim_threshold = 0.0;  // no rim images
     field.settings.attenuation = false;
     field.rig = LightFieldRig::around(renderer.volume().bounds, 12, kMapSize);
     field.transfer_function = tf;

@@ -483,17 +483,21 @@ TEST(LightFieldSettings, JsonRoundTrips) {
     LightFieldSettings defaults;
     const json written = defaults.to_json();
     EXPECT_EQ(written, json::parse(R"({"cameras": 42, "size": 256, "segments": "none",
-        "attenuation": true, "depth_bits": 8, "depth_threshold": 0.3})"));
+        "attenuation": true, "depth_bits": 8, "depth_threshold": 0.3, "rim_threshold": 0.05})"));
     std::vector<std::string> unknown;
     const LightFieldSettings back = LightFieldSettings::from_json(written, &unknown);
     EXPECT_TRUE(unknown.empty());
     EXPECT_EQ(back.to_json(), written);
-    // A rim threshold is written only where there is one: headers without it read as before.
-    LightFieldSettings rims;
-    rims.rim_threshold = 0.05;
-    EXPECT_EQ(rims.to_json().at("rim_threshold"), 0.05);
-    EXPECT_EQ(LightFieldSettings::from_json(rims.to_json(), &unknown).rim_threshold, 0.05);
-    EXPECT_EQ(LightFieldSettings::from_json(written, &unknown).rim_threshold, 0.0);
+    // Rims are on by default and the threshold is always written, none included: a
+    // configuration without the key takes the default, while a light field's header without it
+    // was written before that default and holds none (LightFieldArchive.HeaderWithoutRimKey...).
+    LightFieldSettings none;
+    none.rim_threshold = 0.0;
+    EXPECT_EQ(none.to_json().at("rim_threshold"), 0.0);
+    EXPECT_EQ(LightFieldSettings::from_json(none.to_json(), &unknown).rim_threshold, 0.0);
+    json without = written;
+    without.erase("rim_threshold");
+    EXPECT_EQ(LightFieldSettings::from_json(without, &unknown).rim_threshold, kDefaultRimThreshold);
 
     const json opacity = json::parse(R"({"cameras": 642, "size": 64, "segments": [0.3, 0.7],
         "attenuation": false, "depth_bits": 16, "depth_threshold": 0.25})");
@@ -505,7 +509,10 @@ TEST(LightFieldSettings, JsonRoundTrips) {
     EXPECT_FALSE(parsed.attenuation);
     EXPECT_EQ(parsed.depth_bits, 16);
     EXPECT_EQ(parsed.depth_threshold, 0.25);
-    EXPECT_EQ(parsed.to_json(), opacity);
+    EXPECT_EQ(parsed.rim_threshold, kDefaultRimThreshold);
+    json with_rims = opacity;
+    with_rims["rim_threshold"] = kDefaultRimThreshold;
+    EXPECT_EQ(parsed.to_json(), with_rims);
 
     const LightFieldSettings layers =
         LightFieldSettings::from_json(json{{"segments", "layers"}}, &unknown);

@@ -290,6 +290,7 @@ TEST(LightFieldCapture, LayerSegmentsSplitBetweenTheSamplesAroundTheCrossing) {
     const TransferFunction fog({{range.min, {1, 1, 1, alpha}}, {range.max, {1, 1, 1, alpha}}});
     LightFieldSettings settings = settings_for(SegmentRule::layers);
     settings.depth_threshold = 0.01;
+    settings.rim_threshold = 0.0;  // a rim must lie below the first hit's threshold
     LightFieldRequest request = request_for(settings, fog);
     request.isovalues = {0.0};
     const LightField light_field = capture_light_field(renderer, rig, request);

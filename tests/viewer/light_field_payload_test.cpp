@@ -29,6 +29,7 @@ LightField small_light_field(int segments, int depth_bits) {
     light_field.settings.cameras = 12;
     light_field.settings.size = 8;
     light_field.settings.depth_bits = depth_bits;
+    light_field.settings.rim_threshold = 0.0;  // no rim images here unless a test adds them
     if (segments > 1) {
         light_field.settings.segments = SegmentRule::opacity;
         light_field.settings.opacity_thresholds = {0.5};

@@ -140,7 +140,11 @@ void LightFieldSettings::validate() const {
         settings_out_of_range(settings_key("rim_threshold"), rim_threshold,
                               "opacity of the rim's depth, must be 0 (none) or in (0, "
                               "depth_threshold = ",
-                              depth_threshold, ")");
+                              depth_threshold, ")",
+                              rim_threshold == kDefaultRimThreshold
+                                  ? "; it is the default: a depth_threshold this low needs a "
+                                    "lower rim_threshold, or 0"
+                                  : "");
     }
     if (!(colour_dwa_level >= 0.0 && colour_dwa_level <= kMaxColourDwaLevel)) {
         settings_out_of_range(settings_key("colour_dwa_level"), colour_dwa_level,
@@ -162,7 +166,8 @@ json LightFieldSettings::to_json() const {
                    {"depth_threshold", depth_threshold}};
     // Only where it is not 1: full-size maps keep the header that readers before it take.
     if (attenuation_subsampling != 1) object["attenuation_subsampling"] = attenuation_subsampling;
-    if (rim_threshold != 0.0) object["rim_threshold"] = rim_threshold;
+    // Always: a header without it reads as having no rims (written before they were a default).
+    object["rim_threshold"] = rim_threshold;
     if (colour_dwa_level != 0.0) object["colour_dwa_level"] = colour_dwa_level;
     return object;
 }

@@ -289,6 +289,8 @@ void read_light_field_attributes(const Imf::Header& header, LightField& light_fi
             std::vector<std::string> unknown;
             LightFieldSettings settings = LightFieldSettings::from_json(json, &unknown);
             if (!unknown.empty()) fail<ParseError>("unknown key \"", unknown.front(), "\"");
+            // Written before rims were a default (kDefaultRimThreshold): it holds none.
+            if (!json.contains("rim_threshold")) settings.rim_threshold = 0.0;
             settings.validate();
             return settings;
         });
