@@ -238,13 +238,17 @@ typedef int16 intp;
             buf[(index).s5], buf[(index).s6], buf[(index).s7], buf[(index).s8], buf[(index).s9], \
             buf[(index).sa], buf[(index).sb], buf[(index).sc], buf[(index).sd], buf[(index).se], \
             buf[(index).sf]))
-// Lanes k of two packets read as pairs: first.sk = buf[index.sk], second.sk = buf[index.sk + 1],
-// with one 8-byte element per lane where GATHER takes two 4-byte ones (index even, buf 8-byte
-// aligned). The same floats, half the gathered elements: AMD's Zen cores gather an element at a
-// time (bench/RESULTS.md, "Where a sample's cycles go on AMD EPYC").
-PACKET_INLINE void gather_pairs(__global const float* buf, intp index, floatp* first,
+// Lanes k of two packets read as pairs: first.sk = buf[index.sk + offset], second.sk =
+// buf[index.sk + offset + 1], with one 8-byte element per lane where GATHER takes two 4-byte ones
+// (index and offset even, buf 8-byte aligned). The same floats, half the gathered elements: AMD's
+// Zen cores gather an element at a time (bench/RESULTS.md, "Where a sample's cycles go on AMD
+// EPYC"). The offset, the same for every lane, moves the base pointer, so the gathers of one
+// table entry share one index per lane: without AVX-512 each lane's index leaves the vector
+// register on its own, and one offset index vector per gather cost 5 % of the unshaded
+// ground truth's instructions (bench/RESULTS.md, "The ground truth on AVX2").
+PACKET_INLINE void gather_pairs(__global const float* buf, intp index, int offset, floatp* first,
                                 floatp* second) {
-    __global const ulong* pairs = (__global const ulong*)buf;
+    __global const ulong* pairs = (__global const ulong*)buf + offset / 2;
     const intp q = index >> 1;
     const ulong8 low = (ulong8)(pairs[q.s0], pairs[q.s1], pairs[q.s2], pairs[q.s3], pairs[q.s4],
                                 pairs[q.s5], pairs[q.s6], pairs[q.s7]);
@@ -492,10 +496,10 @@ PACKET_INLINE void packet_lookup_transfer(__global const float4* table4, int2 bi
     // per row instead of eight.
     floatp r0, g0, b0, a0, r1, g1, b1, a1;
     if (bins.y == 1) {
-        gather_pairs(table, e0, &r0, &g0);
-        gather_pairs(table, e0 + 2, &b0, &a0);
-        gather_pairs(table, e0 + 4, &r1, &g1);
-        gather_pairs(table, e0 + 6, &b1, &a1);
+        gather_pairs(table, e0, 0, &r0, &g0);
+        gather_pairs(table, e0, 2, &b0, &a0);
+        gather_pairs(table, e0, 4, &r1, &g1);
+        gather_pairs(table, e0, 6, &b1, &a1);
         *r = mix(r0, r1, fx);
         *g = mix(g0, g1, fx);
         *b = mix(b0, b1, fx);
@@ -506,16 +510,16 @@ PACKET_INLINE void packet_lookup_transfer(__global const float4* table4, int2 bi
     const intp iy = min(convert_intp(y), bins.y - 2);
     const floatp fy = y - convert_floatp(iy);
     const intp row0 = e0 + 4 * iy * bins.x;  // row iy, entry ix
-    const intp row1 = row0 + 4 * bins.x;
+    const int row1 = 4 * bins.x;             // the next row, from row0
     floatp r2, g2, b2, a2, r3, g3, b3, a3;
-    gather_pairs(table, row0, &r0, &g0);
-    gather_pairs(table, row0 + 2, &b0, &a0);
-    gather_pairs(table, row0 + 4, &r1, &g1);
-    gather_pairs(table, row0 + 6, &b1, &a1);
-    gather_pairs(table, row1, &r2, &g2);
-    gather_pairs(table, row1 + 2, &b2, &a2);
-    gather_pairs(table, row1 + 4, &r3, &g3);
-    gather_pairs(table, row1 + 6, &b3, &a3);
+    gather_pairs(table, row0, 0, &r0, &g0);
+    gather_pairs(table, row0, 2, &b0, &a0);
+    gather_pairs(table, row0, 4, &r1, &g1);
+    gather_pairs(table, row0, 6, &b1, &a1);
+    gather_pairs(table, row0, row1, &r2, &g2);
+    gather_pairs(table, row0, row1 + 2, &b2, &a2);
+    gather_pairs(table, row0, row1 + 4, &r3, &g3);
+    gather_pairs(table, row0, row1 + 6, &b3, &a3);
     *r = mix(mix(r0, r1, fx), mix(r2, r3, fx), fy);
     *g = mix(mix(g0, g1, fx), mix(g2, g3, fx), fy);
     *b = mix(mix(b0, b1, fx), mix(b2, b3, fx), fy);
