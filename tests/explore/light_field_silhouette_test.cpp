@@ -81,9 +81,8 @@ TEST(LightFieldSilhouettes, TheBoxsEdgesAndGrazedFacesAreNotFaded) {
         view.elevation_deg = elevation;
         view.width = view.height = kTarget;
         const Camera target = Camera::orbit(view, bounds);
-        const Image truth = renderer.render_ground_truth(target, request.transfer_function,
-                                                         truth_settings)
-                                .rgba;
+        const Image truth =
+            renderer.render_ground_truth(target, request.transfer_function, truth_settings).rgba;
         const Image result = reconstruct_light_field(light_field, target, {}).rgba;
         int faded = 0, box = 0;
         for (std::size_t p = 0; p < truth.pixel_count(); ++p) {

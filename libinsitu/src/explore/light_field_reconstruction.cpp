@@ -383,8 +383,8 @@ private:
             CameraSample& sample = samples[static_cast<std::size_t>(i)];
             sample.blend_weight = sample.weight;
             if (sample.hit_t) {
-                sample.blend_weight *= detail::silhouette_share(
-                    sample.images->depth, rig_.map_size(), sample.read_map);
+                sample.blend_weight *= detail::silhouette_share(sample.images->depth,
+                                                                rig_.map_size(), sample.read_map);
             }
         }
     }
