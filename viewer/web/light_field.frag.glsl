@@ -20,8 +20,9 @@
 //     by), else at their blend;
 //  4. per segment (its own depth search where there are several), RGBA read bilinearly where
 //     each camera sees the hit; the cameras that hold something of the ray blend with
-//     renormalised weights; segments composite front to back, segment s with its opacity
-//     scaled: A' = 1 - (1 - A)^k;
+//     renormalised weights, those that see the hit within 2 map pixels of their own silhouette
+//     scaled down to 0.05 on it (setBlendWeights); segments composite front to back, segment s
+//     with its opacity scaled: A' = 1 - (1 - A)^k;
 //  5. (BASIS) the target camera's depth of the first hit, its t blended over the cameras that
 //     recorded one (LightFieldReconstruction::depth): what lighting and occlusion read; with
 //     SAMPLES, the cameras that see the ray (at most three), where each was read and its weight,
@@ -426,6 +427,7 @@ int gAround;          // of which the first gAround are those around the ray
 int gSlot[MAX_READ];
 int gIndex[MAX_READ];
 float gWeight[MAX_READ];  // renormalised over the cameras around; a substitute takes theirs
+float gBlend[MAX_READ];   // the weight its colour blends with (set_blend_weights)
 RigCamera gCamera[MAX_READ];
 float gHit[MAX_READ];     // whole-ray first hit along the ray, -1 none
 float gReadT[MAX_READ];   // where it reads the ray: its hit, or the others' (tRead)
@@ -606,6 +608,32 @@ float readWithoutHits(float tCentre) {
   return tRead;
 }
 
+// How far inside camera i's own silhouette a map position lies, as a share of the blend
+// (silhouette_share in light_field_rays.cpp): the distance to the nearest texel that recorded no
+// first hit, over 2 texels, clamped to [0.05, 1].
+float silhouetteShare(int i, vec2 map) {
+  const int REACH = 3;
+  ivec2 centre = ivec2(floor(map));
+  float nearest = float(REACH);
+  for (int y = max(centre.y - REACH, 0); y <= min(centre.y + REACH, uMapSize - 1); ++y) {
+    for (int x = max(centre.x - REACH, 0); x <= min(centre.x + REACH, uMapSize - 1); ++x) {
+      if (recorded(texelDistance(gSlot[i], ivec2(x, y)))) continue;
+      vec2 off = max(abs(map - (vec2(x, y) + 0.5)) - 0.5, vec2(0.0));
+      nearest = min(nearest, length(off));
+    }
+  }
+  return clamp(nearest / 2.0, 0.05, 1.0);
+}
+
+// The weights the colours and attenuation blend with (set_blend_weights): a camera that sees the
+// hit near its own silhouette gives way to those that see it from inside.
+void setBlendWeights() {
+  for (int i = 0; i < gCount; ++i) {
+    gBlend[i] = gWeight[i];
+    if (gHit[i] >= 0.0) gBlend[i] *= silhouetteShare(i, project(gCamera[i], rayAt(gReadT[i])));
+  }
+}
+
 // The cameras' first hits blended over those that recorded one: (their weight, t).
 vec2 blendedHit() {
   float hitWeight = 0.0, hitT = 0.0;
@@ -693,6 +721,7 @@ void main() {
   placeCameras(presentWeight, tCentre);
   substitute();
   float tRead = readWithoutHits(readRims(tCentre));
+  setBlendWeights();
 
   vec3 colour = vec3(0.0);
   float transmittance = 1.0;
@@ -711,8 +740,8 @@ void main() {
       bool passesBy = hit < 0.0 && gRim[i] < 0.0 && recorded(storedDistance(layer, map));
       if (passesBy) continue;
       vec4 read = bilinear(gSlot[i] * uSegments + s, map);
-      blended += gWeight[i] * read;
-      segmentWeight += gWeight[i];
+      blended += gBlend[i] * read;
+      segmentWeight += gBlend[i];
       cameraColour[i].rgb += cameraTransmittance[i] * read.rgb;
       cameraTransmittance[i] *= 1.0 - clamp(read.a, 0.0, 1.0);
     }
@@ -748,7 +777,7 @@ void main() {
   for (int i = 0; i < gCount && seeing < 3; ++i) {
     if (gPassesBy[i]) continue;
     vec2 map = project(gCamera[i], rayAt(gReadT[i]));
-    samples[seeing++] = vec4(float(gSlot[i] + 4096 * gIndex[i]), map, gWeight[i]);
+    samples[seeing++] = vec4(float(gSlot[i] + 4096 * gIndex[i]), map, gBlend[i]);
   }
   outSample0 = samples[0];
   outSample1 = samples[1];

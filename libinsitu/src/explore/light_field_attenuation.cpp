@@ -14,7 +14,7 @@ void blend_attenuation(const LightFieldRig& rig, const Camera& target, const Sam
     double seeing_weight = 0.0;
     for (int i = 0; i < present; ++i) {
         if (!samples[static_cast<std::size_t>(i)].passes_by) {
-            seeing_weight += samples[static_cast<std::size_t>(i)].weight;
+            seeing_weight += samples[static_cast<std::size_t>(i)].blend_weight;
         }
     }
     if (!(seeing_weight > 0.0)) return;  // a_j = 0, mean depth +inf
@@ -38,13 +38,13 @@ void blend_attenuation(const LightFieldRig& rig, const Camera& target, const Sam
                     z_weight += taps.weight[t] * a_texel;
                 }
             }
-            a_sum += sample.weight * a;
+            a_sum += sample.blend_weight * a;
             if (!(z_weight > 0.0)) continue;
             const Ray source = camera.ray(sample.read_map.x, sample.read_map.y);
             const double along = (z_sum / z_weight) / glm::dot(source.direction, camera.forward());
             const double z_target = target.depth_of(source.origin + along * source.direction);
-            weighted_depth += sample.weight * a * z_target;
-            depth_weight += sample.weight * a;
+            weighted_depth += sample.blend_weight * a * z_target;
+            depth_weight += sample.blend_weight * a;
         }
         const std::size_t out = p * intervals + j;
         a_sum /= seeing_weight;

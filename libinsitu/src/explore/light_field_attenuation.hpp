@@ -10,8 +10,8 @@
 namespace insitu::detail {
 
 // a_j of each camera at its whole-ray hit (or where the colour was read without one), blended
-// with the weights of the cameras that see the ray (renormalised over them, as the colour
-// is); the mean depth carried into the target camera (the point at the
+// with the blend weights of the cameras that see the ray (renormalised over them, as the
+// colour is); the mean depth carried into the target camera (the point at the
 // stored mean depth along the source camera's ray, seen from the target) and blended with
 // the weights w_k a_jk.
 void blend_attenuation(const LightFieldRig& rig, const Camera& target, const Samples& samples,

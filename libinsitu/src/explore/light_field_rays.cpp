@@ -43,6 +43,23 @@ Taps bilinear_taps(int size, const glm::dvec2& map_position) {
     return taps;
 }
 
+double silhouette_share(const Image& depth, int map_size, const glm::dvec2& map_position) {
+    constexpr double kRampTexels = 2.0, kLeast = 0.05;
+    constexpr int kReach = 3;  // texels searched on each side: beyond the ramp
+    const int cx = static_cast<int>(std::floor(map_position.x));
+    const int cy = static_cast<int>(std::floor(map_position.y));
+    double nearest = kReach;
+    for (int y = std::max(cy - kReach, 0); y <= std::min(cy + kReach, map_size - 1); ++y) {
+        for (int x = std::max(cx - kReach, 0); x <= std::min(cx + kReach, map_size - 1); ++x) {
+            if (std::isfinite(depth.at(x, y, 0))) continue;
+            const double dx = std::max(std::abs(map_position.x - (x + 0.5)) - 0.5, 0.0);
+            const double dy = std::max(std::abs(map_position.y - (y + 0.5)) - 0.5, 0.0);
+            nearest = std::min(nearest, std::sqrt(dx * dx + dy * dy));
+        }
+    }
+    return std::clamp(nearest / kRampTexels, kLeast, 1.0);
+}
+
 double camera_spacing_rad(const Icosphere& icosphere) {
     double sum = 0.0;
     for (const auto& triangle : icosphere.triangles) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "insitu/core/camera.hpp"
+#include "insitu/core/image.hpp"
 #include "insitu/core/light_field.hpp"
 
 namespace insitu::detail {
@@ -37,6 +38,17 @@ struct Taps {
     std::array<double, 4> weight{};
 };
 Taps bilinear_taps(int size, const glm::dvec2& map_position);
+
+// How far inside a camera's own silhouette a map position lies, as a share of the blend: the
+// distance to the nearest texel that recorded no first hit (`depth`, map_size x map_size; its
+// edge, where the nearest-texel silhouette lies), over 2 texels, clamped to [0.05, 1]. A camera
+// that sees a hit on or near its silhouette sees it along a ray that grazes the material and
+// crosses little of it, and half its bilinear taps are empty: its colour there is faint and dark
+// where a camera that sees the hit from inside sees it whole (the grey seams along the README
+// demo's cube edges, the blocky outline of the face it grazes: bench/RESULTS.md, "Light-field
+// silhouettes"). Continuous in the position, so the blend has no seam where it changes; where
+// every camera sees the hit on its silhouette (the target's own), the shares renormalise away.
+double silhouette_share(const Image& depth, int map_size, const glm::dvec2& map_position);
 
 // Each camera's neighbours on the icosphere (the cameras it shares a triangle edge with).
 std::vector<std::vector<int>> icosphere_neighbours(const LightFieldRig& rig);

@@ -242,6 +242,7 @@ private:
         present = substitute(samples, present, span);
         read_rims(samples, around, span);
         read_without_hits(samples, around, span);
+        set_blend_weights(samples, present);
         blend_segments(samples, present, span, scratch);
         const double unscaled_transmittance = composite_segments(scratch, p);
         double hit_t = 0.0;
@@ -375,6 +376,19 @@ private:
         }
     }
 
+    // The weights the colours and attenuation blend with: a camera that sees the hit near its own
+    // silhouette gives way to those that see it from inside (silhouette_share()).
+    void set_blend_weights(Samples& samples, int present) const {
+        for (int i = 0; i < present; ++i) {
+            CameraSample& sample = samples[static_cast<std::size_t>(i)];
+            sample.blend_weight = sample.weight;
+            if (sample.hit_t) {
+                sample.blend_weight *= detail::silhouette_share(sample.images->depth,
+                                                                rig_.map_size(), sample.read_map);
+            }
+        }
+    }
+
     // Cameras without a hit read the ray where the others found its hit (t_read); one that
     // recorded a surface there is occluded at the hit and passes by (read, it mixed the
     // occluder's colour or nothing into the blend: cracks).
@@ -421,8 +435,8 @@ private:
                 add_bilinear(sample.images->segment_rgba[static_cast<std::size_t>(s)], map, 1.0,
                              read);
                 std::array<double, 4>& blended = scratch.segment_rgba[static_cast<std::size_t>(s)];
-                for (int c = 0; c < 4; ++c) blended[c] += sample.weight * read[c];
-                scratch.segment_weight[static_cast<std::size_t>(s)] += sample.weight;
+                for (int c = 0; c < 4; ++c) blended[c] += sample.blend_weight * read[c];
+                scratch.segment_weight[static_cast<std::size_t>(s)] += sample.blend_weight;
                 for (int c = 0; c < 3; ++c) sample.rgba[c] += camera_transmittance * read[c];
                 camera_transmittance *= 1.0 - std::clamp(read[3], 0.0, 1.0);
             }

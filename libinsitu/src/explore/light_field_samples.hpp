@@ -27,7 +27,10 @@ struct RaySpan {
 struct CameraSample {
     int camera = 0;
     const LightFieldImages* images = nullptr;
-    double weight = 0.0;          ///< renormalised over the cameras present
+    double weight = 0.0;  ///< renormalised over the cameras present
+    /// The weight its colour and attenuation blend with: `weight` times silhouette_share() where
+    /// it sees the ray's hit, `weight` where it reads no hit.
+    double blend_weight = 0.0;
     std::optional<double> hit_t;  ///< whole-ray first hit along the target ray
     /// Where no camera around records a first hit: this camera's rim (its faint surface) along
     /// the target ray.

@@ -17,10 +17,14 @@
 //     of this ray;
 //  3. per segment, the samples of the cameras that hold something of the ray are blended with
 //     their weights renormalised over them (cameras the light field lacks drop out the same
-//     way; a camera of weight 0 is not wanted, so never missing); no such camera: empty;
+//     way; a camera of weight 0 is not wanted, so never missing); no such camera: empty. A
+//     camera that sees the hit within 2 map pixels of its own silhouette (of the texels that
+//     recorded no first hit) blends with its weight scaled down, to 0.05 on the silhouette:
+//     its ray grazes the material there and crosses little of it;
 //     segments are composited front to back ("over"), segment s with its opacity scaled:
 //     A' = 1 - (1 - A)^scale, colour scaled by A' / A (by the scale where A = 0);
-//  4. attenuation light fields: a_j read the same way at the whole-ray first hit, blended, and
+//  4. attenuation light fields: a_j read the same way at the whole-ray first hit, blended (with
+//     the colours' weights), and
 //     the per-interval mean depth carried into the target camera's depth (the point at that
 //     depth along the source camera's ray, seen from the target camera), blended with the
 //     weights w_k a_jk, so that recolouring and opacity edits take the path of stored views.
