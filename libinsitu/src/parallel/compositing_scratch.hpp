@@ -6,7 +6,7 @@
 // allocator hands freed memory at the heap's top back to the system: at 2 ranks that was about a
 // third of a rank's compositing time (bench/RESULTS.md, "Compositing cost under MPI: cheaper
 // folding"). So each thread (each rank of a process, or each thread-rank of the tests'
-// communicator) keeps a few of them, capped: a buffer over kKeptBytes is freed as before.
+// communicator) keeps a few of them, capped: past kKeptBytes in all, a buffer is freed as before.
 #include <cstddef>
 #include <vector>
 
@@ -15,7 +15,7 @@
 
 namespace insitu::detail {
 
-/// The largest buffer kept for reuse, and how many of each kind.
+/// The most a thread keeps for reuse, in all and in buffers of each kind.
 constexpr std::size_t kKeptBytes = std::size_t{64} << 20;
 constexpr std::size_t kKeptBuffers = 8;
 
