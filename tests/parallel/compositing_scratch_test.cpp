@@ -16,19 +16,19 @@ namespace {
 // Each on a thread of its own: what earlier tests on the main thread kept stays out of it.
 TEST(CompositingScratch, ABufferHandedBackComesBackEmptyWithItsCapacity) {
     std::thread([] {
-    Bytes bytes = borrow_bytes();
-    bytes.assign(1000, 7);
-    const std::uint8_t* memory = bytes.data();
-    give_back(std::move(bytes));
-    const Bytes again = borrow_bytes();
-    EXPECT_TRUE(again.empty());
-    EXPECT_GE(again.capacity(), 1000u);
-    EXPECT_EQ(again.data(), memory);  // the same memory, not a fresh allocation
-    std::vector<float> floats = borrow_floats();
-    floats.assign(500, 1.0f);
-    give_back(std::move(floats));
-    std::thread([] { EXPECT_EQ(borrow_floats().capacity(), 0u); }).join();  // another thread's
-    EXPECT_GE(borrow_floats().capacity(), 500u);
+        Bytes bytes = borrow_bytes();
+        bytes.assign(1000, 7);
+        const std::uint8_t* memory = bytes.data();
+        give_back(std::move(bytes));
+        const Bytes again = borrow_bytes();
+        EXPECT_TRUE(again.empty());
+        EXPECT_GE(again.capacity(), 1000u);
+        EXPECT_EQ(again.data(), memory);  // the same memory, not a fresh allocation
+        std::vector<float> floats = borrow_floats();
+        floats.assign(500, 1.0f);
+        give_back(std::move(floats));
+        std::thread([] { EXPECT_EQ(borrow_floats().capacity(), 0u); }).join();  // another thread's
+        EXPECT_GE(borrow_floats().capacity(), 500u);
     }).join();
 }
 
