@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "insitu/parallel/compositing.hpp"
@@ -260,6 +261,52 @@ TEST(RadixK, AutoTakesDirectSendAtFewRanksAndRadixKAtMany) {
               CompositingSchedule::radix_k);
     EXPECT_EQ(resolved_schedule(CompositingSchedule::radix_k, 2, 8, 128 * 128, record),
               CompositingSchedule::radix_k);
+}
+
+// A thread's composites reuse their buffers (parallel/compositing_scratch.hpp): composites one
+// after another on the same threads, of other records, sizes and schedules, give what each gives
+// on fresh threads, bit for bit.
+TEST(RadixK, CompositesInARowGiveWhatEachGivesAlone) {
+    constexpr int kRanks = 4;
+    const ProxyFrame dense_alone = proxies_by(CompositingSchedule::direct_send, 2, kRanks, false);
+    const Rendering rendering_alone =
+        rendering_by(CompositingSchedule::direct_send, 2, kRanks, false);
+    const ProxyFrame sparse_alone = proxies_by(CompositingSchedule::radix_k, 2, kRanks, true);
+    ProxyFrame dense;
+    Rendering rendering;
+    ProxyFrame sparse;
+    composite_on_threads(kRanks, [&](Communicator& communicator) {
+        const int rank = communicator.rank();
+        const ProxyFrame full = partial_proxies(rank, kRanks, false);
+        ProxyFrame first = composite_proxies(communicator, proxy_shell(), &full, 0,
+                                             CompositingSchedule::direct_send, 2);
+        const Rendering partial = partial_rendering(rank, kRanks, false);
+        Rendering second = composite_rendering(communicator, kWidth, kHeight, &partial, 0,
+                                               CompositingSchedule::direct_send, 2);
+        const std::optional<ProxyFrame> some =
+            rank == kRanks - 1 ? std::nullopt
+                               : std::optional<ProxyFrame>(partial_proxies(rank, kRanks, true));
+        ProxyFrame third = composite_proxies(communicator, proxy_shell(), some ? &*some : nullptr,
+                                             0, CompositingSchedule::radix_k, 2);
+        if (rank != 0) return;
+        dense = std::move(first);
+        rendering = std::move(second);
+        sparse = std::move(third);
+    });
+    for (const auto& [after, alone] : {std::pair{&dense, &dense_alone}, {&sparse, &sparse_alone}}) {
+        ASSERT_EQ(after->depth_layers.size(), 2u);
+        for (std::size_t l = 0; l < 2; ++l) {
+            EXPECT_EQ(after->depth_layers[l].pixels, alone->depth_layers[l].pixels);
+        }
+        EXPECT_EQ(after->attenuation.pixels, alone->attenuation.pixels);
+        EXPECT_EQ(after->mean_depth.pixels, alone->mean_depth.pixels);
+        EXPECT_EQ(after->optical_depth.pixels, alone->optical_depth.pixels);
+        EXPECT_EQ(after->entry_depth.pixels, alone->entry_depth.pixels);
+    }
+    EXPECT_EQ(rendering.rgba.pixels, rendering_alone.rgba.pixels);
+    EXPECT_EQ(rendering.depth.pixels, rendering_alone.depth.pixels);
+    // The two proxy composites differ (the last rank's records are missing from the second).
+    EXPECT_NE(dense.attenuation.pixels, sparse.attenuation.pixels);
 }
 
 }  // namespace

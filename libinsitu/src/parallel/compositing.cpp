@@ -10,6 +10,7 @@
 #include "insitu/core/check.hpp"
 #include "insitu/error.hpp"
 #include "parallel/compositing_exchange.hpp"
+#include "parallel/compositing_scratch.hpp"
 #include "parallel/interleaving_fold.hpp"
 #include "parallel/record_index.hpp"
 
@@ -110,7 +111,7 @@ void allocate_images(ProxyFrame& frame) {
 Bytes pack_proxy_records(const ProxyLayout& layout, const ProxyFrame& partial, std::int64_t begin,
                          std::int64_t end) {
     std::vector<float> record(static_cast<std::size_t>(layout.record()));
-    Bytes bytes;
+    Bytes bytes = detail::borrow_bytes();
     bytes.reserve(fragments_in(partial.fragment, kFragmentChannels, begin, end) *
                   (sizeof(std::uint32_t) + record.size() * sizeof(float)));
     const int I = layout.intervals;
@@ -272,11 +273,13 @@ void fold_proxy_pixel(const ProxyLayout& layout, const RecordRef* first, const R
 std::vector<float> fold_proxy_tile(const ProxyLayout& layout, const std::vector<Bytes>& messages,
                                    std::int64_t begin, std::int64_t end) {
     const int outputs = layout.outputs();
-    std::vector<float> tile(static_cast<std::size_t>((end - begin) * outputs));
+    std::vector<float> tile = detail::borrow_floats();
+    tile.resize(static_cast<std::size_t>((end - begin) * outputs));
     for (std::int64_t pixel = begin; pixel < end; ++pixel) {
         identity_outputs(layout, &tile[(pixel - begin) * outputs]);
     }
-    const RecordIndex index = index_records(messages, layout.record(), begin, end);
+    RecordIndex& index = detail::reused_record_index();
+    index_records(messages, layout.record(), begin, end, index);
     FoldScratch scratch;
     for (std::int64_t pixel = begin; pixel < end; ++pixel) {
         const std::uint32_t first = index.starts[pixel - begin];
@@ -346,7 +349,7 @@ constexpr int kRenderingRecord = 6;
 constexpr int kRenderingOutputs = 5;
 
 Bytes pack_rendering_records(const Rendering& partial, std::int64_t begin, std::int64_t end) {
-    Bytes bytes;
+    Bytes bytes = detail::borrow_bytes();
     bytes.reserve(fragments_in(partial.fragment, 1, begin, end) *
                   (sizeof(std::uint32_t) + kRenderingRecord * sizeof(float)));
     for (std::int64_t pixel = begin; pixel < end; ++pixel) {
@@ -364,11 +367,13 @@ Bytes pack_rendering_records(const Rendering& partial, std::int64_t begin, std::
 
 std::vector<float> fold_rendering_tile(const std::vector<Bytes>& messages, std::int64_t begin,
                                        std::int64_t end) {
-    std::vector<float> tile(static_cast<std::size_t>((end - begin) * kRenderingOutputs), 0.0f);
+    std::vector<float> tile = detail::borrow_floats();
+    tile.assign(static_cast<std::size_t>((end - begin) * kRenderingOutputs), 0.0f);
     for (std::int64_t pixel = begin; pixel < end; ++pixel) {
         tile[(pixel - begin) * kRenderingOutputs + 4] = kInf;
     }
-    const RecordIndex index = index_records(messages, kRenderingRecord, begin, end);
+    RecordIndex& index = detail::reused_record_index();
+    index_records(messages, kRenderingRecord, begin, end, index);
     float v[kRenderingRecord];
     for (std::int64_t pixel = begin; pixel < end; ++pixel) {
         const std::uint32_t first = index.starts[pixel - begin];

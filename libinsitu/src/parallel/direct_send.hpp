@@ -8,6 +8,7 @@
 
 #include "insitu/error.hpp"
 #include "insitu/parallel/communicator.hpp"
+#include "parallel/compositing_scratch.hpp"
 
 namespace insitu::detail {
 
@@ -50,7 +51,8 @@ struct FirstFailure {
 
 // Direct send: tile k of every rank's records to rank k, fold, gather the tiles at the root,
 // which hands each folded tile to unpack(begin, end, values). A rank's share of its own tile
-// and the root's own folded tile never go through the communicator (no copy of them).
+// and the root's own folded tile never go through the communicator (no copy of them). The
+// buffers are handed back for the next composite (compositing_scratch.hpp).
 template <typename Pack, typename Fold, typename Unpack>
 void direct_send(Communicator& communicator, std::int64_t pixels, int outputs, int root, Pack pack,
                  Fold fold, Unpack unpack) {
@@ -74,21 +76,23 @@ void direct_send(Communicator& communicator, std::int64_t pixels, int outputs, i
     });
     if (local.failure) to_each.assign(static_cast<std::size_t>(ranks), Bytes{});
     std::vector<Bytes> received = communicator.all_to_all(to_each);
+    give_back(to_each);
     received[me] = std::move(own);
     std::vector<float> tile;
     local([&] { tile = fold(received, begin, end); });
     tile.resize(static_cast<std::size_t>((end - begin) * outputs));  // what the root expects
-    received.clear();
-    Bytes mine;
+    give_back(received);
+    Bytes mine = borrow_bytes();
     if (me != root) {
         const auto* tile_bytes = reinterpret_cast<const std::uint8_t*>(tile.data());
         mine.assign(tile_bytes, tile_bytes + tile.size() * sizeof(float));
     }
-    const std::vector<Bytes> tiles =
+    std::vector<Bytes> tiles =
         communicator.gather_known_sizes(mine, root, tile_sizes(pixels, ranks, outputs, root));
+    give_back(std::move(mine));
     if (me == root) {
         local([&] {
-            std::vector<float> values;
+            std::vector<float> values = borrow_floats();
             for (int k = 0; k < ranks; ++k) {
                 const std::int64_t first = tile_begin(pixels, ranks, k);
                 const std::int64_t last = tile_begin(pixels, ranks, k + 1);
@@ -105,8 +109,11 @@ void direct_send(Communicator& communicator, std::int64_t pixels, int outputs, i
                 if (expected > 0) std::memcpy(values.data(), tiles[k].data(), tiles[k].size());
                 unpack(first, last, values.data());
             }
+            give_back(std::move(values));
         });
     }
+    give_back(tiles);
+    give_back(std::move(tile));
     local.rethrow();
 }
 

@@ -55,6 +55,7 @@ inline std::vector<Bytes> split_records(const std::vector<Bytes>& messages,
                                         std::size_t record_bytes,
                                         const std::vector<std::int64_t>& bounds) {
     std::vector<Bytes> parts(bounds.size() - 1);
+    for (Bytes& part : parts) part = borrow_bytes();
     for (const Bytes& message : messages) {
         for_each_record(message, record_bytes, [&](std::uint32_t pixel, std::size_t at) {
             const auto after =
@@ -100,8 +101,10 @@ void radix_k(Communicator& communicator, std::int64_t pixels, int outputs, int r
         std::vector<Bytes> to_group;
         if (!local.failure) local([&] { to_group = split_records(held, record_bytes, bounds); });
         if (local.failure) to_group.assign(static_cast<std::size_t>(k), Bytes{});
+        give_back(held);
         std::vector<Bytes> received;
         local([&] { received = communicator.exchange_within(group, to_group); });
+        give_back(to_group);
         held = std::move(received);
         end = begin + width * (digit + 1) / k;
         begin = begin + width * digit / k;
@@ -110,7 +113,7 @@ void radix_k(Communicator& communicator, std::int64_t pixels, int outputs, int r
     std::vector<float> tile;
     if (!local.failure) local([&] { tile = fold(held, begin, end); });
     tile.resize(static_cast<std::size_t>((end - begin) * outputs));  // what the root expects
-    held.clear();
+    give_back(held);
     const std::vector<std::pair<std::int64_t, std::int64_t>> regions =
         radix_k_regions(pixels, factors, ranks);
     std::vector<std::uint64_t> sizes(static_cast<std::size_t>(ranks), 0);
@@ -119,15 +122,16 @@ void radix_k(Communicator& communicator, std::int64_t pixels, int outputs, int r
         sizes[r] = static_cast<std::uint64_t>(regions[r].second - regions[r].first) *
                    static_cast<std::uint64_t>(outputs) * sizeof(float);
     }
-    Bytes mine;
+    Bytes mine = borrow_bytes();
     if (me != root) {
         const auto* tile_bytes = reinterpret_cast<const std::uint8_t*>(tile.data());
         mine.assign(tile_bytes, tile_bytes + tile.size() * sizeof(float));
     }
-    const std::vector<Bytes> tiles = communicator.gather_known_sizes(mine, root, sizes);
+    std::vector<Bytes> tiles = communicator.gather_known_sizes(mine, root, sizes);
+    give_back(std::move(mine));
     if (me == root) {
         local([&] {
-            std::vector<float> values;
+            std::vector<float> values = borrow_floats();
             for (int r = 0; r < ranks; ++r) {
                 const auto [first, last] = regions[r];
                 if (r == root) {
@@ -138,8 +142,11 @@ void radix_k(Communicator& communicator, std::int64_t pixels, int outputs, int r
                 if (!values.empty()) std::memcpy(values.data(), tiles[r].data(), tiles[r].size());
                 unpack(first, last, values.data());
             }
+            give_back(std::move(values));
         });
     }
+    give_back(tiles);
+    give_back(std::move(tile));
     local.rethrow();
 }
 

@@ -18,10 +18,9 @@ std::size_t fragments_in(const Image& fragment, int channels, std::int64_t begin
     return count;
 }
 
-RecordIndex index_records(const std::vector<Bytes>& messages, int record_floats, std::int64_t begin,
-                          std::int64_t end) {
+void index_records(const std::vector<Bytes>& messages, int record_floats, std::int64_t begin,
+                   std::int64_t end, RecordIndex& index) {
     const std::size_t stride = sizeof(std::uint32_t) + record_floats * sizeof(float);
-    RecordIndex index;
     index.starts.assign(static_cast<std::size_t>(end - begin) + 1, 0);
     std::size_t count = 0;
     for (const Bytes& message : messages) {
@@ -36,7 +35,8 @@ RecordIndex index_records(const std::vector<Bytes>& messages, int record_floats,
     }
     for (std::size_t p = 1; p < index.starts.size(); ++p) index.starts[p] += index.starts[p - 1];
     index.refs.resize(count);
-    std::vector<std::uint32_t> next(index.starts.begin(), index.starts.end() - 1);
+    std::vector<std::uint32_t>& next = index.next;
+    next.assign(index.starts.begin(), index.starts.end() - 1);
     for (const Bytes& message : messages) {
         for (std::size_t at = 0; at < message.size(); at += stride) {
             RecordRef ref;
@@ -57,7 +57,6 @@ RecordIndex index_records(const std::vector<Bytes>& messages, int record_floats,
             *j = moving;
         }
     }
-    return index;
 }
 
 }  // namespace insitu::detail

@@ -52,9 +52,11 @@ inline void load_record(const RecordRef& ref, int record_floats, float* into) {
 struct RecordIndex {
     std::vector<RecordRef> refs;
     std::vector<std::uint32_t> starts;
+    std::vector<std::uint32_t> next;  ///< scratch of the sort
 };
 
-RecordIndex index_records(const std::vector<Bytes>& messages, int record_floats, std::int64_t begin,
-                          std::int64_t end);
+/// Fills `index` (what it held is replaced; its capacity is reused: compositing_scratch.hpp).
+void index_records(const std::vector<Bytes>& messages, int record_floats, std::int64_t begin,
+                   std::int64_t end, RecordIndex& index);
 
 }  // namespace insitu::detail
