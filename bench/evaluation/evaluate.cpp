@@ -8,8 +8,8 @@
 //   insitu_evaluate --out DIR [--smoke] [--sections a,b,...] [--raw PATH:NXxNYxNZ:TYPE ...]
 //   [--sizes N,N,...]
 // Sections: rotation, curvature, colour, configurations, storage, light_fields, budget, volume,
-// crossover, light_field_cracks, light_field_bytes, relit_ceiling (default: all); --sizes: the
-// crossover's volume sizes (default 64,128,256,512).
+// crossover, light_field_cracks, light_field_bytes, relit_ceiling, light_field_ceiling (default:
+// all); --sizes: the crossover's volume sizes (default 64,128,256,512).
 #include <unistd.h>
 
 #include <algorithm>
@@ -47,6 +47,7 @@
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/metrics.hpp"
+#include "light_field_ceiling.hpp"
 #include "light_field_quality.hpp"
 #include "machine.hpp"
 #include "median_time.hpp"
@@ -70,10 +71,19 @@ struct RawInput {
 struct Options {
     std::string out;
     bool smoke = false;
-    std::set<std::string> sections{
-        "rotation",          "curvature",    "colour", "configurations", "storage",
-        "light_fields",      "budget",       "volume", "crossover",      "light_field_cracks",
-        "light_field_bytes", "relit_ceiling"};
+    std::set<std::string> sections{"rotation",
+                                   "curvature",
+                                   "colour",
+                                   "configurations",
+                                   "storage",
+                                   "light_fields",
+                                   "budget",
+                                   "volume",
+                                   "crossover",
+                                   "light_field_cracks",
+                                   "light_field_bytes",
+                                   "relit_ceiling",
+                                   "light_field_ceiling"};
     std::vector<RawInput> raw;
     /// The crossover's volume sizes (--sizes); empty: 64, 128, 256, 512 (smoke: 24, 32).
     std::vector<int> sizes;
@@ -83,7 +93,8 @@ struct Options {
     std::fprintf(stderr,
                  "insitu_evaluate: %s\nusage: insitu_evaluate --out DIR [--smoke] "
                  "[--sections rotation,curvature,colour,configurations,storage,light_fields,"
-                 "budget,volume,crossover,light_field_cracks,light_field_bytes,relit_ceiling] "
+                 "budget,volume,crossover,light_field_cracks,light_field_bytes,relit_ceiling,"
+                 "light_field_ceiling] "
                  "[--sizes N,N,...] "
                  "[--raw PATH:NXxNYxNZ:TYPE ...]\n",
                  message.c_str());
@@ -1481,6 +1492,10 @@ int main(int argc, char** argv) {
         }
         if (options.sections.count("relit_ceiling")) {
             section_relit_ceiling({&primary, &analytic[2]}, options.smoke, options.out, image);
+        }
+        if (options.sections.count("light_field_ceiling")) {
+            section_light_field_ceiling({&primary, &analytic[2]}, options.smoke, options.out,
+                                        scratch, image);
         }
         if (options.sections.count("volume")) {
             // The light-field section's scenes and views: the field beside the light fields.

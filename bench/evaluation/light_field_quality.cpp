@@ -18,10 +18,44 @@
 #include "insitu/render/light_field_capture.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/metrics.hpp"
+#include "light_field_error_budget.hpp"
 #include "light_field_payload.hpp"
 #include "median_time.hpp"
 
 namespace insitu::evaluation {
+
+std::uintmax_t write_light_field_archive(const Scene& scene, ProxyRenderer& renderer,
+                                         const LightFieldRequest& request, LightField light_field,
+                                         const std::string& path, int image) {
+    const Bounds& bounds = renderer.volume().bounds;
+    InstrumentConfig config;
+    config.fields = {scene.volume.name};
+    config.views[0].orbit = stored_view(image);
+    config.transfer_function = request.transfer_function;
+    config.proxies.distortion = false;
+    config.light_field = request.settings;
+    config.archive = path;
+    config.no_volume = true;
+    StepRecord record;
+    record.field = scene.volume.name;
+    ViewRecord view;
+    view.field = scene.volume.name;
+    view.view = config.views[0];
+    const Camera stored = Camera::orbit(stored_view(image), bounds);
+    ProxyRequest view_request;
+    view_request.transfer_function = request.transfer_function;
+    view_request.intervals = request.intervals;
+    view.single = renderer.render(stored, view_request);
+    view.preview = renderer.render_ground_truth(stored, request.transfer_function).rgba;
+    view.transfer_function = request.transfer_function;
+    record.views.push_back(std::move(view));
+    light_field.settings = request.settings;
+    record.light_fields.push_back({scene.volume.name, std::move(light_field)});
+    ArchiveWriter(config).write(record);
+    const std::vector<ArchivedLightField> files = ArchiveReader(path).light_fields(record.step);
+    return files.empty() ? 0 : std::filesystem::file_size(files.front().exr_path);
+}
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -50,50 +84,6 @@ Image crack_mask(const Image& truth, const Image& frame) {
     return mask;
 }
 
-double mean_abs_percent_of(const Image& truth, const Image& frame) {
-    double sum = 0.0;
-    for (std::size_t p = 0; p < truth.pixel_count(); ++p) {
-        for (int c = 0; c < 3; ++c)
-            sum += std::abs(truth.pixels[4 * p + c] - frame.pixels[4 * p + c]);
-    }
-    return 100.0 * sum / (3.0 * static_cast<double>(truth.pixel_count()));
-}
-
-// One step's light field of `scene` in an archive at `path`, as the Instrument writes it (the
-// archive's codec quantises the depth as a reader sees it); `light_field` as captured with
-// `request`. Returns the light field's stored bytes.
-std::uintmax_t write_archive(const Scene& scene, ProxyRenderer& renderer,
-                             const LightFieldRequest& request, LightField light_field,
-                             const std::string& path, int image) {
-    const Bounds& bounds = renderer.volume().bounds;
-    InstrumentConfig config;
-    config.fields = {scene.volume.name};
-    config.views[0].orbit = stored_view(image);
-    config.transfer_function = request.transfer_function;
-    config.proxies.distortion = false;
-    config.light_field = request.settings;
-    config.archive = path;
-    config.no_volume = true;
-    StepRecord record;
-    record.field = scene.volume.name;
-    ViewRecord view;
-    view.field = scene.volume.name;
-    view.view = config.views[0];
-    const Camera stored = Camera::orbit(stored_view(image), bounds);
-    ProxyRequest view_request;
-    view_request.transfer_function = request.transfer_function;
-    view_request.intervals = request.intervals;
-    view.single = renderer.render(stored, view_request);
-    view.preview = renderer.render_ground_truth(stored, request.transfer_function).rgba;
-    view.transfer_function = request.transfer_function;
-    record.views.push_back(std::move(view));
-    light_field.settings = request.settings;
-    record.light_fields.push_back({scene.volume.name, std::move(light_field)});
-    ArchiveWriter(config).write(record);
-    const std::vector<ArchivedLightField> files = ArchiveReader(path).light_fields(record.step);
-    return files.empty() ? 0 : fs::file_size(files.front().exr_path);
-}
-
 /// Means over views of one archive's frames against their truths.
 struct ViewScores {
     double mean_abs_percent = 0.0, psnr = 0.0, crack_percent = 0.0, worst_crack_percent = 0.0;
@@ -103,7 +93,7 @@ struct ViewScores {
     void add(const Image& truth, const Image& frame, std::pair<double, double> view, int views) {
         const double frame_psnr = psnr_db(truth, frame);
         const double cracks = 100.0 * crack_share(truth, frame);
-        mean_abs_percent += mean_abs_percent_of(truth, frame) / views;
+        mean_abs_percent += evaluation::mean_abs_percent(truth, frame) / views;
         psnr += frame_psnr / views;
         crack_percent += cracks / views;
         worst_crack_percent = std::max(worst_crack_percent, cracks);
@@ -203,7 +193,7 @@ void section_light_field_cracks(const std::vector<const Scene*>& scenes, bool sm
         request.intervals = scene_intervals(*scene, 16);
         const fs::path archive = scratch / ("cracks_" + scene->name + std::to_string(map));
         CaptureCost cost = capture_cost(*scene, renderer, request, smoke);
-        const std::uintmax_t stored_bytes = write_archive(
+        const std::uintmax_t stored_bytes = write_light_field_archive(
             *scene, renderer, request, std::move(cost.light_field), archive.string(), image);
         // What `insitu-view serve` sends the page for the step (uncompressed).
         const std::size_t payload_bytes =
@@ -320,13 +310,13 @@ void section_light_field_bytes(const std::vector<const Scene*>& scenes, bool smo
             if (form.subsampling == 1) {
                 LightFieldRequest plain = request;
                 plain.settings.attenuation = false;
-                bytes_without_attenuation =
-                    write_archive(*scene, renderer, plain, without_attenuation(captured),
-                                  archive.string(), image);
+                bytes_without_attenuation = write_light_field_archive(*scene, renderer, plain,
+                                                                      without_attenuation(captured),
+                                                                      archive.string(), image);
                 fs::remove_all(archive);
             }
-            const std::uintmax_t bytes =
-                write_archive(*scene, renderer, request, captured, archive.string(), image);
+            const std::uintmax_t bytes = write_light_field_archive(
+                *scene, renderer, request, captured, archive.string(), image);
             Explorer explorer(archive.string());
             for (const bool edit : {false, true}) {
                 ViewScores scores;

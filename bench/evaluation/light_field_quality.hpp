@@ -5,12 +5,23 @@
 // truth's alpha > 0.1 where the frame's < 0.02) as a share of the view's pixels, mean and worst.
 // Writes light_field_cracks.csv and, besides, the stored view turned 20 degrees as PNGs (frame
 // and truth) to look at.
+#include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
+#include "insitu/render/light_field_capture.hpp"
+#include "insitu/render/proxy_renderer.hpp"
 #include "scenes.hpp"
 
 namespace insitu::evaluation {
+
+/// One step's light field of `scene` in an archive at `path`, as the Instrument writes it (the
+/// archive's codec quantises the depth as a reader sees it), with the stored view `image`^2;
+/// `light_field` as captured with `request`. Returns the light field's stored bytes.
+std::uintmax_t write_light_field_archive(const Scene& scene, ProxyRenderer& renderer,
+                                         const LightFieldRequest& request, LightField light_field,
+                                         const std::string& path, int image);
 
 void section_light_field_cracks(const std::vector<const Scene*>& scenes, bool smoke,
                                 const std::filesystem::path& out,

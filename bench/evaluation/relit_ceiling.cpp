@@ -8,6 +8,7 @@
 #include <limits>
 #include <string>
 
+#include "definition_march.hpp"
 #include "harness.hpp"
 #include "insitu/core/light_field.hpp"
 #include "insitu/testing/metrics.hpp"
@@ -36,49 +37,43 @@ struct RaySums {
 RaySums march(const Ray& ray, const VoxelGrid& grid, const Field& field, const TransferFunction& tf,
               double step_world, double first_hit_opacity, const PhongParameters& phong) {
     RaySums sums;
-    double t_near = 0.0;
-    double t_far = 0.0;
-    if (!reference::clip_to_box(ray, field.bounds(), t_near, t_far)) return sums;
     const glm::dvec3 light = -ray.direction;
     double transmittance = 1.0;
     double largest = 0.0;
     bool first_hit = false;
-    for (std::int64_t i = 0;; ++i) {
-        const double t = t_near + (static_cast<double>(i) + 0.5) * step_world;
-        if (!(t < t_far)) break;
-        const glm::dvec3 position =
-            (ray.origin + t * ray.direction - field.origin()) / field.spacing();
-        const double value = grid.trilinear(position);
-        if (std::isnan(value)) continue;
-        const glm::dvec3 gradient = grid.gradient(position, field.spacing());
-        double magnitude = glm::length(gradient);
-        if (!std::isfinite(magnitude)) magnitude = 0.0;
-        const glm::vec4 rgba = tf.evaluate(value, magnitude);
-        const double alpha =
-            1.0 - std::pow(1.0 - static_cast<double>(rgba.a), step_world / tf.unit_length());
-        if (!(alpha > 0.0)) continue;
-        const glm::dvec3 colour(rgba.r, rgba.g, rgba.b);
-        glm::dvec3 normal(0.0);
-        glm::dvec3 shaded = colour;
-        if (magnitude > reference::kMinShadingGradient) {
-            normal = gradient / magnitude;
-            if (glm::dot(normal, light) < 0.0) normal = -normal;
-            shaded = reference::headlight_phong(colour, 1.0, glm::dot(normal, light), phong);
-        }
-        const double weight = transmittance * alpha;
-        sums.shaded += weight * shaded;
-        sums.colour += weight * colour;
-        sums.normal[kMeanNormal] += weight * normal;
-        if (weight > largest) {
-            largest = weight;
-            sums.normal[kLargestContribution] = normal;
-        }
-        transmittance *= 1.0 - alpha;
-        if (!first_hit && 1.0 - transmittance >= first_hit_opacity) {
-            first_hit = true;
-            sums.normal[kFirstHit] = normal;
-        }
-    }
+    const bool crosses = march_definition(
+        ray, grid, field, step_world, [&](double, const glm::dvec3& position, double value) {
+            const glm::dvec3 gradient = grid.gradient(position, field.spacing());
+            double magnitude = glm::length(gradient);
+            if (!std::isfinite(magnitude)) magnitude = 0.0;
+            const glm::vec4 rgba = tf.evaluate(value, magnitude);
+            const double alpha =
+                1.0 - std::pow(1.0 - static_cast<double>(rgba.a), step_world / tf.unit_length());
+            if (!(alpha > 0.0)) return true;
+            const glm::dvec3 colour(rgba.r, rgba.g, rgba.b);
+            glm::dvec3 normal(0.0);
+            glm::dvec3 shaded = colour;
+            if (magnitude > reference::kMinShadingGradient) {
+                normal = gradient / magnitude;
+                if (glm::dot(normal, light) < 0.0) normal = -normal;
+                shaded = reference::headlight_phong(colour, 1.0, glm::dot(normal, light), phong);
+            }
+            const double weight = transmittance * alpha;
+            sums.shaded += weight * shaded;
+            sums.colour += weight * colour;
+            sums.normal[kMeanNormal] += weight * normal;
+            if (weight > largest) {
+                largest = weight;
+                sums.normal[kLargestContribution] = normal;
+            }
+            transmittance *= 1.0 - alpha;
+            if (!first_hit && 1.0 - transmittance >= first_hit_opacity) {
+                first_hit = true;
+                sums.normal[kFirstHit] = normal;
+            }
+            return true;
+        });
+    if (!crosses) return sums;
     // A ray that never reaches the threshold is lit as its mean normal (what a substitute does).
     if (!first_hit) sums.normal[kFirstHit] = sums.normal[kMeanNormal];
     sums.opacity = 1.0 - transmittance;

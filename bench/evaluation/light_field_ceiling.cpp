@@ -1,0 +1,198 @@
+#include "light_field_ceiling.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <utility>
+
+#include "harness.hpp"
+#include "insitu/archive/archive.hpp"
+#include "insitu/error.hpp"
+#include "insitu/explore/explorer.hpp"
+#include "insitu/render/light_field_capture.hpp"
+#include "insitu/render/proxy_renderer.hpp"
+#include "insitu/testing/metrics.hpp"
+#include "light_field_error_budget.hpp"
+#include "light_field_oracle.hpp"
+#include "light_field_quality.hpp"
+
+namespace insitu::evaluation {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// One light field of the section.
+struct Capture {
+    const char* name;  ///< how the ray is split
+    int cameras;
+    std::vector<double> opacity_thresholds;  ///< empty: whole ray
+};
+
+/// The frames measured of each light field.
+enum Frame { kToday, kOracle, kOracleNearest, kBestDepth, kFrames };
+constexpr std::array<const char*, kFrames> kFrameNames{"today", "oracle", "oracle_nearest",
+                                                       "best_depth"};
+
+/// Means over views of one frame's figures.
+struct Means {
+    int views = 0;
+    double psnr = 0.0, mean_abs_percent = 0.0;
+    std::array<double, kPixelClasses> share{}, psnr_without{};
+
+    void add(const ErrorBudget& budget, double mean_abs) {
+        ++views;
+        psnr += budget.psnr();
+        mean_abs_percent += mean_abs;
+        for (int c = 0; c < kPixelClasses; ++c) {
+            share[c] += budget.share(c);
+            psnr_without[c] += budget.psnr_without(c);
+        }
+    }
+    void print(const std::string& scene, const Capture& capture, const char* frame) const {
+        const double n = std::max(views, 1);
+        std::printf("light-field ceiling: %s %d cameras %s, %s: PSNR %.2f dB, mean error %.2f %%;",
+                    scene.c_str(), capture.cameras, capture.name, frame, psnr / n,
+                    mean_abs_percent / n);
+        for (int c = 0; c < kPixelClasses; ++c) {
+            std::printf(" %s %.1f %% of the error (%.2f dB without)", kPixelClassNames[c],
+                        100.0 * share[c] / n, psnr_without[c] / n);
+        }
+        std::printf("\n");
+    }
+};
+
+// The budget, checked against the harness's PSNR: the classes must account for every pixel's
+// error, or the shares mean nothing.
+ErrorBudget checked_budget(const Image& truth, const Image& frame) {
+    const ErrorBudget budget = error_budget(truth, frame);
+    double classes = 0.0;
+    for (const double e : budget.error) classes += e;
+    if (!(std::abs(budget.psnr() - psnr_db(truth, frame)) < 1e-6) ||
+        !(std::abs(classes - budget.total) <= 1e-9 * std::max(budget.total, 1.0))) {
+        fail<Error>("light_field_ceiling: the error budget (", budget.psnr(), " dB, classes ",
+                    classes, " of ", budget.total, ") does not match psnr_db (",
+                    psnr_db(truth, frame), " dB)");
+    }
+    return budget;
+}
+
+/// What every light field of one scene is measured against.
+struct SceneViews {
+    std::vector<std::pair<double, double>> angles;
+    std::vector<Camera> cameras;
+    std::vector<Image> truths;
+    std::vector<std::vector<double>> hits;  ///< the truth's first hits (light_field_oracle.hpp)
+};
+
+SceneViews scene_views(const Scene& scene, ProxyRenderer& renderer, int views, int image,
+                       double depth_threshold) {
+    const Field field = scene.volume.field();
+    const TransferFunction tf = make_tf(scene);
+    const glm::dvec3 spacing = field.spacing();
+    const double step_world =
+        truth_settings().step_voxels * std::min({spacing.x, spacing.y, spacing.z});
+    const Camera stored = Camera::orbit(stored_view(image), renderer.volume().bounds);
+    SceneViews out;
+    // The light-field sections' random views (the first `views` of their 30).
+    out.angles = random_views(30);
+    out.angles.resize(static_cast<std::size_t>(views));
+    for (const auto& [azimuth, elevation] : out.angles) {
+        out.cameras.push_back(stored.reorbit(azimuth, elevation));
+        out.truths.push_back(
+            renderer.render_ground_truth(out.cameras.back(), tf, truth_settings()).rgba);
+        out.hits.push_back(
+            truth_first_hits(field, tf, out.cameras.back(), step_world, depth_threshold));
+    }
+    return out;
+}
+
+}  // namespace
+
+void section_light_field_ceiling(const std::vector<const Scene*>& scenes, bool smoke,
+                                 const fs::path& out, const fs::path& scratch, int image) {
+    std::string header =
+        "scene,light_field,cameras,segments,map,frame,view,azimuth,elevation,psnr,"
+        "mean_abs_percent";
+    for (const char* name : kPixelClassNames) {
+        header += std::string(",") + name + "_pixels," + name + "_share," + name + "_psnr_without";
+    }
+    Csv csv(out / "light_field_ceiling.csv", header);
+    const int views = smoke ? 2 : 30;
+    const int map = smoke ? 64 : 256;
+    const std::vector<Capture> captures{
+        {"whole_ray", 42, {}}, {"whole_ray", 162, {}}, {"two_segments", 42, {0.5}}};
+    for (const Scene* scene : scenes) {
+        ProxyRenderer renderer;
+        renderer.upload(scene->volume.field());
+        const SceneViews seen =
+            scene_views(*scene, renderer, views, image, LightFieldSettings{}.depth_threshold);
+        for (const Capture& capture : captures) {
+            LightFieldRequest request;
+            request.settings.cameras = capture.cameras;
+            request.settings.size = map;
+            request.settings.attenuation = false;
+            request.settings.rim_threshold = kDefaultRimThreshold;
+            if (!capture.opacity_thresholds.empty()) {
+                request.settings.segments = SegmentRule::opacity;
+                request.settings.opacity_thresholds = capture.opacity_thresholds;
+            }
+            request.transfer_function = make_tf(*scene);
+            request.intervals = scene_intervals(*scene, 16);
+            const fs::path archive =
+                scratch / ("ceiling_" + scene->name + "_" + std::to_string(capture.cameras));
+            fs::remove_all(archive);
+            write_light_field_archive(
+                *scene, renderer, request,
+                capture_light_field(
+                    renderer, LightFieldRig::around(renderer.volume().bounds, capture.cameras, map),
+                    request),
+                archive.string(), image);
+            Explorer explorer(archive.string());
+            const LightField stored =
+                ArchiveReader(archive.string()).load_light_field(0, scene->volume.name);
+            const int segments = stored.segment_count();
+            std::array<Means, kFrames> means;
+            for (int v = 0; v < views; ++v) {
+                ExploreRequest explore;
+                explore.azimuth_deg = seen.angles[v].first;
+                explore.elevation_deg = seen.angles[v].second;
+                explore.source = ProxySource::lightfield;
+                std::array<Image, kFrames> frames;
+                frames[kToday] = explorer.render(explore).colour;
+                if (segments == 1) {
+                    frames[kOracle] =
+                        oracle_frame(stored, seen.cameras[v], seen.hits[v], OracleBlend::visible);
+                    frames[kOracleNearest] =
+                        oracle_frame(stored, seen.cameras[v], seen.hits[v], OracleBlend::nearest);
+                    frames[kBestDepth] = oracle_frame(stored, seen.cameras[v], seen.hits[v],
+                                                      OracleBlend::best_depth, &seen.truths[v]);
+                }
+                for (int f = 0; f < kFrames; ++f) {
+                    if (frames[f].pixel_count() == 0) continue;
+                    const Image& truth = seen.truths[v];
+                    const ErrorBudget budget = checked_budget(truth, frames[f]);
+                    const double mean_abs = mean_abs_percent(truth, frames[f]);
+                    means[f].add(budget, mean_abs);
+                    std::string classes;
+                    for (int c = 0; c < kPixelClasses; ++c) {
+                        char text[96];
+                        std::snprintf(text, sizeof text, "%s%zu,%.6g,%.6g", c > 0 ? "," : "",
+                                      budget.pixels[c], budget.share(c), budget.psnr_without(c));
+                        classes += text;
+                    }
+                    csv.row(scene->name, capture.name, capture.cameras, segments, map,
+                            kFrameNames[f], v, seen.angles[v].first, seen.angles[v].second,
+                            budget.psnr(), mean_abs, classes);
+                }
+            }
+            for (int f = 0; f < kFrames; ++f) {
+                if (means[f].views > 0) means[f].print(scene->name, capture, kFrameNames[f]);
+            }
+            std::fflush(stdout);
+            fs::remove_all(archive);
+        }
+    }
+}
+
+}  // namespace insitu::evaluation

@@ -1,0 +1,26 @@
+#pragma once
+// The ceiling of the one-segment light field (issue 41): first-hit depth and RGBA per camera
+// texel, blended from the cameras around a ray. Per scene and light field (42 cameras, 162
+// cameras, 42 cameras with two opacity segments; 256^2 maps, whole-ray colour, no attenuation,
+// through the archive), from the first views of the light-field sections' random views against
+// the ground truth:
+//  - today's frame (the Explorer, source lightfield) and its error budget: each pixel class's
+//    share of the squared error and the PSNR with that class's error removed
+//    (light_field_error_budget.hpp);
+//  - for the one-segment fields, the oracle frames (light_field_oracle.hpp): the truth's own
+//    first hit read in the cameras around the ray (blended, and the nearest camera alone), and
+//    the best single point of each ray's chord (chosen against the truth: a bound on any
+//    geometry), and their error budgets.
+// Writes light_field_ceiling.csv, one row per scene, light field, frame and view.
+#include <filesystem>
+#include <vector>
+
+#include "scenes.hpp"
+
+namespace insitu::evaluation {
+
+void section_light_field_ceiling(const std::vector<const Scene*>& scenes, bool smoke,
+                                 const std::filesystem::path& out,
+                                 const std::filesystem::path& scratch, int image);
+
+}  // namespace insitu::evaluation

@@ -1,0 +1,47 @@
+#pragma once
+// The one-segment light field with its geometry given (issue 41): what a target pixel would show
+// if the reconstruction knew where along its ray to read the cameras. The truth's own first hit
+// (the ray's point where its opacity reaches the light field's depth threshold, marched in
+// double precision as the ground truth defines it) is read in the cameras around the ray, with
+// the reconstruction's weights (barycentric, scaled down near a camera's own silhouette), each
+// camera's recorded colour (its own ray's composite through that point) bilinear where the point
+// projects. What such a frame still gets wrong is the colour of a semi-transparent volume seen
+// from another direction, not the geometry.
+#include <vector>
+
+#include "insitu/core/camera.hpp"
+#include "insitu/core/image.hpp"
+#include "insitu/field.hpp"
+#include "insitu/render/light_field_capture.hpp"
+
+namespace insitu::evaluation {
+
+/// Per pixel of `view` (row-major), the distance along its ray where the truth's opacity first
+/// reaches `threshold`; where it never does, where it reaches half the ray's total (the middle of
+/// its faint material); NaN where the ray crosses nothing. `step_world`: the truth's step.
+std::vector<double> truth_first_hits(const Field& field, const TransferFunction& tf,
+                                     const Camera& view, double step_world, double threshold);
+
+enum class OracleBlend {
+    /// The cameras around the ray that see the point (no surface recorded in front of it, within
+    /// the reconstruction's 4 map pixels' footprint plus the depth's 8-bit resolution); where none
+    /// does, the first camera further out that does (the reconstruction's search order); where
+    /// none does either, the cameras around as they are.
+    visible,
+    /// Of those, only the one of largest barycentric weight: no blend between directions.
+    nearest,
+    /// The cameras around as `visible` reads them (no search further out), at whichever point
+    /// of the ray's chord through the bounding sphere (kBestDepthSteps evenly, the truth's hit,
+    /// then kBestDepthRefine steps on each side of the best) comes nearest the truth's colour,
+    /// or nothing: a bound for any geometry that reads one point per ray with these weights.
+    best_depth,
+};
+inline constexpr int kBestDepthSteps = 64, kBestDepthRefine = 8;
+
+/// The frame (RGBA premultiplied, `view`'s size) of one-segment `light_field` read at `hits`;
+/// `truth` (`view`'s size, RGBA premultiplied) only for OracleBlend::best_depth.
+Image oracle_frame(const LightField& light_field, const Camera& view,
+                   const std::vector<double>& hits, OracleBlend blend,
+                   const Image* truth = nullptr);
+
+}  // namespace insitu::evaluation
