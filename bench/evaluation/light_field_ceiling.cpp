@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <utility>
 
@@ -107,6 +108,77 @@ SceneViews scene_views(const Scene& scene, ProxyRenderer& renderer, int views, i
     return out;
 }
 
+// The section's light field `capture` of `scene` (map^2, whole-ray colour or opacity segments,
+// no attenuation, rims as by default) in an archive at `archive`.
+void capture_into(const Scene& scene, ProxyRenderer& renderer, const Capture& capture, int map,
+                  int image, const fs::path& archive) {
+    LightFieldRequest request;
+    request.settings.cameras = capture.cameras;
+    request.settings.size = map;
+    request.settings.attenuation = false;
+    request.settings.rim_threshold = kDefaultRimThreshold;
+    if (!capture.opacity_thresholds.empty()) {
+        request.settings.segments = SegmentRule::opacity;
+        request.settings.opacity_thresholds = capture.opacity_thresholds;
+    }
+    request.transfer_function = make_tf(scene);
+    request.intervals = scene_intervals(scene, 16);
+    write_light_field_archive(
+        scene, renderer, request,
+        capture_light_field(renderer,
+                            LightFieldRig::around(renderer.volume().bounds, capture.cameras, map),
+                            request),
+        archive.string(), image);
+}
+
+// Today's frames of the archive's light field and, for one segment, the oracle frames, from
+// every view: their budgets as CSV rows, and their means printed.
+void measure(const Scene& scene, const SceneViews& seen, const Capture& capture, int map,
+             const fs::path& archive, Csv& csv) {
+    Explorer explorer(archive.string());
+    const LightField stored =
+        ArchiveReader(archive.string()).load_light_field(0, scene.volume.name);
+    const int segments = stored.segment_count();
+    std::array<Means, kFrames> means;
+    for (std::size_t v = 0; v < seen.angles.size(); ++v) {
+        ExploreRequest explore;
+        explore.azimuth_deg = seen.angles[v].first;
+        explore.elevation_deg = seen.angles[v].second;
+        explore.source = ProxySource::lightfield;
+        std::array<Image, kFrames> frames;
+        frames[kToday] = explorer.render(explore).colour;
+        if (segments == 1) {
+            frames[kOracle] =
+                oracle_frame(stored, seen.cameras[v], seen.hits[v], OracleBlend::visible);
+            frames[kOracleNearest] =
+                oracle_frame(stored, seen.cameras[v], seen.hits[v], OracleBlend::nearest);
+            frames[kBestDepth] = oracle_frame(stored, seen.cameras[v], seen.hits[v],
+                                              OracleBlend::best_depth, &seen.truths[v]);
+        }
+        for (int f = 0; f < kFrames; ++f) {
+            if (frames[f].pixel_count() == 0) continue;
+            const Image& truth = seen.truths[v];
+            const ErrorBudget budget = checked_budget(truth, frames[f]);
+            const double mean_abs = mean_abs_percent(truth, frames[f]);
+            means[f].add(budget, mean_abs);
+            std::string classes;
+            for (int c = 0; c < kPixelClasses; ++c) {
+                char text[96];
+                std::snprintf(text, sizeof text, "%s%zu,%.6g,%.6g", c > 0 ? "," : "",
+                              budget.pixels[c], budget.share(c), budget.psnr_without(c));
+                classes += text;
+            }
+            csv.row(scene.name, capture.name, capture.cameras, segments, map, kFrameNames[f],
+                    static_cast<int>(v), seen.angles[v].first, seen.angles[v].second, budget.psnr(),
+                    mean_abs, classes);
+        }
+    }
+    for (int f = 0; f < kFrames; ++f) {
+        if (means[f].views > 0) means[f].print(scene.name, capture, kFrameNames[f]);
+    }
+    std::fflush(stdout);
+}
+
 }  // namespace
 
 void section_light_field_ceiling(const std::vector<const Scene*>& scenes, bool smoke,
@@ -120,76 +192,26 @@ void section_light_field_ceiling(const std::vector<const Scene*>& scenes, bool s
     Csv csv(out / "light_field_ceiling.csv", header);
     const int views = smoke ? 2 : 30;
     const int map = smoke ? 64 : 256;
-    const std::vector<Capture> captures{
-        {"whole_ray", 42, {}}, {"whole_ray", 162, {}}, {"two_segments", 42, {0.5}}};
+    // Captures outermost, so that a run cut short has measured every scene's first ones.
+    std::vector<Capture> captures{{"whole_ray", 42, {}},
+                                  {"whole_ray", 162, {}},
+                                  {"two_segments", 42, {0.5}},
+                                  {"whole_ray", 642, {}}};
+    if (smoke) captures.pop_back();  // 642 cameras: the smoke run's minute
+    std::vector<std::unique_ptr<ProxyRenderer>> renderers;
+    std::vector<SceneViews> seen;
     for (const Scene* scene : scenes) {
-        ProxyRenderer renderer;
-        renderer.upload(scene->volume.field());
-        const SceneViews seen =
-            scene_views(*scene, renderer, views, image, LightFieldSettings{}.depth_threshold);
-        for (const Capture& capture : captures) {
-            LightFieldRequest request;
-            request.settings.cameras = capture.cameras;
-            request.settings.size = map;
-            request.settings.attenuation = false;
-            request.settings.rim_threshold = kDefaultRimThreshold;
-            if (!capture.opacity_thresholds.empty()) {
-                request.settings.segments = SegmentRule::opacity;
-                request.settings.opacity_thresholds = capture.opacity_thresholds;
-            }
-            request.transfer_function = make_tf(*scene);
-            request.intervals = scene_intervals(*scene, 16);
-            const fs::path archive =
-                scratch / ("ceiling_" + scene->name + "_" + std::to_string(capture.cameras));
+        renderers.push_back(std::make_unique<ProxyRenderer>());
+        renderers.back()->upload(scene->volume.field());
+        seen.push_back(scene_views(*scene, *renderers.back(), views, image,
+                                   LightFieldSettings{}.depth_threshold));
+    }
+    for (const Capture& capture : captures) {
+        for (std::size_t s = 0; s < scenes.size(); ++s) {
+            const fs::path archive = scratch / ("ceiling_" + scenes[s]->name);
             fs::remove_all(archive);
-            write_light_field_archive(
-                *scene, renderer, request,
-                capture_light_field(
-                    renderer, LightFieldRig::around(renderer.volume().bounds, capture.cameras, map),
-                    request),
-                archive.string(), image);
-            Explorer explorer(archive.string());
-            const LightField stored =
-                ArchiveReader(archive.string()).load_light_field(0, scene->volume.name);
-            const int segments = stored.segment_count();
-            std::array<Means, kFrames> means;
-            for (int v = 0; v < views; ++v) {
-                ExploreRequest explore;
-                explore.azimuth_deg = seen.angles[v].first;
-                explore.elevation_deg = seen.angles[v].second;
-                explore.source = ProxySource::lightfield;
-                std::array<Image, kFrames> frames;
-                frames[kToday] = explorer.render(explore).colour;
-                if (segments == 1) {
-                    frames[kOracle] =
-                        oracle_frame(stored, seen.cameras[v], seen.hits[v], OracleBlend::visible);
-                    frames[kOracleNearest] =
-                        oracle_frame(stored, seen.cameras[v], seen.hits[v], OracleBlend::nearest);
-                    frames[kBestDepth] = oracle_frame(stored, seen.cameras[v], seen.hits[v],
-                                                      OracleBlend::best_depth, &seen.truths[v]);
-                }
-                for (int f = 0; f < kFrames; ++f) {
-                    if (frames[f].pixel_count() == 0) continue;
-                    const Image& truth = seen.truths[v];
-                    const ErrorBudget budget = checked_budget(truth, frames[f]);
-                    const double mean_abs = mean_abs_percent(truth, frames[f]);
-                    means[f].add(budget, mean_abs);
-                    std::string classes;
-                    for (int c = 0; c < kPixelClasses; ++c) {
-                        char text[96];
-                        std::snprintf(text, sizeof text, "%s%zu,%.6g,%.6g", c > 0 ? "," : "",
-                                      budget.pixels[c], budget.share(c), budget.psnr_without(c));
-                        classes += text;
-                    }
-                    csv.row(scene->name, capture.name, capture.cameras, segments, map,
-                            kFrameNames[f], v, seen.angles[v].first, seen.angles[v].second,
-                            budget.psnr(), mean_abs, classes);
-                }
-            }
-            for (int f = 0; f < kFrames; ++f) {
-                if (means[f].views > 0) means[f].print(scene->name, capture, kFrameNames[f]);
-            }
-            std::fflush(stdout);
+            capture_into(*scenes[s], *renderers[s], capture, map, image, archive);
+            measure(*scenes[s], seen[s], capture, map, archive, csv);
             fs::remove_all(archive);
         }
     }
