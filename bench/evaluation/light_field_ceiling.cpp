@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <utility>
@@ -31,9 +32,9 @@ struct Capture {
 };
 
 /// The frames measured of each light field.
-enum Frame { kToday, kOracle, kOracleNearest, kBestDepth, kFrames };
-constexpr std::array<const char*, kFrames> kFrameNames{"today", "oracle", "oracle_nearest",
-                                                       "best_depth"};
+enum Frame { kToday, kOracle, kOracleNearest, kOracleCentroid, kOracleMedian, kBestDepth, kFrames };
+constexpr std::array<const char*, kFrames> kFrameNames{
+    "today", "oracle", "oracle_nearest", "oracle_centroid", "oracle_median", "best_depth"};
 
 /// Means over views of one frame's figures.
 struct Means {
@@ -83,7 +84,7 @@ struct SceneViews {
     std::vector<std::pair<double, double>> angles;
     std::vector<Camera> cameras;
     std::vector<Image> truths;
-    std::vector<std::vector<double>> hits;  ///< the truth's first hits (light_field_oracle.hpp)
+    std::vector<TruthDepths> depths;  ///< the truth's depths (light_field_oracle.hpp)
 };
 
 SceneViews scene_views(const Scene& scene, ProxyRenderer& renderer, int views, int image,
@@ -102,8 +103,8 @@ SceneViews scene_views(const Scene& scene, ProxyRenderer& renderer, int views, i
         out.cameras.push_back(stored.reorbit(azimuth, elevation));
         out.truths.push_back(
             renderer.render_ground_truth(out.cameras.back(), tf, truth_settings()).rgba);
-        out.hits.push_back(
-            truth_first_hits(field, tf, out.cameras.back(), step_world, depth_threshold));
+        out.depths.push_back(
+            truth_depths(field, tf, out.cameras.back(), step_world, depth_threshold));
     }
     return out;
 }
@@ -148,11 +149,16 @@ void measure(const Scene& scene, const SceneViews& seen, const Capture& capture,
         std::array<Image, kFrames> frames;
         frames[kToday] = explorer.render(explore).colour;
         if (segments == 1) {
-            frames[kOracle] =
-                oracle_frame(stored, seen.cameras[v], seen.hits[v], OracleBlend::visible);
+            const TruthDepths& depths = seen.depths[v];
+            const Camera& camera = seen.cameras[v];
+            frames[kOracle] = oracle_frame(stored, camera, depths.first_hit, OracleBlend::visible);
             frames[kOracleNearest] =
-                oracle_frame(stored, seen.cameras[v], seen.hits[v], OracleBlend::nearest);
-            frames[kBestDepth] = oracle_frame(stored, seen.cameras[v], seen.hits[v],
+                oracle_frame(stored, camera, depths.first_hit, OracleBlend::nearest);
+            frames[kOracleCentroid] =
+                oracle_frame(stored, camera, depths.centroid, OracleBlend::visible);
+            frames[kOracleMedian] =
+                oracle_frame(stored, camera, depths.median, OracleBlend::visible);
+            frames[kBestDepth] = oracle_frame(stored, camera, depths.first_hit,
                                               OracleBlend::best_depth, &seen.truths[v]);
         }
         for (int f = 0; f < kFrames; ++f) {
@@ -179,6 +185,43 @@ void measure(const Scene& scene, const SceneViews& seen, const Capture& capture,
     std::fflush(stdout);
 }
 
+// The section's light fields, restricted to INSITU_CEILING_CAPTURES where it is set (a
+// comma-separated list of NAME_CAMERAS, e.g. "whole_ray_42"): a run of one light field's frames.
+std::vector<Capture> chosen_captures(bool smoke) {
+    std::vector<Capture> captures{{"whole_ray", 42, {}},
+                                  {"whole_ray", 162, {}},
+                                  {"two_segments", 42, {0.5}},
+                                  {"whole_ray", 642, {}}};
+    if (smoke) captures.pop_back();  // 642 cameras: the smoke run's minute
+    const char* wanted = std::getenv("INSITU_CEILING_CAPTURES");
+    if (wanted == nullptr || *wanted == '\0') return captures;
+    const std::string list = std::string(",") + wanted + ",";
+    std::vector<Capture> kept;
+    for (const Capture& capture : captures) {
+        const std::string key =
+            std::string(",") + capture.name + "_" + std::to_string(capture.cameras) + ",";
+        if (list.find(key) != std::string::npos) kept.push_back(capture);
+    }
+    if (kept.empty()) {
+        fail<InvalidArgument>("light_field_ceiling: INSITU_CEILING_CAPTURES=", wanted,
+                              " names none of the section's light fields (NAME_CAMERAS, e.g. "
+                              "whole_ray_42)");
+    }
+    return kept;
+}
+
+// The number of views: 30 (the smoke run's 2), or INSITU_CEILING_VIEWS (1 to 30) where set.
+int chosen_views(bool smoke) {
+    const char* wanted = std::getenv("INSITU_CEILING_VIEWS");
+    if (wanted == nullptr || *wanted == '\0') return smoke ? 2 : 30;
+    const int views = std::atoi(wanted);
+    if (views < 1 || views > 30) {
+        fail<InvalidArgument>("light_field_ceiling: INSITU_CEILING_VIEWS=", wanted,
+                              " (1 to 30 of the light-field sections' views)");
+    }
+    return views;
+}
+
 }  // namespace
 
 void section_light_field_ceiling(const std::vector<const Scene*>& scenes, bool smoke,
@@ -190,14 +233,10 @@ void section_light_field_ceiling(const std::vector<const Scene*>& scenes, bool s
         header += std::string(",") + name + "_pixels," + name + "_share," + name + "_psnr_without";
     }
     Csv csv(out / "light_field_ceiling.csv", header);
-    const int views = smoke ? 2 : 30;
+    const int views = chosen_views(smoke);
     const int map = smoke ? 64 : 256;
     // Captures outermost, so that a run cut short has measured every scene's first ones.
-    std::vector<Capture> captures{{"whole_ray", 42, {}},
-                                  {"whole_ray", 162, {}},
-                                  {"two_segments", 42, {0.5}},
-                                  {"whole_ray", 642, {}}};
-    if (smoke) captures.pop_back();  // 642 cameras: the smoke run's minute
+    const std::vector<Capture> captures = chosen_captures(smoke);
     std::vector<std::unique_ptr<ProxyRenderer>> renderers;
     std::vector<SceneViews> seen;
     for (const Scene* scene : scenes) {

@@ -8,10 +8,13 @@
 //    share of the squared error and the PSNR with that class's error removed
 //    (light_field_error_budget.hpp);
 //  - for the one-segment fields, the oracle frames (light_field_oracle.hpp): the truth's own
-//    first hit read in the cameras around the ray (blended, and the nearest camera alone), and
+//    first hit read in the cameras around the ray (blended, and the nearest camera alone), its
+//    contribution centroid and median depth read the same way (blended), and
 //    the best single point of each ray's chord (chosen against the truth: a bound on any
 //    geometry), and their error budgets.
 // Writes light_field_ceiling.csv, one row per scene, light field, frame and view.
+// INSITU_CEILING_CAPTURES (e.g. "whole_ray_42,two_segments_42") and INSITU_CEILING_VIEWS (1-30)
+// restrict a run to some light fields and the first views.
 #include <filesystem>
 #include <vector>
 

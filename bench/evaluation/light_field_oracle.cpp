@@ -5,6 +5,8 @@
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "definition_march.hpp"
 #include "explore/light_field_inputs.hpp"
@@ -20,12 +22,17 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 // The reconstruction's tolerance behind a recorded surface (light_field_reconstruction.cpp).
 constexpr double kSurfaceFootprints = 4.0;
 
-// Where the ray's opacity first reaches `target`, or NaN; the ray's total opacity in `total`
-// (only complete when the target is not reached: the march stops there).
-double march_to(const Ray& ray, const reference::VoxelGrid& grid, const Field& field,
-                const TransferFunction& tf, double step_world, double target, double& total) {
-    total = 0.0;
-    double transmittance = 1.0, reached = kNone;
+// The ray's depths (TruthDepths), marched to its end in double precision.
+struct RayDepths {
+    double first_hit = kNone, centroid = kNone, median = kNone;
+};
+
+RayDepths march_depths(const Ray& ray, const reference::VoxelGrid& grid, const Field& field,
+                       const TransferFunction& tf, double step_world, double threshold,
+                       std::vector<std::pair<double, double>>& opacities) {
+    RayDepths out;
+    opacities.clear();  // (t, the ray's opacity after the sample at t)
+    double transmittance = 1.0, weighted_t = 0.0;
     march_definition(
         ray, grid, field, step_world, [&](double t, const glm::dvec3& position, double value) {
             double magnitude = 0.0;
@@ -36,12 +43,23 @@ double march_to(const Ray& ray, const reference::VoxelGrid& grid, const Field& f
             const double a = tf.evaluate(value, magnitude).a;
             const double alpha = 1.0 - std::pow(1.0 - a, step_world / tf.unit_length());
             if (!(alpha > 0.0)) return true;
+            weighted_t += transmittance * alpha * t;  // the compositing weight T_i alpha_i
             transmittance *= 1.0 - alpha;
-            total = 1.0 - transmittance;
-            if (total >= target) reached = t;
-            return !(total >= target);
+            opacities.emplace_back(t, 1.0 - transmittance);
+            if (std::isnan(out.first_hit) && 1.0 - transmittance >= threshold) out.first_hit = t;
+            return true;
         });
-    return reached;
+    const double total = 1.0 - transmittance;
+    if (!(total > 0.0)) return out;
+    out.centroid = weighted_t / total;  // the weights sum to the ray's opacity
+    for (const auto& [t, opacity] : opacities) {
+        if (opacity >= 0.5 * total) {
+            out.median = t;
+            break;
+        }
+    }
+    if (std::isnan(out.first_hit)) out.first_hit = out.median;
+    return out;
 }
 
 // One camera read for the oracle: its weight and where it reads.
@@ -195,23 +213,25 @@ private:
 
 }  // namespace
 
-std::vector<double> truth_first_hits(const Field& field, const TransferFunction& tf,
-                                     const Camera& view, double step_world, double threshold) {
+TruthDepths truth_depths(const Field& field, const TransferFunction& tf, const Camera& view,
+                         double step_world, double threshold) {
     const reference::VoxelGrid grid(field);
     const int width = view.width();
-    std::vector<double> hits(static_cast<std::size_t>(width) * view.height(), kNone);
+    const std::size_t pixels = static_cast<std::size_t>(width) * view.height();
+    TruthDepths out{std::vector<double>(pixels, kNone), std::vector<double>(pixels, kNone),
+                    std::vector<double>(pixels, kNone)};
     detail::parallel_rows(view.height(), [&](unsigned, int y) {
+        std::vector<std::pair<double, double>> opacities;
         for (int x = 0; x < width; ++x) {
-            const Ray ray = view.ray(x + 0.5, y + 0.5);
-            double total = 0.0;
-            double t = march_to(ray, grid, field, tf, step_world, threshold, total);
-            if (std::isnan(t) && total > 0.0) {
-                t = march_to(ray, grid, field, tf, step_world, 0.5 * total, total);
-            }
-            hits[static_cast<std::size_t>(y) * width + x] = t;
+            const RayDepths depths = march_depths(view.ray(x + 0.5, y + 0.5), grid, field, tf,
+                                                  step_world, threshold, opacities);
+            const std::size_t p = static_cast<std::size_t>(y) * width + x;
+            out.first_hit[p] = depths.first_hit;
+            out.centroid[p] = depths.centroid;
+            out.median[p] = depths.median;
         }
     });
-    return hits;
+    return out;
 }
 
 Image oracle_frame(const LightField& light_field, const Camera& view,
