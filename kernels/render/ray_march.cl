@@ -446,10 +446,6 @@ PACKET_INLINE floatp packet_trilinear(__global const float* volume, int4 dims, f
     return packet_cell_value(&cell);
 }
 
-// Eight lanes of four vectors from one float4 per lane: lane k of (a, b, c, d) is buf[i_k]'s
-// (x, y, z, w). Lanes k and k + 4 load into the two halves of a float8 and four lanes are
-// transposed in each half, with the unpack shuffles AVX2 does within 128-bit halves: eight
-// 16-byte loads and eight shuffles for what GATHER would load as 32 floats one by one.
 // An empty asm statement the value passes through, in a vector register: LLVM cannot see through
 // it, so it lowers the transpose's shuffles as written. Without it, LLVM 15 merged each output's
 // chain of shuffles back into one shuffle of the sixteen loaded floats and built it from element
@@ -461,6 +457,11 @@ PACKET_INLINE floatp packet_trilinear(__global const float* volume, int4 dims, f
 #else
 #define KEEP_VECTOR(v)
 #endif
+
+// Eight lanes of four vectors from one float4 per lane: lane k of (a, b, c, d) is buf[i_k]'s
+// (x, y, z, w). Lanes k and k + 4 load into the two halves of a float8 and four lanes are
+// transposed in each half, with the unpack shuffles AVX2 does within 128-bit halves: eight
+// 16-byte loads and eight shuffles for what GATHER would load as 32 floats one by one.
 PACKET_INLINE void gather_float4_8(__global const float4* buf, int8 i, float8* a, float8* b,
                                    float8* c, float8* d) {
     float8 r0 = (float8)(buf[i.s0], buf[i.s4]), r1 = (float8)(buf[i.s1], buf[i.s5]);
