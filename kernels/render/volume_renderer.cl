@@ -98,16 +98,14 @@ PACKET_INLINE floatp packet_pow_unit(floatp x, float w) {
 // samples skipped there have zero opacity, which render_volume passes over with `continue`.
 // Where gradients are needed (shading, 2D function), values and gradients come from
 // shading_volume (gradient_volume.cl, packet_shaded_sample); otherwise it is not read.
-__kernel void render_volume_packets(__global const float* volume, int4 dims, float4 origin_world,
-                                    float4 inv_spacing, float4 box_lower, float4 box_upper,
-                                    float4 data_offset, float4 owned_lower, float4 owned_upper,
-                                    __global const float4* tf_table, int2 tf_bins, float4 tf_domain,
-                                    float4 cam_position, float4 cam_forward, float4 cam_right,
-                                    float4 cam_up, float4 cam_half_extent, int2 size, float4 march,
-                                    float4 phong, __global float4* rgba_out,
-                                    __global float* depth_out,
-                                    __global const uchar* skippable_blocks, int4 block_counts,
-                                    int block_size, __global const float4* shading_volume) {
+__kernel void render_volume_packets(
+    __global const float4* shading_volume, __global const float* volume, int4 dims,
+    float4 origin_world, float4 inv_spacing, float4 box_lower, float4 box_upper, float4 data_offset,
+    float4 owned_lower, float4 owned_upper, __global const float4* tf_table, int2 tf_bins,
+    float4 tf_domain, float4 cam_position, float4 cam_forward, float4 cam_right, float4 cam_up,
+    float4 cam_half_extent, int2 size, float4 march, float4 phong, __global float4* rgba_out,
+    __global float* depth_out, __global const uchar* skippable_blocks, int4 block_counts,
+    int block_size) {
     const int gx = get_global_id(0);
     const int gy = get_global_id(1);
     if (gx * PACKET_W >= size.x || gy * PACKET_H >= size.y) return;

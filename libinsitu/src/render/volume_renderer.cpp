@@ -209,11 +209,11 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
         const cl::Buffer& shading =
             needs_gradient ? state_->gradient_volume->of(opencl, volume_) : volume_.memory->buffer;
         opencl.launch(state_->packet_kernel, detail::packet_global_range(width, height),
-                      detail::packet_local_range(), detail::volume_args(volume_),
+                      detail::packet_local_range(), shading, detail::volume_args(volume_),
                       detail::transfer_args(state_->table.buffer, table),
                       detail::camera_args(camera), detail::image_size(camera), march,
                       phong_parameters, state_->rgba_out.buffer, state_->depth_out.buffer,
-                      skipped.skippable, skipped.block_counts, skipped.block_voxels, shading);
+                      skipped.skippable, skipped.block_counts, skipped.block_voxels);
     } else {
         last_skippable_fraction_ = 0.0;
         opencl.launch(
