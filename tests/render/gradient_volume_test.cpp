@@ -9,12 +9,14 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <random>
 #include <vector>
 
 #include "device/kernel_constants.hpp"
 #include "insitu/field.hpp"
 #include "insitu/render/volume_renderer.hpp"
+#include "insitu/testing/analytic_fields.hpp"
 
 namespace insitu::detail {
 namespace {
@@ -78,6 +80,47 @@ TEST(GradientVolume, HoldsValuesAndClampedCentralDifferencesPerVoxel) {
     const std::vector<float> second = random_values(8);
     renderer.upload(Field("v", second.data(), ScalarType::float32, kDims));
     expect_shading_volume_of(second, opencl, gradients, renderer.volume());
+}
+
+// A field whose shading volume would take more than RenderSettings::shading_volume_max_bytes is
+// rendered shaded one ray per work-item, building nothing: the frame ray_packets off gives, bit
+// for bit. At the cap itself it still takes packets.
+TEST(GradientVolume, ShadedRendersPastTheCapMarchOneRayPerWorkItem) {
+    const SampledVolume volume = make_gaussian_blobs({21, 19, 23}, 3, 5);
+    VolumeRenderer renderer;
+    renderer.upload(volume.field());
+    const TransferFunction tf({ControlPoint{0.1, glm::vec4(0.0f)},
+                               ControlPoint{0.5, glm::vec4(0.9f, 0.6f, 0.1f, 0.4f)},
+                               ControlPoint{0.9, glm::vec4(0.2f, 0.5f, 1.0f, 0.9f)}});
+    OrbitView view;
+    view.azimuth_deg = 30.0;
+    view.elevation_deg = 20.0;
+    view.width = 40;
+    view.height = 32;
+    const Camera camera = Camera::orbit(view, volume.field().bounds());
+    const std::uint64_t bytes = GradientVolume::bytes_for(renderer.volume());
+    RenderSettings settings;
+    settings.shading = true;
+
+    settings.ray_packets = false;
+    const Rendering rays = renderer.render(camera, tf, settings);
+    settings.ray_packets = true;
+    settings.shading_volume_max_bytes = bytes - 1;
+    const Rendering capped = renderer.render(camera, tf, settings);
+    EXPECT_FALSE(renderer.last_render_in_packets());
+    ASSERT_EQ(capped.rgba.pixels.size(), rays.rgba.pixels.size());
+    EXPECT_EQ(std::memcmp(capped.rgba.pixels.data(), rays.rgba.pixels.data(),
+                          rays.rgba.pixels.size() * sizeof(float)),
+              0);
+    // Unshaded renders need no shading volume: packets whatever the cap.
+    settings.shading = false;
+    renderer.render(camera, tf, settings);
+    EXPECT_TRUE(renderer.last_render_in_packets());
+
+    settings.shading = true;
+    settings.shading_volume_max_bytes = bytes;
+    renderer.render(camera, tf, settings);
+    EXPECT_TRUE(renderer.last_render_in_packets());
 }
 
 }  // namespace

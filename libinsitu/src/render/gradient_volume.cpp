@@ -11,8 +11,7 @@ GradientVolume::GradientVolume(OpenClDevice& opencl)
 const cl::Buffer& GradientVolume::of(OpenClDevice& opencl, const DeviceVolume& volume) {
     if (volume.empty()) fail<Error>("GradientVolume::of called before upload()");
     if (built_generation_ == volume.generation) return memory_.buffer;
-    opencl.ensure_buffer(memory_.buffer, memory_.capacity,
-                         volume.device_samples * 4 * sizeof(float), CL_MEM_READ_WRITE);
+    opencl.ensure_buffer(memory_.buffer, memory_.capacity, bytes_for(volume), CL_MEM_READ_WRITE);
     const Index3& d = volume.dims;
     const cl_int4 dims = {
         {static_cast<cl_int>(d[0]), static_cast<cl_int>(d[1]), static_cast<cl_int>(d[2]), 0}};

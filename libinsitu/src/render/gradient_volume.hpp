@@ -24,6 +24,11 @@ public:
     /// Bytes of device memory held (0 until a render needed gradients).
     std::size_t capacity_bytes() const { return memory_.capacity; }
 
+    /// Bytes the shading volume of `volume` takes (RenderSettings::shading_volume_max_bytes).
+    static std::uint64_t bytes_for(const DeviceVolume& volume) {
+        return volume.device_samples * 4 * sizeof(float);
+    }
+
 private:
     cl::Kernel kernel_;  ///< kernels/render/gradient_volume.cl
     DeviceMemory memory_;

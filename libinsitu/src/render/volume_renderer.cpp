@@ -195,8 +195,12 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
     const cl_float4 phong_parameters =
         to_float4(phong.ambient, phong.diffuse, phong.specular, phong.shininess);
 
-    last_render_in_packets_ =
-        settings.ray_packets && !volume_.region && volume_.packets_addressable() && opencl.is_cpu();
+    const bool shading_volume_affordable =
+        !needs_gradient ||
+        detail::GradientVolume::bytes_for(volume_) <= settings.shading_volume_max_bytes;
+    last_render_in_packets_ = settings.ray_packets && !volume_.region &&
+                              volume_.packets_addressable() && opencl.is_cpu() &&
+                              shading_volume_affordable;
     if (last_render_in_packets_) {
         // A transparent sample adds nothing: opacity alone decides what a packet may skip.
         detail::SkippedBlocks skipped;
@@ -261,6 +265,7 @@ std::ostream& operator<<(std::ostream& out, const RenderSettings& settings) {
     if (settings.shading) out << " " << settings.phong;
     if (!settings.ray_packets) out << ", one ray per work-item";
     if (!settings.skip_empty_space) out << ", no empty-space skipping";
+    out << ", shading volume up to " << settings.shading_volume_max_bytes << " bytes";
     return out << ", table " << settings.tf_value_bins << "x" << settings.tf_gradient_bins << "}";
 }
 
