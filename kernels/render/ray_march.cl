@@ -364,12 +364,39 @@ PACKET_INLINE intp packet_block_skip(const MarchPacket* rays, floatp t, floatp x
     return select(advance, last - sample, jump);
 }
 
-// The cell of a packet of sample positions (sample_trilinear's clamping and fractions) and its
-// eight corner values c_xyz, x, y, z in {0, 1}. Lanes outside `active` take the grid's first cell
-// (any in-grid address would do): their positions may be anything, and a gather must not leave
-// the buffer.
+// Where a packet of sample positions falls in the grid: sample_trilinear's clamping, cell and
+// fractions, and the buffer offsets of the cell's two columns, rows and slices. Lanes outside
+// `active` take the grid's first cell (any in-grid address would do): their positions may be
+// anything, and a gather must not leave the buffer.
 typedef struct {
     intp ix, iy, iz;
+    floatp fx, fy, fz;
+    intp x_0, x_1, y_0, y_1, z_0, z_1;
+} PacketPlace;
+
+PACKET_INLINE PacketPlace packet_place(int4 dims, floatp x, floatp y, floatp z, intp active) {
+    PacketPlace place;
+    const floatp px = clamp(select((floatp)0.0f, x, active), 0.0f, (float)(dims.x - 1));
+    const floatp py = clamp(select((floatp)0.0f, y, active), 0.0f, (float)(dims.y - 1));
+    const floatp pz = clamp(select((floatp)0.0f, z, active), 0.0f, (float)(dims.z - 1));
+    place.ix = min(convert_intp(px), dims.x - 2);
+    place.iy = min(convert_intp(py), dims.y - 2);
+    place.iz = min(convert_intp(pz), dims.z - 2);
+    place.fx = px - convert_floatp(place.ix);
+    place.fy = py - convert_floatp(place.iy);
+    place.fz = pz - convert_floatp(place.iz);
+    const int2 bricks = volume_bricks(dims);
+    place.x_0 = volume_offset_x(place.ix);
+    place.x_1 = volume_offset_x(place.ix + 1);
+    place.y_0 = volume_offset_y(place.iy, bricks.x);
+    place.y_1 = volume_offset_y(place.iy + 1, bricks.x);
+    place.z_0 = volume_offset_z(place.iz, bricks.x, bricks.y);
+    place.z_1 = volume_offset_z(place.iz + 1, bricks.x, bricks.y);
+    return place;
+}
+
+// The cell of a packet of sample positions and its eight corner values c_xyz, x, y, z in {0, 1}.
+typedef struct {
     floatp fx, fy, fz;
     floatp c000, c100, c010, c110, c001, c101, c011, c111;
 } PacketCell;
@@ -379,32 +406,22 @@ typedef struct {
 
 PACKET_INLINE PacketCell packet_cell(__global const float* volume, int4 dims, floatp x, floatp y,
                                      floatp z, intp active) {
+    const PacketPlace p = packet_place(dims, x, y, z, active);
     PacketCell cell;
-    const floatp px = clamp(select((floatp)0.0f, x, active), 0.0f, (float)(dims.x - 1));
-    const floatp py = clamp(select((floatp)0.0f, y, active), 0.0f, (float)(dims.y - 1));
-    const floatp pz = clamp(select((floatp)0.0f, z, active), 0.0f, (float)(dims.z - 1));
-    cell.ix = min(convert_intp(px), dims.x - 2);
-    cell.iy = min(convert_intp(py), dims.y - 2);
-    cell.iz = min(convert_intp(pz), dims.z - 2);
-    cell.fx = px - convert_floatp(cell.ix);
-    cell.fy = py - convert_floatp(cell.iy);
-    cell.fz = pz - convert_floatp(cell.iz);
-    const int2 bricks = volume_bricks(dims);
-    const intp x_0 = volume_offset_x(cell.ix), x_1 = volume_offset_x(cell.ix + 1);
-    const intp y_0 = volume_offset_y(cell.iy, bricks.x);
-    const intp y_1 = volume_offset_y(cell.iy + 1, bricks.x);
-    const intp z_0 = volume_offset_z(cell.iz, bricks.x, bricks.y);
-    const intp z_1 = volume_offset_z(cell.iz + 1, bricks.x, bricks.y);
-    cell.c000 = AT(x_0, y_0, z_0);
-    cell.c100 = AT(x_1, y_0, z_0);
-    cell.c010 = AT(x_0, y_1, z_0);
-    cell.c110 = AT(x_1, y_1, z_0);
-    cell.c001 = AT(x_0, y_0, z_1);
-    cell.c101 = AT(x_1, y_0, z_1);
-    cell.c011 = AT(x_0, y_1, z_1);
-    cell.c111 = AT(x_1, y_1, z_1);
+    cell.fx = p.fx;
+    cell.fy = p.fy;
+    cell.fz = p.fz;
+    cell.c000 = AT(p.x_0, p.y_0, p.z_0);
+    cell.c100 = AT(p.x_1, p.y_0, p.z_0);
+    cell.c010 = AT(p.x_0, p.y_1, p.z_0);
+    cell.c110 = AT(p.x_1, p.y_1, p.z_0);
+    cell.c001 = AT(p.x_0, p.y_0, p.z_1);
+    cell.c101 = AT(p.x_1, p.y_0, p.z_1);
+    cell.c011 = AT(p.x_0, p.y_1, p.z_1);
+    cell.c111 = AT(p.x_1, p.y_1, p.z_1);
     return cell;
 }
+#undef AT
 
 // Trilinear interpolation of one cell's corners in sample_trilinear's order of operations.
 PACKET_INLINE floatp packet_cell_trilinear(floatp c000, floatp c100, floatp c010, floatp c110,
@@ -429,58 +446,94 @@ PACKET_INLINE floatp packet_trilinear(__global const float* volume, int4 dims, f
     return packet_cell_value(&cell);
 }
 
-// gradient_central() at a packet's samples, from their cells. The six samples one voxel to
-// either side fall in the neighbouring cells with the same fractions, so they share the cell's
-// eight corners and need only 24 more values (x, y or z at -1 and +2 around the cell) instead of
-// six full trilinear samples' 48. Clamping the neighbour's index to the grid gives what clamping
-// its position gives (a face value), so this is gradient_central's definition, to rounding of
-// the fractions.
-PACKET_INLINE void packet_cell_gradient(__global const float* volume, int4 dims,
-                                        const PacketCell* c, float4 inv_spacing, floatp* gx,
-                                        floatp* gy, floatp* gz) {
-    const int2 b = volume_bricks(dims);
-    // Row, column and slice offsets of the stencil: -1, 0, 1, 2 around the cell, clamped.
-    const intp x_m = volume_offset_x(max(c->ix - 1, 0)), x_0 = volume_offset_x(c->ix),
-               x_1 = volume_offset_x(c->ix + 1), x_2 = volume_offset_x(min(c->ix + 2, dims.x - 1));
-    const intp y_m = volume_offset_y(max(c->iy - 1, 0), b.x), y_0 = volume_offset_y(c->iy, b.x),
-               y_1 = volume_offset_y(c->iy + 1, b.x),
-               y_2 = volume_offset_y(min(c->iy + 2, dims.y - 1), b.x);
-    const intp z_m = volume_offset_z(max(c->iz - 1, 0), b.x, b.y),
-               z_0 = volume_offset_z(c->iz, b.x, b.y), z_1 = volume_offset_z(c->iz + 1, b.x, b.y),
-               z_2 = volume_offset_z(min(c->iz + 2, dims.z - 1), b.x, b.y);
-    const floatp fx = c->fx, fy = c->fy, fz = c->fz;
-    // x: the cells at ix - 1 and ix + 1.
-    const floatp xm00 = AT(x_m, y_0, z_0), xm10 = AT(x_m, y_1, z_0);
-    const floatp xm01 = AT(x_m, y_0, z_1), xm11 = AT(x_m, y_1, z_1);
-    const floatp x200 = AT(x_2, y_0, z_0), x210 = AT(x_2, y_1, z_0);
-    const floatp x201 = AT(x_2, y_0, z_1), x211 = AT(x_2, y_1, z_1);
-    *gx = (packet_cell_trilinear(c->c100, x200, c->c110, x210, c->c101, x201, c->c111, x211, fx, fy,
-                                 fz) -
-           packet_cell_trilinear(xm00, c->c000, xm10, c->c010, xm01, c->c001, xm11, c->c011, fx, fy,
-                                 fz)) *
-          (0.5f * inv_spacing.x);
-    // y: the cells at iy - 1 and iy + 1.
-    const floatp ym00 = AT(x_0, y_m, z_0), ym10 = AT(x_1, y_m, z_0);
-    const floatp ym01 = AT(x_0, y_m, z_1), ym11 = AT(x_1, y_m, z_1);
-    const floatp y200 = AT(x_0, y_2, z_0), y210 = AT(x_1, y_2, z_0);
-    const floatp y201 = AT(x_0, y_2, z_1), y211 = AT(x_1, y_2, z_1);
-    *gy = (packet_cell_trilinear(c->c010, c->c110, y200, y210, c->c011, c->c111, y201, y211, fx, fy,
-                                 fz) -
-           packet_cell_trilinear(ym00, ym10, c->c000, c->c100, ym01, ym11, c->c001, c->c101, fx, fy,
-                                 fz)) *
-          (0.5f * inv_spacing.y);
-    // z: the cells at iz - 1 and iz + 1.
-    const floatp zm00 = AT(x_0, y_0, z_m), zm10 = AT(x_1, y_0, z_m);
-    const floatp zm01 = AT(x_0, y_1, z_m), zm11 = AT(x_1, y_1, z_m);
-    const floatp z200 = AT(x_0, y_0, z_2), z210 = AT(x_1, y_0, z_2);
-    const floatp z201 = AT(x_0, y_1, z_2), z211 = AT(x_1, y_1, z_2);
-    *gz = (packet_cell_trilinear(c->c001, c->c101, c->c011, c->c111, z200, z210, z201, z211, fx, fy,
-                                 fz) -
-           packet_cell_trilinear(zm00, zm10, zm01, zm11, c->c000, c->c100, c->c010, c->c110, fx, fy,
-                                 fz)) *
-          (0.5f * inv_spacing.z);
+// An empty asm statement the value passes through, in a vector register: LLVM cannot see through
+// it, so it lowers the transpose's shuffles as written. Without it, LLVM 15 merged each output's
+// chain of shuffles back into one shuffle of the sixteen loaded floats and built it from element
+// broadcasts and blends: 250 M instructions a shaded test frame where the kept shuffles take 201 M
+// (bench/RESULTS.md, "A shading volume"). x86 with AVX only (the packets' CPU devices); elsewhere
+// nothing.
+#if defined(__AVX__)
+#define KEEP_VECTOR(v) __asm__("" : "+x"(v))
+#else
+#define KEEP_VECTOR(v)
+#endif
+
+// Eight lanes of four vectors from one float4 per lane: lane k of (a, b, c, d) is buf[i_k]'s
+// (x, y, z, w). Lanes k and k + 4 load into the two halves of a float8 and four lanes are
+// transposed in each half, with the unpack shuffles AVX2 does within 128-bit halves: eight
+// 16-byte loads and eight shuffles for what GATHER would load as 32 floats one by one.
+PACKET_INLINE void gather_float4_8(__global const float4* buf, int8 i, float8* a, float8* b,
+                                   float8* c, float8* d) {
+    float8 r0 = (float8)(buf[i.s0], buf[i.s4]), r1 = (float8)(buf[i.s1], buf[i.s5]);
+    float8 r2 = (float8)(buf[i.s2], buf[i.s6]), r3 = (float8)(buf[i.s3], buf[i.s7]);
+    KEEP_VECTOR(r0);
+    KEEP_VECTOR(r1);
+    KEEP_VECTOR(r2);
+    KEEP_VECTOR(r3);
+    const uint8 low = (uint8)(0, 8, 1, 9, 4, 12, 5, 13), high = (uint8)(2, 10, 3, 11, 6, 14, 7, 15);
+    float8 t0 = shuffle2(r0, r1, low), t1 = shuffle2(r0, r1, high);
+    float8 t2 = shuffle2(r2, r3, low), t3 = shuffle2(r2, r3, high);
+    KEEP_VECTOR(t0);
+    KEEP_VECTOR(t1);
+    KEEP_VECTOR(t2);
+    KEEP_VECTOR(t3);
+    const uint8 even = (uint8)(0, 1, 8, 9, 4, 5, 12, 13), odd = (uint8)(2, 3, 10, 11, 6, 7, 14, 15);
+    *a = shuffle2(t0, t2, even);
+    *b = shuffle2(t0, t2, odd);
+    *c = shuffle2(t1, t3, even);
+    *d = shuffle2(t1, t3, odd);
 }
-#undef AT
+
+// Lanes of four packets from one float4 per lane: lane k of (a, b, c, d) is buf[index.sk]'s
+// (x, y, z, w).
+PACKET_INLINE void gather_float4(__global const float4* buf, intp index, floatp* a, floatp* b,
+                                 floatp* c, floatp* d) {
+    float8 a0, b0, c0, d0, a1, b1, c1, d1;
+    gather_float4_8(buf, index.lo, &a0, &b0, &c0, &d0);
+    gather_float4_8(buf, index.hi, &a1, &b1, &c1, &d1);
+    *a = (floatp)(a0, a1);
+    *b = (floatp)(b0, b1);
+    *c = (floatp)(c0, c1);
+    *d = (floatp)(d0, d1);
+}
+
+// One x-edge of a cell from the shading volume (gradient_volume.cl): the value and the three
+// central differences, each interpolated along x (packet_cell_trilinear's first step).
+PACKET_INLINE void packet_shaded_edge(__global const float4* shading, const PacketPlace* p, intp yz,
+                                      floatp* v, floatp* dx, floatp* dy, floatp* dz) {
+    floatp v0, dx0, dy0, dz0, v1, dx1, dy1, dz1;
+    gather_float4(shading, p->x_0 + yz, &v0, &dx0, &dy0, &dz0);
+    gather_float4(shading, p->x_1 + yz, &v1, &dx1, &dy1, &dz1);
+    *v = mix(v0, v1, p->fx);
+    *dx = mix(dx0, dx1, p->fx);
+    *dy = mix(dy0, dy1, p->fx);
+    *dz = mix(dz0, dz1, p->fx);
+}
+
+// packet_trilinear() and gradient_central() at a packet's samples, from the shading volume
+// (gradient_volume.cl: per voxel the value and its central differences): the value is
+// packet_trilinear's, float for float (the same corners, the same operations), and the gradient
+// the trilinear interpolation of the voxels' differences, which is gradient_central's difference
+// of interpolations to float rounding. Eight 16-byte loads per lane where the cell and the
+// neighbours' values were 32 gathered floats.
+PACKET_INLINE floatp packet_shaded_sample(__global const float4* shading, int4 dims, floatp x,
+                                          floatp y, floatp z, intp active, float4 inv_spacing,
+                                          floatp* gx, floatp* gy, floatp* gz) {
+    const PacketPlace p = packet_place(dims, x, y, z, active);
+    floatp v00, x00, y00, z00, v10, x10, y10, z10;
+    packet_shaded_edge(shading, &p, p.y_0 + p.z_0, &v00, &x00, &y00, &z00);
+    packet_shaded_edge(shading, &p, p.y_1 + p.z_0, &v10, &x10, &y10, &z10);
+    const floatp v0 = mix(v00, v10, p.fy), gx0 = mix(x00, x10, p.fy);
+    const floatp gy0 = mix(y00, y10, p.fy), gz0 = mix(z00, z10, p.fy);
+    floatp v01, x01, y01, z01, v11, x11, y11, z11;
+    packet_shaded_edge(shading, &p, p.y_0 + p.z_1, &v01, &x01, &y01, &z01);
+    packet_shaded_edge(shading, &p, p.y_1 + p.z_1, &v11, &x11, &y11, &z11);
+    // Halving is exact in float: gradient_central's 1 / (2 spacing).
+    *gx = mix(gx0, mix(x01, x11, p.fy), p.fz) * (0.5f * inv_spacing.x);
+    *gy = mix(gy0, mix(y01, y11, p.fy), p.fz) * (0.5f * inv_spacing.y);
+    *gz = mix(gz0, mix(z01, z11, p.fy), p.fz) * (0.5f * inv_spacing.z);
+    return mix(v0, mix(v01, v11, p.fy), p.fz);
+}
 
 // lookup_transfer() for a packet: colour and step-corrected opacity, bilinear in (value, gradient
 // magnitude). Values must not be NaN (callers replace them and mask their opacity).

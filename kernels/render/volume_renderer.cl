@@ -96,13 +96,16 @@ PACKET_INLINE floatp packet_pow_unit(floatp x, float w) {
 // or at the early-termination opacity, like `break` above; the packet stops when all have. Lanes
 // skip blocks where the table is transparent (packet_block_skip; block_size 0: none): the
 // samples skipped there have zero opacity, which render_volume passes over with `continue`.
+// Where gradients are needed (shading, 2D function), values and gradients come from
+// shading_volume (gradient_volume.cl, packet_shaded_sample); otherwise it is not read.
 __kernel void render_volume_packets(
-    __global const float* volume, int4 dims, float4 origin_world, float4 inv_spacing,
-    float4 box_lower, float4 box_upper, float4 data_offset, float4 owned_lower, float4 owned_upper,
-    __global const float4* tf_table, int2 tf_bins, float4 tf_domain, float4 cam_position,
-    float4 cam_forward, float4 cam_right, float4 cam_up, float4 cam_half_extent, int2 size,
-    float4 march, float4 phong, __global float4* rgba_out, __global float* depth_out,
-    __global const uchar* skippable_blocks, int4 block_counts, int block_size) {
+    __global const float4* shading_volume, __global const float* volume, int4 dims,
+    float4 origin_world, float4 inv_spacing, float4 box_lower, float4 box_upper, float4 data_offset,
+    float4 owned_lower, float4 owned_upper, __global const float4* tf_table, int2 tf_bins,
+    float4 tf_domain, float4 cam_position, float4 cam_forward, float4 cam_right, float4 cam_up,
+    float4 cam_half_extent, int2 size, float4 march, float4 phong, __global float4* rgba_out,
+    __global float* depth_out, __global const uchar* skippable_blocks, int4 block_counts,
+    int block_size) {
     const int gx = get_global_id(0);
     const int gy = get_global_id(1);
     if (gx * PACKET_W >= size.x || gy * PACKET_H >= size.y) return;
@@ -129,14 +132,20 @@ __kernel void render_volume_packets(
         // below need no bookkeeping.
         sample += packet_block_skip(&rays, t, x, y, z, sample, active, step, skippable_blocks,
                                     block_counts, block_size, &next_block_t);
-        const PacketCell cell = packet_cell(volume, dims, x, y, z, active);
-        const floatp sampled = packet_cell_value(&cell);
+        // The gradient's samples come with the values from the shading volume (value and
+        // central differences per voxel), which the host builds only when they are needed.
+        floatp gradient_x = 0.0f, gradient_y = 0.0f, gradient_z = 0.0f, magnitude = 0.0f;
+        const floatp sampled =
+            needs_gradient
+                ? packet_shaded_sample(shading_volume, dims, x, y, z, active, inv_spacing,
+                                       &gradient_x, &gradient_y, &gradient_z)
+                : packet_trilinear(volume, dims, x, y, z, active);
         const intp usable = active & ~isnan(sampled);  // NaN is empty space
         const floatp value = select((floatp)tf_domain.x, sampled, usable);
-        floatp gradient_x = 0.0f, gradient_y = 0.0f, gradient_z = 0.0f, magnitude = 0.0f;
         floatp sample_red, sample_green, sample_blue, alpha;
         // A 1D function classifies without the gradient: where no lane of the packet is opaque
-        // enough to be seen, shading needs none (transparent space costs what it does unshaded).
+        // enough to be seen, the normal's arithmetic and the lighting are skipped (its corners
+        // were loaded with the value's).
         const bool classify_first = tf_bins.y == 1;
         if (classify_first) {
             packet_lookup_transfer(tf_table, tf_bins, tf_domain, value, 0.0f, &sample_red,
@@ -144,8 +153,6 @@ __kernel void render_volume_packets(
             if (!any(usable & (alpha > 0.0f))) continue;
         }
         if (needs_gradient) {
-            packet_cell_gradient(volume, dims, &cell, inv_spacing, &gradient_x, &gradient_y,
-                                 &gradient_z);
             magnitude =
                 sqrt(gradient_x * gradient_x + gradient_y * gradient_y + gradient_z * gradient_z);
             magnitude = select((floatp)0.0f, magnitude, isfinite(magnitude));

@@ -11,6 +11,7 @@
 #include "device/opencl_device.hpp"
 #include "insitu/error.hpp"
 #include "render/empty_space.hpp"
+#include "render/gradient_volume.hpp"
 
 namespace insitu {
 
@@ -118,6 +119,7 @@ struct VolumeRenderer::DeviceState {
     cl::Kernel kernel, packet_kernel;
     detail::DeviceMemory table, rgba_out, depth_out, fragment_out;
     std::optional<detail::EmptySpace> empty_space;
+    std::optional<detail::GradientVolume> gradient_volume;
 };
 
 VolumeRenderer::VolumeRenderer(std::shared_ptr<ComputeDevice> device)
@@ -126,6 +128,7 @@ VolumeRenderer::VolumeRenderer(std::shared_ptr<ComputeDevice> device)
     state_->kernel = device_->opencl().kernel("volume_renderer", "render_volume");
     state_->packet_kernel = device_->opencl().kernel("volume_renderer", "render_volume_packets");
     state_->empty_space.emplace(device_->opencl());
+    state_->gradient_volume.emplace(device_->opencl());
 }
 
 VolumeRenderer::~VolumeRenderer() = default;
@@ -192,8 +195,12 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
     const cl_float4 phong_parameters =
         to_float4(phong.ambient, phong.diffuse, phong.specular, phong.shininess);
 
-    last_render_in_packets_ =
-        settings.ray_packets && !volume_.region && volume_.packets_addressable() && opencl.is_cpu();
+    const bool shading_volume_affordable =
+        !needs_gradient ||
+        detail::GradientVolume::bytes_for(volume_) <= settings.shading_volume_max_bytes;
+    last_render_in_packets_ = settings.ray_packets && !volume_.region &&
+                              volume_.packets_addressable() && opencl.is_cpu() &&
+                              shading_volume_affordable;
     if (last_render_in_packets_) {
         // A transparent sample adds nothing: opacity alone decides what a packet may skip.
         detail::SkippedBlocks skipped;
@@ -201,8 +208,12 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
             skipped = state_->empty_space->skip(opencl, volume_, table, {}, true);
         }
         last_skippable_fraction_ = skipped.skippable_fraction;
+        // Gradients come from the shading volume, built on the first render after an upload
+        // that needs them; otherwise the kernel reads none and takes the values' buffer.
+        const cl::Buffer& shading =
+            needs_gradient ? state_->gradient_volume->of(opencl, volume_) : volume_.memory->buffer;
         opencl.launch(state_->packet_kernel, detail::packet_global_range(width, height),
-                      detail::packet_local_range(), detail::volume_args(volume_),
+                      detail::packet_local_range(), shading, detail::volume_args(volume_),
                       detail::transfer_args(state_->table.buffer, table),
                       detail::camera_args(camera), detail::image_size(camera), march,
                       phong_parameters, state_->rgba_out.buffer, state_->depth_out.buffer,
@@ -254,6 +265,7 @@ std::ostream& operator<<(std::ostream& out, const RenderSettings& settings) {
     if (settings.shading) out << " " << settings.phong;
     if (!settings.ray_packets) out << ", one ray per work-item";
     if (!settings.skip_empty_space) out << ", no empty-space skipping";
+    out << ", shading volume up to " << settings.shading_volume_max_bytes << " bytes";
     return out << ", table " << settings.tf_value_bins << "x" << settings.tf_gradient_bins << "}";
 }
 

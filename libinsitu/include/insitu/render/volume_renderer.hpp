@@ -69,6 +69,12 @@ struct RenderSettings {
     /// sample there adds nothing), only faster where the function has transparent ranges. Rays
     /// marched one per work-item never skip: the reference packets are tested against.
     bool skip_empty_space = true;
+    /// Shaded packets (and those of a 2D transfer function) read each sample's value and gradient
+    /// from a shading volume of four times the field's device memory, built once per upload
+    /// (bench/RESULTS.md, "A shading volume for the shaded packets"). Where it would take more
+    /// than this many bytes, those renders march one ray per work-item instead and allocate
+    /// nothing more: the node's memory is the simulation's first. The default admits a 512^3 field.
+    std::uint64_t shading_volume_max_bytes = std::uint64_t{2} << 30;
 };
 std::ostream& operator<<(std::ostream& out, const RenderSettings& settings);
 
