@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
@@ -29,6 +30,9 @@ struct Capture {
     const char* name;  ///< how the ray is split
     int cameras;
     std::vector<double> opacity_thresholds;  ///< empty: whole ray
+    /// The maps' side is the section's over this: more cameras with smaller maps hold as many
+    /// texels as 42 cameras at the section's size (162 at half, 642 at a quarter).
+    int map_divisor = 1;
 };
 
 /// The frames measured of each light field.
@@ -110,9 +114,9 @@ SceneViews scene_views(const Scene& scene, ProxyRenderer& renderer, int views, i
 }
 
 // The section's light field `capture` of `scene` (map^2, whole-ray colour or opacity segments,
-// no attenuation, rims as by default) in an archive at `archive`.
-void capture_into(const Scene& scene, ProxyRenderer& renderer, const Capture& capture, int map,
-                  int image, const fs::path& archive) {
+// no attenuation, rims as by default) in an archive at `archive`; the light field's stored bytes.
+std::uintmax_t capture_into(const Scene& scene, ProxyRenderer& renderer, const Capture& capture,
+                            int map, int image, const fs::path& archive) {
     LightFieldRequest request;
     request.settings.cameras = capture.cameras;
     request.settings.size = map;
@@ -124,7 +128,7 @@ void capture_into(const Scene& scene, ProxyRenderer& renderer, const Capture& ca
     }
     request.transfer_function = make_tf(scene);
     request.intervals = scene_intervals(scene, 16);
-    write_light_field_archive(
+    return write_light_field_archive(
         scene, renderer, request,
         capture_light_field(renderer,
                             LightFieldRig::around(renderer.volume().bounds, capture.cameras, map),
@@ -188,11 +192,10 @@ void measure(const Scene& scene, const SceneViews& seen, const Capture& capture,
 // The section's light fields, restricted to INSITU_CEILING_CAPTURES where it is set (a
 // comma-separated list of NAME_CAMERAS, e.g. "whole_ray_42"): a run of one light field's frames.
 std::vector<Capture> chosen_captures(bool smoke) {
-    std::vector<Capture> captures{{"whole_ray", 42, {}},
-                                  {"whole_ray", 162, {}},
-                                  {"two_segments", 42, {0.5}},
-                                  {"whole_ray", 642, {}}};
-    if (smoke) captures.pop_back();  // 642 cameras: the smoke run's minute
+    std::vector<Capture> captures{{"whole_ray", 42, {}},        {"whole_ray", 162, {}},
+                                  {"two_segments", 42, {0.5}},  {"equal_texels", 162, {}, 2},
+                                  {"equal_texels", 642, {}, 4}, {"whole_ray", 642, {}}};
+    if (smoke) captures.pop_back();  // 642 cameras at full size: the smoke run's minute
     const char* wanted = std::getenv("INSITU_CEILING_CAPTURES");
     if (wanted == nullptr || *wanted == '\0') return captures;
     const std::string list = std::string(",") + wanted + ",";
@@ -249,8 +252,13 @@ void section_light_field_ceiling(const std::vector<const Scene*>& scenes, bool s
         for (std::size_t s = 0; s < scenes.size(); ++s) {
             const fs::path archive = scratch / ("ceiling_" + scenes[s]->name);
             fs::remove_all(archive);
-            capture_into(*scenes[s], *renderers[s], capture, map, image, archive);
-            measure(*scenes[s], seen[s], capture, map, archive, csv);
+            const int capture_map = map / capture.map_divisor;
+            const std::uintmax_t stored =
+                capture_into(*scenes[s], *renderers[s], capture, capture_map, image, archive);
+            std::printf("light-field ceiling: %s %d cameras %s at %d^2: %.2f MB stored\n",
+                        scenes[s]->name.c_str(), capture.cameras, capture.name, capture_map,
+                        static_cast<double>(stored) / 1e6);
+            measure(*scenes[s], seen[s], capture, capture_map, archive, csv);
             fs::remove_all(archive);
         }
     }

@@ -1,8 +1,9 @@
 #pragma once
 // The ceiling of the one-segment light field (issue 41): first-hit depth and RGBA per camera
 // texel, blended from the cameras around a ray. Per scene and light field (42, 162 and 642
-// cameras, and 42 cameras with two opacity segments; 256^2 maps, whole-ray colour, no
-// attenuation, through the archive), from the first views of the light-field sections' random views
+// cameras, and 42 cameras with two opacity segments, at 256^2 maps; 162 at 128^2 and 642 at 64^2,
+// as many texels as 42 at 256^2; whole-ray colour, no attenuation, through the archive; the
+// stored bytes printed), from the first views of the light-field sections' random views
 // against the ground truth:
 //  - today's frame (the Explorer, source lightfield) and its error budget: each pixel class's
 //    share of the squared error and the PSNR with that class's error removed
