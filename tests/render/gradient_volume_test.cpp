@@ -83,8 +83,8 @@ TEST(GradientVolume, HoldsValuesAndClampedCentralDifferencesPerVoxel) {
 }
 
 // A field whose shading volume would take more than RenderSettings::shading_volume_max_bytes is
-// rendered shaded one ray per work-item, building nothing: the frame ray_packets off gives, bit
-// for bit. At the cap itself it still takes packets.
+// rendered shaded one ray per work-item (the kernel that reads no shading volume, so none is
+// built): the frame ray_packets off gives, bit for bit. At the cap itself it still takes packets.
 TEST(GradientVolume, ShadedRendersPastTheCapMarchOneRayPerWorkItem) {
     const SampledVolume volume = make_gaussian_blobs({21, 19, 23}, 3, 5);
     VolumeRenderer renderer;

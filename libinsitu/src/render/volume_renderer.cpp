@@ -265,7 +265,8 @@ std::ostream& operator<<(std::ostream& out, const RenderSettings& settings) {
     if (settings.shading) out << " " << settings.phong;
     if (!settings.ray_packets) out << ", one ray per work-item";
     if (!settings.skip_empty_space) out << ", no empty-space skipping";
-    out << ", shading volume up to " << settings.shading_volume_max_bytes << " bytes";
+    if (settings.shading_volume_max_bytes != RenderSettings{}.shading_volume_max_bytes)
+        out << ", shading volume up to " << settings.shading_volume_max_bytes << " bytes";
     return out << ", table " << settings.tf_value_bins << "x" << settings.tf_gradient_bins << "}";
 }
 
