@@ -34,7 +34,7 @@ ExploreFrame volume_frame(const FramePlan& plan, const ExploreRequest& request,
     frame.synthesised_view = !plan.same_view;
     frame.proxy_source = ProxySource::volume;
     std::vector<std::string> ignored;
-    if (request.lighting) ignored.push_back("the lights' directions and strengths");
+    if (request.lighting) ignored.push_back("the choice of lights");
     if (request.ambient_occlusion) ignored.push_back("ambient occlusion");
     if (request.enhancement) ignored.push_back("enhancement");
     for (std::size_t i = 0; i < ignored.size(); ++i) {
