@@ -19,8 +19,6 @@ namespace {
 
 constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-// The reconstruction's tolerance behind a recorded surface (light_field_reconstruction.cpp).
-constexpr double kSurfaceFootprints = 4.0;
 
 // The ray's depths (TruthDepths), marched to its end in double precision.
 struct RayDepths {
@@ -41,7 +39,7 @@ RayDepths march_depths(const Ray& ray, const reference::VoxelGrid& grid, const F
                 if (!std::isfinite(magnitude)) magnitude = 0.0;
             }
             const double a = tf.evaluate(value, magnitude).a;
-            const double alpha = 1.0 - std::pow(1.0 - a, step_world / tf.unit_length());
+            const double alpha = reference::step_opacity(a, step_world, tf.unit_length());
             if (!(alpha > 0.0)) return true;
             weighted_t += transmittance * alpha * t;  // the compositing weight T_i alpha_i
             transmittance *= 1.0 - alpha;
@@ -170,8 +168,8 @@ private:
         const int py = static_cast<int>(std::clamp(std::floor(map.y), 0.0, n - 1.0));
         const double stored = depth.at(px, py, 0) * rig_.secant_length(px + 0.5, py + 0.5);
         const double distance = glm::length(point - rig_.camera(k).position());
-        const double tolerance =
-            kSurfaceFootprints * 2.0 * distance / n + rig_.secant_length(map.x, map.y) / 255.0;
+        const double tolerance = detail::depth_tolerance(rig_, light_field_.settings.depth_bits,
+                                                         distance, map, detail::kSurfaceFootprints);
         return !(stored < distance - tolerance);
     }
 

@@ -37,7 +37,7 @@ TruthDepths truth_depths(const Field& field, const TransferFunction& tf, const C
 
 enum class OracleBlend {
     /// The cameras around the ray that see the point (no surface recorded in front of it, within
-    /// the reconstruction's 4 map pixels' footprint plus the depth's 8-bit resolution); where none
+    /// the reconstruction's tolerance: detail::depth_tolerance, kSurfaceFootprints); where none
     /// does, the first camera further out that does (the reconstruction's search order); where
     /// none does either, the cameras around as they are.
     visible,

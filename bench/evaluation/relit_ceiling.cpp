@@ -47,8 +47,7 @@ RaySums march(const Ray& ray, const VoxelGrid& grid, const Field& field, const T
             double magnitude = glm::length(gradient);
             if (!std::isfinite(magnitude)) magnitude = 0.0;
             const glm::vec4 rgba = tf.evaluate(value, magnitude);
-            const double alpha =
-                1.0 - std::pow(1.0 - static_cast<double>(rgba.a), step_world / tf.unit_length());
+            const double alpha = reference::step_opacity(rgba.a, step_world, tf.unit_length());
             if (!(alpha > 0.0)) return true;
             const glm::dvec3 colour(rgba.r, rgba.g, rgba.b);
             glm::dvec3 normal(0.0);

@@ -1,8 +1,10 @@
 #pragma once
 // Where a target ray meets a light field's rig (light_field_reconstruction.hpp, step 1): its
-// chord through the bounding sphere, the cameras around it and those further out, and the
-// bilinear taps with which a camera's map is read; the rig's camera spacing.
+// chord through the bounding sphere, the cameras around it and those further out, the
+// bilinear taps with which a camera's map is read and how far a point may lie behind a recorded
+// surface; the rig's camera spacing.
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -38,6 +40,22 @@ struct Taps {
     std::array<double, 4> weight{};
 };
 Taps bilinear_taps(int size, const glm::dvec2& map_position);
+
+// Tolerances in map pixels' footprints: a depth stored per pixel is piecewise constant, and on
+// a sloped surface neighbouring pixels (and neighbouring cameras) differ by about a footprint.
+// A hit may lie this far behind the stored surface (more is an occluding edge, not a surface).
+inline constexpr double kSurfaceFootprints = 4.0;
+
+// How far a point `distance` from a camera's eye, at `map` in its map, may lie behind the
+// surface the camera recorded there and still be on it: `footprints` map pixels' footprint at
+// that distance (2 s / N) plus the stored depth's resolution (`depth_bits` 8: fractions of the
+// secant in 255 steps; 16: half floats, 2^-10 of the distance).
+inline double depth_tolerance(const LightFieldRig& rig, int depth_bits, double distance,
+                              const glm::dvec2& map, double footprints) {
+    const double quantum =
+        depth_bits == 8 ? rig.secant_length(map.x, map.y) / 255.0 : distance * std::ldexp(1.0, -10);
+    return footprints * 2.0 * distance / rig.map_size() + quantum;
+}
 
 // How far inside a camera's own silhouette a map position lies, as a share of the blend: the
 // distance to the nearest texel that recorded no first hit (`depth`, map_size x map_size; its

@@ -28,6 +28,7 @@ using detail::check_settings;
 using detail::DepthBounds;
 using detail::icosphere_neighbours;
 using detail::kMaxSearchSteps;
+using detail::kSurfaceFootprints;
 using detail::ray_neighbourhood;
 using detail::RayNeighbourhood;
 using detail::RaySpan;
@@ -39,11 +40,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Halvings of the coarse bracket: 2^-16 of a coarse step is far below a map pixel's footprint
 // for any search_steps allowed, so the hit is as exact as the stored depth.
 constexpr int kBisections = 16;
-// Tolerances in map pixels' footprints: a depth stored per pixel is piecewise constant, and on
-// a sloped surface neighbouring pixels (and neighbouring cameras) differ by about a footprint.
-// A hit may lie this far behind the stored surface (more is an occluding edge, not a surface):
-constexpr double kSurfaceFootprints = 4.0;
-// and the cameras' hits along the ray are told to agree within:
+// The cameras' hits along the ray are told to agree within this many map pixels' footprints (a
+// hit may lie detail::kSurfaceFootprints behind a stored surface):
 constexpr double kAgreementFootprints = 2.0;
 // The cameras' colours of the ray (each camera's segments composited) are told to agree within
 // this (premultiplied, of full scale 1). Chosen on bench/evaluate's random views: a tighter
@@ -131,14 +129,11 @@ private:
         return high - low <= depth_tolerance(nearest, map, kSurfaceFootprints) ? sum : nearest;
     }
 
-    // How far a point may lie behind camera k's recorded surface and still be on it: `footprints`
-    // map pixels' footprint at that distance (2 s / N) plus the stored depth's resolution
-    // (8-bit fractions of the secant, or half floats).
+    // How far a point may lie behind a camera's recorded surface and still be on it
+    // (detail::depth_tolerance at this light field's depth bits).
     double depth_tolerance(double distance, const glm::dvec2& map, double footprints) const {
-        const double quantum = light_field_.settings.depth_bits == 8
-                                   ? rig_.secant_length(map.x, map.y) / 255.0
-                                   : distance * std::ldexp(1.0, -10);
-        return footprints * 2.0 * distance / rig_.map_size() + quantum;
+        return detail::depth_tolerance(rig_, light_field_.settings.depth_bits, distance, map,
+                                       footprints);
     }
 
     // Seed 001 §3.2 depth correction against one camera's stored depth (secant fractions): the

@@ -57,8 +57,7 @@ PixelResult march(const Ray& ray, const VoxelGrid& grid, const Field& field, con
         }
 
         const glm::vec4 rgba = tf.evaluate(value, gradient_magnitude);
-        const double alpha =
-            1.0 - std::pow(1.0 - static_cast<double>(rgba.a), step_world / tf.unit_length());
+        const double alpha = step_opacity(rgba.a, step_world, tf.unit_length());
         if (!(alpha > 0.0)) continue;
         if (std::isinf(result.depth)) result.depth = camera.depth_of(position_world);
 

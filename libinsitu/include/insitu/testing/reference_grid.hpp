@@ -2,6 +2,7 @@
 // The field and the ray as the ground-truth definition (insitu/render/volume_renderer.hpp) sees
 // them, in double precision, for the scalar reference renderer and for benchmarks that march
 // the definition themselves to measure what a representation can reach (the relit ceiling).
+#include <cmath>
 #include <cstdint>
 #include <glm/vec3.hpp>
 
@@ -14,6 +15,12 @@ namespace insitu::reference {
 // Below this |gradient| (field units per world unit) a sample has no usable normal and stays
 // unshaded (the same threshold the definition states).
 constexpr double kMinShadingGradient = 1e-12;
+
+/// A sample's opacity over a step of `step_world` from the transfer function's opacity `a`, which
+/// holds per `unit_length` of ray (the definition's step correction).
+inline double step_opacity(double a, double step_world, double unit_length) {
+    return 1.0 - std::pow(1.0 - a, step_world / unit_length);
+}
 
 /// The field in voxel coordinates, non-finite input read as NaN (empty).
 class VoxelGrid {
