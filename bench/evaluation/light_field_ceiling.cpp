@@ -13,11 +13,13 @@
 #include "insitu/archive/archive.hpp"
 #include "insitu/error.hpp"
 #include "insitu/explore/explorer.hpp"
+#include "insitu/explore/light_field_reconstruction.hpp"
 #include "insitu/render/light_field_capture.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/metrics.hpp"
 #include "light_field_error_budget.hpp"
 #include "light_field_oracle.hpp"
+#include "light_field_own_depth.hpp"
 #include "light_field_quality.hpp"
 
 namespace insitu::evaluation {
@@ -33,12 +35,30 @@ struct Capture {
     /// The maps' side is the section's over this: more cameras with smaller maps hold as many
     /// texels as 42 cameras at the section's size (162 at half, 642 at a quarter).
     int map_divisor = 1;
+    /// With attenuation maps (a_j and mean depth of 16 intervals): measured with each camera
+    /// read at its own centroid, median and their blend with the first hit
+    /// (light_field_own_depth.hpp) instead of the oracle frames.
+    bool attenuation = false;
 };
 
 /// The frames measured of each light field.
-enum Frame { kToday, kOracle, kOracleNearest, kOracleCentroid, kOracleMedian, kBestDepth, kFrames };
+enum Frame {
+    kToday,
+    kOracle,
+    kOracleNearest,
+    kOracleCentroid,
+    kOracleMedian,
+    kBestDepth,
+    kOwnCentroid,
+    kOwnMedian,
+    kOwnBlend,
+    kFrames
+};
 constexpr std::array<const char*, kFrames> kFrameNames{
-    "today", "oracle", "oracle_nearest", "oracle_centroid", "oracle_median", "best_depth"};
+    "today",      "oracle",       "oracle_nearest", "oracle_centroid", "oracle_median",
+    "best_depth", "own_centroid", "own_median",     "own_blend"};
+/// The own-depth frames' light fields, in Frame order from kOwnCentroid.
+constexpr std::array<OwnDepth, 3> kOwnDepths{OwnDepth::centroid, OwnDepth::median, OwnDepth::blend};
 
 /// Means over views of one frame's figures.
 struct Means {
@@ -114,13 +134,14 @@ SceneViews scene_views(const Scene& scene, ProxyRenderer& renderer, int views, i
 }
 
 // The section's light field `capture` of `scene` (map^2, whole-ray colour or opacity segments,
-// no attenuation, rims as by default) in an archive at `archive`; the light field's stored bytes.
+// attenuation as the capture asks, rims as by default) in an archive at `archive`; the light
+// field's stored bytes.
 std::uintmax_t capture_into(const Scene& scene, ProxyRenderer& renderer, const Capture& capture,
                             int map, int image, const fs::path& archive) {
     LightFieldRequest request;
     request.settings.cameras = capture.cameras;
     request.settings.size = map;
-    request.settings.attenuation = false;
+    request.settings.attenuation = capture.attenuation;
     request.settings.rim_threshold = kDefaultRimThreshold;
     if (!capture.opacity_thresholds.empty()) {
         request.settings.segments = SegmentRule::opacity;
@@ -136,35 +157,79 @@ std::uintmax_t capture_into(const Scene& scene, ProxyRenderer& renderer, const C
         archive.string(), image);
 }
 
-// Today's frames of the archive's light field and, for one segment, the oracle frames, from
-// every view: their budgets as CSV rows, and their means printed.
+// The light field with each camera read at its own depths (kOwnDepths), their counts printed.
+std::vector<LightField> own_depth_light_fields(const LightField& stored, const std::string& scene,
+                                               const Capture& capture) {
+    std::vector<LightField> out;
+    for (std::size_t i = 0; i < kOwnDepths.size(); ++i) {
+        OwnDepthCounts counts;
+        out.push_back(with_own_depth(stored, kOwnDepths[i], &counts));
+        std::printf(
+            "light-field ceiling: %s %d cameras %s, %s: %zu of %zu texels hold a first hit, %zu "
+            "of them without attenuation (kept); mean shift %+.4f of the secant; mean |sum a_j - "
+            "alpha| %.2g\n",
+            scene.c_str(), capture.cameras, capture.name, kFrameNames[kOwnCentroid + i],
+            counts.first_hits, counts.texels, counts.kept, counts.mean_shift,
+            counts.mean_coverage_gap);
+    }
+    return out;
+}
+
+// The frames of one view: today's (the Explorer's), and the oracle's (one segment) or the
+// own-depth light fields' (`own`, attenuation captures).
+std::array<Image, kFrames> view_frames(Explorer& explorer, const LightField& stored,
+                                       const std::vector<LightField>& own, const SceneViews& seen,
+                                       std::size_t v) {
+    ExploreRequest explore;
+    explore.azimuth_deg = seen.angles[v].first;
+    explore.elevation_deg = seen.angles[v].second;
+    explore.source = ProxySource::lightfield;
+    std::array<Image, kFrames> frames;
+    frames[kToday] = explorer.render(explore).colour;
+    const Camera& camera = seen.cameras[v];
+    if (!own.empty()) {
+        LightFieldReconstructionSettings settings;
+        settings.attenuation = false;  // as the Explorer reconstructs a frame without edits
+        // The own-depth frames are the reconstruction's: only if it gives today's frame from
+        // the stored light field do they compare with today's.
+        if (v == 0 && reconstruct_light_field(stored, camera, settings).rgba.pixels !=
+                          frames[kToday].pixels) {
+            fail<Error>(
+                "light_field_ceiling: the reconstruction of the stored light field is "
+                "not the Explorer's frame");
+        }
+        for (std::size_t i = 0; i < own.size(); ++i) {
+            frames[kOwnCentroid + i] = reconstruct_light_field(own[i], camera, settings).rgba;
+        }
+    } else if (stored.segment_count() == 1) {
+        const TruthDepths& depths = seen.depths[v];
+        frames[kOracle] = oracle_frame(stored, camera, depths.first_hit, OracleBlend::visible);
+        frames[kOracleNearest] =
+            oracle_frame(stored, camera, depths.first_hit, OracleBlend::nearest);
+        frames[kOracleCentroid] =
+            oracle_frame(stored, camera, depths.centroid, OracleBlend::visible);
+        frames[kOracleMedian] = oracle_frame(stored, camera, depths.median, OracleBlend::visible);
+        frames[kBestDepth] = oracle_frame(stored, camera, depths.first_hit, OracleBlend::best_depth,
+                                          &seen.truths[v]);
+    }
+    return frames;
+}
+
+// Today's frames of the archive's light field and, for one segment, the oracle frames, or for
+// an attenuation capture the own-depth frames, from every view: their budgets as CSV rows, and
+// their means printed.
 void measure(const Scene& scene, const SceneViews& seen, const Capture& capture, int map,
              const fs::path& archive, Csv& csv) {
     Explorer explorer(archive.string());
     const LightField stored =
         ArchiveReader(archive.string()).load_light_field(0, scene.volume.name);
     const int segments = stored.segment_count();
+    const std::vector<LightField> own = capture.attenuation
+                                            ? own_depth_light_fields(stored, scene.name, capture)
+                                            : std::vector<LightField>{};
     std::array<Means, kFrames> means;
     for (std::size_t v = 0; v < seen.angles.size(); ++v) {
-        ExploreRequest explore;
-        explore.azimuth_deg = seen.angles[v].first;
-        explore.elevation_deg = seen.angles[v].second;
-        explore.source = ProxySource::lightfield;
-        std::array<Image, kFrames> frames;
-        frames[kToday] = explorer.render(explore).colour;
-        if (segments == 1) {
-            const TruthDepths& depths = seen.depths[v];
-            const Camera& camera = seen.cameras[v];
-            frames[kOracle] = oracle_frame(stored, camera, depths.first_hit, OracleBlend::visible);
-            frames[kOracleNearest] =
-                oracle_frame(stored, camera, depths.first_hit, OracleBlend::nearest);
-            frames[kOracleCentroid] =
-                oracle_frame(stored, camera, depths.centroid, OracleBlend::visible);
-            frames[kOracleMedian] =
-                oracle_frame(stored, camera, depths.median, OracleBlend::visible);
-            frames[kBestDepth] = oracle_frame(stored, camera, depths.first_hit,
-                                              OracleBlend::best_depth, &seen.truths[v]);
-        }
+        const std::array<Image, kFrames> frames = view_frames(explorer, stored, own, seen, v);
         for (int f = 0; f < kFrames; ++f) {
             if (frames[f].pixel_count() == 0) continue;
             const Image& truth = seen.truths[v];
@@ -192,9 +257,14 @@ void measure(const Scene& scene, const SceneViews& seen, const Capture& capture,
 // The section's light fields, restricted to INSITU_CEILING_CAPTURES where it is set (a
 // comma-separated list of NAME_CAMERAS, e.g. "whole_ray_42"): a run of one light field's frames.
 std::vector<Capture> chosen_captures(bool smoke) {
-    std::vector<Capture> captures{{"whole_ray", 42, {}},        {"whole_ray", 162, {}},
-                                  {"two_segments", 42, {0.5}},  {"equal_texels", 162, {}, 2},
-                                  {"equal_texels", 642, {}, 4}, {"whole_ray", 642, {}}};
+    std::vector<Capture> captures{{"whole_ray", 42, {}},
+                                  {"whole_ray", 162, {}},
+                                  {"two_segments", 42, {0.5}},
+                                  {"equal_texels", 162, {}, 2},
+                                  {"equal_texels", 642, {}, 4},
+                                  {"attenuation", 42, {}, 1, true},
+                                  {"attenuation_equal_texels", 162, {}, 2, true},
+                                  {"whole_ray", 642, {}}};
     if (smoke) captures.pop_back();  // 642 cameras at full size: the smoke run's minute
     const char* wanted = std::getenv("INSITU_CEILING_CAPTURES");
     if (wanted == nullptr || *wanted == '\0') return captures;

@@ -2,19 +2,23 @@
 // The ceiling of the one-segment light field (issue 41): first-hit depth and RGBA per camera
 // texel, blended from the cameras around a ray. Per scene and light field (42, 162 and 642
 // cameras, and 42 cameras with two opacity segments, at 256^2 maps; 162 at 128^2 and 642 at 64^2,
-// as many texels as 42 at 256^2; whole-ray colour, no attenuation, through the archive; the
+// as many texels as 42 at 256^2; whole-ray colour, attenuation where said, through the archive; the
 // stored bytes printed), from the first views of the light-field sections' random views
 // against the ground truth:
 //  - today's frame (the Explorer, source lightfield) and its error budget: each pixel class's
 //    share of the squared error and the PSNR with that class's error removed
 //    (light_field_error_budget.hpp);
-//  - for the one-segment fields, the oracle frames (light_field_oracle.hpp): the truth's own
+//  - for the one-segment fields without attenuation, the oracle frames (light_field_oracle.hpp):
+//  the truth's own
 //    first hit read in the cameras around the ray (blended, and the nearest camera alone), its
 //    contribution centroid and median depth read the same way (blended), and
 //    the best single point of each ray's chord (chosen against the truth: a bound on any
-//    geometry), and their error budgets.
+//    geometry), and their error budgets;
+//  - for the attenuation light fields (42 cameras at 256^2, 162 at 128^2, 16 intervals), each
+//    camera read at its own centroid, median or halfway between its first hit and centroid, as
+//    the attenuation maps give them (light_field_own_depth.hpp), through the reconstruction.
 // Writes light_field_ceiling.csv, one row per scene, light field, frame and view.
-// INSITU_CEILING_CAPTURES (e.g. "whole_ray_42,two_segments_42") and INSITU_CEILING_VIEWS (1-30)
+// INSITU_CEILING_CAPTURES (e.g. "whole_ray_42,attenuation_42") and INSITU_CEILING_VIEWS (1-30)
 // restrict a run to some light fields and the first views.
 #include <filesystem>
 #include <vector>
