@@ -13,6 +13,7 @@
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "insitu/archive/archive.hpp"
@@ -384,6 +385,27 @@ TEST_F(ExplorerLightField, MissingCamerasAreReconstructedFromTheRestAndSaidSo) {
     }
     EXPECT_GT(filled, 0u);
     EXPECT_LT(fused.light_field_share, 1.0);
+}
+
+TEST_F(ExplorerLightField, AFrameDoesNotDependOnTheViewsBeforeIt) {
+    // The Explorer reads the cameras facing a view; substitutes further out may lie beyond
+    // them. A fresh Explorer's frame must be the one an Explorer holding every camera makes, and
+    // it must not call cameras the file holds missing.
+    write_step();
+    Explorer seasoned(config_.archive);
+    for (const auto& [azimuth, elevation] : std::vector<std::pair<double, double>>{
+             {0, 0}, {90, 0}, {180, 0}, {270, 0}, {0, 89}, {0, -89}}) {
+        seasoned.render(at(azimuth, elevation, ProxySource::lightfield));
+    }
+    for (const auto& [azimuth, elevation] :
+         std::vector<std::pair<double, double>>{{30, 20}, {140, -35}, {250, 55}, {320, -70}}) {
+        Explorer fresh(config_.archive);
+        const ExploreFrame first = fresh.render(at(azimuth, elevation, ProxySource::lightfield));
+        const ExploreFrame later = seasoned.render(at(azimuth, elevation, ProxySource::lightfield));
+        EXPECT_TRUE(first.missing_cameras.empty()) << "azimuth " << azimuth;
+        EXPECT_EQ(first.colour.pixels, later.colour.pixels) << "azimuth " << azimuth;
+        EXPECT_EQ(first.confidence.pixels, later.confidence.pixels) << "azimuth " << azimuth;
+    }
 }
 
 TEST_F(ExplorerLightField, AskingForALightFieldTheArchiveLacksNamesIt) {

@@ -48,6 +48,16 @@ ExploreFrame light_field_frame(const FramePlan& plan, const ExploreRequest& requ
         has_attenuation && (plan.edits || request.lighting || request.enhancement);
     auto reconstruction = std::make_shared<LightFieldReconstruction>(
         reconstruct_light_field(*light_field, plan.target, settings));
+    // Substitutes further out on the icosphere can lie beyond the cameras facing the view. Read
+    // them and reconstruct again, so that a frame never depends on the views before it (which
+    // cameras the cache already holds) and only cameras the file lacks are reported missing.
+    while (!reconstruction->missing_cameras.empty()) {
+        const std::size_t held = light_field->cameras.size();
+        light_field =
+            steps.load_light_field(request.step, plan.field, reconstruction->missing_cameras);
+        if (light_field->cameras.size() == held) break;  // the file lacks every one of them
+        *reconstruction = reconstruct_light_field(*light_field, plan.target, settings);
+    }
     ExploreFrame out = planned_frame(plan);
     out.proxy_source = ProxySource::lightfield;
     out.light_field_share = 1.0;
