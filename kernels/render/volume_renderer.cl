@@ -91,10 +91,66 @@ PACKET_INLINE floatp packet_pow_unit(floatp x, float w) {
     return exp2(w * log2(x));  // log2(0) = -inf gives 0
 }
 
+// Empty-space skipping of the ground truth's packets, per lane: a lane of `active` whose sample
+// (x, y, z, in the buffer's voxels) lies in a block the pass may skip (empty_space.hpp: every
+// sample there has zero opacity) moves on without taking it, to the block's last sample (or the
+// next sample, where it is there already); `passing` says which lanes did, and where they land is
+// looked up again. Other lanes look their block up once, on entering it (t >= next_block_t), and
+// keep their sample. Returns each lane's sample index. Nothing is composited in a skippable block
+// and the ground truth looks for no crossings, so, unlike the proxies (packet_block_skip), no
+// sample of such a block need be taken: a packet whose lanes all cross transparent blocks costs
+// lookups, not samples. Exact whatever the rounding of the block's exit: a lane skips its own
+// sample only where that sample lies in the block, and every sample before `last` lies a step or
+// more before the exit (one rounding of the exit's reciprocal form moves it by far less). The
+// inverse directions and step replace render_proxies' divisions (bench/RESULTS.md, "The block
+// lookups of the packets").
+PACKET_INLINE intp packet_skip_transparent(const MarchPacket* rays, floatp inverse_x,
+                                           floatp inverse_y, floatp inverse_z, float step,
+                                           float inverse_step, floatp t, floatp x, floatp y,
+                                           floatp z, intp sample, intp active,
+                                           __global const uchar* skippable_blocks,
+                                           int4 block_counts, int block_size, floatp* next_block_t,
+                                           intp* passing) {
+    *passing = 0;
+    const intp look_up = active & (t >= *next_block_t);
+    if (!any(look_up)) return sample;
+    const float bs = (float)block_size;
+    intp bx, by, bz;
+    packet_block(x, y, z, block_counts, block_size, &bx, &by, &bz);
+    const floatp exit_x = convert_floatp(bx * block_size) +
+                          select((floatp)0.0f, (floatp)bs, rays->direction_x > 0.0f);
+    const floatp exit_y = convert_floatp(by * block_size) +
+                          select((floatp)0.0f, (floatp)bs, rays->direction_y > 0.0f);
+    const floatp exit_z = convert_floatp(bz * block_size) +
+                          select((floatp)0.0f, (floatp)bs, rays->direction_z > 0.0f);
+    const floatp t_x =
+        select((exit_x - rays->start_x) * inverse_x, (floatp)INFINITY, rays->direction_x == 0.0f);
+    const floatp t_y =
+        select((exit_y - rays->start_y) * inverse_y, (floatp)INFINITY, rays->direction_y == 0.0f);
+    const floatp t_z =
+        select((exit_z - rays->start_z) * inverse_z, (floatp)INFINITY, rays->direction_z == 0.0f);
+    const floatp exit_t = fmin(fmin(t_x, t_y), t_z);
+    *passing = packet_block_skippable(skippable_blocks, block_counts, bx, by, bz, look_up);
+    // Clamped so that the conversion stays in range whatever the exit (an axis-parallel ray's
+    // infinite one never reaches it: some axis moves).
+    const floatp q = clamp((exit_t - rays->t_near) * inverse_step - 0.5f, -2.0f, 16777216.0f);
+    const intp last = packet_ceil(q) - 1;
+    // Where the last sample's position (packet_position's, as the march computes it) lies in the
+    // block too, as it almost always does, the lane passes it as well: one lookup per block.
+    floatp last_x, last_y, last_z;
+    packet_position(rays, packet_sample_t(rays, last, step), &last_x, &last_y, &last_z);
+    intp last_bx, last_by, last_bz;
+    packet_block(last_x, last_y, last_z, block_counts, block_size, &last_bx, &last_by, &last_bz);
+    const intp last_inside = (last_bx == bx) & (last_by == by) & (last_bz == bz);
+    // A lane that passes looks up where it lands; one that stays, when it leaves the block.
+    *next_block_t = select(*next_block_t, select(exit_t, (floatp)(-INFINITY), *passing), look_up);
+    return select(sample, max(last - last_inside, sample + 1), *passing);
+}
+
 // render_volume for a whole volume, one packet of rays per work-item (ray_march.cl): the same
 // samples, classification, shading and compositing per lane. A lane stops at the end of its span
 // or at the early-termination opacity, like `break` above; the packet stops when all have. Lanes
-// skip blocks where the table is transparent (packet_block_skip; block_size 0: none): the
+// skip blocks where the table is transparent (packet_skip_transparent; block_size 0: none): the
 // samples skipped there have zero opacity, which render_volume passes over with `continue`.
 // Where gradients are needed (shading, 2D function), values and gradients come from
 // shading_volume (gradient_volume.cl, packet_shaded_sample); otherwise it is not read.
@@ -122,16 +178,29 @@ __kernel void render_volume_packets(
     intp marching = rays.hits;
     floatp next_block_t = -INFINITY;
     intp sample = 0;  // each lane's sample index: lanes skip empty blocks independently
+    const floatp inverse_x = 1.0f / rays.direction_x, inverse_y = 1.0f / rays.direction_y;
+    const floatp inverse_z = 1.0f / rays.direction_z;
+    const float inverse_step = 1.0f / step;
     while (true) {
-        const floatp t = rays.t_near + (convert_floatp(sample) + 0.5f) * step;
-        const intp active = marching & (t < rays.t_far);
+        floatp t, x, y, z;
+        intp active;
+        // Lanes in transparent blocks move on without sampling until every lane has a sample to
+        // take or has finished.
+        while (true) {
+            t = packet_sample_t(&rays, sample, step);
+            active = marching & (t < rays.t_far);
+            packet_position(&rays, t, &x, &y, &z);
+            if (block_size == 0) break;
+            intp passing;
+            sample = packet_skip_transparent(
+                &rays, inverse_x, inverse_y, inverse_z, step, inverse_step, t, x, y, z, sample,
+                active, skippable_blocks, block_counts, block_size, &next_block_t, &passing);
+            if (!any(passing)) break;
+        }
         if (!any(active)) break;
-        floatp x, y, z;
-        packet_position(&rays, t, &x, &y, &z);
         // The lanes' next samples are known before this one is classified, so the `continue`s
         // below need no bookkeeping.
-        sample += packet_block_skip(&rays, t, x, y, z, sample, active, step, skippable_blocks,
-                                    block_counts, block_size, &next_block_t);
+        sample += 1;
         // The gradient's samples come with the values from the shading volume (value and
         // central differences per voxel), which the host builds only when they are needed.
         floatp gradient_x = 0.0f, gradient_y = 0.0f, gradient_z = 0.0f, magnitude = 0.0f;
