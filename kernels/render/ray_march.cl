@@ -575,13 +575,19 @@ PACKET_INLINE floatp packet_shaded_sample(__global const float4* shading, int4 d
     return mix(v0, mix(v01, v11, p.fy), p.fz);
 }
 
+// Where a value falls in the table: lookup_transfer()'s x, the bins ix = min(floor(x), bins.x - 2)
+// and ix + 1 are what it interpolates.
+PACKET_INLINE floatp packet_table_x(int2 bins, float4 domain, floatp value) {
+    return clamp((value - domain.x) * domain.y, 0.0f, 1.0f) * (float)(bins.x - 1);
+}
+
 // lookup_transfer() for a packet: colour and step-corrected opacity, bilinear in (value, gradient
 // magnitude). Values must not be NaN (callers replace them and mask their opacity).
 PACKET_INLINE void packet_lookup_transfer(__global const float4* table4, int2 bins, float4 domain,
                                           floatp value, floatp gradient_magnitude, floatp* r,
                                           floatp* g, floatp* b, floatp* a) {
     __global const float* table = (__global const float*)table4;
-    const floatp x = clamp((value - domain.x) * domain.y, 0.0f, 1.0f) * (float)(bins.x - 1);
+    const floatp x = packet_table_x(bins, domain, value);
     const intp ix = min(convert_intp(x), bins.x - 2);
     const floatp fx = x - convert_floatp(ix);
     const intp e0 = 4 * ix;
@@ -630,7 +636,7 @@ PACKET_INLINE floatp packet_lookup_opacity(__global const float4* table4, int2 b
         return a;
     }
     __global const float* table = (__global const float*)table4;
-    const floatp x = clamp((value - domain.x) * domain.y, 0.0f, 1.0f) * (float)(bins.x - 1);
+    const floatp x = packet_table_x(bins, domain, value);
     const intp ix = min(convert_intp(x), bins.x - 2);
     const floatp fx = x - convert_floatp(ix);
     const intp alpha0 = 4 * ix + 3;

@@ -152,8 +152,10 @@ PACKET_INLINE intp packet_skip_transparent(const MarchPacket* rays, floatp inver
 // or at the early-termination opacity, like `break` above; the packet stops when all have. Lanes
 // skip blocks where the table is transparent (packet_skip_transparent; block_size 0: none): the
 // samples skipped there have zero opacity, which render_volume passes over with `continue`.
-// Where gradients are needed (shading, 2D function), values and gradients come from
-// shading_volume (gradient_volume.cl, packet_shaded_sample); otherwise it is not read.
+// transparent_x: below it in the table every lookup is transparent (empty_space.hpp,
+// transparent_table_x; 0: nowhere). Where gradients are needed (shading, 2D function), values and
+// gradients come from shading_volume (gradient_volume.cl, packet_shaded_sample); otherwise it is
+// not read.
 __kernel void render_volume_packets(
     __global const float4* shading_volume, __global const float* volume, int4 dims,
     float4 origin_world, float4 inv_spacing, float4 box_lower, float4 box_upper, float4 data_offset,
@@ -161,7 +163,7 @@ __kernel void render_volume_packets(
     float4 tf_domain, float4 cam_position, float4 cam_forward, float4 cam_right, float4 cam_up,
     float4 cam_half_extent, int2 size, float4 march, float4 phong, __global float4* rgba_out,
     __global float* depth_out, __global const uchar* skippable_blocks, int4 block_counts,
-    int block_size) {
+    int block_size, float transparent_x) {
     const int gx = get_global_id(0);
     const int gy = get_global_id(1);
     if (gx * PACKET_W >= size.x || gy * PACKET_H >= size.y) return;
@@ -217,6 +219,13 @@ __kernel void render_volume_packets(
         // were loaded with the value's).
         const bool classify_first = tf_bins.y == 1;
         if (classify_first) {
+            // Where every lane's value falls below transparent_x in the table (the bins there
+            // and the next have zero opacity in every row), the lookup would give each lane
+            // zero: the same `continue`, without the table's gathers.
+            if (transparent_x > 0.0f &&
+                !any(usable & (packet_table_x(tf_bins, tf_domain, value) >= transparent_x))) {
+                continue;
+            }
             packet_lookup_transfer(tf_table, tf_bins, tf_domain, value, 0.0f, &sample_red,
                                    &sample_green, &sample_blue, &alpha);
             if (!any(usable & (alpha > 0.0f))) continue;

@@ -217,7 +217,8 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
                       detail::transfer_args(state_->table.buffer, table),
                       detail::camera_args(camera), detail::image_size(camera), march,
                       phong_parameters, state_->rgba_out.buffer, state_->depth_out.buffer,
-                      skipped.skippable, skipped.block_counts, skipped.block_voxels);
+                      skipped.skippable, skipped.block_counts, skipped.block_voxels,
+                      static_cast<cl_float>(detail::transparent_table_x(table)));
     } else {
         last_skippable_fraction_ = 0.0;
         opencl.launch(
