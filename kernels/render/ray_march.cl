@@ -348,6 +348,17 @@ PACKET_INLINE void packet_block(floatp x, floatp y, floatp z, int4 block_counts,
     *bz = clamp(convert_intp(floor(z / bs)), 0, block_counts.z - 1);
 }
 
+// The faces through which each lane's ray leaves block (bx, by, bz): per axis the block's lower
+// or upper face, by the direction's sign, in the buffer's voxels.
+PACKET_INLINE void packet_block_exit_faces(const MarchPacket* rays, intp bx, intp by, intp bz,
+                                           int block_size, floatp* exit_x, floatp* exit_y,
+                                           floatp* exit_z) {
+    const floatp bs = (float)block_size;
+    *exit_x = convert_floatp(bx * block_size) + select((floatp)0.0f, bs, rays->direction_x > 0.0f);
+    *exit_y = convert_floatp(by * block_size) + select((floatp)0.0f, bs, rays->direction_y > 0.0f);
+    *exit_z = convert_floatp(bz * block_size) + select((floatp)0.0f, bs, rays->direction_z > 0.0f);
+}
+
 // convert_intp(ceil(q)) for |q| < 2^31: truncation rounds towards zero, one more where that fell
 // below q. The same integers as PoCL's vector ceil, in a third of its instructions on AVX2.
 PACKET_INLINE intp packet_ceil(floatp q) {
@@ -380,15 +391,10 @@ PACKET_INLINE intp packet_block_skip(const MarchPacket* rays, floatp t, floatp x
     if (block_size == 0) return advance;
     const intp look_up = look_up_lanes & (t >= *next_block_t);
     if (!any(look_up)) return advance;
-    const float bs = (float)block_size;
     intp bx, by, bz;
     packet_block(x, y, z, block_counts, block_size, &bx, &by, &bz);
-    const floatp exit_x = convert_floatp(bx * block_size) +
-                          select((floatp)0.0f, (floatp)bs, rays->direction_x > 0.0f);
-    const floatp exit_y = convert_floatp(by * block_size) +
-                          select((floatp)0.0f, (floatp)bs, rays->direction_y > 0.0f);
-    const floatp exit_z = convert_floatp(bz * block_size) +
-                          select((floatp)0.0f, (floatp)bs, rays->direction_z > 0.0f);
+    floatp exit_x, exit_y, exit_z;
+    packet_block_exit_faces(rays, bx, by, bz, block_size, &exit_x, &exit_y, &exit_z);
     // start is already in the buffer's coordinates (grid minus offset).
     const floatp t_x = select((exit_x - rays->start_x) / rays->direction_x, (floatp)INFINITY,
                               rays->direction_x == 0.0f);

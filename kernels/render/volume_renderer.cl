@@ -114,15 +114,10 @@ PACKET_INLINE intp packet_skip_transparent(const MarchPacket* rays, floatp inver
     *passing = 0;
     const intp look_up = active & (t >= *next_block_t);
     if (!any(look_up)) return sample;
-    const float bs = (float)block_size;
     intp bx, by, bz;
     packet_block(x, y, z, block_counts, block_size, &bx, &by, &bz);
-    const floatp exit_x = convert_floatp(bx * block_size) +
-                          select((floatp)0.0f, (floatp)bs, rays->direction_x > 0.0f);
-    const floatp exit_y = convert_floatp(by * block_size) +
-                          select((floatp)0.0f, (floatp)bs, rays->direction_y > 0.0f);
-    const floatp exit_z = convert_floatp(bz * block_size) +
-                          select((floatp)0.0f, (floatp)bs, rays->direction_z > 0.0f);
+    floatp exit_x, exit_y, exit_z;
+    packet_block_exit_faces(rays, bx, by, bz, block_size, &exit_x, &exit_y, &exit_z);
     const floatp t_x =
         select((exit_x - rays->start_x) * inverse_x, (floatp)INFINITY, rays->direction_x == 0.0f);
     const floatp t_y =
