@@ -142,6 +142,28 @@ PACKET_INLINE intp packet_skip_transparent(const MarchPacket* rays, floatp inver
     return select(sample, max(last - last_inside, sample + 1), *passing);
 }
 
+// The samples a packet takes next: each lane's t and position at its sample index once the lanes
+// in transparent blocks have moved on (packet_skip_transparent), until every lane has a sample to
+// take or has finished. Returns the lanes still marching inside their span.
+PACKET_INLINE intp packet_next_samples(const MarchPacket* rays, floatp inverse_x, floatp inverse_y,
+                                       floatp inverse_z, float step, float inverse_step,
+                                       intp marching, __global const uchar* skippable_blocks,
+                                       int4 block_counts, int block_size, intp* sample,
+                                       floatp* next_block_t, floatp* t, floatp* x, floatp* y,
+                                       floatp* z) {
+    while (true) {
+        *t = packet_sample_t(rays, *sample, step);
+        const intp active = marching & (*t < rays->t_far);
+        packet_position(rays, *t, x, y, z);
+        if (block_size == 0) return active;
+        intp passing;
+        *sample = packet_skip_transparent(rays, inverse_x, inverse_y, inverse_z, step, inverse_step,
+                                          *t, *x, *y, *z, *sample, active, skippable_blocks,
+                                          block_counts, block_size, next_block_t, &passing);
+        if (!any(passing)) return active;
+    }
+}
+
 // render_volume for a whole volume, one packet of rays per work-item (ray_march.cl): the same
 // samples, classification, shading and compositing per lane. A lane stops at the end of its span
 // or at the early-termination opacity, like `break` above; the packet stops when all have. Lanes
@@ -180,20 +202,9 @@ __kernel void render_volume_packets(
     const float inverse_step = 1.0f / step;
     while (true) {
         floatp t, x, y, z;
-        intp active;
-        // Lanes in transparent blocks move on without sampling until every lane has a sample to
-        // take or has finished.
-        while (true) {
-            t = packet_sample_t(&rays, sample, step);
-            active = marching & (t < rays.t_far);
-            packet_position(&rays, t, &x, &y, &z);
-            if (block_size == 0) break;
-            intp passing;
-            sample = packet_skip_transparent(
-                &rays, inverse_x, inverse_y, inverse_z, step, inverse_step, t, x, y, z, sample,
-                active, skippable_blocks, block_counts, block_size, &next_block_t, &passing);
-            if (!any(passing)) break;
-        }
+        const intp active = packet_next_samples(
+            &rays, inverse_x, inverse_y, inverse_z, step, inverse_step, marching, skippable_blocks,
+            block_counts, block_size, &sample, &next_block_t, &t, &x, &y, &z);
         if (!any(active)) break;
         // The lanes' next samples are known before this one is classified, so the `continue`s
         // below need no bookkeeping.
@@ -214,9 +225,8 @@ __kernel void render_volume_packets(
         // were loaded with the value's).
         const bool classify_first = tf_bins.y == 1;
         if (classify_first) {
-            // Where every lane's value falls below transparent_x in the table (the bins there
-            // and the next have zero opacity in every row), the lookup would give each lane
-            // zero: the same `continue`, without the table's gathers.
+            // Every lane below transparent_x in the table: its lookup would give zero opacity,
+            // so the same `continue` without the table's gathers.
             if (transparent_x > 0.0f &&
                 !any(usable & (packet_table_x(tf_bins, tf_domain, value) >= transparent_x))) {
                 continue;
