@@ -620,7 +620,7 @@ __kernel void render_proxies_packets(
     intp sample = 0;  // each lane's sample index
     intp marching = rays.hits;
     while (true) {
-        const floatp t = rays.t_near + (convert_floatp(sample) + 0.5f) * step;
+        const floatp t = packet_sample_t(&rays, sample, step);
         const intp active = marching & (t < rays.t_far);
         if (!any(active)) break;
         floatp x, y, z;

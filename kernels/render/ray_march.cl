@@ -314,6 +314,11 @@ PACKET_INLINE MarchPacket march_packet(int gx, int gy, int2 size, float4 cam_pos
     return packet;
 }
 
+// sample_t() for a packet: each lane's t of its sample index.
+PACKET_INLINE floatp packet_sample_t(const MarchPacket* rays, intp sample, float step) {
+    return rays->t_near + (convert_floatp(sample) + 0.5f) * step;
+}
+
 // sample_position_voxels() for a packet: the lanes' positions at their t, in the buffer's voxels.
 PACKET_INLINE void packet_position(const MarchPacket* rays, floatp t, floatp* x, floatp* y,
                                    floatp* z) {
@@ -322,13 +327,62 @@ PACKET_INLINE void packet_position(const MarchPacket* rays, floatp t, floatp* x,
     *z = rays->start_z + t * rays->direction_z;
 }
 
+// The block of each lane's position (x, y, z, in the buffer's voxels), clamped into the grid of
+// blocks: clamp(floor(p / block_size)), as render_proxies computes it. Where block_size is a power
+// of two (the library's 8), p * (1 / block_size) is p / block_size exactly, and truncation gives
+// what floor gives once clamped to block 0 (they differ only below 0): no division, and none of
+// the compare-and-blend sequence PoCL's vector floor is on AVX2 (bench/RESULTS.md, "The block
+// lookups of the packets").
+PACKET_INLINE void packet_block(floatp x, floatp y, floatp z, int4 block_counts, int block_size,
+                                intp* bx, intp* by, intp* bz) {
+    const float bs = (float)block_size;
+    if ((block_size & (block_size - 1)) == 0) {
+        const float inverse = 1.0f / bs;
+        *bx = clamp(convert_intp(x * inverse), 0, block_counts.x - 1);
+        *by = clamp(convert_intp(y * inverse), 0, block_counts.y - 1);
+        *bz = clamp(convert_intp(z * inverse), 0, block_counts.z - 1);
+        return;
+    }
+    *bx = clamp(convert_intp(floor(x / bs)), 0, block_counts.x - 1);
+    *by = clamp(convert_intp(floor(y / bs)), 0, block_counts.y - 1);
+    *bz = clamp(convert_intp(floor(z / bs)), 0, block_counts.z - 1);
+}
+
+// The faces through which each lane's ray leaves block (bx, by, bz): per axis the block's lower
+// or upper face, by the direction's sign, in the buffer's voxels.
+PACKET_INLINE void packet_block_exit_faces(const MarchPacket* rays, intp bx, intp by, intp bz,
+                                           int block_size, floatp* exit_x, floatp* exit_y,
+                                           floatp* exit_z) {
+    const floatp bs = (float)block_size;
+    *exit_x = convert_floatp(bx * block_size) + select((floatp)0.0f, bs, rays->direction_x > 0.0f);
+    *exit_y = convert_floatp(by * block_size) + select((floatp)0.0f, bs, rays->direction_y > 0.0f);
+    *exit_z = convert_floatp(bz * block_size) + select((floatp)0.0f, bs, rays->direction_z > 0.0f);
+}
+
+// convert_intp(ceil(q)) for |q| < 2^31: truncation rounds towards zero, one more where that fell
+// below q. The same integers as PoCL's vector ceil, in a third of its instructions on AVX2.
+PACKET_INLINE intp packet_ceil(floatp q) {
+    const intp truncated = convert_intp(q);
+    return truncated - (convert_floatp(truncated) < q);  // a true vector compare is -1
+}
+
+// The skippable flag of each lane's block (lanes outside `look_up` read a flag and get 0). Every
+// lane's block index is clamped into the grid of blocks, so all lanes read without a branch per
+// lane.
+PACKET_INLINE intp packet_block_skippable(__global const uchar* skippable_blocks, int4 block_counts,
+                                          intp bx, intp by, intp bz, intp look_up) {
+    const intp block_index = (bz * block_counts.y + by) * block_counts.x + bx;
+    return look_up & (GATHER_BYTES(skippable_blocks, block_index) != 0);
+}
+
 // Empty-space skipping per lane (libinsitu/src/render/empty_space.hpp): a lane of `look_up` whose
 // sample (x, y, z, in the buffer's voxels) has entered a new block (t >= its next_block_t) looks
 // the block up and, if the pass may skip it, jumps to the block's last sample, which it still
 // takes, so a float rounding of where the block ends never skips a sample of the next block (and
 // the proxies still find crossings between consecutive samples). Returns each lane's step in
 // samples (1, or the jump); next_block_t becomes where each lane that looked up leaves its block.
-// block_size 0: no lookups.
+// block_size 0: no lookups. The block's exit and last sample are render_proxies' formulas, so
+// the proxy packets skip what its rays skip.
 PACKET_INLINE intp packet_block_skip(const MarchPacket* rays, floatp t, floatp x, floatp y,
                                      floatp z, intp sample, intp look_up_lanes, float step,
                                      __global const uchar* skippable_blocks, int4 block_counts,
@@ -337,16 +391,10 @@ PACKET_INLINE intp packet_block_skip(const MarchPacket* rays, floatp t, floatp x
     if (block_size == 0) return advance;
     const intp look_up = look_up_lanes & (t >= *next_block_t);
     if (!any(look_up)) return advance;
-    const float bs = (float)block_size;
-    const intp bx = clamp(convert_intp(floor(x / bs)), 0, block_counts.x - 1);
-    const intp by = clamp(convert_intp(floor(y / bs)), 0, block_counts.y - 1);
-    const intp bz = clamp(convert_intp(floor(z / bs)), 0, block_counts.z - 1);
-    const floatp exit_x = convert_floatp(bx * block_size) +
-                          select((floatp)0.0f, (floatp)bs, rays->direction_x > 0.0f);
-    const floatp exit_y = convert_floatp(by * block_size) +
-                          select((floatp)0.0f, (floatp)bs, rays->direction_y > 0.0f);
-    const floatp exit_z = convert_floatp(bz * block_size) +
-                          select((floatp)0.0f, (floatp)bs, rays->direction_z > 0.0f);
+    intp bx, by, bz;
+    packet_block(x, y, z, block_counts, block_size, &bx, &by, &bz);
+    floatp exit_x, exit_y, exit_z;
+    packet_block_exit_faces(rays, bx, by, bz, block_size, &exit_x, &exit_y, &exit_z);
     // start is already in the buffer's coordinates (grid minus offset).
     const floatp t_x = select((exit_x - rays->start_x) / rays->direction_x, (floatp)INFINITY,
                               rays->direction_x == 0.0f);
@@ -355,11 +403,9 @@ PACKET_INLINE intp packet_block_skip(const MarchPacket* rays, floatp t, floatp x
     const floatp t_z = select((exit_z - rays->start_z) / rays->direction_z, (floatp)INFINITY,
                               rays->direction_z == 0.0f);
     *next_block_t = select(*next_block_t, fmin(fmin(t_x, t_y), t_z), look_up);
-    const intp block_index = (bz * block_counts.y + by) * block_counts.x + bx;
-    // Every lane's block index is clamped into the grid of blocks, so all lanes read without a
-    // branch per lane, and those not looking up are masked after.
-    const intp skippable = look_up & (GATHER_BYTES(skippable_blocks, block_index) != 0);
-    const intp last = convert_intp(ceil((*next_block_t - rays->t_near) / step - 0.5f)) - 1;
+    const intp skippable =
+        packet_block_skippable(skippable_blocks, block_counts, bx, by, bz, look_up);
+    const intp last = packet_ceil((*next_block_t - rays->t_near) / step - 0.5f) - 1;
     const intp jump = skippable & (last > sample + 1);
     return select(advance, last - sample, jump);
 }
@@ -535,13 +581,19 @@ PACKET_INLINE floatp packet_shaded_sample(__global const float4* shading, int4 d
     return mix(v0, mix(v01, v11, p.fy), p.fz);
 }
 
+// Where a value falls in the table: lookup_transfer()'s x, the bins ix = min(floor(x), bins.x - 2)
+// and ix + 1 are what it interpolates.
+PACKET_INLINE floatp packet_table_x(int2 bins, float4 domain, floatp value) {
+    return clamp((value - domain.x) * domain.y, 0.0f, 1.0f) * (float)(bins.x - 1);
+}
+
 // lookup_transfer() for a packet: colour and step-corrected opacity, bilinear in (value, gradient
 // magnitude). Values must not be NaN (callers replace them and mask their opacity).
 PACKET_INLINE void packet_lookup_transfer(__global const float4* table4, int2 bins, float4 domain,
                                           floatp value, floatp gradient_magnitude, floatp* r,
                                           floatp* g, floatp* b, floatp* a) {
     __global const float* table = (__global const float*)table4;
-    const floatp x = clamp((value - domain.x) * domain.y, 0.0f, 1.0f) * (float)(bins.x - 1);
+    const floatp x = packet_table_x(bins, domain, value);
     const intp ix = min(convert_intp(x), bins.x - 2);
     const floatp fx = x - convert_floatp(ix);
     const intp e0 = 4 * ix;
@@ -590,7 +642,7 @@ PACKET_INLINE floatp packet_lookup_opacity(__global const float4* table4, int2 b
         return a;
     }
     __global const float* table = (__global const float*)table4;
-    const floatp x = clamp((value - domain.x) * domain.y, 0.0f, 1.0f) * (float)(bins.x - 1);
+    const floatp x = packet_table_x(bins, domain, value);
     const intp ix = min(convert_intp(x), bins.x - 2);
     const floatp fx = x - convert_floatp(ix);
     const intp alpha0 = 4 * ix + 3;

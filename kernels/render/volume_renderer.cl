@@ -91,13 +91,88 @@ PACKET_INLINE floatp packet_pow_unit(floatp x, float w) {
     return exp2(w * log2(x));  // log2(0) = -inf gives 0
 }
 
+// Empty-space skipping of the ground truth's packets, per lane: a lane of `active` whose sample
+// (x, y, z, in the buffer's voxels) lies in a block the pass may skip (empty_space.hpp: every
+// sample there has zero opacity) moves on without taking it, to the block's last sample (or the
+// next sample, where it is there already); `passing` says which lanes did, and where they land is
+// looked up again. Other lanes look their block up once, on entering it (t >= next_block_t), and
+// keep their sample. Returns each lane's sample index. Nothing is composited in a skippable block
+// and the ground truth looks for no crossings, so, unlike the proxies (packet_block_skip), no
+// sample of such a block need be taken: a packet whose lanes all cross transparent blocks costs
+// lookups, not samples. Exact whatever the rounding of the block's exit: a lane skips its own
+// sample only where that sample lies in the block, and every sample before `last` lies a step or
+// more before the exit (one rounding of the exit's reciprocal form moves it by far less). The
+// inverse directions and step replace render_proxies' divisions (bench/RESULTS.md, "The block
+// lookups of the packets").
+PACKET_INLINE intp packet_skip_transparent(const MarchPacket* rays, floatp inverse_x,
+                                           floatp inverse_y, floatp inverse_z, float step,
+                                           float inverse_step, floatp t, floatp x, floatp y,
+                                           floatp z, intp sample, intp active,
+                                           __global const uchar* skippable_blocks,
+                                           int4 block_counts, int block_size, floatp* next_block_t,
+                                           intp* passing) {
+    *passing = 0;
+    const intp look_up = active & (t >= *next_block_t);
+    if (!any(look_up)) return sample;
+    intp bx, by, bz;
+    packet_block(x, y, z, block_counts, block_size, &bx, &by, &bz);
+    floatp exit_x, exit_y, exit_z;
+    packet_block_exit_faces(rays, bx, by, bz, block_size, &exit_x, &exit_y, &exit_z);
+    const floatp t_x =
+        select((exit_x - rays->start_x) * inverse_x, (floatp)INFINITY, rays->direction_x == 0.0f);
+    const floatp t_y =
+        select((exit_y - rays->start_y) * inverse_y, (floatp)INFINITY, rays->direction_y == 0.0f);
+    const floatp t_z =
+        select((exit_z - rays->start_z) * inverse_z, (floatp)INFINITY, rays->direction_z == 0.0f);
+    const floatp exit_t = fmin(fmin(t_x, t_y), t_z);
+    *passing = packet_block_skippable(skippable_blocks, block_counts, bx, by, bz, look_up);
+    // Clamped so that the conversion stays in range whatever the exit (an axis-parallel ray's
+    // infinite one never reaches it: some axis moves).
+    const floatp q = clamp((exit_t - rays->t_near) * inverse_step - 0.5f, -2.0f, 16777216.0f);
+    const intp last = packet_ceil(q) - 1;
+    // Where the last sample's position (packet_position's, as the march computes it) lies in the
+    // block too, as it almost always does, the lane passes it as well: one lookup per block.
+    floatp last_x, last_y, last_z;
+    packet_position(rays, packet_sample_t(rays, last, step), &last_x, &last_y, &last_z);
+    intp last_bx, last_by, last_bz;
+    packet_block(last_x, last_y, last_z, block_counts, block_size, &last_bx, &last_by, &last_bz);
+    const intp last_inside = (last_bx == bx) & (last_by == by) & (last_bz == bz);
+    // A lane that passes looks up where it lands; one that stays, when it leaves the block.
+    *next_block_t = select(*next_block_t, select(exit_t, (floatp)(-INFINITY), *passing), look_up);
+    return select(sample, max(last - last_inside, sample + 1), *passing);
+}
+
+// The samples a packet takes next: each lane's t and position at its sample index once the lanes
+// in transparent blocks have moved on (packet_skip_transparent), until every lane has a sample to
+// take or has finished. Returns the lanes still marching inside their span.
+PACKET_INLINE intp packet_next_samples(const MarchPacket* rays, floatp inverse_x, floatp inverse_y,
+                                       floatp inverse_z, float step, float inverse_step,
+                                       intp marching, __global const uchar* skippable_blocks,
+                                       int4 block_counts, int block_size, intp* sample,
+                                       floatp* next_block_t, floatp* t, floatp* x, floatp* y,
+                                       floatp* z) {
+    while (true) {
+        *t = packet_sample_t(rays, *sample, step);
+        const intp active = marching & (*t < rays->t_far);
+        packet_position(rays, *t, x, y, z);
+        if (block_size == 0) return active;
+        intp passing;
+        *sample = packet_skip_transparent(rays, inverse_x, inverse_y, inverse_z, step, inverse_step,
+                                          *t, *x, *y, *z, *sample, active, skippable_blocks,
+                                          block_counts, block_size, next_block_t, &passing);
+        if (!any(passing)) return active;
+    }
+}
+
 // render_volume for a whole volume, one packet of rays per work-item (ray_march.cl): the same
 // samples, classification, shading and compositing per lane. A lane stops at the end of its span
 // or at the early-termination opacity, like `break` above; the packet stops when all have. Lanes
-// skip blocks where the table is transparent (packet_block_skip; block_size 0: none): the
+// skip blocks where the table is transparent (packet_skip_transparent; block_size 0: none): the
 // samples skipped there have zero opacity, which render_volume passes over with `continue`.
-// Where gradients are needed (shading, 2D function), values and gradients come from
-// shading_volume (gradient_volume.cl, packet_shaded_sample); otherwise it is not read.
+// transparent_x: below it in the table every lookup is transparent (empty_space.hpp,
+// transparent_table_x; 0: nowhere). Where gradients are needed (shading, 2D function), values and
+// gradients come from shading_volume (gradient_volume.cl, packet_shaded_sample); otherwise it is
+// not read.
 __kernel void render_volume_packets(
     __global const float4* shading_volume, __global const float* volume, int4 dims,
     float4 origin_world, float4 inv_spacing, float4 box_lower, float4 box_upper, float4 data_offset,
@@ -105,7 +180,7 @@ __kernel void render_volume_packets(
     float4 tf_domain, float4 cam_position, float4 cam_forward, float4 cam_right, float4 cam_up,
     float4 cam_half_extent, int2 size, float4 march, float4 phong, __global float4* rgba_out,
     __global float* depth_out, __global const uchar* skippable_blocks, int4 block_counts,
-    int block_size) {
+    int block_size, float transparent_x) {
     const int gx = get_global_id(0);
     const int gy = get_global_id(1);
     if (gx * PACKET_W >= size.x || gy * PACKET_H >= size.y) return;
@@ -122,16 +197,18 @@ __kernel void render_volume_packets(
     intp marching = rays.hits;
     floatp next_block_t = -INFINITY;
     intp sample = 0;  // each lane's sample index: lanes skip empty blocks independently
+    const floatp inverse_x = 1.0f / rays.direction_x, inverse_y = 1.0f / rays.direction_y;
+    const floatp inverse_z = 1.0f / rays.direction_z;
+    const float inverse_step = 1.0f / step;
     while (true) {
-        const floatp t = rays.t_near + (convert_floatp(sample) + 0.5f) * step;
-        const intp active = marching & (t < rays.t_far);
+        floatp t, x, y, z;
+        const intp active = packet_next_samples(
+            &rays, inverse_x, inverse_y, inverse_z, step, inverse_step, marching, skippable_blocks,
+            block_counts, block_size, &sample, &next_block_t, &t, &x, &y, &z);
         if (!any(active)) break;
-        floatp x, y, z;
-        packet_position(&rays, t, &x, &y, &z);
         // The lanes' next samples are known before this one is classified, so the `continue`s
         // below need no bookkeeping.
-        sample += packet_block_skip(&rays, t, x, y, z, sample, active, step, skippable_blocks,
-                                    block_counts, block_size, &next_block_t);
+        sample += 1;
         // The gradient's samples come with the values from the shading volume (value and
         // central differences per voxel), which the host builds only when they are needed.
         floatp gradient_x = 0.0f, gradient_y = 0.0f, gradient_z = 0.0f, magnitude = 0.0f;
@@ -148,6 +225,12 @@ __kernel void render_volume_packets(
         // were loaded with the value's).
         const bool classify_first = tf_bins.y == 1;
         if (classify_first) {
+            // Every lane below transparent_x in the table: its lookup would give zero opacity,
+            // so the same `continue` without the table's gathers.
+            if (transparent_x > 0.0f &&
+                !any(usable & (packet_table_x(tf_bins, tf_domain, value) >= transparent_x))) {
+                continue;
+            }
             packet_lookup_transfer(tf_table, tf_bins, tf_domain, value, 0.0f, &sample_red,
                                    &sample_green, &sample_blue, &alpha);
             if (!any(usable & (alpha > 0.0f))) continue;

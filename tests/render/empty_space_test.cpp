@@ -153,6 +153,18 @@ TEST(EmptySpace, BlocksHoldingNaNAreNeverSkipped) {
     EXPECT_EQ(skippable_blocks(blocks, transparent, {}, false), (Flags{0, 0}));
 }
 
+// Below transparent_table_x, a lookup's two bins (floor(x) and the next) are transparent in every
+// gradient row; at it, the second is the first opaque bin.
+TEST(EmptySpace, TransparentTableXStopsOneBinBeforeTheFirstOpaqueBin) {
+    EXPECT_EQ(transparent_table_x(table_with_opaque_bins(17, 0.0, 16.0, {5, 9})), 4.0f);
+    EXPECT_EQ(transparent_table_x(table_with_opaque_bins(17, 0.0, 16.0, {1})), 0.0f);
+    EXPECT_EQ(transparent_table_x(table_with_opaque_bins(17, 0.0, 16.0, {0, 3})), 0.0f);
+    // Nothing opaque: every x below the last bin (whose lookup reads bins 15 and 16) is.
+    EXPECT_EQ(transparent_table_x(table_with_opaque_bins(17, 0.0, 16.0, {})), 16.0f);
+    // A 2D table: a bin is opaque if any gradient row is.
+    EXPECT_EQ(transparent_table_x(table_with_opaque_bins(17, 0.0, 16.0, {7}, 3, 2)), 6.0f);
+}
+
 // The device scan (kernels/render/empty_space.cl), which the proxy pass uses, gives the host
 // reference's ranges value for value: random values with NaNs, on grids that do and do not
 // divide into blocks, down to the smallest.

@@ -32,16 +32,6 @@ std::vector<float> random_values(std::uint32_t seed) {
     return values;
 }
 
-// The offset of voxel (x, y, z) in the bricked device buffer (DeviceVolume::upload's layout).
-std::size_t bricked_offset(std::int64_t x, std::int64_t y, std::int64_t z) {
-    const std::int64_t side = kVolumeBrickSide, brick = side * side * side;
-    const std::int64_t bricks_x = (kDims[0] + side - 1) / side;
-    const std::int64_t bricks_y = (kDims[1] + side - 1) / side;
-    return static_cast<std::size_t>((x / side) * brick + x % side + (y / side) * brick * bricks_x +
-                                    (y % side) * side + (z / side) * brick * bricks_x * bricks_y +
-                                    (z % side) * side * side);
-}
-
 void expect_shading_volume_of(const std::vector<float>& values, OpenClDevice& opencl,
                               GradientVolume& gradients, const DeviceVolume& volume) {
     std::vector<float> device(static_cast<std::size_t>(volume.device_samples) * 4);
@@ -57,7 +47,7 @@ void expect_shading_volume_of(const std::vector<float>& values, OpenClDevice& op
     for (std::int64_t z = 0; z < kDims[2]; ++z) {
         for (std::int64_t y = 0; y < kDims[1]; ++y) {
             for (std::int64_t x = 0; x < kDims[0]; ++x) {
-                const float* sample = device.data() + 4 * bricked_offset(x, y, z);
+                const float* sample = device.data() + 4 * volume_offset(kDims, x, y, z);
                 SCOPED_TRACE(::testing::Message() << "voxel " << x << " " << y << " " << z);
                 ASSERT_EQ(sample[0], at(x, y, z));
                 ASSERT_EQ(sample[1], at(x + 1, y, z) - at(x - 1, y, z));

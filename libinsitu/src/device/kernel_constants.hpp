@@ -3,11 +3,13 @@
 // handed to every OpenCL build as a -D option (OpenClDevice::build_options), so a kernel never
 // carries a hand-copied limit. Kernels refer to them by the names in kKernelConstants.
 #include <array>
+#include <cstdint>
 
 #include "insitu/core/intervals.hpp"
 #include "insitu/core/layers.hpp"
 #include "insitu/core/light_field.hpp"
 #include "insitu/explore/relighting.hpp"
+#include "insitu/field.hpp"
 
 namespace insitu::detail {
 
@@ -58,6 +60,22 @@ constexpr int kSegmentsOpacity = static_cast<int>(SegmentRule::opacity);
 /// (volume_offset_* in kernels/device/common.cl) agree on it through this constant.
 constexpr int kVolumeBrickShift = 2;
 constexpr int kVolumeBrickSide = 1 << kVolumeBrickShift;
+
+/// Bricks along an axis of `samples` samples, the last one padded (the kernels' volume_bricks).
+constexpr std::int64_t volume_bricks(std::int64_t samples) {
+    return (samples + kVolumeBrickSide - 1) / kVolumeBrickSide;
+}
+
+/// The index of sample (x, y, z) of a volume of `dims` samples in the bricked device buffer: the
+/// host's volume_offset_x + volume_offset_y + volume_offset_z (kernels/device/common.cl), which
+/// DeviceVolume::upload writes and tests read back.
+constexpr std::int64_t volume_offset(const Index3& dims, std::int64_t x, std::int64_t y,
+                                     std::int64_t z) {
+    constexpr std::int64_t side = kVolumeBrickSide, brick = side * side * side;
+    const std::int64_t bricks_x = volume_bricks(dims[0]), bricks_y = volume_bricks(dims[1]);
+    return (x / side) * brick + x % side + (y / side) * brick * bricks_x + (y % side) * side +
+           (z / side) * brick * bricks_x * bricks_y + (z % side) * side * side;
+}
 
 struct KernelConstant {
     const char* name;  ///< the macro the kernels use

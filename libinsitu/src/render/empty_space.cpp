@@ -109,11 +109,12 @@ BlockRanges scan_blocks(const std::vector<float>& values, const Index3& dims, in
     return blocks;
 }
 
-std::vector<std::uint8_t> skippable_blocks(const BlockRanges& blocks, const TransferTable& table,
-                                           const std::vector<double>& isovalues, bool accumulates) {
-    // next_opaque[b]: the first table bin >= b with non-zero opacity, so "any opacity between
-    // bins lo and hi" is one comparison. In a 2D table a bin is opaque if any gradient row is
-    // (conservative: the proxies look up the row of gradient 0).
+namespace {
+
+// next_opaque[b]: the first table bin >= b with non-zero opacity (value_bins where none), so "any
+// opacity between bins lo and hi" is one comparison. In a 2D table a bin is opaque if any
+// gradient row is (conservative: the proxies look up the row of gradient 0).
+std::vector<int> next_opaque_bins(const TransferTable& table) {
     const int bins = table.value_bins;
     std::vector<int> next_opaque(static_cast<std::size_t>(bins) + 1, bins);
     for (int b = bins - 1; b >= 0; --b) {
@@ -123,6 +124,20 @@ std::vector<std::uint8_t> skippable_blocks(const BlockRanges& blocks, const Tran
         }
         next_opaque[b] = opaque ? b : next_opaque[b + 1];
     }
+    return next_opaque;
+}
+
+}  // namespace
+
+float transparent_table_x(const TransferTable& table) {
+    // A whole number below 2^24: exact in float, as the kernel compares it.
+    return static_cast<float>(std::max(0, next_opaque_bins(table)[0] - 1));
+}
+
+std::vector<std::uint8_t> skippable_blocks(const BlockRanges& blocks, const TransferTable& table,
+                                           const std::vector<double>& isovalues, bool accumulates) {
+    const int bins = table.value_bins;
+    const std::vector<int> next_opaque = next_opaque_bins(table);
     auto bin_of = [&](double value) {
         const double x = (value - table.value_min) / (table.value_max - table.value_min);
         return std::clamp(x, 0.0, 1.0) * (bins - 1);

@@ -47,6 +47,12 @@ BlockRanges scan_blocks_on_device(OpenClDevice& opencl, cl::Kernel& kernel, Devi
 std::vector<std::uint8_t> skippable_blocks(const BlockRanges& blocks, const TransferTable& table,
                                            const std::vector<double>& isovalues, bool accumulates);
 
+/// The table coordinate below which every lookup is transparent: a lookup at x (the value's
+/// place in the table, 0 .. value_bins - 1, kernels/render/ray_march.cl packet_table_x)
+/// interpolates bins floor(x) and floor(x) + 1, whose opacity is zero in every gradient row for x
+/// below the first opaque bin - 1. 0 where bin 0 or 1 is opaque (nothing is transparent so).
+float transparent_table_x(const TransferTable& table);
+
 /// The blocks a pass may skip, as its kernel takes them; the defaults make the kernel look up no
 /// blocks (block_voxels 0).
 struct SkippedBlocks {

@@ -16,8 +16,7 @@ const cl::Buffer& GradientVolume::of(OpenClDevice& opencl, const DeviceVolume& v
     const cl_int4 dims = {
         {static_cast<cl_int>(d[0]), static_cast<cl_int>(d[1]), static_cast<cl_int>(d[2]), 0}};
     // One work-item per brick row of x (gradient_volume.cl).
-    const std::size_t bricks_x =
-        static_cast<std::size_t>((d[0] + kVolumeBrickSide - 1) / kVolumeBrickSide);
+    const auto bricks_x = static_cast<std::size_t>(volume_bricks(d[0]));
     opencl.launch(
         kernel_,
         cl::NDRange(bricks_x, static_cast<std::size_t>(d[1]), static_cast<std::size_t>(d[2])),

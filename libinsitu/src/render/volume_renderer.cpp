@@ -72,9 +72,9 @@ void DeviceVolume::upload(ComputeDevice& device, const Field& field) {
     // count is what a buffer index must reach.
     constexpr std::int64_t side = detail::kVolumeBrickSide;
     const std::int64_t nx = field_dims[0], ny = field_dims[1], nz = field_dims[2];
-    const std::int64_t bricks_x = (nx + side - 1) / side, bricks_y = (ny + side - 1) / side;
-    const std::int64_t bricks_z = (nz + side - 1) / side;
-    const std::int64_t slab_samples = bricks_x * bricks_y * side * side * side;
+    const std::int64_t bricks_z = detail::volume_bricks(nz);
+    // One slab of bricks: the offset of the first sample of the next.
+    const std::int64_t slab_samples = detail::volume_offset(field_dims, 0, 0, side);
     const auto padded_samples = static_cast<std::uint64_t>(slab_samples * bricks_z);
     if (padded_samples > std::numeric_limits<std::uint32_t>::max()) {
         fail<InvalidArgument>("field \"", field.name(), "\": ", field.sample_count(), " samples (",
@@ -95,8 +95,7 @@ void DeviceVolume::upload(ComputeDevice& device, const Field& field) {
             for (std::int64_t y = 0; y < ny; ++y) {
                 const float* row = host_values.data() + (z * ny + y) * nx;
                 // The offset of (0, y, z) within the slab, then per x the brick and position.
-                float* out = slab.data() + (y / side) * bricks_x * side * side * side +
-                             (z % side) * side * side + (y % side) * side;
+                float* out = slab.data() + detail::volume_offset(field_dims, 0, y, z % side);
                 // A brick's row holds `side` consecutive x samples: copied as one run.
                 for (std::int64_t x0 = 0; x0 < nx; x0 += side) {
                     std::copy_n(row + x0, std::min(side, nx - x0), out);
@@ -217,7 +216,8 @@ Rendering VolumeRenderer::render(const Camera& camera, const TransferFunction& t
                       detail::transfer_args(state_->table.buffer, table),
                       detail::camera_args(camera), detail::image_size(camera), march,
                       phong_parameters, state_->rgba_out.buffer, state_->depth_out.buffer,
-                      skipped.skippable, skipped.block_counts, skipped.block_voxels);
+                      skipped.skippable, skipped.block_counts, skipped.block_voxels,
+                      static_cast<cl_float>(detail::transparent_table_x(table)));
     } else {
         last_skippable_fraction_ = 0.0;
         opencl.launch(
