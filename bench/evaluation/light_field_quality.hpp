@@ -42,7 +42,7 @@ void section_light_field_bytes(const std::vector<const Scene*>& scenes, bool smo
 /// the same pixels (the bound), stored through the archive and made into the page's
 /// payload. Writes light_field_rig.csv.
 void section_light_field_rig(const std::vector<const Scene*>& scenes, bool smoke,
-                             const std::filesystem::path& out,
-                             const std::filesystem::path& scratch, int image);
+                             const std::filesystem::path& out, const std::filesystem::path& scratch,
+                             int image);
 
 }  // namespace insitu::evaluation
