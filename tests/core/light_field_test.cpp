@@ -482,7 +482,7 @@ TEST(LightFieldRig, FromJsonRefusesWhatItDidNotMake) {
 TEST(LightFieldSettings, JsonRoundTrips) {
     LightFieldSettings defaults;
     const json written = defaults.to_json();
-    EXPECT_EQ(written, json::parse(R"({"cameras": 162, "size": 128, "segments": "none",
+    EXPECT_EQ(written, json::parse(R"({"cameras": 42, "size": 256, "segments": "none",
         "attenuation": true, "depth_bits": 8, "depth_threshold": 0.3, "rim_threshold": 0.05})"));
     std::vector<std::string> unknown;
     const LightFieldSettings back = LightFieldSettings::from_json(written, &unknown);
