@@ -989,6 +989,7 @@ TEST_F(InstrumentTest, AnErrorBudgetChoosesTheLightFieldsCamerasAndMapSize) {
         InstrumentConfig config = small_config(directory_ / name, 48);
         config.interval_count = 8;
         LightFieldSettings light_field;
+        light_field.cameras = 42;  // what a configuration that gives the cameras stores
         light_field.attenuation = attenuation;
         light_field.size = 2 * kBudgetMinLightFieldSide;  // measured at 128^2 and 64^2
         config.light_field = light_field;

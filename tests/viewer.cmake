@@ -144,7 +144,9 @@ viewer_browser_test(proxies lf)
 # occludes and enhances an orbit view in the page, comparing the canvas with
 # `insitu-view render --source lightfield` each time. Without rims (they are on by default), so
 # that the page's reconstruction without them, as archives written before hold, stays tested.
-viewer_light_field_archive(lf_attenuation [=[{"cameras": 42, "size": 128, "attenuation": true,]=]
+# 162 cameras at 64^2 (the texels of the other suites' 42 at 128^2), the rig bench/RESULTS.md
+# ("Cameras or texels") weighs against today's 42.
+viewer_light_field_archive(lf_attenuation [=[{"cameras": 162, "size": 64, "attenuation": true,]=]
                            [=[ "rim_threshold": 0}]=])
 viewer_browser_test(light_field_edits lf_attenuation)
 # The light field fetched by need and streamed (issues 41, 42): streaming.test.mjs edits the

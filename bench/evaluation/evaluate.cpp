@@ -8,7 +8,8 @@
 //   insitu_evaluate --out DIR [--smoke] [--sections a,b,...] [--raw PATH:NXxNYxNZ:TYPE ...]
 //   [--sizes N,N,...]
 // Sections: rotation, curvature, colour, configurations, storage, light_fields, budget, volume,
-// crossover, light_field_cracks, light_field_bytes, relit_ceiling, light_field_ceiling (default:
+// crossover, light_field_cracks, light_field_bytes, relit_ceiling, light_field_ceiling,
+// light_field_rig (default:
 // all); --sizes: the crossover's volume sizes (default 64,128,256,512).
 #include <unistd.h>
 
@@ -83,7 +84,8 @@ struct Options {
                                    "light_field_cracks",
                                    "light_field_bytes",
                                    "relit_ceiling",
-                                   "light_field_ceiling"};
+                                   "light_field_ceiling",
+                                   "light_field_rig"};
     std::vector<RawInput> raw;
     /// The crossover's volume sizes (--sizes); empty: 64, 128, 256, 512 (smoke: 24, 32).
     std::vector<int> sizes;
@@ -94,7 +96,7 @@ struct Options {
                  "insitu_evaluate: %s\nusage: insitu_evaluate --out DIR [--smoke] "
                  "[--sections rotation,curvature,colour,configurations,storage,light_fields,"
                  "budget,volume,crossover,light_field_cracks,light_field_bytes,relit_ceiling,"
-                 "light_field_ceiling] "
+                 "light_field_ceiling,light_field_rig] "
                  "[--sizes N,N,...] "
                  "[--raw PATH:NXxNYxNZ:TYPE ...]\n",
                  message.c_str());
@@ -1496,6 +1498,10 @@ int main(int argc, char** argv) {
         if (options.sections.count("light_field_ceiling")) {
             section_light_field_ceiling({&primary, &analytic[2]}, options.smoke, options.out,
                                         scratch, image);
+        }
+        if (options.sections.count("light_field_rig")) {
+            section_light_field_rig({&primary, &analytic[2]}, options.smoke, options.out, scratch,
+                                    image);
         }
         if (options.sections.count("volume")) {
             // The light-field section's scenes and views: the field beside the light fields.

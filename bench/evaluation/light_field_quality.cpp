@@ -118,6 +118,14 @@ void write_orbit_pngs(const Scene& scene, ProxyRenderer& renderer, Explorer& exp
                   .rgba);
 }
 
+// What `insitu-view serve` sends the page for the archive's step 0 (uncompressed).
+std::size_t payload_size(const fs::path& archive, const Scene& scene) {
+    return viewer::light_field_payload(
+               ArchiveReader(archive.string()).load_light_field(0, scene.volume.name), 0,
+               scene.volume.name)
+        .size();
+}
+
 // The capture's cost per camera with the rims' pass (request's rim threshold) and without,
 // against the bound: a single-perspective proxy pass (layers, attenuation, mean depth)
 // of each rig camera, the same pixels, as the light_fields section times it. Interleaved after
@@ -195,12 +203,7 @@ void section_light_field_cracks(const std::vector<const Scene*>& scenes, bool sm
         CaptureCost cost = capture_cost(*scene, renderer, request, smoke);
         const std::uintmax_t stored_bytes = write_light_field_archive(
             *scene, renderer, request, std::move(cost.light_field), archive.string(), image);
-        // What `insitu-view serve` sends the page for the step (uncompressed).
-        const std::size_t payload_bytes =
-            viewer::light_field_payload(
-                ArchiveReader(archive.string()).load_light_field(0, scene->volume.name), 0,
-                scene->volume.name)
-                .size();
+        const std::size_t payload_bytes = payload_size(archive, *scene);
         Explorer explorer(archive.string());
         ViewScores unlit, relit;
         double ms = 0.0;
@@ -358,6 +361,44 @@ void section_light_field_bytes(const std::vector<const Scene*>& scenes, bool smo
                     scores.worst_crack_percent);
             }
             fs::remove_all(archive);
+        }
+    }
+}
+
+void section_light_field_rig(const std::vector<const Scene*>& scenes, bool smoke,
+                             const fs::path& out, const fs::path& scratch, int image) {
+    Csv csv(out / "light_field_rig.csv",
+            "scene,cameras,map,capture_ms_per_camera,capture_without_rims_ms_per_camera,"
+            "proxy_pass_ms_per_camera,capture_ms,stored_bytes,payload_bytes");
+    // Today's default and the same texels over 162 cameras; the page's first-frame archive
+    // (42 at 192^2) and its same texels over 162 (96^2).
+    const std::vector<std::pair<int, int>> rigs =
+        smoke ? std::vector<std::pair<int, int>>{{42, 64}, {162, 32}}
+              : std::vector<std::pair<int, int>>{{42, 256}, {162, 128}, {42, 192}, {162, 96}};
+    for (const Scene* scene : scenes) {
+        ProxyRenderer renderer;
+        renderer.upload(scene->volume.field());
+        for (const auto& [cameras, map] : rigs) {
+            LightFieldRequest request;  // the configuration's defaults but for the rig
+            request.settings.cameras = cameras;
+            request.settings.size = map;
+            request.transfer_function = make_tf(*scene);
+            request.intervals = scene_intervals(*scene, 16);
+            CaptureCost cost = capture_cost(*scene, renderer, request, smoke);
+            const fs::path archive = scratch / ("rig_" + scene->name);
+            const std::uintmax_t stored_bytes = write_light_field_archive(
+                *scene, renderer, request, std::move(cost.light_field), archive.string(), image);
+            const std::size_t payload_bytes = payload_size(archive, *scene);
+            fs::remove_all(archive);
+            csv.row(scene->name, cameras, map, cost.with_rims_ms, cost.without_rims_ms,
+                    cost.proxy_pass_ms, cost.with_rims_ms * cameras, stored_bytes, payload_bytes);
+            std::printf(
+                "light-field rig: %s %d cameras %d^2 (attenuation, rims): capture per camera "
+                "%.2f ms (%.2f without rims) against a proxy pass of %.2f ms (%.2fx), whole "
+                "capture %.0f ms, %.2f MB stored, %.2f MB to the page\n",
+                scene->name.c_str(), cameras, map, cost.with_rims_ms, cost.without_rims_ms,
+                cost.proxy_pass_ms, cost.with_rims_ms / cost.proxy_pass_ms,
+                cost.with_rims_ms * cameras, stored_bytes / 1e6, payload_bytes / 1e6);
         }
     }
 }

@@ -36,4 +36,13 @@ void section_light_field_bytes(const std::vector<const Scene*>& scenes, bool smo
                                const std::filesystem::path& out,
                                const std::filesystem::path& scratch, int image);
 
+/// The default rig's choice (bench/RESULTS.md, "The default rig: 162 cameras at 128²"): per rig
+/// (42 cameras at 256^2 and 162 at 128^2, 42 at 192^2 and 162 at 96^2), the configuration's
+/// default light field (attenuation, rims) captured, timed per camera against a proxy pass of
+/// the same pixels (the bound), stored through the archive and made into the page's
+/// payload. Writes light_field_rig.csv.
+void section_light_field_rig(const std::vector<const Scene*>& scenes, bool smoke,
+                             const std::filesystem::path& out, const std::filesystem::path& scratch,
+                             int image);
+
 }  // namespace insitu::evaluation

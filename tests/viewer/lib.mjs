@@ -278,6 +278,17 @@ export function lightFieldFrameMatches(page, binary, archive, workDir, what, min
     { source: 'lightfield' });
 }
 
+/// The JSON header of `/api/lightfield?QUERY` (viewer/light_field_payload.hpp): the rig
+/// (`cameras`, its frames), the cameras `present`; tests read the archive's rig from it rather
+/// than assume one.
+export async function lightFieldHeader(serverUrl, query) {
+  const response = await fetch(`${serverUrl}api/lightfield?${query}`);
+  assert.equal(response.status, 200, query);
+  const bytes = new Uint8Array(await response.arrayBuffer());
+  const length = new DataView(bytes.buffer).getUint32(12, true);
+  return JSON.parse(new TextDecoder().decode(bytes.subarray(16, 16 + length)));
+}
+
 /// Registers the hooks of a browser test file: before its tests `insitu-view serve` on `archive`
 /// and headless chromium with WebGL2 (SwiftShader) start, after them both stop (serve must exit
 /// 0 on SIGTERM). Returns {server, browser}, filled in once the tests run.

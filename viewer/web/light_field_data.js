@@ -39,8 +39,9 @@ export function parseLightField(buffer) {
     meanDepth: grouped(planes.mean_depth), bytes: buffer.byteLength };
 }
 
-// The cameras sent ahead of the rest: those within this angle of the view's direction (42
-// cameras: about a quarter of the rig, bench/RESULTS.md "Streaming the light field").
+// The cameras sent ahead of the rest: those within this angle of the view's direction (10 of
+// 42 cameras, 40 of 162: about a quarter of the rig's bytes; bench/RESULTS.md "The web viewer's
+// waits by need" and "The default rig: 162 cameras at 128²").
 export const NEAR_CAMERAS_DEG = 60;
 
 /// Whether the light field can be asked for by part (the server can; a gallery's files hold it

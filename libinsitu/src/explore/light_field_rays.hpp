@@ -73,10 +73,10 @@ std::vector<std::vector<int>> icosphere_neighbours(const LightFieldRig& rig);
 
 // The cameras further out than those `around` a ray, in the order the reconstruction's
 // substitute() searches them: their icosphere neighbours, then the neighbours' neighbours (two
-// rings: up to about 60 degrees from the ray with 42 cameras), each ring nearest the ray's
-// direction first; only cameras the light field holds (`held`, by camera). A second ring finds
-// the ray's surface where the whole first ring is occluded too (bench/RESULTS.md, "Light-field
-// cracks: a second ring of substitutes").
+// rings: up to about 60 degrees from the ray with 42 cameras, 30 with 162), each ring nearest the
+// ray's direction first; only cameras the light field holds (`held`, by camera). A second ring
+// finds the ray's surface where the whole first ring is occluded too (bench/RESULTS.md,
+// "Light-field cracks: a second ring of substitutes").
 std::vector<int> cameras_further_out(const LightFieldRig& rig,
                                      const std::vector<std::vector<int>>& neighbours,
                                      const std::vector<int>& around, const std::vector<char>& held,
