@@ -64,6 +64,10 @@ add_test(NAME viewer.page_modules
          COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/page_modules.test.mjs
          WORKING_DIRECTORY ${viewer_tests_dir})
 set_tests_properties(viewer.page_modules PROPERTIES TIMEOUT 60)
+add_test(NAME viewer.gpu_frames
+         COMMAND ${NODE_EXECUTABLE} --test-reporter=spec ${viewer_tests_dir}/gpu_frames.test.mjs
+         WORKING_DIRECTORY ${viewer_tests_dir})
+set_tests_properties(viewer.gpu_frames PROPERTIES TIMEOUT 60)
 
 # Also on this archive, which has a colour model and no light field, frames the page draws
 # (WebGL2 through chromium's SwiftShader): colour_model.test.mjs edits opacity and compares the

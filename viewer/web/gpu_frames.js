@@ -111,8 +111,11 @@ export class GpuFrames {
   /// seconds on a software GPU (bench/RESULTS.md, "An orbit's first light-field frame"), which
   /// the page spends showing the server's frame of the light field instead. One at a time;
   /// resolves once lightFieldWarm (also where the GPU cannot draw it: the page then asks the
-  /// server, as it would have).
+  /// server, as it would have). Once a light-field frame has been drawn it draws nothing: the
+  /// warm-up draws on the page's canvas, which then shows that frame (a stand-in's warm-up that
+  /// starts after it, on a busy machine, left an 8-pixel frame in its place).
   warmLightField(step, view, storedCamera, azimuthDeg, elevationDeg, segmentScales, recipe) {
+    if (this.lightFieldWarm) return Promise.resolve();
     if (!this.warming) {
       const small = { ...storedCamera, size: [WARM_SIDE, WARM_SIDE] };
       this.warming = this.draw(step, view, small, azimuthDeg, elevationDeg, segmentScales, false,
