@@ -148,8 +148,7 @@ viewer_browser_test(proxies lf)
 # occludes and enhances an orbit view in the page, comparing the canvas with
 # `insitu-view render --source lightfield` each time. Without rims (they are on by default), so
 # that the page's reconstruction without them, as archives written before hold, stays tested.
-# 162 cameras at 64^2 (the texels of the other suites' 42 at 128^2), the rig bench/RESULTS.md
-# ("Cameras or texels") weighs against today's 42.
+# 162 cameras, as the default rig has, at 64^2 (the texels of the other suites' 42 at 128^2).
 viewer_light_field_archive(lf_attenuation [=[{"cameras": 162, "size": 64, "attenuation": true,]=]
                            [=[ "rim_threshold": 0}]=])
 viewer_browser_test(light_field_edits lf_attenuation)

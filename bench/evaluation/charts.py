@@ -702,7 +702,8 @@ def write_markdown(d, path, prefix, elapsed):
                   "views no check measures (azimuth +90 and +180 degrees at the stored elevation, "
                   "and 70 degrees up), the steps that met it, the rigs chosen (cameras@map size), "
                   "the mean light-field bytes and capture time per step and the checks' own time "
-                  "(views and light field); 'default' is the fixed 42 cameras at 256².", "",
+                  "(views and light field); 'default' is the default rig (162 cameras at 128²; "
+                  "42 at 256² in runs before 2026-12-07).", "",
                   "![budget light field](%sbudget_light_field.png)" % prefix, ""]
         body = []
         for run in sorted({r["run"] for r in budget_lf}, key=lambda n: (n != "default", n)):

@@ -781,9 +781,10 @@ void section_budget(const Options& options, const fs::path& scratch) {
 // asked, the rig the budget chose and measured in situ, and what the archive's light field
 // achieves, measured here through the Explorer (source lightfield) against the ground truth of
 // the run's own function, in the budget's views (the stored one and +-20 degrees) and in views
-// it never measured (kFarViews), the least counting; beside it the fixed default rig (42 cameras
-// at 256^2). The views' own settings stay fixed (the budget chooses only the light field), and
-// the light field has no attenuation, so the run's function is what it shows.
+// it never measured (kFarViews), the least counting; beside it the default rig
+// (LightFieldSettings: 162 cameras at 128^2; 42 at 256^2 in runs before 2026-12-07). The views'
+// own settings stay fixed (the budget chooses only the light field), and the light field has no
+// attenuation, so the run's function is what it shows.
 void section_budget_light_field(const Options& options, const fs::path& scratch) {
     const auto start = std::chrono::steady_clock::now();
     const int size = options.smoke ? 32 : 64;

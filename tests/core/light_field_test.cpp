@@ -482,7 +482,7 @@ TEST(LightFieldRig, FromJsonRefusesWhatItDidNotMake) {
 TEST(LightFieldSettings, JsonRoundTrips) {
     LightFieldSettings defaults;
     const json written = defaults.to_json();
-    EXPECT_EQ(written, json::parse(R"({"cameras": 42, "size": 256, "segments": "none",
+    EXPECT_EQ(written, json::parse(R"({"cameras": 162, "size": 128, "segments": "none",
         "attenuation": true, "depth_bits": 8, "depth_threshold": 0.3, "rim_threshold": 0.05})"));
     std::vector<std::string> unknown;
     const LightFieldSettings back = LightFieldSettings::from_json(written, &unknown);
@@ -518,7 +518,8 @@ TEST(LightFieldSettings, JsonRoundTrips) {
         LightFieldSettings::from_json(json{{"segments", "layers"}}, &unknown);
     EXPECT_EQ(layers.segments, SegmentRule::layers);
     EXPECT_EQ(layers.to_json()["segments"], "layers");
-    EXPECT_EQ(layers.cameras, 42);  // absent keys keep their defaults
+    EXPECT_EQ(layers.cameras, defaults.cameras);  // absent keys keep their defaults
+    EXPECT_EQ(layers.size, defaults.size);
     EXPECT_TRUE(unknown.empty());
 
     EXPECT_EQ(to_string(SegmentRule::whole_ray), "whole_ray");

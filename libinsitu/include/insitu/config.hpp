@@ -14,7 +14,7 @@
 //  "archive": "run.cdb", "precision": "half", "compression": "zip",
 //  "writer": {"queue": 4, "when_full": "block"},
 //  "colour_model": {"clusters": 24, "enabled": true},
-//  "light_field": {"cameras": 42, "size": 256, "segments": "layers", "attenuation": true,
+//  "light_field": {"cameras": 162, "size": 128, "segments": "layers", "attenuation": true,
 //                  "depth_bits": 8, "depth_threshold": 0.3},
 //  "volume": {"codec": "zfp", "tolerance": 0.001},
 //  "budget": {"psnr_db": 40, "bytes_per_step": 8e6, "ms_per_step": 500, "check_every": 10,
