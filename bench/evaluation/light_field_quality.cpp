@@ -370,8 +370,8 @@ void section_light_field_rig(const std::vector<const Scene*>& scenes, bool smoke
     Csv csv(out / "light_field_rig.csv",
             "scene,cameras,map,capture_ms_per_camera,capture_without_rims_ms_per_camera,"
             "proxy_pass_ms_per_camera,capture_ms,stored_bytes,payload_bytes");
-    // Today's default and the same texels over 162 cameras; the page's first-frame archive
-    // (42 at 192^2) and its same texels over 162 (96^2).
+    // The default before 2026-12-07 (42 at 256^2) and the same texels over 162 cameras (the
+    // default since); the page's first-frame archive (42 at 192^2) and its texels over 162 (96^2).
     const std::vector<std::pair<int, int>> rigs =
         smoke ? std::vector<std::pair<int, int>>{{42, 64}, {162, 32}}
               : std::vector<std::pair<int, int>>{{42, 256}, {162, 128}, {42, 192}, {162, 96}};
