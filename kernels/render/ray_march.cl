@@ -504,14 +504,11 @@ PACKET_INLINE floatp packet_trilinear(__global const float* volume, int4 dims, f
 #define KEEP_VECTOR(v)
 #endif
 
-// Eight lanes of four vectors from one float4 per lane: lane k of (a, b, c, d) is buf[i_k]'s
-// (x, y, z, w). Lanes k and k + 4 load into the two halves of a float8 and four lanes are
-// transposed in each half, with the unpack shuffles AVX2 does within 128-bit halves: eight
-// 16-byte loads and eight shuffles for what GATHER would load as 32 floats one by one.
-PACKET_INLINE void gather_float4_8(__global const float4* buf, int8 i, float8* a, float8* b,
-                                   float8* c, float8* d) {
-    float8 r0 = (float8)(buf[i.s0], buf[i.s4]), r1 = (float8)(buf[i.s1], buf[i.s5]);
-    float8 r2 = (float8)(buf[i.s2], buf[i.s6]), r3 = (float8)(buf[i.s3], buf[i.s7]);
+// Four vectors of eight lanes from four float8 that hold one float4 per lane, lanes k and k + 4 in
+// r_k's halves: lane k of (a, b, c, d) is its float4's (x, y, z, w). Four lanes are transposed in
+// each half, with the unpack shuffles AVX2 does within 128-bit halves: eight shuffles.
+PACKET_INLINE void transpose_float4_8(float8 r0, float8 r1, float8 r2, float8 r3, float8* a,
+                                      float8* b, float8* c, float8* d) {
     KEEP_VECTOR(r0);
     KEEP_VECTOR(r1);
     KEEP_VECTOR(r2);
@@ -530,31 +527,43 @@ PACKET_INLINE void gather_float4_8(__global const float4* buf, int8 i, float8* a
     *d = shuffle2(t1, t3, odd);
 }
 
-// Lanes of four packets from one float4 per lane: lane k of (a, b, c, d) is buf[index.sk]'s
-// (x, y, z, w).
-PACKET_INLINE void gather_float4(__global const float4* buf, intp index, floatp* a, floatp* b,
-                                 floatp* c, floatp* d) {
-    float8 a0, b0, c0, d0, a1, b1, c1, d1;
-    gather_float4_8(buf, index.lo, &a0, &b0, &c0, &d0);
-    gather_float4_8(buf, index.hi, &a1, &b1, &c1, &d1);
-    *a = (floatp)(a0, a1);
-    *b = (floatp)(b0, b1);
-    *c = (floatp)(c0, c1);
-    *d = (floatp)(d0, d1);
-}
+// Two lanes' cells from the shading volume, interpolated without transposing the corners: lanes
+// k and k + 4 of an 8-lane half load each corner's float4 (value, dx, dy, dz) into the two halves
+// of a float8, and the weights of each lane are spread over its half, so one 8-wide mix
+// interpolates all four components of both lanes; packet_cell_trilinear's operations in its
+// order, element by element, so the same floats as mixing transposed corners. Only the result is
+// transposed (transpose_float4_8): three weight shuffles a pair where transposing the eight corners
+// took eight shuffles for four lanes each, the same mixes, and LLVM's code ran about 10 % faster
+// (bench/RESULTS.md, "Shaded samples without the corners' transposes").
+#define SHADED_PAIR(k, m)                                                                    \
+    do {                                                                                     \
+        const uint8 pick = (uint8)(k, k, k, k, m, m, m, m);                                  \
+        const float8 wx = shuffle(fx, pick), wy = shuffle(fy, pick), wz = shuffle(fz, pick); \
+        const float8 c00 = mix(SHADED_CORNER(i000, k, m), SHADED_CORNER(i100, k, m), wx);    \
+        const float8 c10 = mix(SHADED_CORNER(i010, k, m), SHADED_CORNER(i110, k, m), wx);    \
+        const float8 c01 = mix(SHADED_CORNER(i001, k, m), SHADED_CORNER(i101, k, m), wx);    \
+        const float8 c11 = mix(SHADED_CORNER(i011, k, m), SHADED_CORNER(i111, k, m), wx);    \
+        r##k = mix(mix(c00, c10, wy), mix(c01, c11, wy), wz);                                \
+    } while (0)
+#define SHADED_CORNER(i, k, m) ((float8)(shading[(i).s##k], shading[(i).s##m]))
 
-// One x-edge of a cell from the shading volume (gradient_volume.cl): the value and the three
-// central differences, each interpolated along x (packet_cell_trilinear's first step).
-PACKET_INLINE void packet_shaded_edge(__global const float4* shading, const PacketPlace* p, intp yz,
-                                      floatp* v, floatp* dx, floatp* dy, floatp* dz) {
-    floatp v0, dx0, dy0, dz0, v1, dx1, dy1, dz1;
-    gather_float4(shading, p->x_0 + yz, &v0, &dx0, &dy0, &dz0);
-    gather_float4(shading, p->x_1 + yz, &v1, &dx1, &dy1, &dz1);
-    *v = mix(v0, v1, p->fx);
-    *dx = mix(dx0, dx1, p->fx);
-    *dy = mix(dy0, dy1, p->fx);
-    *dz = mix(dz0, dz1, p->fx);
+// packet_shaded_sample for lanes 0-7 or 8-15: *v the value, *dx, *dy, *dz the interpolated
+// differences (not yet scaled).
+PACKET_INLINE void packet_shaded_half(__global const float4* shading, int8 x_0, int8 x_1, int8 y_0,
+                                      int8 y_1, int8 z_0, int8 z_1, float8 fx, float8 fy, float8 fz,
+                                      float8* v, float8* dx, float8* dy, float8* dz) {
+    const int8 i000 = x_0 + y_0 + z_0, i100 = x_1 + y_0 + z_0, i010 = x_0 + y_1 + z_0;
+    const int8 i110 = x_1 + y_1 + z_0, i001 = x_0 + y_0 + z_1, i101 = x_1 + y_0 + z_1;
+    const int8 i011 = x_0 + y_1 + z_1, i111 = x_1 + y_1 + z_1;
+    float8 r0, r1, r2, r3;
+    SHADED_PAIR(0, 4);
+    SHADED_PAIR(1, 5);
+    SHADED_PAIR(2, 6);
+    SHADED_PAIR(3, 7);
+    transpose_float4_8(r0, r1, r2, r3, v, dx, dy, dz);
 }
+#undef SHADED_CORNER
+#undef SHADED_PAIR
 
 // packet_trilinear() and gradient_central() at a packet's samples, from the shading volume
 // (gradient_volume.cl: per voxel the value and its central differences): the value is
@@ -566,19 +575,16 @@ PACKET_INLINE floatp packet_shaded_sample(__global const float4* shading, int4 d
                                           floatp y, floatp z, intp active, float4 inv_spacing,
                                           floatp* gx, floatp* gy, floatp* gz) {
     const PacketPlace p = packet_place(dims, x, y, z, active);
-    floatp v00, x00, y00, z00, v10, x10, y10, z10;
-    packet_shaded_edge(shading, &p, p.y_0 + p.z_0, &v00, &x00, &y00, &z00);
-    packet_shaded_edge(shading, &p, p.y_1 + p.z_0, &v10, &x10, &y10, &z10);
-    const floatp v0 = mix(v00, v10, p.fy), gx0 = mix(x00, x10, p.fy);
-    const floatp gy0 = mix(y00, y10, p.fy), gz0 = mix(z00, z10, p.fy);
-    floatp v01, x01, y01, z01, v11, x11, y11, z11;
-    packet_shaded_edge(shading, &p, p.y_0 + p.z_1, &v01, &x01, &y01, &z01);
-    packet_shaded_edge(shading, &p, p.y_1 + p.z_1, &v11, &x11, &y11, &z11);
+    float8 v0, x0, y0, z0, v1, x1, y1, z1;
+    packet_shaded_half(shading, p.x_0.lo, p.x_1.lo, p.y_0.lo, p.y_1.lo, p.z_0.lo, p.z_1.lo, p.fx.lo,
+                       p.fy.lo, p.fz.lo, &v0, &x0, &y0, &z0);
+    packet_shaded_half(shading, p.x_0.hi, p.x_1.hi, p.y_0.hi, p.y_1.hi, p.z_0.hi, p.z_1.hi, p.fx.hi,
+                       p.fy.hi, p.fz.hi, &v1, &x1, &y1, &z1);
     // Halving is exact in float: gradient_central's 1 / (2 spacing).
-    *gx = mix(gx0, mix(x01, x11, p.fy), p.fz) * (0.5f * inv_spacing.x);
-    *gy = mix(gy0, mix(y01, y11, p.fy), p.fz) * (0.5f * inv_spacing.y);
-    *gz = mix(gz0, mix(z01, z11, p.fy), p.fz) * (0.5f * inv_spacing.z);
-    return mix(v0, mix(v01, v11, p.fy), p.fz);
+    *gx = (floatp)(x0, x1) * (0.5f * inv_spacing.x);
+    *gy = (floatp)(y0, y1) * (0.5f * inv_spacing.y);
+    *gz = (floatp)(z0, z1) * (0.5f * inv_spacing.z);
+    return (floatp)(v0, v1);
 }
 
 // Where a value falls in the table: lookup_transfer()'s x, the bins ix = min(floor(x), bins.x - 2)

@@ -113,5 +113,48 @@ TEST(GradientVolume, ShadedRendersPastTheCapMarchOneRayPerWorkItem) {
     EXPECT_TRUE(renderer.last_render_in_packets());
 }
 
+// A shaded sample's value comes from the shading volume's corners (packet_shaded_sample), bit for
+// bit the plain volume's (packet_trilinear: the same corners, the same operations in the same
+// order), so the depth and the classification do not move with shading. Seen from the host: a 2D
+// function whose rows are all the 1D function (the lookup mixes equal rows, which gives the row)
+// reads values from the shading volume, the 1D function unshaded from the plain volume, and both
+// frames must be the same floats. A different order of the corners' interpolation, the same value
+// to rounding, fails it.
+TEST(GradientVolume, ValuesFromTheShadingVolumeAreThePlainVolumesBitForBit) {
+    const SampledVolume volume = make_gaussian_blobs({21, 19, 23}, 3, 5);
+    VolumeRenderer renderer;
+    renderer.upload(volume.field());
+    const std::vector<ControlPoint> points{ControlPoint{0.0, glm::vec4(0.1f, 0.2f, 0.9f, 0.0f)},
+                                           ControlPoint{0.3, glm::vec4(0.1f, 0.8f, 0.9f, 0.2f)},
+                                           ControlPoint{0.6, glm::vec4(0.9f, 0.9f, 0.2f, 0.5f)},
+                                           ControlPoint{1.0, glm::vec4(0.9f, 0.2f, 0.1f, 0.9f)}};
+    const TransferFunction tf_1d(points);
+    const TransferFunction tf_2d({TransferRow{0.0, points}, TransferRow{0.75, points}}, 1.0);
+    OrbitView view;
+    view.azimuth_deg = 30.0;
+    view.elevation_deg = 20.0;
+    view.width = 40;
+    view.height = 32;
+    const Camera camera = Camera::orbit(view, volume.field().bounds());
+    RenderSettings settings;
+    settings.step_voxels = 0.6;  // samples between the voxels
+    const Rendering plain = renderer.render(camera, tf_1d, settings);
+    ASSERT_TRUE(renderer.last_render_in_packets());
+    const Rendering from_shading_volume = renderer.render(camera, tf_2d, settings);
+    ASSERT_TRUE(renderer.last_render_in_packets());
+    ASSERT_EQ(plain.rgba.pixels.size(), from_shading_volume.rgba.pixels.size());
+    float largest = 0.0f;
+    for (std::size_t i = 0; i < plain.rgba.pixels.size(); ++i) {
+        largest = std::max(largest, plain.rgba.pixels[i]);
+    }
+    EXPECT_GT(largest, 0.1f) << "the frame shows the field";
+    EXPECT_EQ(std::memcmp(plain.rgba.pixels.data(), from_shading_volume.rgba.pixels.data(),
+                          plain.rgba.pixels.size() * sizeof(float)),
+              0);
+    EXPECT_EQ(std::memcmp(plain.depth.pixels.data(), from_shading_volume.depth.pixels.data(),
+                          plain.depth.pixels.size() * sizeof(float)),
+              0);
+}
+
 }  // namespace
 }  // namespace insitu::detail
