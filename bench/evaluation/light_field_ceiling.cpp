@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <utility>
 
@@ -106,14 +107,15 @@ ErrorBudget checked_budget(const Image& truth, const Image& frame) {
 
 /// What every light field of one scene is measured against.
 struct SceneViews {
+    std::vector<int> indices;  ///< of the light-field sections' 30 random views
     std::vector<std::pair<double, double>> angles;
     std::vector<Camera> cameras;
     std::vector<Image> truths;
     std::vector<TruthDepths> depths;  ///< the truth's depths (light_field_oracle.hpp)
 };
 
-SceneViews scene_views(const Scene& scene, ProxyRenderer& renderer, int views, int image,
-                       double depth_threshold) {
+SceneViews scene_views(const Scene& scene, ProxyRenderer& renderer, const std::vector<int>& views,
+                       int image, double depth_threshold) {
     const Field field = scene.volume.field();
     const TransferFunction tf = make_tf(scene);
     const glm::dvec3 spacing = field.spacing();
@@ -121,9 +123,10 @@ SceneViews scene_views(const Scene& scene, ProxyRenderer& renderer, int views, i
         truth_settings().step_voxels * std::min({spacing.x, spacing.y, spacing.z});
     const Camera stored = Camera::orbit(stored_view(image), renderer.volume().bounds);
     SceneViews out;
-    // The light-field sections' random views (the first `views` of their 30).
-    out.angles = random_views(30);
-    out.angles.resize(static_cast<std::size_t>(views));
+    // The light-field sections' random views (`views` of their 30).
+    const std::vector<std::pair<double, double>> all = random_views(30);
+    out.indices = views;
+    for (const int v : views) out.angles.push_back(all[static_cast<std::size_t>(v)]);
     for (const auto& [azimuth, elevation] : out.angles) {
         out.cameras.push_back(stored.reorbit(azimuth, elevation));
         out.truths.push_back(
@@ -171,6 +174,14 @@ std::size_t differing_pixels(const Image& a, const Image& b) {
     return count;
 }
 
+// A view's truth, today's frame and where their error lies (error_classes_image), as PNGs
+// `stem`_truth.png, _today.png and _classes.png, to look at (INSITU_CEILING_PICTURES=1).
+void write_pictures(const fs::path& stem, const Image& truth, const Image& today) {
+    write_png(stem.string() + "_truth.png", truth);
+    write_png(stem.string() + "_today.png", today);
+    write_png(stem.string() + "_classes.png", error_classes_image(truth, today));
+}
+
 // The light field with each camera read at its own depths (kOwnDepths), their counts printed.
 std::vector<LightField> own_depth_light_fields(const LightField& stored, const std::string& scene,
                                                const Capture& capture) {
@@ -187,6 +198,13 @@ std::vector<LightField> own_depth_light_fields(const LightField& stored, const s
             counts.mean_coverage_gap);
     }
     return out;
+}
+
+// Whether INSITU_CEILING_TODAY_ONLY=1 asks for today's frames alone (no oracle frames: a quick
+// run to compare reconstructions).
+bool today_only() {
+    const char* wanted = std::getenv("INSITU_CEILING_TODAY_ONLY");
+    return wanted != nullptr && std::string(wanted) == "1";
 }
 
 // The frames of one view: today's (the Explorer's), and the oracle's (one segment) or the
@@ -211,7 +229,7 @@ std::array<Image, kFrames> view_frames(Explorer& explorer, const LightField& sto
         for (std::size_t i = 0; i < own.size(); ++i) {
             frames[kOwnCentroid + i] = reconstruct_light_field(own[i], camera, settings).rgba;
         }
-    } else if (stored.segment_count() == 1) {
+    } else if (stored.segment_count() == 1 && !today_only()) {
         const TruthDepths& depths = seen.depths[v];
         frames[kOracle] = oracle_frame(stored, camera, depths.first_hit, OracleBlend::visible);
         frames[kOracleNearest] =
@@ -229,7 +247,7 @@ std::array<Image, kFrames> view_frames(Explorer& explorer, const LightField& sto
 // an attenuation capture the own-depth frames, from every view: their budgets as CSV rows, and
 // their means printed.
 void measure(const Scene& scene, const SceneViews& seen, const Capture& capture, int map,
-             const fs::path& archive, Csv& csv) {
+             const fs::path& archive, const fs::path& out, bool pictures, Csv& csv) {
     Explorer explorer(archive.string());
     const LightField stored =
         ArchiveReader(archive.string()).load_light_field(0, scene.volume.name);
@@ -243,6 +261,12 @@ void measure(const Scene& scene, const SceneViews& seen, const Capture& capture,
         const std::array<Image, kFrames> frames = view_frames(explorer, stored, own, seen, v);
         if (frames[kTodayDirect].pixel_count() > 0) {
             moved += differing_pixels(frames[kToday], frames[kTodayDirect]);
+        }
+        if (pictures) {
+            write_pictures(
+                out / ("light_field_ceiling_" + scene.name + "_" + capture.name + "_" +
+                       std::to_string(capture.cameras) + "_view" + std::to_string(seen.indices[v])),
+                seen.truths[v], frames[kToday]);
         }
         for (int f = 0; f < kFrames; ++f) {
             if (frames[f].pixel_count() == 0) continue;
@@ -258,7 +282,7 @@ void measure(const Scene& scene, const SceneViews& seen, const Capture& capture,
                 classes += text;
             }
             csv.row(scene.name, capture.name, capture.cameras, segments, map, kFrameNames[f],
-                    static_cast<int>(v), seen.angles[v].first, seen.angles[v].second, budget.psnr(),
+                    seen.indices[v], seen.angles[v].first, seen.angles[v].second, budget.psnr(),
                     mean_abs, classes);
         }
     }
@@ -303,16 +327,44 @@ std::vector<Capture> chosen_captures(bool smoke) {
     return kept;
 }
 
-// The number of views: 30 (the smoke run's 2), or INSITU_CEILING_VIEWS (1 to 30) where set.
-int chosen_views(bool smoke) {
-    const char* wanted = std::getenv("INSITU_CEILING_VIEWS");
-    if (wanted == nullptr || *wanted == '\0') return smoke ? 2 : 30;
-    const int views = std::atoi(wanted);
-    if (views < 1 || views > 30) {
-        fail<InvalidArgument>("light_field_ceiling: INSITU_CEILING_VIEWS=", wanted,
-                              " (1 to 30 of the light-field sections' views)");
+// The views: the first 30 (the smoke run's 2), or INSITU_CEILING_VIEWS (1 to 30) where set, or
+// the views INSITU_CEILING_VIEW_LIST names (indices 0-29, comma-separated: e.g. a worst view and
+// its runners-up, to look at).
+std::vector<int> chosen_views(bool smoke) {
+    std::vector<int> views;
+    const char* list = std::getenv("INSITU_CEILING_VIEW_LIST");
+    if (list != nullptr && *list != '\0') {
+        std::stringstream items(list);
+        std::string item;
+        while (std::getline(items, item, ',')) {
+            const int v = std::atoi(item.c_str());
+            if (item.empty() || v < 0 || v > 29 || std::to_string(v) != item) {
+                fail<InvalidArgument>("light_field_ceiling: INSITU_CEILING_VIEW_LIST=", list,
+                                      " (indices 0 to 29 of the light-field sections' views)");
+            }
+            views.push_back(v);
+        }
+        return views;
     }
+    const char* wanted = std::getenv("INSITU_CEILING_VIEWS");
+    int count = smoke ? 2 : 30;
+    if (wanted != nullptr && *wanted != '\0') {
+        count = std::atoi(wanted);
+        if (count < 1 || count > 30) {
+            fail<InvalidArgument>("light_field_ceiling: INSITU_CEILING_VIEWS=", wanted,
+                                  " (1 to 30 of the light-field sections' views)");
+        }
+    }
+    for (int v = 0; v < count; ++v) views.push_back(v);
     return views;
+}
+
+// Whether scene `name` is measured: every scene, or those INSITU_CEILING_SCENES names
+// (comma-separated, e.g. "marschner_lobb").
+bool chosen_scene(const std::string& name) {
+    const char* wanted = std::getenv("INSITU_CEILING_SCENES");
+    if (wanted == nullptr || *wanted == '\0') return true;
+    return (std::string(",") + wanted + ",").find("," + name + ",") != std::string::npos;
 }
 
 }  // namespace
@@ -326,29 +378,39 @@ void section_light_field_ceiling(const std::vector<const Scene*>& scenes, bool s
         header += std::string(",") + name + "_pixels," + name + "_share," + name + "_psnr_without";
     }
     Csv csv(out / "light_field_ceiling.csv", header);
-    const int views = chosen_views(smoke);
+    const std::vector<int> views = chosen_views(smoke);
+    const char* pictures_wanted = std::getenv("INSITU_CEILING_PICTURES");
+    const bool pictures = pictures_wanted != nullptr && std::string(pictures_wanted) == "1";
     const int map = smoke ? 64 : 256;
     // Captures outermost, so that a run cut short has measured every scene's first ones.
     const std::vector<Capture> captures = chosen_captures(smoke);
     std::vector<std::unique_ptr<ProxyRenderer>> renderers;
     std::vector<SceneViews> seen;
+    std::vector<const Scene*> measured;
     for (const Scene* scene : scenes) {
+        if (chosen_scene(scene->name)) measured.push_back(scene);
+    }
+    if (measured.empty()) {
+        fail<InvalidArgument>("light_field_ceiling: INSITU_CEILING_SCENES=",
+                              std::getenv("INSITU_CEILING_SCENES"), " names none of the scenes");
+    }
+    for (const Scene* scene : measured) {
         renderers.push_back(std::make_unique<ProxyRenderer>());
         renderers.back()->upload(scene->volume.field());
         seen.push_back(scene_views(*scene, *renderers.back(), views, image,
                                    LightFieldSettings{}.depth_threshold));
     }
     for (const Capture& capture : captures) {
-        for (std::size_t s = 0; s < scenes.size(); ++s) {
-            const fs::path archive = scratch / ("ceiling_" + scenes[s]->name);
+        for (std::size_t s = 0; s < measured.size(); ++s) {
+            const fs::path archive = scratch / ("ceiling_" + measured[s]->name);
             fs::remove_all(archive);
             const int capture_map = map / capture.map_divisor;
             const std::uintmax_t stored =
-                capture_into(*scenes[s], *renderers[s], capture, capture_map, image, archive);
+                capture_into(*measured[s], *renderers[s], capture, capture_map, image, archive);
             std::printf("light-field ceiling: %s %d cameras %s at %d^2: %.2f MB stored\n",
-                        scenes[s]->name.c_str(), capture.cameras, capture.name, capture_map,
+                        measured[s]->name.c_str(), capture.cameras, capture.name, capture_map,
                         static_cast<double>(stored) / 1e6);
-            measure(*scenes[s], seen[s], capture, capture_map, archive, csv);
+            measure(*measured[s], seen[s], capture, capture_map, archive, out, pictures, csv);
             fs::remove_all(archive);
         }
     }

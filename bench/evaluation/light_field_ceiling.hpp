@@ -18,8 +18,11 @@
 //    camera read at its own centroid, median or halfway between its first hit and centroid, as
 //    the attenuation maps give them (light_field_own_depth.hpp), through the reconstruction.
 // Writes light_field_ceiling.csv, one row per scene, light field, frame and view.
-// INSITU_CEILING_CAPTURES (e.g. "whole_ray_42,attenuation_42") and INSITU_CEILING_VIEWS (1-30)
-// restrict a run to some light fields and the first views.
+// INSITU_CEILING_CAPTURES (e.g. "whole_ray_42,attenuation_42"), INSITU_CEILING_SCENES (e.g.
+// "marschner_lobb"), INSITU_CEILING_VIEWS (1-30: the first views) or INSITU_CEILING_VIEW_LIST
+// (e.g. "11,20,10") restrict a run to some light fields, scenes and views;
+// INSITU_CEILING_TODAY_ONLY=1 leaves out the oracle frames; INSITU_CEILING_PICTURES=1 writes each
+// view's truth, today's frame and its error classes as PNGs.
 #include <filesystem>
 #include <vector>
 

@@ -36,6 +36,11 @@ struct ErrorBudget {
 /// `truth` and `frame`: RGBA, premultiplied, one size.
 ErrorBudget error_budget(const Image& truth, const Image& frame);
 
+/// Where a frame's error lies, to look at: each pixel the truth's colour at a quarter, plus its
+/// class's colour (empty grey, ghost blue, crack red, silhouette yellow, interior green) scaled by
+/// its error (root mean square over premultiplied RGB, times 4, at most 1). Opaque RGBA.
+Image error_classes_image(const Image& truth, const Image& frame);
+
 /// The light-field sections' mean error: mean absolute difference over premultiplied RGB and
 /// every pixel, in percent of full scale.
 double mean_abs_percent(const Image& truth, const Image& frame);

@@ -179,25 +179,54 @@ float depthTolerance(float distance, vec2 map, float footprints) {
   return footprints * 2.0 * distance / float(uMapSize) + quantum;
 }
 
+// One axis of nearestOnSlope's slope (minmod): the smaller of the one-sided differences to the
+// texel's neighbours where both recorded a surface and they have one sign, else 0.
+float limitedSlope(float before, float nearest, float after) {
+  if (!(recorded(before) && recorded(after))) return 0.0;
+  float down = nearest - before, up = after - nearest;
+  if (down * up <= 0.0) return 0.0;
+  return down > 0.0 ? min(down, up) : max(down, up);
+}
+
+// The nearest texel's distance carried along the surface's slope to the map position
+// (nearest_on_slope in the C++ code).
+float nearestOnSlope(int layer, ivec2 pixel, vec2 map, float nearest) {
+  ivec2 last = ivec2(uMapSize - 1);
+  float slopeX = limitedSlope(texelDistance(layer, clamp(pixel - ivec2(1, 0), ivec2(0), last)),
+                              nearest,
+                              texelDistance(layer, clamp(pixel + ivec2(1, 0), ivec2(0), last)));
+  float slopeY = limitedSlope(texelDistance(layer, clamp(pixel - ivec2(0, 1), ivec2(0), last)),
+                              nearest,
+                              texelDistance(layer, clamp(pixel + ivec2(0, 1), ivec2(0), last)));
+  return nearest + slopeX * (map.x - (float(pixel.x) + 0.5)) +
+         slopeY * (map.y - (float(pixel.y) + 0.5));
+}
+
 // Eq. 3 at a map position (stored_distance): bilinear where the four texels around it recorded
-// one surface (within SURFACE_FOOTPRINTS of each other), else the nearest texel's (bilinear
-// between a silhouette and the background would invent a surface); NO_HIT where none.
-float storedDistance(int layer, vec2 map) {
+// one surface (within SURFACE_FOOTPRINTS of each other), else the nearest texel's (alongSlope:
+// carried along its slope); bilinear between a silhouette and the background would invent a
+// surface. NO_HIT where none.
+float storedDistanceOf(int layer, vec2 map, bool alongSlope) {
   float last = float(uMapSize - 1);
   ivec2 pixel = ivec2(clamp(floor(map), vec2(0.0), vec2(last)));
   float nearest = texelDistance(layer, pixel);
   if (!recorded(nearest)) return NO_HIT;
+  float fallback = alongSlope ? nearestOnSlope(layer, pixel, map, nearest) : nearest;
   vec2 f = clamp(map - 0.5, vec2(0.0), vec2(last));
   ivec2 p0 = ivec2(f);
   ivec2 p1 = min(p0 + 1, ivec2(uMapSize - 1));
   vec2 w = f - vec2(p0);
   vec4 d = vec4(texelDistance(layer, p0), texelDistance(layer, ivec2(p1.x, p0.y)),
                 texelDistance(layer, ivec2(p0.x, p1.y)), texelDistance(layer, p1));
-  if (!(recorded(d.x) && recorded(d.y) && recorded(d.z) && recorded(d.w))) return nearest;
+  if (!(recorded(d.x) && recorded(d.y) && recorded(d.z) && recorded(d.w))) return fallback;
   float low = min(min(d.x, d.y), min(d.z, d.w)), high = max(max(d.x, d.y), max(d.z, d.w));
   float sum = (1.0 - w.x) * (1.0 - w.y) * d.x + w.x * (1.0 - w.y) * d.y +
               (1.0 - w.x) * w.y * d.z + w.x * w.y * d.w;
-  return high - low <= depthTolerance(nearest, map, SURFACE_FOOTPRINTS) ? sum : nearest;
+  return high - low <= depthTolerance(nearest, map, SURFACE_FOOTPRINTS) ? sum : fallback;
+}
+
+float storedDistance(int layer, vec2 map) {
+  return storedDistanceOf(layer, map, false);
 }
 
 // The least and greatest stored distance (DepthBounds::between) over the map segment from a to
@@ -232,7 +261,7 @@ float behindBy(RigCamera c, int layer, vec3 origin, vec3 direction, float t) {
 
 // Where the step [t - step, t] crossed from in front of the stored surface to behind it: t of
 // the hit after BISECTIONS halvings, or -1 where the point behind lies too far behind (an
-// occluding edge, not a surface).
+// occluding edge, not a surface) or in front of the surface along its slope.
 float refinedHit(RigCamera c, int layer, vec3 origin, vec3 direction, float t, float step) {
   float inFront = t - step, hidden = t;
   for (int b = 0; b < BISECTIONS; ++b) {
@@ -241,9 +270,16 @@ float refinedHit(RigCamera c, int layer, vec3 origin, vec3 direction, float t, f
     else inFront = middle;
   }
   vec3 point = origin + hidden * direction;
-  float tolerance = depthTolerance(length(point - c.eye), project(c, point), SURFACE_FOOTPRINTS);
-  return behindBy(c, layer, origin, direction, hidden) <= tolerance ? 0.5 * (inFront + hidden)
-                                                                     : -1.0;
+  vec2 map = project(c, point);
+  float distance = length(point - c.eye);
+  float tolerance = depthTolerance(distance, map, SURFACE_FOOTPRINTS);
+  // Nor in front of the surface carried along its slope: a surface seen at a grazing angle as
+  // a staircase lets a ray that passes just in front of it fall behind a texel's step (the C++
+  // first_hit).
+  float inFrontOfSlope = storedDistanceOf(layer, map, true) - distance;
+  return behindBy(c, layer, origin, direction, hidden) <= tolerance && inFrontOfSlope <= tolerance
+             ? 0.5 * (inFront + hidden)
+             : -1.0;
 }
 
 // The first hit along [t0, t1] against a camera's stored depth (first_hit in the C++ code):

@@ -106,27 +106,59 @@ private:
     // where it recorded none. Bilinear where the four texels around the position recorded one
     // surface (within a few footprints of each other): nearest-pixel depth puts the hit on a
     // staircase that moves from camera to camera (blocky silhouettes, seams where the blend
-    // changes). Else the nearest texel's: bilinear between a silhouette and the background
-    // (+inf) would be +inf or invent a surface between the two.
-    double stored_distance(const Image& depth, const glm::dvec2& map) const {
+    // changes). Else the nearest texel's (`along_slope`: carried along its slope,
+    // nearest_on_slope()): bilinear between a silhouette and the background (+inf) would be +inf
+    // or invent a surface between the two.
+    double stored_distance(const Image& depth, const glm::dvec2& map,
+                           bool along_slope = false) const {
         const int n = rig_.map_size();
         const int px = static_cast<int>(std::clamp(std::floor(map.x), 0.0, n - 1.0));
         const int py = static_cast<int>(std::clamp(std::floor(map.y), 0.0, n - 1.0));
-        const double nearest = depth.at(px, py, 0) * rig_.secant_length(px + 0.5, py + 0.5);
+        const double nearest = texel_distance(depth, px, py);
         if (!std::isfinite(nearest)) return nearest;
+        const auto fallback = [&] {
+            return along_slope ? nearest_on_slope(depth, px, py, map, nearest) : nearest;
+        };
         const Taps taps = bilinear_taps(n, map);
         double sum = 0.0, low = kInf, high = -kInf;
         for (int i = 0; i < 4; ++i) {
             const std::size_t texel = taps.pixel[static_cast<std::size_t>(i)];
-            const double x = static_cast<double>(texel % static_cast<std::size_t>(n)) + 0.5;
-            const double y = static_cast<double>(texel / static_cast<std::size_t>(n)) + 0.5;
-            const double distance = depth.pixels[texel] * rig_.secant_length(x, y);
-            if (!std::isfinite(distance)) return nearest;
+            const double distance =
+                texel_distance(depth, static_cast<int>(texel % static_cast<std::size_t>(n)),
+                               static_cast<int>(texel / static_cast<std::size_t>(n)));
+            if (!std::isfinite(distance)) return fallback();
             sum += taps.weight[static_cast<std::size_t>(i)] * distance;
             low = std::min(low, distance);
             high = std::max(high, distance);
         }
-        return high - low <= depth_tolerance(nearest, map, kSurfaceFootprints) ? sum : nearest;
+        return high - low <= depth_tolerance(nearest, map, kSurfaceFootprints) ? sum : fallback();
+    }
+
+    // Texel (x, y)'s stored distance (clamped to the map), +inf where it recorded none.
+    double texel_distance(const Image& depth, int x, int y) const {
+        const int last = rig_.map_size() - 1;
+        x = std::clamp(x, 0, last);
+        y = std::clamp(y, 0, last);
+        return depth.at(x, y, 0) * rig_.secant_length(x + 0.5, y + 0.5);
+    }
+
+    // The nearest texel's distance carried along the surface's slope to the map position: per
+    // axis the smaller of the two one-sided differences to the texel's neighbours where both
+    // recorded a surface and the differences have one sign, else 0 (minmod, as slope limiters
+    // do). At an occluding edge one difference is the surface's own slope and the other the
+    // jump, so the surface is carried no further than its own slope.
+    double nearest_on_slope(const Image& depth, int px, int py, const glm::dvec2& map,
+                            double nearest) const {
+        const auto limited = [nearest](double before, double after) {
+            const double down = nearest - before, up = after - nearest;
+            if (!std::isfinite(down) || !std::isfinite(up) || down * up <= 0.0) return 0.0;
+            return down > 0.0 ? std::min(down, up) : std::max(down, up);
+        };
+        const double slope_x =
+            limited(texel_distance(depth, px - 1, py), texel_distance(depth, px + 1, py));
+        const double slope_y =
+            limited(texel_distance(depth, px, py - 1), texel_distance(depth, px, py + 1));
+        return nearest + slope_x * (map.x - (px + 0.5)) + slope_y * (map.y - (py + 0.5));
     }
 
     // How far a point may lie behind a camera's recorded surface and still be on it
@@ -196,7 +228,20 @@ private:
                     const double tolerance =
                         depth_tolerance(glm::length(point - camera.position()),
                                         camera.project(point), kSurfaceFootprints);
-                    if (behind_by(hidden) <= tolerance) return 0.5 * (in_front + hidden);
+                    // A surface seen at a grazing angle changes by many footprints from texel
+                    // to texel, too many for the bilinear read, and as a staircase it lets a ray
+                    // that passes just in front of it fall behind a texel's step: the hit counts
+                    // only where the point does not lie in front of the surface carried along
+                    // its slope either (the ghost rows beside an edge-on face: bench/RESULTS.md,
+                    // "The worst view at the default rig"). Where it is found stays the
+                    // staircase's: carried along the slope, grazing hits moved and lost more
+                    // than they gained.
+                    const double in_front_of_slope =
+                        stored_distance(depth, camera.project(point), true) -
+                        glm::length(point - camera.position());
+                    if (behind_by(hidden) <= tolerance && in_front_of_slope <= tolerance) {
+                        return 0.5 * (in_front + hidden);
+                    }
                 }
                 was_behind = is_behind;
             }
