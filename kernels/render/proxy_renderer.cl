@@ -64,8 +64,8 @@ __kernel void render_proxies(
     int segment_count, __global const float* segment_thresholds, float depth_threshold,
     __global float4* segment_rgba_out, __global float* segment_depth_out,
     __global float* first_hit_out, float rim_threshold, __global float* rim_out,
-    __global const uchar* skippable_blocks, int4 block_counts,
-    int block_size, __global float* fragment_out, __global const float* front_in) {
+    __global const uchar* skippable_blocks, int4 block_counts, int block_size,
+    __global float* fragment_out, __global const float* front_in) {
     const int x = get_global_id(0);
     const int y = get_global_id(1);
     if (x >= size.x || y >= size.y) return;
@@ -99,9 +99,8 @@ __kernel void render_proxies(
     const bool want_optical_depth = (wanted & WANT_OPTICAL_DEPTH) != 0;
     const bool want_interleaving = (wanted & WANT_INTERLEAVING) != 0;
     const bool want_entry_depth = (wanted & WANT_ENTRY_DEPTH) != 0;
-    const bool want_segments =
-        (wanted & (WANT_SEGMENT_RGBA | WANT_SEGMENT_DEPTH | WANT_FIRST_HIT_DEPTH |
-                   WANT_RIM_DEPTH)) != 0;
+    const bool want_segments = (wanted & (WANT_SEGMENT_RGBA | WANT_SEGMENT_DEPTH |
+                                          WANT_FIRST_HIT_DEPTH | WANT_RIM_DEPTH)) != 0;
     // Segments split at the layers' crossings need them found even where depth layers are not
     // stored; the host then passes the isovalues as layers all the same.
     const bool find_crossings =
@@ -562,8 +561,8 @@ __kernel void render_proxies_packets(
     __global const float* segment_thresholds, float depth_threshold,
     __global float4* segment_rgba_out, __global float* segment_depth_out,
     __global float* first_hit_out, float rim_threshold, __global float* rim_out,
-    __global const uchar* skippable_blocks, int4 block_counts,
-    int block_size, __global float* fragment_out, __global const float* front_in) {
+    __global const uchar* skippable_blocks, int4 block_counts, int block_size,
+    __global float* fragment_out, __global const float* front_in) {
     const int gx = get_global_id(0);
     const int gy = get_global_id(1);
     if (gx * PACKET_W >= size.x || gy * PACKET_H >= size.y) return;
@@ -583,9 +582,8 @@ __kernel void render_proxies_packets(
     // render_proxies). The whole ray is one segment composited from T = 1, the ray itself, so
     // its depth is the first hit; opacity segments are composited on their own beside the ray,
     // whose opacity says where each starts, as in render_proxies.
-    const bool want_segments =
-        (wanted & (WANT_SEGMENT_RGBA | WANT_SEGMENT_DEPTH | WANT_FIRST_HIT_DEPTH |
-                   WANT_RIM_DEPTH)) != 0;
+    const bool want_segments = (wanted & (WANT_SEGMENT_RGBA | WANT_SEGMENT_DEPTH |
+                                          WANT_FIRST_HIT_DEPTH | WANT_RIM_DEPTH)) != 0;
     const bool opacity_segments = want_segments && segment_rule == SEGMENTS_OPACITY;
 
     const MarchPacket rays = march_packet(gx, gy, size, cam_position, cam_forward, cam_right,
@@ -721,9 +719,9 @@ __kernel void render_proxies_packets(
             composite_lanes(ray_composites, alpha, sample_red, sample_green, sample_blue, depth,
                             depth_threshold, stop_opacity, &ray_transmittance, &red, &green, &blue,
                             &first_hit, &compositing);
-            rim_hit = select(rim_hit, depth,
-                             ray_composites & isinf(rim_hit) &
-                                 (1.0f - ray_transmittance >= rim_threshold));
+            rim_hit = select(
+                rim_hit, depth,
+                ray_composites & isinf(rim_hit) & (1.0f - ray_transmittance >= rim_threshold));
             composite_lanes(usable & compositing_segment & (alpha > 0.0f), alpha, sample_red,
                             sample_green, sample_blue, depth, depth_threshold, stop_opacity,
                             &segment_transmittance, &segment_red, &segment_green, &segment_blue,

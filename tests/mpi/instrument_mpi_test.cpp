@@ -225,10 +225,9 @@ void expect_same_archive_as_one_process(const std::string& name, Index3 parts,
             if (!light_field.is_null()) {
                 std::size_t rims = 0;
                 for (const LightFieldImages& images : single.load_light_field(step, "f").cameras) {
-                    rims += static_cast<std::size_t>(
-                        std::count_if(images.rim_depth.pixels.begin(),
-                                      images.rim_depth.pixels.end(),
-                                      [](float depth) { return std::isfinite(depth); }));
+                    rims += static_cast<std::size_t>(std::count_if(
+                        images.rim_depth.pixels.begin(), images.rim_depth.pixels.end(),
+                        [](float depth) { return std::isfinite(depth); }));
                 }
                 EXPECT_GT(rims, 0u) << "step " << step;
             }

@@ -73,8 +73,13 @@ TEST(LightFieldRims, TheLightFieldsOwnPassGivesTheRimPassesDepthsBitForBit) {
         {"whole ray, faint, attenuation", SegmentRule::whole_ray, {}, {}, true, true, true},
         {"whole ray, one ray per work-item", SegmentRule::whole_ray, {}, {}, false, false, true},
         {"opacity segments", SegmentRule::opacity, {0.1, 0.5}, {}, true, true, false},
-        {"layer segments (one ray per work-item)", SegmentRule::layers, {}, {0.2, 0.5}, false,
-         true, false},
+        {"layer segments (one ray per work-item)",
+         SegmentRule::layers,
+         {},
+         {0.2, 0.5},
+         false,
+         true,
+         false},
     };
     for (const RimCase& c : cases) {
         SCOPED_TRACE(c.name);
@@ -183,8 +188,8 @@ TEST(LightFieldRims, BlocksOfADistributedRunCompositeTheWholeGridsRims) {
         EXPECT_EQ(rim.pixels, expected.rim_depth.pixels) << "camera " << k;
         EXPECT_TRUE(composited[1].rim_depth.pixels.empty());  // the root alone holds it
         for (std::size_t p = 0; p < rim.pixels.size(); ++p) {
-            rims += std::isfinite(rim.pixels[p]) &&
-                    std::isinf(composited[0].first_hit_depth.pixels[p]);
+            rims +=
+                std::isfinite(rim.pixels[p]) && std::isinf(composited[0].first_hit_depth.pixels[p]);
         }
     }
     EXPECT_GT(rims, 3 * 10);  // rays with a rim and no first hit

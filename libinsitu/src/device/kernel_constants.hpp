@@ -119,8 +119,8 @@ static_assert(kMaxLights >= 1 && kMaxLights <= 64, "half_vectors[] is a private 
 // The wanted bits must be distinct powers of two.
 static_assert((kWantDepth | kWantDistortion | kWantAttenuation | kWantMeanDepth |
                kWantOpticalDepth | kWantSegmentRgba | kWantSegmentDepth | kWantFirstHitDepth |
-               kWantFragment | kWantInterleaving | kWantEntryDepth | kWantFront |
-               kWantRimDepth) == 8191,
+               kWantFragment | kWantInterleaving | kWantEntryDepth | kWantFront | kWantRimDepth) ==
+                  8191,
               "wanted bits are the thirteen distinct low bits");
 static_assert(kSegmentsWholeRay != kSegmentsLayers && kSegmentsLayers != kSegmentsOpacity &&
                   kSegmentsWholeRay != kSegmentsOpacity,

@@ -484,8 +484,8 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
         static_cast<cl_int>(request.segments), static_cast<cl_int>(plan.segments),
         inputs.thresholds, static_cast<cl_float>(request.first_hit_threshold), outputs.segment_rgba,
         outputs.segment_depth, outputs.first_hit, static_cast<cl_float>(request.rim_threshold),
-        outputs.rim, skipped.skippable, skipped.block_counts,
-        skipped.block_voxels, outputs.fragment, inputs.front);
+        outputs.rim, skipped.skippable, skipped.block_counts, skipped.block_voxels,
+        outputs.fragment, inputs.front);
 
     download_outputs(opencl, request, plan, outputs, frame);
     return frame;

@@ -32,11 +32,11 @@ namespace insitu {
 using BlockPass = std::function<ProxyFrame(const ProxyRequest&)>;
 
 /// The light-field pass of `request` (segments, segment depth, first hit, rim, attenuation and
-/// mean depth: what capture_light_field asks) from `camera`, composited at `root`: the frame one pass
-/// over the whole grid gives there, its shell (images sized, not filled) elsewhere. `march` marches
-/// this rank's block; null for a rank that owns nothing. Collective: a rank whose march fails
-/// still takes part in every exchange and throws once they are done. The time spent exchanging
-/// adds to `exchange_seconds` when given.
+/// mean depth: what capture_light_field asks) from `camera`, composited at `root`: the frame one
+/// pass over the whole grid gives there, its shell (images sized, not filled) elsewhere. `march`
+/// marches this rank's block; null for a rank that owns nothing. Collective: a rank whose march
+/// fails still takes part in every exchange and throws once they are done. The time spent
+/// exchanging adds to `exchange_seconds` when given.
 ProxyFrame composite_light_field_pass(Communicator& communicator, const Camera& camera,
                                       const ProxyRequest& request, const BlockPass& march, int root,
                                       double* exchange_seconds = nullptr);

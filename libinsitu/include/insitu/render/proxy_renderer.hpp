@@ -134,7 +134,7 @@ struct ProxyFrame {
     /// 1 channel: the depth where the whole ray's opacity first reaches rim_threshold; +inf where
     /// it never does (or compositing stopped before: early termination below the threshold).
     Image rim_depth;
-    std::vector<Image> training;       ///< RGBA each
+    std::vector<Image> training;  ///< RGBA each
     /// RGBA, premultiplied: the ground truth of the run's own transfer function in this camera
     /// (the preview, before its 8-bit PNG), single perspective only ("rendering" proxy).
     Image rendering;
