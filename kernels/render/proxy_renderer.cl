@@ -63,8 +63,9 @@ __kernel void render_proxies(
     __global float* interleaving_out, __global float* entry_depth_out, int segment_rule,
     int segment_count, __global const float* segment_thresholds, float depth_threshold,
     __global float4* segment_rgba_out, __global float* segment_depth_out,
-    __global float* first_hit_out, __global const uchar* skippable_blocks, int4 block_counts,
-    int block_size, __global float* fragment_out, __global const float* front_in) {
+    __global float* first_hit_out, float rim_threshold, __global float* rim_out,
+    __global const uchar* skippable_blocks, int4 block_counts, int block_size,
+    __global float* fragment_out, __global const float* front_in) {
     const int x = get_global_id(0);
     const int y = get_global_id(1);
     if (x >= size.x || y >= size.y) return;
@@ -98,8 +99,8 @@ __kernel void render_proxies(
     const bool want_optical_depth = (wanted & WANT_OPTICAL_DEPTH) != 0;
     const bool want_interleaving = (wanted & WANT_INTERLEAVING) != 0;
     const bool want_entry_depth = (wanted & WANT_ENTRY_DEPTH) != 0;
-    const bool want_segments =
-        (wanted & (WANT_SEGMENT_RGBA | WANT_SEGMENT_DEPTH | WANT_FIRST_HIT_DEPTH)) != 0;
+    const bool want_segments = (wanted & (WANT_SEGMENT_RGBA | WANT_SEGMENT_DEPTH |
+                                          WANT_FIRST_HIT_DEPTH | WANT_RIM_DEPTH)) != 0;
     // Segments split at the layers' crossings need them found even where depth layers are not
     // stored; the host then passes the isovalues as layers all the same.
     const bool find_crossings =
@@ -148,6 +149,9 @@ __kernel void render_proxies(
     float segment_depth = INFINITY;
     float ray_transmittance = 1.0f;
     float first_hit = INFINITY;
+    // The light field's rims: the first hit at a second, lower opacity (rim_threshold), taken
+    // from the same samples and the same T as the first hit, so a pass of its own is not needed.
+    float rim_hit = INFINITY;
 
     // A block's light-field pass (WANT_FRONT) continues the march where the blocks in front of
     // it left it (insitu/parallel/light_field_compositing.hpp): the ray's transmittance, the
@@ -306,6 +310,9 @@ __kernel void render_proxies(
                     if (isinf(first_hit) && 1.0f - ray_transmittance >= depth_threshold) {
                         first_hit = sample_depth(&ray, t);
                     }
+                    if (isinf(rim_hit) && 1.0f - ray_transmittance >= rim_threshold) {
+                        rim_hit = sample_depth(&ray, t);
+                    }
                     if (1.0f - ray_transmittance >= stop_opacity) compositing_ray = false;
                 }
             }
@@ -358,6 +365,7 @@ __kernel void render_proxies(
         store_segments(wanted, segment_rgba_out, segment_depth_out, pixel, pixel_count, segment,
                        segment_count, segment_colour, segment_transmittance, segment_depth);
         if ((wanted & WANT_FIRST_HIT_DEPTH) != 0) first_hit_out[pixel] = first_hit;
+        if ((wanted & WANT_RIM_DEPTH) != 0) rim_out[pixel] = rim_hit;
     }
     if (want_layers) {
         for (int l = 0; l < layer_count; ++l) {
@@ -552,8 +560,9 @@ __kernel void render_proxies_packets(
     __global float* entry_depth_out, int segment_rule, int segment_count,
     __global const float* segment_thresholds, float depth_threshold,
     __global float4* segment_rgba_out, __global float* segment_depth_out,
-    __global float* first_hit_out, __global const uchar* skippable_blocks, int4 block_counts,
-    int block_size, __global float* fragment_out, __global const float* front_in) {
+    __global float* first_hit_out, float rim_threshold, __global float* rim_out,
+    __global const uchar* skippable_blocks, int4 block_counts, int block_size,
+    __global float* fragment_out, __global const float* front_in) {
     const int gx = get_global_id(0);
     const int gy = get_global_id(1);
     if (gx * PACKET_W >= size.x || gy * PACKET_H >= size.y) return;
@@ -573,8 +582,8 @@ __kernel void render_proxies_packets(
     // render_proxies). The whole ray is one segment composited from T = 1, the ray itself, so
     // its depth is the first hit; opacity segments are composited on their own beside the ray,
     // whose opacity says where each starts, as in render_proxies.
-    const bool want_segments =
-        (wanted & (WANT_SEGMENT_RGBA | WANT_SEGMENT_DEPTH | WANT_FIRST_HIT_DEPTH)) != 0;
+    const bool want_segments = (wanted & (WANT_SEGMENT_RGBA | WANT_SEGMENT_DEPTH |
+                                          WANT_FIRST_HIT_DEPTH | WANT_RIM_DEPTH)) != 0;
     const bool opacity_segments = want_segments && segment_rule == SEGMENTS_OPACITY;
 
     const MarchPacket rays = march_packet(gx, gy, size, cam_position, cam_forward, cam_right,
@@ -608,6 +617,7 @@ __kernel void render_proxies_packets(
     intp compositing = want_segments ? (intp)(-1) : (intp)(0);
     floatp red = 0.0f, green = 0.0f, blue = 0.0f, ray_transmittance = 1.0f;
     floatp first_hit = INFINITY;
+    floatp rim_hit = INFINITY;  // the first hit at rim_threshold, as render_proxies takes it
     // Opacity segments: each lane's segment and its own colour, T and depth.
     intp segment = 0;
     intp compositing_segment = opacity_segments ? (intp)(-1) : (intp)(0);
@@ -703,10 +713,15 @@ __kernel void render_proxies_packets(
                                      interval_edges, gx, gy, size, &interval_outputs, &held);
                 accumulating &= ~(contributes & (1.0f - transmittance >= stop_opacity));
             }
-            // The whole ray, then the opacity segment (none unless asked for).
-            composite_lanes(usable & compositing & (alpha > 0.0f), alpha, sample_red, sample_green,
-                            sample_blue, depth, depth_threshold, stop_opacity, &ray_transmittance,
-                            &red, &green, &blue, &first_hit, &compositing);
+            // The whole ray (and its rim, from the same T), then the opacity segment (none unless
+            // asked for).
+            const intp ray_composites = usable & compositing & (alpha > 0.0f);
+            composite_lanes(ray_composites, alpha, sample_red, sample_green, sample_blue, depth,
+                            depth_threshold, stop_opacity, &ray_transmittance, &red, &green, &blue,
+                            &first_hit, &compositing);
+            rim_hit = select(
+                rim_hit, depth,
+                ray_composites & isinf(rim_hit) & (1.0f - ray_transmittance >= rim_threshold));
             composite_lanes(usable & compositing_segment & (alpha > 0.0f), alpha, sample_red,
                             sample_green, sample_blue, depth, depth_threshold, stop_opacity,
                             &segment_transmittance, &segment_red, &segment_green, &segment_blue,
@@ -761,6 +776,7 @@ __kernel void render_proxies_packets(
                 segment_depth_out[pixel] = LANE(first_hit, lane);
         }
         if ((wanted & WANT_FIRST_HIT_DEPTH) != 0) first_hit_out[pixel] = LANE(first_hit, lane);
+        if ((wanted & WANT_RIM_DEPTH) != 0) rim_out[pixel] = LANE(rim_hit, lane);
         if (want_interleaving) {
             vstore2((float2)(LANE(held.reentries, lane), LANE(held.reentered, lane)), pixel,
                     interleaving_out);

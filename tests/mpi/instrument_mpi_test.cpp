@@ -220,6 +220,17 @@ void expect_same_archive_as_one_process(const std::string& name, Index3 parts,
                     << "step " << step << " view " << view;
             }
             expect_same_compressed_field(single, ranks, step);
+            // The rims (on by default) that the comparison above held equal are there: rays
+            // that reach the rim threshold and not the first hit's.
+            if (!light_field.is_null()) {
+                std::size_t rims = 0;
+                for (const LightFieldImages& images : single.load_light_field(step, "f").cameras) {
+                    rims += static_cast<std::size_t>(std::count_if(
+                        images.rim_depth.pixels.begin(), images.rim_depth.pixels.end(),
+                        [](float depth) { return std::isfinite(depth); }));
+                }
+                EXPECT_GT(rims, 0u) << "step " << step;
+            }
         }
         EXPECT_TRUE(ranks.verify().empty());
     }

@@ -37,6 +37,9 @@ constexpr int kWantEntryDepth = 1024;
 /// A block's light-field pass reads, per pixel, the march's state where the ray enters the
 /// block (kFrontChannels floats, insitu/parallel/light_field_compositing.hpp).
 constexpr int kWantFront = 2048;
+/// Per pixel, the depth where the whole ray's opacity first reaches a second, lower threshold
+/// than the first hit's (ProxyRequest::rim_depth: the light field's rims), in the same pass.
+constexpr int kWantRimDepth = 4096;
 /// Transmittance in front, the entry segment's transmittance in front, the isovalues crossed in
 /// front (bits), the value of the sample just in front (NaN when none adjoins).
 constexpr int kFrontChannels = 4;
@@ -84,7 +87,7 @@ struct KernelConstant {
 
 /// Every constant passed to the kernels. Private arrays are sized by the MAX_* limits, so they
 /// bound each work-item's private memory.
-inline constexpr std::array<KernelConstant, 21> kKernelConstants{{
+inline constexpr std::array<KernelConstant, 22> kKernelConstants{{
     {"MAX_LAYERS", kMaxLayers},        // depth layers per pass (layer_t[] in the proxy kernel)
     {"MAX_INTERVALS", kMaxIntervals},  // intensity intervals (a[] in colour model, edits)
     {"MAX_LIGHTS", kMaxLights},        // lights per relighting call (half_vectors[])
@@ -100,6 +103,7 @@ inline constexpr std::array<KernelConstant, 21> kKernelConstants{{
     {"WANT_INTERLEAVING", kWantInterleaving},
     {"WANT_ENTRY_DEPTH", kWantEntryDepth},
     {"WANT_FRONT", kWantFront},
+    {"WANT_RIM_DEPTH", kWantRimDepth},
     {"FRAGMENT_CHANNELS", kFragmentChannels},
     {"INTERLEAVING_HEAD", kInterleavingHead},
     {"SEGMENTS_WHOLE_RAY", kSegmentsWholeRay},
@@ -115,8 +119,9 @@ static_assert(kMaxLights >= 1 && kMaxLights <= 64, "half_vectors[] is a private 
 // The wanted bits must be distinct powers of two.
 static_assert((kWantDepth | kWantDistortion | kWantAttenuation | kWantMeanDepth |
                kWantOpticalDepth | kWantSegmentRgba | kWantSegmentDepth | kWantFirstHitDepth |
-               kWantFragment | kWantInterleaving | kWantEntryDepth | kWantFront) == 4095,
-              "wanted bits are the twelve distinct low bits");
+               kWantFragment | kWantInterleaving | kWantEntryDepth | kWantFront | kWantRimDepth) ==
+                  8191,
+              "wanted bits are the thirteen distinct low bits");
 static_assert(kSegmentsWholeRay != kSegmentsLayers && kSegmentsLayers != kSegmentsOpacity &&
                   kSegmentsWholeRay != kSegmentsOpacity,
               "the kernel tells the segment rules apart by these values");

@@ -127,8 +127,10 @@ int entry_segment(const ProxyRequest& request, int segments, const float* front)
     return segment;
 }
 
-// 2. Segment colours "over" in ray order and the front-most first hit, at the root; each block
-// learns its entry segment's transmittance in front (fronts' channel 1).
+// 2. Segment colours "over" in ray order and the front-most first hit and rim hit (each block's
+// taken at the ray's opacity, its march starting from the transmittance in front), at the root;
+// each block learns its entry segment's transmittance in front (fronts' channel 1). Records:
+// ray order, entry segment, first hit, rim hit, the segments' RGBA.
 void composite_segments(Exchanges& exchanges, const ProxyFrame* partial,
                         const ProxyRequest& request, int segments, Image& fronts,
                         ProxyFrame& frame) {
@@ -137,10 +139,13 @@ void composite_segments(Exchanges& exchanges, const ProxyFrame* partial,
         if (!starts_record(partial, pixel, record)) return false;
         record[1] =
             static_cast<float>(entry_segment(request, S, &fronts.pixels[pixel * kFrontChannels]));
-        record[2] =
-            partial->first_hit_depth.pixels.empty() ? kInf : partial->first_hit_depth.pixels[pixel];
+        const auto hit = [pixel](const Image& depth) {
+            return depth.pixels.empty() ? kInf : depth.pixels[pixel];
+        };
+        record[2] = hit(partial->first_hit_depth);
+        record[3] = hit(partial->rim_depth);
         for (int s = 0; s < S; ++s) {
-            std::copy_n(&partial->segment_rgba[s].pixels[pixel * 4], 4, record + 3 + 4 * s);
+            std::copy_n(&partial->segment_rgba[s].pixels[pixel * 4], 4, record + 4 + 4 * s);
         }
         return true;
     };
@@ -151,9 +156,10 @@ void composite_segments(Exchanges& exchanges, const ProxyFrame* partial,
             const float* block = records[r];
             replies[r][0] = static_cast<float>(transmittance[static_cast<int>(block[1])]);
             if (std::isinf(out[0])) out[0] = block[2];
+            if (std::isinf(out[1])) out[1] = block[3];
             for (int s = 0; s < S; ++s) {
-                const float* rgba = block + 3 + 4 * s;
-                float* into = out + 1 + 4 * s;
+                const float* rgba = block + 4 + 4 * s;
+                float* into = out + 2 + 4 * s;
                 for (int c = 0; c < 3; ++c) {
                     into[c] = static_cast<float>(into[c] + transmittance[s] * rgba[c]);
                 }
@@ -162,19 +168,20 @@ void composite_segments(Exchanges& exchanges, const ProxyFrame* partial,
             }
         }
     };
-    std::vector<float> identity(static_cast<std::size_t>(1 + 4 * S), 0.0f);
-    identity[0] = kInf;
+    std::vector<float> identity(static_cast<std::size_t>(2 + 4 * S), 0.0f);
+    identity[0] = identity[1] = kInf;
     const auto unpack = [&](std::int64_t begin, std::int64_t end, const float* values) {
         for (std::int64_t pixel = begin; pixel < end; ++pixel) {
-            const float* in = values + (pixel - begin) * (1 + 4 * S);
+            const float* in = values + (pixel - begin) * (2 + 4 * S);
             if (!frame.first_hit_depth.pixels.empty()) frame.first_hit_depth.pixels[pixel] = in[0];
+            if (!frame.rim_depth.pixels.empty()) frame.rim_depth.pixels[pixel] = in[1];
             for (int s = 0; s < S && !frame.segment_rgba.empty(); ++s) {
-                std::copy_n(in + 1 + 4 * s, 4, &frame.segment_rgba[s].pixels[pixel * 4]);
+                std::copy_n(in + 2 + 4 * s, 4, &frame.segment_rgba[s].pixels[pixel * 4]);
             }
         }
     };
     const std::vector<float> entry_fronts =
-        exchanges.scan({2 + 1 + 4 * S, 1, 1 + 4 * S}, pack, fold, identity, {1.0f}, unpack);
+        exchanges.scan({2 + 2 + 4 * S, 1, 2 + 4 * S}, pack, fold, identity, {1.0f}, unpack);
     for (std::size_t p = 0; p < entry_fronts.size(); ++p) {
         fronts.pixels[p * kFrontChannels + 1] = entry_fronts[p];
     }
@@ -207,7 +214,8 @@ void composite_segment_depths(Exchanges& exchanges, const ProxyFrame* partial, i
     exchanges.scan({1 + S, 0, S}, pack, fold, std::vector<float>(S, kInf), {}, unpack);
 }
 
-// The frame the root fills: the segment images, the first hit; attenuation comes composited.
+// The frame the root fills: the segment images, the first hit and the rim; attenuation comes
+// composited.
 ProxyFrame segment_frame(const Camera& camera, const ProxyRequest& request, int segments,
                          bool root) {
     ProxyFrame frame;
@@ -220,6 +228,7 @@ ProxyFrame segment_frame(const Camera& camera, const ProxyRequest& request, int 
     if (request.segment_rgba) frame.segment_rgba.assign(segments, image(4));
     if (request.segment_depth) frame.segment_depth.assign(segments, image(1));
     if (request.first_hit_depth) frame.first_hit_depth = image(1);
+    if (request.rim_depth) frame.rim_depth = image(1);
     return frame;
 }
 
@@ -230,8 +239,7 @@ ProxyFrame composite_light_field_pass(Communicator& communicator, const Camera& 
                                       double* exchange_seconds) {
     validate(asked);
     // A block cannot stop early (it does not know the opacity in front of it), so it marches to
-    // its end: a request that stops once its first hit is found (the light field's rim pass)
-    // gets the same first hit.
+    // its end: a request that stops once its first hit is found gets the same first hit.
     ProxyRequest request = asked;
     request.march.early_termination_opacity = 1.0;
     const int segments = segment_count(request);
@@ -244,6 +252,7 @@ ProxyFrame composite_light_field_pass(Communicator& communicator, const Camera& 
     ProxyRequest first = request;
     first.segment_depth = false;
     first.first_hit_depth = false;
+    first.rim_depth = false;
     first.segment_rgba = true;  // the ray's transmittance is marched for the segments
     first.depth_layers = request.segments == SegmentRule::layers && !request.isovalues.empty();
     first.front = Image(camera.width(), camera.height(), kFrontChannels);
@@ -286,7 +295,7 @@ ProxyFrame composite_light_field_pass(Communicator& communicator, const Camera& 
     // 3. With the entry segment's transmittance in front too: the segment depths.
     if (request.segment_depth) {
         ProxyRequest third = second;
-        third.segment_rgba = third.first_hit_depth = false;
+        third.segment_rgba = third.first_hit_depth = third.rim_depth = false;
         third.segment_depth = true;
         third.front = std::move(fronts);
         partial = exchanges.march(march, third);

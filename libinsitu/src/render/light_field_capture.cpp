@@ -14,8 +14,11 @@ namespace insitu {
 namespace {
 
 // The proxy pass that records one camera of the light field: segments, their first hits and
-// the whole ray's, and the attenuation light field when asked for; nothing else (no depth
-// layers: the layers rule only reads their crossings; no training renderings).
+// the whole ray's, the rim's depth (the whole ray's first hit at the rim threshold, from the same
+// samples: a separate pass stopped at the rim threshold marched the empty and faint rays whole,
+// bench/RESULTS.md "Rims in the light field's own pass"), and the attenuation light field when
+// asked for; nothing else (no depth layers: the layers rule only reads their crossings; no
+// training renderings).
 ProxyRequest proxy_request(const LightFieldRequest& request, int segment_count) {
     const LightFieldSettings& settings = request.settings;
     ProxyRequest proxies;
@@ -29,29 +32,14 @@ ProxyRequest proxy_request(const LightFieldRequest& request, int segment_count) 
     proxies.segments = settings.segments;
     proxies.segment_thresholds = settings.opacity_thresholds;
     proxies.first_hit_threshold = settings.depth_threshold;
+    proxies.rim_depth = settings.rim_threshold > 0.0;
+    if (proxies.rim_depth) proxies.rim_threshold = settings.rim_threshold;
     if (settings.segments == SegmentRule::layers) proxies.isovalues = request.isovalues;
     if (settings.attenuation) proxies.intervals = request.intervals;
     proxies.transfer_function = request.transfer_function;
     proxies.skip_empty_space = request.skip_empty_space;
     proxies.march = request.march;
     return proxies;
-}
-
-// The pass that records the rim's depth: the first hit at the rim threshold, nothing else, the
-// march stopped once it is found (a distributed run's blocks march to their end: the same hit).
-// A pass of its own keeps the proxy kernels' marching as it is (bench/RESULTS.md, "Light-field
-// rims").
-ProxyRequest rim_request(const ProxyRequest& proxies, double rim_threshold) {
-    ProxyRequest rim = proxies;
-    rim.attenuation = rim.mean_depth = false;
-    rim.segment_rgba = rim.segment_depth = false;
-    rim.segments = SegmentRule::whole_ray;
-    rim.segment_thresholds.clear();
-    rim.isovalues.clear();
-    rim.intervals.reset();
-    rim.first_hit_threshold = rim_threshold;
-    rim.march.early_termination_opacity = rim_threshold;
-    return rim;
 }
 
 // The rim's depth only where no first hit is recorded: elsewhere the first hit says where the
@@ -134,7 +122,6 @@ LightField capture_light_field(const CameraPass& pass, const LightFieldRig& rig,
     const ProxyRequest proxies = proxy_request(request, segments);
     validate(proxies);  // names a bad isovalue or interval set before the first camera
     INSITU_CHECK_EQ(segment_count(proxies), segments);
-    const ProxyRequest rim = rim_request(proxies, settings.rim_threshold);
 
     std::vector<int> cameras = request.cameras;
     if (cameras.empty()) {
@@ -159,8 +146,8 @@ LightField capture_light_field(const CameraPass& pass, const LightFieldRig& rig,
         }
         images.depth = std::move(frame.first_hit_depth);
         to_secant_fractions(rig, images.depth);
-        if (settings.rim_threshold > 0.0) {
-            images.rim_depth = std::move(pass(rig.camera(k), rim).first_hit_depth);
+        if (proxies.rim_depth) {
+            images.rim_depth = std::move(frame.rim_depth);
             to_secant_fractions(rig, images.rim_depth);
             keep_rim_without_hit(images.depth, images.rim_depth);
         }

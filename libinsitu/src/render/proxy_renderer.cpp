@@ -29,7 +29,8 @@ bool accumulates(const ProxyRequest& request) {
 }
 
 bool wants_segments(const ProxyRequest& request) {
-    return request.segment_rgba || request.segment_depth || request.first_hit_depth;
+    return request.segment_rgba || request.segment_depth || request.first_hit_depth ||
+           request.rim_depth;
 }
 
 // Planar device output -> one image of `channels` interleaved channels per plane.
@@ -114,6 +115,7 @@ PassPlan plan_pass(const ProxyRequest& request, bool multi_perspective, bool par
     if (request.segment_rgba) wanted |= detail::kWantSegmentRgba;
     if (request.segment_depth) wanted |= detail::kWantSegmentDepth;
     if (request.first_hit_depth) wanted |= detail::kWantFirstHitDepth;
+    if (request.rim_depth) wanted |= detail::kWantRimDepth;
     if (request.interleaving) wanted |= detail::kWantInterleaving;
     if (request.entry_depth) wanted |= detail::kWantEntryDepth;
     if (!request.front.pixels.empty()) wanted |= detail::kWantFront;
@@ -128,7 +130,7 @@ PassPlan plan_pass(const ProxyRequest& request, bool multi_perspective, bool par
 /// The pass's output buffers; null for outputs the pass does not make.
 struct PassOutputs {
     cl::Buffer depth, distortion, attenuation, mean_depth, optical_depth, interleaving, entry_depth,
-        segment_rgba, segment_depth, first_hit, fragment;
+        segment_rgba, segment_depth, first_hit, rim, fragment;
 };
 
 /// The pass's inputs on the device (null buffers for those it does not read).
@@ -158,6 +160,10 @@ void validate(const ProxyRequest& request) {
         }
         if (!(request.first_hit_threshold > 0.0 && request.first_hit_threshold < 1.0)) {
             fail<InvalidArgument>("first-hit threshold = ", request.first_hit_threshold,
+                                  " (an opacity, must be in (0, 1))");
+        }
+        if (request.rim_depth && !(request.rim_threshold > 0.0 && request.rim_threshold < 1.0)) {
+            fail<InvalidArgument>("rim threshold = ", request.rim_threshold,
                                   " (an opacity, must be in (0, 1))");
         }
         if (request.segments == SegmentRule::layers) validate_isovalues(request.isovalues);
@@ -199,7 +205,7 @@ struct ProxyRenderer::DeviceState {
     cl::Kernel kernel, packet_kernel;  // one ray per work-item; ray packets
     detail::DeviceMemory table, isovalues, edges, thresholds, depth_out, distortion_out,
         attenuation_out, mean_depth_out, optical_depth_out, interleaving_out, entry_depth_out,
-        segment_rgba_out, segment_depth_out, first_hit_out, fragment_out, front;
+        segment_rgba_out, segment_depth_out, first_hit_out, rim_out, fragment_out, front;
     std::optional<detail::EmptySpace> empty_space;
 
     PassOutputs outputs(detail::OpenClDevice& opencl, const ProxyRequest& request,
@@ -310,6 +316,7 @@ PassOutputs ProxyRenderer::DeviceState::outputs(detail::OpenClDevice& opencl,
     out.segment_depth =
         output_buffer(opencl, segment_depth_out, request.segment_depth, pixels, plan.segments);
     out.first_hit = output_buffer(opencl, first_hit_out, request.first_hit_depth, pixels, 1);
+    out.rim = output_buffer(opencl, rim_out, request.rim_depth, pixels, 1);
     out.fragment =
         output_buffer(opencl, fragment_out, plan.partial, pixels, detail::kFragmentChannels);
     return out;
@@ -403,6 +410,11 @@ void download_outputs(detail::OpenClDevice& opencl, const ProxyRequest& request,
         opencl.download(outputs.first_hit, frame.first_hit_depth.pixels.data(),
                         pixels * sizeof(float), "first-hit depth");
     }
+    if (request.rim_depth) {
+        frame.rim_depth = Image(width, height, 1);
+        opencl.download(outputs.rim, frame.rim_depth.pixels.data(), pixels * sizeof(float),
+                        "rim depth");
+    }
     if (plan.partial) {
         frame.fragment = Image(width, height, detail::kFragmentChannels);
         opencl.download(outputs.fragment, frame.fragment.pixels.data(),
@@ -471,8 +483,9 @@ ProxyFrame ProxyRenderer::march(const Camera& camera, double tilt_deg, bool mult
         outputs.optical_depth, outputs.interleaving, outputs.entry_depth,
         static_cast<cl_int>(request.segments), static_cast<cl_int>(plan.segments),
         inputs.thresholds, static_cast<cl_float>(request.first_hit_threshold), outputs.segment_rgba,
-        outputs.segment_depth, outputs.first_hit, skipped.skippable, skipped.block_counts,
-        skipped.block_voxels, outputs.fragment, inputs.front);
+        outputs.segment_depth, outputs.first_hit, static_cast<cl_float>(request.rim_threshold),
+        outputs.rim, skipped.skippable, skipped.block_counts, skipped.block_voxels,
+        outputs.fragment, inputs.front);
 
     download_outputs(opencl, request, plan, outputs, frame);
     return frame;
@@ -495,7 +508,9 @@ std::ostream& operator<<(std::ostream& out, const ProxyRequest& request) {
         if (request.segment_rgba) out << " RGBA";
         if (request.segment_depth) out << " depth";
         if (request.first_hit_depth) out << " first hit";
-        out << " at " << request.first_hit_threshold << "), ";
+        out << " at " << request.first_hit_threshold;
+        if (request.rim_depth) out << ", rim at " << request.rim_threshold;
+        out << "), ";
     }
     if (request.intervals) out << *request.intervals << ", ";
     out << request.training_transfer_functions.size() << " training TFs, skip empty space "
@@ -529,6 +544,7 @@ std::ostream& operator<<(std::ostream& out, const ProxyFrame& frame) {
     images("segment RGBA", frame.segment_rgba);
     images("segment depth", frame.segment_depth);
     image("first-hit depth", frame.first_hit_depth);
+    image("rim depth", frame.rim_depth);
     images("training images", frame.training);
     if (frame.colour_model) out << ", " << *frame.colour_model;
     return out << "}";

@@ -11,8 +11,9 @@
 //     with the state in front of its block: the transmittance, the isovalues crossed, the value
 //     of the sample just in front where one adjoins (ProxyRequest::front);
 //  2. segments: each block marches again from that state, so its samples fall in the segments
-//     one pass gives and its first hit is taken at the ray's opacity; segment colours (each from
-//     T = 1 within the block) composite "over" in ray order, the front-most first hit wins, and
+//     one pass gives and its first hit (and rim hit) is taken at the ray's opacity; segment
+//     colours (each from T = 1 within the block) composite "over" in ray order, the front-most
+//     first hit (and rim hit) wins, and
 //     each record is answered with its entry segment's transmittance in front;
 //  3. segment depths (more than one segment): marched with that transmittance too, the
 //     front-most depth of each segment wins.
@@ -30,12 +31,12 @@ namespace insitu {
 /// This rank's pass over its block: ProxyRenderer::render of the camera with `request`.
 using BlockPass = std::function<ProxyFrame(const ProxyRequest&)>;
 
-/// The light-field pass of `request` (segments, segment depth, first hit, attenuation and mean
-/// depth: what capture_light_field asks) from `camera`, composited at `root`: the frame one pass
-/// over the whole grid gives there, its shell (images sized, not filled) elsewhere. `march` marches
-/// this rank's block; null for a rank that owns nothing. Collective: a rank whose march fails
-/// still takes part in every exchange and throws once they are done. The time spent exchanging
-/// adds to `exchange_seconds` when given.
+/// The light-field pass of `request` (segments, segment depth, first hit, rim, attenuation and
+/// mean depth: what capture_light_field asks) from `camera`, composited at `root`: the frame one
+/// pass over the whole grid gives there, its shell (images sized, not filled) elsewhere. `march`
+/// marches this rank's block; null for a rank that owns nothing. Collective: a rank whose march
+/// fails still takes part in every exchange and throws once they are done. The time spent
+/// exchanging adds to `exchange_seconds` when given.
 ProxyFrame composite_light_field_pass(Communicator& communicator, const Camera& camera,
                                       const ProxyRequest& request, const BlockPass& march, int root,
                                       double* exchange_seconds = nullptr);

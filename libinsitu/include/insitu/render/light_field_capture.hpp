@@ -16,6 +16,8 @@
 //  * segment depth: Camera depth of the first sample at which the segment's own accumulated
 //    opacity reaches depth_threshold, as a secant fraction (Eq. 3); +inf where it never does.
 //  * depth: the same for the whole ray (the ray's first hit); +inf where none.
+//  * rim depth (settings.rim_threshold > 0): where the depth is +inf, the same at the rim
+//    threshold, from the same pass (the same samples and transmittance as the first hit).
 //  * attenuation light field (settings.attenuation): a_j and mean depth per interval, exactly
 //    the single-perspective proxies of proxy_renderer.hpp for that camera (mean depth in world
 //    units along the camera's forward, +inf where a_j = 0).

@@ -15,7 +15,8 @@
 //    ray split by a SegmentRule, each segment's premultiplied RGBA (unshaded transfer-function
 //    colour) composited front to back from T = 1 on its own, and the depth (world units from the
 //    camera plane) of the first sample at which the segment's own opacity reaches
-//    first_hit_threshold; first-hit depth: the same for the whole ray. +inf where none.
+//    first_hit_threshold; first-hit depth: the same for the whole ray; rim depth: the same at
+//    rim_threshold (the light field's rims). +inf where none.
 // Attenuation stops, like the ground truth, once 1 - T reaches the early-termination opacity;
 // the proxies' default (1.0) stops only where T is exactly 0, so nothing is lost. A segment
 // stops once its own 1 - T reaches it, the first hit once the ray's does. Depth layers keep
@@ -59,6 +60,10 @@ struct ProxyRequest {
     bool segment_rgba = false;
     bool segment_depth = false;
     bool first_hit_depth = false;
+    /// The whole ray's first hit at `rim_threshold` too (ProxyFrame::rim_depth): the light
+    /// field's rims, from the samples and transmittance the first hit reads, so the capture
+    /// needs no pass of its own for them. Needs the transfer function.
+    bool rim_depth = false;
     /// Where the segments split each ray: at the first crossing of each of `isovalues`
     /// (SegmentRule::layers, whether or not depth layers are requested) or where the ray's
     /// accumulated opacity reaches each of `segment_thresholds` (SegmentRule::opacity).
@@ -67,6 +72,8 @@ struct ProxyRequest {
     std::vector<double> segment_thresholds;
     /// Opacity, in (0, 1), that the segment and first-hit depths are taken at.
     double first_hit_threshold = 0.1;
+    /// Opacity, in (0, 1), that the rim depth is taken at.
+    double rim_threshold = 0.05;
     /// Isovalues of the depth layers (at most kMaxLayers), in field units.
     std::vector<double> isovalues;
     /// Intervals of the attenuation proxies; required when attenuation is requested.
@@ -124,7 +131,10 @@ struct ProxyFrame {
     std::vector<Image> segment_rgba;   ///< RGBA each, one per segment, front first
     std::vector<Image> segment_depth;  ///< 1 channel each, one per segment
     Image first_hit_depth;             ///< 1 channel
-    std::vector<Image> training;       ///< RGBA each
+    /// 1 channel: the depth where the whole ray's opacity first reaches rim_threshold; +inf where
+    /// it never does (or compositing stopped before: early termination below the threshold).
+    Image rim_depth;
+    std::vector<Image> training;  ///< RGBA each
     /// RGBA, premultiplied: the ground truth of the run's own transfer function in this camera
     /// (the preview, before its 8-bit PNG), single perspective only ("rendering" proxy).
     Image rendering;
