@@ -104,6 +104,9 @@ LightFieldSettings settings(int depth_bits, bool attenuation,
     result.attenuation = attenuation;
     result.depth_bits = depth_bits;
     result.rim_threshold = 0.0;  // hand-made light fields have rims only where a test adds them
+    // The round trips here are the lossless store's; lossy colour (the default) has its own
+    // tests (light_field_lossy_colour_test.cpp).
+    result.colour_dwa_level = 0.0;
     return result;
 }
 
@@ -251,6 +254,24 @@ protected:
         ArchiveWriter(config_).write(step_with(10, field));
         return ArchiveReader(archive().string()).load_light_field(10, "v", cameras);
     }
+    // Step 10's light field with `key` (as written, value and comma) blanked out of its header,
+    // as a writer from before the key's default wrote it; the manifest's CRC of the part
+    // follows, as that writer recorded it.
+    void write_without_header_key(const LightField& field, const std::string& key) {
+        ArchiveWriter(config_).write(step_with(10, field));
+        std::string bytes = read_text(light_field_file(10));
+        const std::size_t at = bytes.find(key);
+        ASSERT_NE(at, std::string::npos) << "the header should hold " << key;
+        const std::uint32_t crc = file_crc(light_field_file(10));
+        bytes.replace(at, key.size(), std::string(key.size(), ' '));
+        write_text(light_field_file(10), bytes);
+        std::string manifest = read_text(archive() / "manifest.json");
+        const std::size_t recorded = manifest.find(std::to_string(crc));
+        ASSERT_NE(recorded, std::string::npos);
+        manifest.replace(recorded, std::to_string(crc).size(),
+                         std::to_string(file_crc(light_field_file(10))));
+        write_text(archive() / "manifest.json", manifest);
+    }
 
     std::filesystem::path directory_;
     InstrumentConfig config_;
@@ -320,24 +341,21 @@ TEST_F(LightFieldArchive, RimDepthRoundTripsAsTheFirstHitsDepth) {
 TEST_F(LightFieldArchive, HeaderWithoutRimKeyReadsAsWithoutRims) {
     LightFieldSettings none = settings(8, false);
     none.rim_threshold = 0.0;
-    ArchiveWriter(config_).write(step_with(10, hand_made(none)));
-    std::string bytes = read_text(light_field_file(10));
-    const std::string key = "\"rim_threshold\":0.0,";
-    const std::size_t at = bytes.find(key);
-    ASSERT_NE(at, std::string::npos) << "the header should hold " << key;
-    const std::uint32_t crc = file_crc(light_field_file(10));
-    bytes.replace(at, key.size(), std::string(key.size(), ' '));
-    write_text(light_field_file(10), bytes);
-    // The manifest's CRC of the part follows, as the writer of such an archive recorded it.
-    std::string manifest = read_text(archive() / "manifest.json");
-    const std::size_t recorded = manifest.find(std::to_string(crc));
-    ASSERT_NE(recorded, std::string::npos);
-    manifest.replace(recorded, std::to_string(crc).size(),
-                     std::to_string(file_crc(light_field_file(10))));
-    write_text(archive() / "manifest.json", manifest);
+    write_without_header_key(hand_made(none), "\"rim_threshold\":0.0,");
     const LightField read = ArchiveReader(archive().string()).load_light_field(10, "v");
     EXPECT_EQ(read.settings.rim_threshold, 0.0);
     EXPECT_TRUE(read.cameras[0].rim_depth.pixels.empty());
+}
+
+// Lossy colour became the default (kDefaultColourDwaLevel) after light fields were stored
+// losslessly without the key: such a header reads as lossless, not as the default.
+TEST_F(LightFieldArchive, HeaderWithoutColourLevelReadsAsLossless) {
+    const LightField field = hand_made(settings(8, false));
+    ASSERT_EQ(field.settings.colour_dwa_level, 0.0);
+    write_without_header_key(field, "\"colour_dwa_level\":0.0,");
+    const LightField read = ArchiveReader(archive().string()).load_light_field(10, "v");
+    EXPECT_EQ(read.settings.colour_dwa_level, 0.0);
+    expect_light_fields_match(field, read, Stored::exact, Stored::eight_bit);
 }
 
 TEST_F(LightFieldArchive, LoadsOnlyTheCamerasAskedFor) {

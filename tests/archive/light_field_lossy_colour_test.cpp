@@ -129,13 +129,19 @@ TEST(LightFieldLossyColour, PartsSayDwabAndAHigherLevelStoresFewerBytes) {
     EXPECT_EQ(Imf::MultiPartInputFile(plain).header(0).compression(), Imf::ZIP_COMPRESSION);
 }
 
-TEST(LightFieldLossyColour, SettingWritesItsKeyOnlyWhenSetAndNamesABadValue) {
+TEST(LightFieldLossyColour, SettingIsAlwaysWrittenDefaultsTo45AndNamesABadValue) {
     std::vector<std::string> unknown;
     LightFieldSettings settings;
-    EXPECT_FALSE(settings.to_json().contains("colour_dwa_level"));
-    settings.colour_dwa_level = 45.0;
+    EXPECT_EQ(settings.colour_dwa_level, 45.0);
     EXPECT_EQ(settings.to_json().at("colour_dwa_level"), 45.0);
-    EXPECT_EQ(LightFieldSettings::from_json(settings.to_json(), &unknown).colour_dwa_level, 45.0);
+    // Lossless is written too: a configuration without the key takes the default.
+    settings.colour_dwa_level = 0.0;
+    EXPECT_EQ(settings.to_json().at("colour_dwa_level"), 0.0);
+    EXPECT_EQ(LightFieldSettings::from_json(settings.to_json(), &unknown).colour_dwa_level, 0.0);
+    EXPECT_EQ(LightFieldSettings::from_json(nlohmann::json::object(), &unknown).colour_dwa_level,
+              45.0);
+    settings.colour_dwa_level = 100.0;
+    EXPECT_EQ(LightFieldSettings::from_json(settings.to_json(), &unknown).colour_dwa_level, 100.0);
     EXPECT_TRUE(unknown.empty());
     for (const char* bad : {R"({"colour_dwa_level": -1})", R"({"colour_dwa_level": 501})"}) {
         expect_error_naming<InvalidArgument>(

@@ -69,7 +69,8 @@ LightField disks(int size, int subsampling) {
     field.settings.size = size;
     field.settings.attenuation = true;
     field.settings.attenuation_subsampling = subsampling;
-    field.settings.rim_threshold = 0.0;  // no rim images
+    field.settings.rim_threshold = 0.0;     // no rim images
+    field.settings.colour_dwa_level = 0.0;  // colour and depth compared exactly
     field.rig = LightFieldRig::around(kBounds, kCameras, size);
     field.intervals = IntervalSet::uniform(0.0, 1.0, kIntervals);
     field.transfer_function =

@@ -483,7 +483,8 @@ TEST(LightFieldSettings, JsonRoundTrips) {
     LightFieldSettings defaults;
     const json written = defaults.to_json();
     EXPECT_EQ(written, json::parse(R"({"cameras": 162, "size": 128, "segments": "none",
-        "attenuation": true, "depth_bits": 8, "depth_threshold": 0.3, "rim_threshold": 0.05})"));
+        "attenuation": true, "depth_bits": 8, "depth_threshold": 0.3, "rim_threshold": 0.05,
+        "colour_dwa_level": 45.0})"));
     std::vector<std::string> unknown;
     const LightFieldSettings back = LightFieldSettings::from_json(written, &unknown);
     EXPECT_TRUE(unknown.empty());
@@ -512,6 +513,7 @@ TEST(LightFieldSettings, JsonRoundTrips) {
     EXPECT_EQ(parsed.rim_threshold, kDefaultRimThreshold);
     json with_rims = opacity;
     with_rims["rim_threshold"] = kDefaultRimThreshold;
+    with_rims["colour_dwa_level"] = kDefaultColourDwaLevel;
     EXPECT_EQ(parsed.to_json(), with_rims);
 
     const LightFieldSettings layers =

@@ -166,9 +166,10 @@ json LightFieldSettings::to_json() const {
                    {"depth_threshold", depth_threshold}};
     // Only where it is not 1: full-size maps keep the header that readers before it take.
     if (attenuation_subsampling != 1) object["attenuation_subsampling"] = attenuation_subsampling;
-    // Always: a header without it reads as having no rims (written before they were a default).
+    // Always: a header without one of these was written before it was a default, and reads as
+    // without it (no rims, lossless colour).
     object["rim_threshold"] = rim_threshold;
-    if (colour_dwa_level != 0.0) object["colour_dwa_level"] = colour_dwa_level;
+    object["colour_dwa_level"] = colour_dwa_level;
     return object;
 }
 

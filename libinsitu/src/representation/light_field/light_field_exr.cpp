@@ -289,8 +289,9 @@ void read_light_field_attributes(const Imf::Header& header, LightField& light_fi
             std::vector<std::string> unknown;
             LightFieldSettings settings = LightFieldSettings::from_json(json, &unknown);
             if (!unknown.empty()) fail<ParseError>("unknown key \"", unknown.front(), "\"");
-            // Written before rims were a default (kDefaultRimThreshold): it holds none.
+            // Written before each was a default (light_field.hpp): no rims, lossless colour.
             if (!json.contains("rim_threshold")) settings.rim_threshold = 0.0;
+            if (!json.contains("colour_dwa_level")) settings.colour_dwa_level = 0.0;
             settings.validate();
             return settings;
         });
