@@ -72,6 +72,16 @@ TEST(GradientVolume, HoldsValuesAndClampedCentralDifferencesPerVoxel) {
     expect_shading_volume_of(second, opencl, gradients, renderer.volume());
 }
 
+// A 40x32 orbit view (azimuth 30, elevation 20) of the volume.
+Camera small_orbit(const SampledVolume& volume) {
+    OrbitView view;
+    view.azimuth_deg = 30.0;
+    view.elevation_deg = 20.0;
+    view.width = 40;
+    view.height = 32;
+    return Camera::orbit(view, volume.field().bounds());
+}
+
 // A field whose shading volume would take more than RenderSettings::shading_volume_max_bytes is
 // rendered shaded one ray per work-item (the kernel that reads no shading volume, so none is
 // built): the frame ray_packets off gives, bit for bit. At the cap itself it still takes packets.
@@ -82,12 +92,7 @@ TEST(GradientVolume, ShadedRendersPastTheCapMarchOneRayPerWorkItem) {
     const TransferFunction tf({ControlPoint{0.1, glm::vec4(0.0f)},
                                ControlPoint{0.5, glm::vec4(0.9f, 0.6f, 0.1f, 0.4f)},
                                ControlPoint{0.9, glm::vec4(0.2f, 0.5f, 1.0f, 0.9f)}});
-    OrbitView view;
-    view.azimuth_deg = 30.0;
-    view.elevation_deg = 20.0;
-    view.width = 40;
-    view.height = 32;
-    const Camera camera = Camera::orbit(view, volume.field().bounds());
+    const Camera camera = small_orbit(volume);
     const std::uint64_t bytes = GradientVolume::bytes_for(renderer.volume());
     RenderSettings settings;
     settings.shading = true;
@@ -130,12 +135,7 @@ TEST(GradientVolume, ValuesFromTheShadingVolumeAreThePlainVolumesBitForBit) {
                                            ControlPoint{1.0, glm::vec4(0.9f, 0.2f, 0.1f, 0.9f)}};
     const TransferFunction tf_1d(points);
     const TransferFunction tf_2d({TransferRow{0.0, points}, TransferRow{0.75, points}}, 1.0);
-    OrbitView view;
-    view.azimuth_deg = 30.0;
-    view.elevation_deg = 20.0;
-    view.width = 40;
-    view.height = 32;
-    const Camera camera = Camera::orbit(view, volume.field().bounds());
+    const Camera camera = small_orbit(volume);
     RenderSettings settings;
     settings.step_voxels = 0.6;  // samples between the voxels
     const Rendering plain = renderer.render(camera, tf_1d, settings);
