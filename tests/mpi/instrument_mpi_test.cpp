@@ -161,9 +161,14 @@ void expect_same_archive_as_one_process(const std::string& name, Index3 parts,
         nlohmann::json text =
             nlohmann::json::parse(configuration(archive, layers, interval_mode, transfer_function));
         if (!light_field.is_null()) {
-            // Depths as half floats: 8-bit codes would round apart what half keeps together.
-            text["light_field"] = {
-                {"cameras", 12}, {"size", 24}, {"segments", light_field}, {"depth_bits", 16}};
+            // Depths as half floats: 8-bit codes would round apart what half keeps together;
+            // lossless colour for the same reason (DWAB's quantisation, the default, turns the
+            // compositing's 1e-7 differences into a step of its own, about 0.002).
+            text["light_field"] = {{"cameras", 12},
+                                   {"size", 24},
+                                   {"segments", light_field},
+                                   {"depth_bits", 16},
+                                   {"colour_dwa_level", 0}};
         }
         return text.dump();
     };
@@ -797,7 +802,13 @@ TEST(InstrumentMpi, TheBudgetChoosesTheLightFieldWithARankThatOwnsNothing) {
     expect_same_budget_as_one_process(
         "budget_light_field", {1, 1, blocks},
         {{"psnr_db", 20}, {"check_every", 2}, {"choose", {"intervals", "light_field"}}},
-        {{"cameras", 12}, {"size", 32}, {"segments", "none"}, {"depth_bits", 16}});
+        // Lossless colour: the bytes are compared, and DWAB's (the default) follow the
+        // compositing's 1e-7 differences.
+        {{"cameras", 12},
+         {"size", 32},
+         {"segments", "none"},
+         {"depth_bits", 16},
+         {"colour_dwa_level", 0}});
 }
 
 // A rank whose block is wrong at a step whose check is due (at 1 rank, with nothing to differ
