@@ -12,12 +12,14 @@
 #include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <string>
 #include <vector>
 
 #include "insitu/error.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
+#include "insitu/testing/archive_comparison.hpp"
 #include "representation/light_field/light_field_exr.hpp"
 #include "support/expect_error.hpp"
 #include "support/light_field_images.hpp"
@@ -127,6 +129,63 @@ TEST(LightFieldLossyColour, PartsSayDwabAndAHigherLevelStoresFewerBytes) {
     Imf::StdISStream plain;
     plain.str(lossless.bytes);
     EXPECT_EQ(Imf::MultiPartInputFile(plain).header(0).compression(), Imf::ZIP_COMPRESSION);
+}
+
+// Colour that is hard for an 8x8 DCT: white noise (premultiplied, alpha uniform) in three
+// quarters of every stored camera, hard edges between 0 and full colour in the last.
+LightField hard_colour_light_field(unsigned seed) {
+    LightField field = rendered_light_field();
+    std::mt19937 random(seed);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    for (LightFieldImages& camera : field.cameras) {
+        Image& rgba = camera.segment_rgba[0];
+        for (int y = 0; y < rgba.height; ++y) {
+            for (int x = 0; x < rgba.width; ++x) {
+                const bool noise = 4 * x < 3 * rgba.width;
+                const float alpha = noise ? unit(random) : 1.0f;
+                for (int c = 0; c < 3; ++c) {
+                    const bool lit = ((x / 3 + y / 5 + c) % 2) == 0;
+                    rgba.at(x, y, c) = noise ? alpha * unit(random) : (lit ? 1.0f : 0.0f);
+                }
+                rgba.at(x, y, 3) = alpha;
+            }
+        }
+    }
+    return field;
+}
+
+// What `insitu-view compare` allows two lossily stored archives (ArchiveTolerances::
+// lossy_colour_per_level and its mean) must cover the codec's own error, and not by far more.
+TEST(LightFieldLossyColour, ErrsWithinWhatComparingArchivesAllows) {
+    const ArchiveTolerances tolerances = ArchiveTolerances::for_precision(StoragePrecision::half);
+    for (const unsigned seed : {1u, 2u, 3u}) {
+        const LightField field = hard_colour_light_field(seed);
+        for (const double level : {5.0, 45.0, 100.0, 500.0}) {
+            const Stored lossy = store(field, level);
+            double largest = 0.0, sum = 0.0;
+            std::size_t values = 0;
+            for (int k = 0; k < kStoredCameras; ++k) {
+                const std::vector<float>& exact = field.cameras[k].segment_rgba[0].pixels;
+                const std::vector<float>& read = lossy.read.cameras[k].segment_rgba[0].pixels;
+                ASSERT_EQ(read.size(), exact.size());
+                for (std::size_t i = 0; i < exact.size(); ++i) {
+                    const double error = std::abs(read[i] - exact[i]);
+                    largest = std::max(largest, error);
+                    sum += error;
+                }
+                values += exact.size();
+            }
+            const double allowed = tolerances.lossy_colour_per_level * level;
+            const std::string where =
+                "seed " + std::to_string(seed) + ", level " + std::to_string(level);
+            EXPECT_LE(largest, tolerances.stored_step_absolute + allowed) << where;
+            EXPECT_GT(largest, 0.25 * allowed) << where << ": the allowance is too loose";
+            EXPECT_LE(
+                sum / static_cast<double>(values),
+                tolerances.stored_step_absolute + tolerances.lossy_colour_mean_per_level * level)
+                << where;
+        }
+    }
 }
 
 TEST(LightFieldLossyColour, SettingIsAlwaysWrittenDefaultsTo45AndNamesABadValue) {

@@ -64,6 +64,26 @@ ProxyMeasurement compare_images(const std::string& quantity, const std::vector<I
     return measurement;
 }
 
+/// The mean absolute difference of two lists of images of the same shapes (compare_images
+/// reports shapes that differ), over the values not zero in both: empty space, which every codec
+/// keeps, would otherwise dilute a difference by how little of the image is covered.
+ProxyMeasurement compare_image_means(const std::string& quantity, const std::vector<Image>& one,
+                                     const std::vector<Image>& other, double tolerance) {
+    ProxyMeasurement measurement{quantity, 0.0, tolerance, {}, {}};
+    double sum = 0.0;
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < std::min(one.size(), other.size()); ++i) {
+        if (one[i].pixels.size() != other[i].pixels.size()) continue;
+        for (std::size_t at = 0; at < one[i].pixels.size(); ++at) {
+            if (one[i].pixels[at] == 0.0f && other[i].pixels[at] == 0.0f) continue;
+            sum += difference(one[i].pixels[at], other[i].pixels[at], false);
+            ++count;
+        }
+    }
+    measurement.largest = count == 0 ? 0.0 : sum / static_cast<double>(count);
+    return measurement;
+}
+
 ProxyMeasurement compare_values(const std::string& quantity, const std::vector<double>& one,
                                 const std::vector<double>& other, double tolerance) {
     ProxyMeasurement measurement{quantity, 0.0, tolerance, {}, {}};
@@ -166,8 +186,11 @@ std::vector<ProxyMeasurement> compare_perspective(const ArchiveReader& one,
 
 /// One camera of a light field from both archives: segment colours and the attenuation as
 /// fractions, the depths (secant fractions) and mean depths relative, each with its stored step.
+/// Colour stored lossily (`colour_dwa_level` > 0, the larger of the two archives') may differ by
+/// the codec's error in each archive (ArchiveTolerances::lossy_colour_per_level).
 std::vector<ProxyMeasurement> compare_light_field_camera(const LightFieldImages& a,
                                                          const LightFieldImages& b, int depth_bits,
+                                                         double colour_dwa_level,
                                                          const ArchiveTolerances& tolerances) {
     const double stored =
         std::max(tolerances.stored_step_absolute, tolerances.stored_step_relative);
@@ -181,9 +204,10 @@ std::vector<ProxyMeasurement> compare_light_field_camera(const LightFieldImages&
     // Depths are stored as 8-bit codes of 1/254 or as half floats (light_field.depth_bits).
     const double depth_step =
         depth_bits == 8 ? 1.0 / kLightFieldDepthCodeSteps : std::ldexp(1.0, -11);
-    return {
+    const double colour = tolerances.attenuation + tolerances.stored_step_absolute;
+    std::vector<ProxyMeasurement> measured{
         compare_images("segment_rgba", a.segment_rgba, b.segment_rgba, false,
-                       tolerances.attenuation + tolerances.stored_step_absolute),
+                       colour + 2.0 * tolerances.lossy_colour_per_level * colour_dwa_level),
         compare_images("segment_depth", a.segment_depth, b.segment_depth, true,
                        tolerances.depth + depth_step),
         compare_images("first_hit", {a.depth}, {b.depth}, true, tolerances.depth + depth_step),
@@ -194,6 +218,12 @@ std::vector<ProxyMeasurement> compare_light_field_camera(const LightFieldImages&
         compare_images("mean_depth", {one.mean_depth}, {other.mean_depth}, true,
                        tolerances.depth + stored),
     };
+    if (colour_dwa_level > 0.0) {
+        measured.push_back(compare_image_means(
+            "segment_rgba_mean", a.segment_rgba, b.segment_rgba,
+            colour + 2.0 * tolerances.lossy_colour_mean_per_level * colour_dwa_level));
+    }
+    return measured;
 }
 
 /// Every light field of `step` in both archives, camera by camera.
@@ -223,9 +253,11 @@ std::vector<FrameComparison> compare_light_fields(const ArchiveReader& one,
                 frames.push_back({step, 0, name, {missing}});
                 continue;
             }
-            frames.push_back(
-                {step, 0, name,
-                 compare_light_field_camera(camera, *theirs, a.settings.depth_bits, tolerances)});
+            const double colour_dwa_level =
+                std::max(a.settings.colour_dwa_level, b.settings.colour_dwa_level);
+            frames.push_back({step, 0, name,
+                              compare_light_field_camera(camera, *theirs, a.settings.depth_bits,
+                                                         colour_dwa_level, tolerances)});
         }
     }
     return frames;
@@ -274,7 +306,9 @@ std::string to_string(const ArchiveTolerances& tolerances) {
          << tolerances.stored_step_absolute << " (stored step), depth " << tolerances.depth
          << " relative (mean and optical depth + "
          << std::max(tolerances.stored_step_absolute, tolerances.stored_step_relative)
-         << "), preview " << tolerances.preview << ", values " << tolerances.value;
+         << "), preview " << tolerances.preview << ", values " << tolerances.value
+         << ", light-field colour stored lossily + 2 x " << tolerances.lossy_colour_per_level
+         << " (mean 2 x " << tolerances.lossy_colour_mean_per_level << ") per DWA level";
     return text.str();
 }
 

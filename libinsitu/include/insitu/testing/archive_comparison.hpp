@@ -35,6 +35,15 @@ struct ArchiveTolerances {
     /// for_precision sets them.
     double stored_step_absolute = 0.0;
     double stored_step_relative = 0.0;
+    /// Light-field colour stored lossily (DWAB at level L, "colour_dwa_level"): one archive's
+    /// colour may be off by up to lossy_colour_per_level * L per component, and by
+    /// lossy_colour_mean_per_level * L on average, about 1.6 and 1.5 times the largest and the
+    /// mean errors DWAB makes on noise and hard edges (LightFieldLossyColour.*). Two archives
+    /// coded from nearly equal colours (a distributed run and one process: 1e-7 apart) may
+    /// therefore differ by twice each: segment_rgba's tolerance gains the largest, and its mean
+    /// difference is held to the mean, so a shift of every colour still shows.
+    double lossy_colour_per_level = 1e-3;
+    double lossy_colour_mean_per_level = 4e-5;
 
     /// The defaults above with one step of `precision` (StoragePrecision) added.
     static ArchiveTolerances for_precision(StoragePrecision precision);
@@ -80,7 +89,8 @@ std::ostream& operator<<(std::ostream& out, const ArchiveComparison& comparison)
 
 /// Compares every step and view of the archives at `expected` and `actual` (paths), and every
 /// camera of their light fields (segment colours, segment and first-hit depths, attenuation and
-/// mean depth; a step's light fields listed in one archive only are a mismatch); throws what
+/// mean depth; colour stored lossily also by its mean difference; a step's light fields listed
+/// in one archive only are a mismatch); throws what
 /// ArchiveReader throws for an archive that cannot be read.
 ArchiveComparison compare_archives(const std::string& expected, const std::string& actual,
                                    const ArchiveTolerances& tolerances = {});
