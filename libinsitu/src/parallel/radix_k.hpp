@@ -29,9 +29,9 @@ namespace insitu::detail {
 
 /// The pixels [first, second) each rank holds after the rounds `factors` of radix-k over
 /// `pixels`, by rank.
-inline std::vector<std::pair<std::int64_t, std::int64_t>> radix_k_regions(
-    std::int64_t pixels, const std::vector<int>& factors, int ranks) {
-    std::vector<std::pair<std::int64_t, std::int64_t>> regions;
+inline TileRegions radix_k_regions(std::int64_t pixels, const std::vector<int>& factors,
+                                   int ranks) {
+    TileRegions regions;
     for (int rank = 0; rank < ranks; ++rank) {
         std::int64_t begin = 0;
         std::int64_t end = pixels;
@@ -112,41 +112,9 @@ void radix_k(Communicator& communicator, std::int64_t pixels, int outputs, int r
     }
     std::vector<float> tile;
     if (!local.failure) local([&] { tile = fold(held, begin, end); });
-    tile.resize(static_cast<std::size_t>((end - begin) * outputs));  // what the root expects
     give_back(held);
-    const std::vector<std::pair<std::int64_t, std::int64_t>> regions =
-        radix_k_regions(pixels, factors, ranks);
-    std::vector<std::uint64_t> sizes(static_cast<std::size_t>(ranks), 0);
-    for (int r = 0; r < ranks; ++r) {
-        if (r == root) continue;
-        sizes[r] = static_cast<std::uint64_t>(regions[r].second - regions[r].first) *
-                   static_cast<std::uint64_t>(outputs) * sizeof(float);
-    }
-    Bytes mine = borrow_bytes();
-    if (me != root) {
-        const auto* tile_bytes = reinterpret_cast<const std::uint8_t*>(tile.data());
-        mine.assign(tile_bytes, tile_bytes + tile.size() * sizeof(float));
-    }
-    std::vector<Bytes> tiles = communicator.gather_known_sizes(mine, root, sizes);
-    give_back(std::move(mine));
-    if (me == root) {
-        local([&] {
-            std::vector<float> values = borrow_floats();
-            for (int r = 0; r < ranks; ++r) {
-                const auto [first, last] = regions[r];
-                if (r == root) {
-                    unpack(first, last, tile.data());
-                    continue;
-                }
-                values.resize(static_cast<std::size_t>((last - first) * outputs));
-                if (!values.empty()) std::memcpy(values.data(), tiles[r].data(), tiles[r].size());
-                unpack(first, last, values.data());
-            }
-            give_back(std::move(values));
-        });
-    }
-    give_back(tiles);
-    give_back(std::move(tile));
+    gather_folded_tiles(communicator, std::move(tile), radix_k_regions(pixels, factors, ranks),
+                        outputs, root, local, unpack);
     local.rethrow();
 }
 

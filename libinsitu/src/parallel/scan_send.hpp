@@ -178,25 +178,8 @@ inline std::vector<float> scan_send(Communicator& communicator, std::int64_t pix
             }
         });
     if (shape.outputs > 0) {
-        tile.resize(static_cast<std::size_t>(end - begin) * shape.outputs);
-        const std::vector<Bytes> tiles =
-            communicator.gather_known_sizes(me == root ? Bytes{} : scan::float_bytes(tile), root,
-                                            tile_sizes(pixels, ranks, shape.outputs, root));
-        if (me == root) {
-            local([&] {
-                for (int k = 0; k < ranks; ++k) {
-                    const std::int64_t first = tile_begin(pixels, ranks, k);
-                    const std::int64_t last = tile_begin(pixels, ranks, k + 1);
-                    const std::vector<float> values =
-                        k == root ? tile : scan::bytes_floats(tiles[k], shape.outputs);
-                    if (values.size() != static_cast<std::size_t>(last - first) * shape.outputs) {
-                        fail<Error>("compositing: rank ", k, " sent a tile of ", values.size(),
-                                    " values");
-                    }
-                    unpack(first, last, values.data());
-                }
-            });
-        }
+        gather_folded_tiles(communicator, std::move(tile), equal_tiles(pixels, ranks),
+                            shape.outputs, root, local, unpack);
     }
     local.rethrow();
     return mine;
