@@ -110,10 +110,12 @@ void validate(const AmbientOcclusionSettings& settings) {
 
 namespace {
 
-/// A per-pixel pass of kernel `name` over a depth image and its camera's axes (smooth_depth,
-/// normals_from_depth): an image of `channels` named `what`.
+/// A per-pixel pass of kernel `name` over a depth image (smooth_depth, normals_from_depth, the
+/// occlusions): an image of `channels` named `what`. The kernel takes the depth, `arguments`
+/// and the output, in that order.
+template <typename... Arguments>
 Image depth_pass(const Image& depth, const Camera& camera, const char* name, int channels,
-                 const char* what, ComputeDevice& device) {
+                 const char* what, ComputeDevice& device, const Arguments&... arguments) {
     check_image(depth, "depth", 1, camera);
     DeviceImage depth_device;
     DeviceImage out_device;
@@ -121,8 +123,7 @@ Image depth_pass(const Image& depth, const Camera& camera, const char* name, int
     out_device.allocate(device, depth.width, depth.height, channels);
     cl::Kernel kernel = device.opencl().kernel("relighting", name);
     device.opencl().launch(kernel, detail::image_global_range(depth.width, depth.height),
-                           detail::image_local_range(), depth_device.buffer(),
-                           detail::image_size(camera), detail::camera_axes(camera),
+                           detail::image_local_range(), depth_device.buffer(), arguments...,
                            out_device.buffer());
     return out_device.download(device, what);
 }
@@ -130,11 +131,13 @@ Image depth_pass(const Image& depth, const Camera& camera, const char* name, int
 }  // namespace
 
 Image smooth_depth(const Image& depth, const Camera& camera, ComputeDevice& device) {
-    return depth_pass(depth, camera, "smooth_depth", 1, "smoothed depth", device);
+    return depth_pass(depth, camera, "smooth_depth", 1, "smoothed depth", device,
+                      detail::image_size(camera), detail::camera_axes(camera));
 }
 
 Image normals_from_depth(const Image& depth, const Camera& camera, ComputeDevice& device) {
-    return depth_pass(depth, camera, "normals_from_depth", 3, "normals", device);
+    return depth_pass(depth, camera, "normals_from_depth", 3, "normals", device,
+                      detail::image_size(camera), detail::camera_axes(camera));
 }
 
 Image shade(const Image& base_colour, const Image& normals, const Camera& camera,
@@ -178,21 +181,12 @@ OcclusionTerms occlusion_terms(const AmbientOcclusionSettings& settings, const C
 
 Image ambient_occlusion(const Image& depth, const Camera& camera,
                         const AmbientOcclusionSettings& settings, ComputeDevice& device) {
-    check_image(depth, "depth", 1, camera);
     const OcclusionTerms terms = occlusion_terms(settings, camera);
-    const int radius = terms.radius_pixels;
     const cl_float4 occlusion =
         to_float4(terms.strength, terms.inverse_depth_scale, terms.inverse_neighbours, 0.0);
-    DeviceImage depth_device;
-    DeviceImage occlusion_device;
-    depth_device.upload(device, depth, "depth");
-    occlusion_device.allocate(device, depth.width, depth.height, 1);
-    cl::Kernel kernel = device.opencl().kernel("relighting", "ambient_occlusion");
-    device.opencl().launch(kernel, detail::image_global_range(depth.width, depth.height),
-                           detail::image_local_range(), depth_device.buffer(),
-                           detail::camera_plane(camera), static_cast<cl_int>(radius), occlusion,
-                           occlusion_device.buffer());
-    return occlusion_device.download(device, "ambient occlusion");
+    return depth_pass(depth, camera, "ambient_occlusion", 1, "ambient occlusion", device,
+                      detail::camera_plane(camera), static_cast<cl_int>(terms.radius_pixels),
+                      occlusion);
 }
 
 Image unsharp_mask_occlusion(const Image& depth, const Camera& camera,
@@ -210,16 +204,9 @@ Image unsharp_mask_occlusion(const Image& depth, const Camera& camera,
         device, gaussian.data(), gaussian.size() * sizeof(float), "Gaussian weights");
     const cl_float4 occlusion =
         to_float4(settings.strength, 1.0 / depth_scale_world(settings, camera), 0.0, 0.0);
-    DeviceImage depth_device;
-    DeviceImage occlusion_device;
-    depth_device.upload(device, depth, "depth");
-    occlusion_device.allocate(device, depth.width, depth.height, 1);
-    cl::Kernel kernel = device.opencl().kernel("relighting", "unsharp_mask_occlusion");
-    device.opencl().launch(kernel, detail::image_global_range(depth.width, depth.height),
-                           detail::image_local_range(), depth_device.buffer(),
-                           detail::image_size(depth), static_cast<cl_int>(radius), gaussian_device,
-                           occlusion, occlusion_device.buffer());
-    return occlusion_device.download(device, "unsharp-mask occlusion");
+    return depth_pass(depth, camera, "unsharp_mask_occlusion", 1, "unsharp-mask occlusion", device,
+                      detail::image_size(depth), static_cast<cl_int>(radius), gaussian_device,
+                      occlusion);
 }
 
 Image light_volume(const Image& attenuation, const Image& mean_depth,
