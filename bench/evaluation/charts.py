@@ -130,10 +130,16 @@ def light_field_goals(rows, met, rig_rows=()):
                     met(best <= 2.0)])
         default = lookup(rig_rows, scene=scene, cameras="162", map="128")
         if default:
-            ratio = num(default, "capture_ms_per_camera") / num(default, "proxy_pass_ms_per_camera")
+            # The rounds' own ratios decide: the bests of ~10 ms a camera spread by +-20 %.
+            best = num(default, "capture_ms_per_camera") / num(default, "proxy_pass_ms_per_camera")
+            rounds = default.get("capture_to_proxy_pass_round_median")
+            ratio = float(rounds) if rounds else best
+            detail = ("%.2f× (median of the rounds' ratios; bests %.2f×, CPU time %.2f×)" %
+                      (ratio, best, num(default, "capture_to_proxy_pass_cpu")) if rounds
+                      else "%.2f×" % best)
             out.append(["light field capture per camera against one proxy pass of the same pixels "
                         "(%s, the default light field: 162 cameras at 128², attenuation, rims)" % scene,
-                        "≤ 1.0×", "%.2f×" % ratio, met(ratio <= 1.0)])
+                        "≤ 1.0×", detail, met(ratio <= 1.0)])
             continue
         out.append(["light field capture per camera against one proxy pass of the same pixels "
                     "(%s, 42 cameras at 512² without attenuation or rims, whole ray / split)" % scene,
