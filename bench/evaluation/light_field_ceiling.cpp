@@ -19,6 +19,7 @@
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/metrics.hpp"
 #include "light_field_error_budget.hpp"
+#include "light_field_exact_colour.hpp"
 #include "light_field_oracle.hpp"
 #include "light_field_own_depth.hpp"
 #include "light_field_quality.hpp"
@@ -54,11 +55,17 @@ enum Frame {
     kOwnCentroid,
     kOwnMedian,
     kOwnBlend,
+    kExactColour,
+    kExactViewPath,
+    kExactSegments2,
+    kExactSegments4,
+    kExactSegments8,
     kFrames
 };
 constexpr std::array<const char*, kFrames> kFrameNames{
-    "today",      "oracle",       "oracle_nearest", "oracle_centroid", "oracle_median",
-    "best_depth", "today_direct", "own_centroid",   "own_median",      "own_blend"};
+    "today",        "oracle",          "oracle_nearest",   "oracle_centroid",  "oracle_median",
+    "best_depth",   "today_direct",    "own_centroid",     "own_median",       "own_blend",
+    "exact_colour", "exact_view_path", "exact_segments_2", "exact_segments_4", "exact_segments_8"};
 /// The own-depth frames' light fields, in Frame order from kOwnCentroid.
 constexpr std::array<OwnDepth, 3> kOwnDepths{OwnDepth::centroid, OwnDepth::median, OwnDepth::blend};
 
@@ -112,6 +119,7 @@ struct SceneViews {
     std::vector<Camera> cameras;
     std::vector<Image> truths;
     std::vector<TruthDepths> depths;  ///< the truth's depths (light_field_oracle.hpp)
+    double step_world = 0.0;          ///< the truth's step
 };
 
 SceneViews scene_views(const Scene& scene, ProxyRenderer& renderer, const std::vector<int>& views,
@@ -123,6 +131,7 @@ SceneViews scene_views(const Scene& scene, ProxyRenderer& renderer, const std::v
         truth_settings().step_voxels * std::min({spacing.x, spacing.y, spacing.z});
     const Camera stored = Camera::orbit(stored_view(image), renderer.volume().bounds);
     SceneViews out;
+    out.step_world = step_world;
     // The light-field sections' random views (`views` of their 30).
     const std::vector<std::pair<double, double>> all = random_views(30);
     out.indices = views;
@@ -174,12 +183,34 @@ std::size_t differing_pixels(const Image& a, const Image& b) {
     return count;
 }
 
-// A view's truth, today's frame and where their error lies (error_classes_image), as PNGs
-// `stem`_truth.png, _today.png and _classes.png, to look at (INSITU_CEILING_PICTURES=1).
-void write_pictures(const fs::path& stem, const Image& truth, const Image& today) {
+// Each pixel's RMS error over RGBA (premultiplied) against the truth, grey, white at 0.08.
+Image error_image(const Image& truth, const Image& frame) {
+    Image out(truth.width, truth.height, 4, 1.0f);
+    for (std::size_t p = 0; p < truth.pixel_count(); ++p) {
+        double sum = 0.0;
+        for (int c = 0; c < 4; ++c) {
+            const double d = double(frame.pixels[4 * p + c]) - truth.pixels[4 * p + c];
+            sum += d * d;
+        }
+        const auto grey = static_cast<float>(std::min(std::sqrt(sum / 4.0) / 0.08, 1.0));
+        for (int c = 0; c < 3; ++c) out.pixels[4 * p + c] = grey;
+    }
+    return out;
+}
+
+// A view's truth, today's frame, where their error lies (error_classes_image) and how large it is
+// per pixel (error_image), as PNGs `stem`_truth.png, _today.png, _classes.png and _error.png,
+// and with the exact-colour frame (INSITU_CEILING_EXACT=1) _exact.png and _exact_error.png, to
+// look at (INSITU_CEILING_PICTURES=1).
+void write_pictures(const fs::path& stem, const Image& truth, const Image& today,
+                    const Image& exact) {
     write_png(stem.string() + "_truth.png", truth);
     write_png(stem.string() + "_today.png", today);
     write_png(stem.string() + "_classes.png", error_classes_image(truth, today));
+    write_png(stem.string() + "_error.png", error_image(truth, today));
+    if (exact.pixel_count() == 0) return;
+    write_png(stem.string() + "_exact.png", exact);
+    write_png(stem.string() + "_exact_error.png", error_image(truth, exact));
 }
 
 // The light field with each camera read at its own depths (kOwnDepths), their counts printed.
@@ -200,6 +231,13 @@ std::vector<LightField> own_depth_light_fields(const LightField& stored, const s
     return out;
 }
 
+// Whether INSITU_CEILING_EXACT=1 asks for the exact-colour frames (light_field_exact_colour.hpp)
+// and the error by path-length gap.
+bool exact_colours() {
+    const char* wanted = std::getenv("INSITU_CEILING_EXACT");
+    return wanted != nullptr && std::string(wanted) == "1";
+}
+
 // Whether INSITU_CEILING_TODAY_ONLY=1 asks for today's frames alone (no oracle frames: a quick
 // run to compare reconstructions).
 bool today_only() {
@@ -209,9 +247,9 @@ bool today_only() {
 
 // The frames of one view: today's (the Explorer's), and the oracle's (one segment) or the
 // own-depth light fields' (`own`, attenuation captures).
-std::array<Image, kFrames> view_frames(Explorer& explorer, const LightField& stored,
-                                       const std::vector<LightField>& own, const SceneViews& seen,
-                                       std::size_t v) {
+std::array<Image, kFrames> view_frames(const Scene& scene, Explorer& explorer,
+                                       const LightField& stored, const std::vector<LightField>& own,
+                                       const SceneViews& seen, std::size_t v) {
     ExploreRequest explore;
     explore.azimuth_deg = seen.angles[v].first;
     explore.elevation_deg = seen.angles[v].second;
@@ -219,6 +257,30 @@ std::array<Image, kFrames> view_frames(Explorer& explorer, const LightField& sto
     std::array<Image, kFrames> frames;
     frames[kToday] = explorer.render(explore).colour;
     const Camera& camera = seen.cameras[v];
+    if (exact_colours() && stored.segment_count() == 1) {
+        const Field field = scene.volume.field();
+        const TransferFunction tf = make_tf(scene);
+        const std::vector<double>& hits = seen.depths[v].first_hit;
+        frames[kExactColour] = exact_colour_frame(field, tf, stored.rig, camera, hits,
+                                                  seen.step_world, ExactColour::whole_ray);
+        frames[kExactViewPath] = exact_colour_frame(field, tf, stored.rig, camera, hits,
+                                                    seen.step_world, ExactColour::view_path);
+        for (int k = 0; k < 3; ++k) {
+            frames[kExactSegments2 + k] =
+                exact_colour_frame(field, tf, stored.rig, camera, hits, seen.step_world,
+                                   ExactColour::segments, 2 << k);
+        }
+        const std::vector<double> gap = path_length_gap(field, stored.rig, camera, hits);
+        const std::vector<double> behind = hit_behind_entry(field, camera, hits);
+        for (const int f : {kToday, kExactColour, kExactViewPath}) {
+            const std::string label =
+                scene.name + " view " + std::to_string(seen.indices[v]) + " " + kFrameNames[f];
+            print_error_by_gap(label.c_str(), "path-length gap", seen.truths[v], frames[f], gap,
+                               {0.01, 0.03, 0.1, 0.3});
+            print_error_by_gap(label.c_str(), "first hit behind the box's entry", seen.truths[v],
+                               frames[f], behind, {0.02, 0.05, 0.1, 0.2});
+        }
+    }
     if (!own.empty()) {
         LightFieldReconstructionSettings settings;
         settings.attenuation = false;  // as the Explorer reconstructs a frame without edits
@@ -258,7 +320,8 @@ void measure(const Scene& scene, const SceneViews& seen, const Capture& capture,
     std::array<Means, kFrames> means;
     std::size_t moved = 0;  // pixels of today's frames unlike today_direct's
     for (std::size_t v = 0; v < seen.angles.size(); ++v) {
-        const std::array<Image, kFrames> frames = view_frames(explorer, stored, own, seen, v);
+        const std::array<Image, kFrames> frames =
+            view_frames(scene, explorer, stored, own, seen, v);
         if (frames[kTodayDirect].pixel_count() > 0) {
             moved += differing_pixels(frames[kToday], frames[kTodayDirect]);
         }
@@ -266,7 +329,7 @@ void measure(const Scene& scene, const SceneViews& seen, const Capture& capture,
             write_pictures(
                 out / ("light_field_ceiling_" + scene.name + "_" + capture.name + "_" +
                        std::to_string(capture.cameras) + "_view" + std::to_string(seen.indices[v])),
-                seen.truths[v], frames[kToday]);
+                seen.truths[v], frames[kToday], frames[kExactColour]);
         }
         for (int f = 0; f < kFrames; ++f) {
             if (frames[f].pixel_count() == 0) continue;
@@ -308,6 +371,7 @@ std::vector<Capture> chosen_captures(bool smoke) {
                                   {"equal_texels", 642, {}, 4},
                                   {"attenuation", 42, {}, 1, true},
                                   {"attenuation_equal_texels", 162, {}, 2, true},
+                                  {"two_segments_equal_texels", 162, {0.5}, 2},
                                   {"whole_ray", 642, {}}};
     if (smoke) captures.pop_back();  // 642 cameras at full size: the smoke run's minute
     const char* wanted = std::getenv("INSITU_CEILING_CAPTURES");
