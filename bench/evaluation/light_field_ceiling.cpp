@@ -231,18 +231,24 @@ std::vector<LightField> own_depth_light_fields(const LightField& stored, const s
     return out;
 }
 
-// Whether INSITU_CEILING_EXACT=1 asks for the exact-colour frames (light_field_exact_colour.hpp)
-// and the error by path-length gap.
-bool exact_colours() {
-    const char* wanted = std::getenv("INSITU_CEILING_EXACT");
+// Whether the environment sets the section's switch `name` to 1.
+bool switched_on(const char* name) {
+    const char* wanted = std::getenv(name);
     return wanted != nullptr && std::string(wanted) == "1";
 }
 
+// Whether INSITU_CEILING_EXACT=1 asks for the exact-colour frames (light_field_exact_colour.hpp)
+// and the error by path-length gap. Read once: asked at every view.
+bool exact_colours() {
+    static const bool on = switched_on("INSITU_CEILING_EXACT");
+    return on;
+}
+
 // Whether INSITU_CEILING_TODAY_ONLY=1 asks for today's frames alone (no oracle frames: a quick
-// run to compare reconstructions).
+// run to compare reconstructions). Read once: asked at every view.
 bool today_only() {
-    const char* wanted = std::getenv("INSITU_CEILING_TODAY_ONLY");
-    return wanted != nullptr && std::string(wanted) == "1";
+    static const bool on = switched_on("INSITU_CEILING_TODAY_ONLY");
+    return on;
 }
 
 // The frames of one view: today's (the Explorer's), and the oracle's (one segment) or the
@@ -443,8 +449,7 @@ void section_light_field_ceiling(const std::vector<const Scene*>& scenes, bool s
     }
     Csv csv(out / "light_field_ceiling.csv", header);
     const std::vector<int> views = chosen_views(smoke);
-    const char* pictures_wanted = std::getenv("INSITU_CEILING_PICTURES");
-    const bool pictures = pictures_wanted != nullptr && std::string(pictures_wanted) == "1";
+    const bool pictures = switched_on("INSITU_CEILING_PICTURES");
     const int map = smoke ? 64 : 256;
     // Captures outermost, so that a run cut short has measured every scene's first ones.
     const std::vector<Capture> captures = chosen_captures(smoke);
