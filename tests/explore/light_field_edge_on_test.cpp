@@ -17,11 +17,10 @@
 #include <iostream>
 #include <vector>
 
-#include "insitu/explore/light_field_reconstruction.hpp"
-#include "insitu/render/light_field_capture.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/metrics.hpp"
+#include "support/light_field_views.hpp"
 
 namespace insitu {
 namespace {
@@ -39,24 +38,10 @@ TransferFunction semi_transparent_tf() {
 TEST(LightFieldEdgeOn, AFaceSeenEdgeOnGrowsNoStaircaseGhosts) {
     ProxyRenderer renderer;
     renderer.upload(make_marschner_lobb(kSize).field());
-    const Bounds& bounds = renderer.volume().bounds;
-    LightFieldRequest request;
-    request.settings.cameras = 162;
-    request.settings.size = kMap;
-    request.settings.attenuation = false;
-    request.transfer_function = semi_transparent_tf();
     const LightField light_field =
-        capture_light_field(renderer, LightFieldRig::around(bounds, 162, kMap), request);
-    RenderSettings truth_settings;
-    truth_settings.early_termination_opacity = 2.0;  // as the light field's own images
-    OrbitView view;
-    view.azimuth_deg = 152.2;  // the bench's worst view
-    view.elevation_deg = 0.0;
-    view.width = view.height = kTarget;
-    const Camera target = Camera::orbit(view, bounds);
-    const Image truth =
-        renderer.render_ground_truth(target, request.transfer_function, truth_settings).rgba;
-    const Image result = reconstruct_light_field(light_field, target, {}).rgba;
+        testing::capture_without_attenuation(renderer, 162, kMap, semi_transparent_tf());
+    // The bench's worst view.
+    const auto [truth, result] = testing::orbit_view(renderer, light_field, 152.2, 0.0, kTarget);
     int ghosts = 0, shown = 0;
     double ghost_error = 0.0, error = 0.0;
     for (std::size_t p = 0; p < truth.pixel_count(); ++p) {

@@ -17,11 +17,10 @@
 #include <utility>
 #include <vector>
 
-#include "insitu/explore/light_field_reconstruction.hpp"
-#include "insitu/render/light_field_capture.hpp"
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/metrics.hpp"
+#include "support/light_field_views.hpp"
 
 namespace insitu {
 namespace {
@@ -63,27 +62,13 @@ TransferFunction translucent_tf() {
 TEST(LightFieldSilhouettes, TheBoxsEdgesAndGrazedFacesAreNotFaded) {
     ProxyRenderer renderer;
     renderer.upload(filled_box().field());
-    const Bounds& bounds = renderer.volume().bounds;
-    LightFieldRequest request;
-    request.settings.cameras = 42;
-    request.settings.size = 128;
-    request.settings.attenuation = false;
-    request.transfer_function = translucent_tf();
     const LightField light_field =
-        capture_light_field(renderer, LightFieldRig::around(bounds, 42, 128), request);
-    RenderSettings truth_settings;
-    truth_settings.early_termination_opacity = 2.0;  // as the light field's own images
+        testing::capture_without_attenuation(renderer, 42, 128, translucent_tf());
     const std::vector<std::pair<double, double>> views = {
         {20.0, 24.0}, {200.0, -30.0}, {75.0, 10.0}, {130.0, 45.0}};
     for (const auto& [azimuth, elevation] : views) {
-        OrbitView view;
-        view.azimuth_deg = azimuth;
-        view.elevation_deg = elevation;
-        view.width = view.height = kTarget;
-        const Camera target = Camera::orbit(view, bounds);
-        const Image truth =
-            renderer.render_ground_truth(target, request.transfer_function, truth_settings).rgba;
-        const Image result = reconstruct_light_field(light_field, target, {}).rgba;
+        const auto [truth, result] =
+            testing::orbit_view(renderer, light_field, azimuth, elevation, kTarget);
         int faded = 0, box = 0;
         for (std::size_t p = 0; p < truth.pixel_count(); ++p) {
             const float truth_alpha = truth.pixels[4 * p + 3];
