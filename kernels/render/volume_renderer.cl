@@ -91,6 +91,30 @@ PACKET_INLINE floatp packet_pow_unit(floatp x, float w) {
     return exp2(w * log2(x));  // log2(0) = -inf gives 0
 }
 
+// The largest shininess raised by packet_pow_integer: at most 7 squarings, each doubling the
+// relative error before it, and 7 multiplies, so a relative error below 2^8 half-ulps (1.6e-5).
+#define PACKET_POW_INTEGER_MAX 128
+
+// Which power the packets take for the shininess w: w itself where it is a whole number in
+// [0, PACKET_POW_INTEGER_MAX] (packet_pow_integer), otherwise -1 (packet_pow_unit).
+PACKET_INLINE int packet_integer_exponent(float w) {
+    return w >= 0.0f && w <= (float)PACKET_POW_INTEGER_MAX && w == floor(w) ? (int)w : -1;
+}
+
+// x^n for a whole n >= 0 that is the same for every lane and work-item (the shininess), by
+// binary exponentiation: about 2 log2(n) multiplies where exp2 and log2 are library calls (log2
+// took a tenth of a shaded packet's instructions; bench/RESULTS.md, "The specular power by
+// squaring"). x^0 is 1, also at x = 0.
+PACKET_INLINE floatp packet_pow_integer(floatp x, int n) {
+    floatp power = 1.0f;
+    while (true) {
+        if (n & 1) power *= x;
+        n >>= 1;
+        if (n == 0) return power;
+        x *= x;
+    }
+}
+
 // Empty-space skipping of the ground truth's packets, per lane: a lane of `active` whose sample
 // (x, y, z, in the buffer's voxels) lies in a block the pass may skip (empty_space.hpp: every
 // sample there has zero opacity) moves on without taking it, to the block's last sample (or the
@@ -200,6 +224,7 @@ __kernel void render_volume_packets(
     const floatp inverse_x = 1.0f / rays.direction_x, inverse_y = 1.0f / rays.direction_y;
     const floatp inverse_z = 1.0f / rays.direction_z;
     const float inverse_step = 1.0f / step;
+    const int integer_exponent = packet_integer_exponent(phong.w);
     while (true) {
         floatp t, x, y, z;
         const intp active = packet_next_samples(
@@ -251,12 +276,16 @@ __kernel void render_volume_packets(
 
         if (shading) {
             const intp lit = magnitude > 1e-12f;
-            const floatp n_dot_l = fabs((gradient_x / magnitude) * rays.light_x +
-                                        (gradient_y / magnitude) * rays.light_y +
-                                        (gradient_z / magnitude) * rays.light_z);
+            // One division where render_volume normalises the gradient first (three): the same
+            // n.l to a rounding.
+            const floatp n_dot_l = fabs(gradient_x * rays.light_x + gradient_y * rays.light_y +
+                                        gradient_z * rays.light_z) /
+                                   magnitude;
             const floatp diffuse = phong.x + phong.y * n_dot_l;
+            const floatp base = select((floatp)0.0f, n_dot_l, lit);
             const floatp specular =
-                phong.z * packet_pow_unit(select((floatp)0.0f, n_dot_l, lit), phong.w);
+                phong.z * (integer_exponent >= 0 ? packet_pow_integer(base, integer_exponent)
+                                                 : packet_pow_unit(base, phong.w));
             sample_red = select(sample_red, sample_red * diffuse + specular, lit);
             sample_green = select(sample_green, sample_green * diffuse + specular, lit);
             sample_blue = select(sample_blue, sample_blue * diffuse + specular, lit);

@@ -328,7 +328,9 @@ INSTANTIATE_TEST_SUITE_P(VolumeRenderer, MatchesReference, ::testing::ValuesIn(r
 // one fma in one form and not in the other, so positions differ by a float rounding, which a
 // steep transfer function magnifies (measured over these cases: at most 1.3e-5 in a channel, on
 // the Marschner-Lobb peak; never a depth mask). Shading adds the 16-wide sqrt and division, the
-// specular power as exp2(w log2 n.l) where render_volume calls pow, and a gradient that the
+// specular power as exp2(w log2 n.l) or, for a whole shininess, by squaring (specular_power_test)
+// where render_volume calls pow, n.l with one division where render_volume normalises the
+// gradient (three), and a gradient that the
 // packets interpolate from the shading volume's per-voxel central differences where
 // render_volume takes differences of trilinear samples (the same gradient, rounded in another
 // order), which the normal of a faint gradient magnifies: measured at most 3e-6 in a channel over
