@@ -8,7 +8,8 @@
 //   insitu_evaluate --out DIR [--smoke] [--sections a,b,...] [--raw PATH:NXxNYxNZ:TYPE ...]
 //   [--sizes N,N,...]
 // Sections: rotation, curvature, colour, configurations, storage, light_fields, budget, volume,
-// crossover, light_field_cracks, light_field_bytes, relit_ceiling, light_field_ceiling,
+// crossover, light_field_cracks, light_field_bytes, light_field_attenuation_coding,
+// relit_ceiling, light_field_ceiling,
 // light_field_rig (default:
 // all); --sizes: the crossover's volume sizes (default 64,128,256,512).
 #include <unistd.h>
@@ -48,6 +49,7 @@
 #include "insitu/render/proxy_renderer.hpp"
 #include "insitu/testing/analytic_fields.hpp"
 #include "insitu/testing/metrics.hpp"
+#include "light_field_attenuation_coding.hpp"
 #include "light_field_ceiling.hpp"
 #include "light_field_quality.hpp"
 #include "machine.hpp"
@@ -83,6 +85,7 @@ struct Options {
                                    "crossover",
                                    "light_field_cracks",
                                    "light_field_bytes",
+                                   "light_field_attenuation_coding",
                                    "relit_ceiling",
                                    "light_field_ceiling",
                                    "light_field_rig"};
@@ -95,7 +98,9 @@ struct Options {
     std::fprintf(stderr,
                  "insitu_evaluate: %s\nusage: insitu_evaluate --out DIR [--smoke] "
                  "[--sections rotation,curvature,colour,configurations,storage,light_fields,"
-                 "budget,volume,crossover,light_field_cracks,light_field_bytes,relit_ceiling,"
+                 "budget,volume,crossover,light_field_cracks,light_field_bytes,light_field_"
+                 "attenuation_coding,"
+                 "relit_ceiling,"
                  "light_field_ceiling,light_field_rig] "
                  "[--sizes N,N,...] "
                  "[--raw PATH:NXxNYxNZ:TYPE ...]\n",
@@ -1492,6 +1497,10 @@ int main(int argc, char** argv) {
         if (options.sections.count("light_field_bytes")) {
             section_light_field_bytes({&primary, &analytic[2]}, options.smoke, options.out, scratch,
                                       image);
+        }
+        if (options.sections.count("light_field_attenuation_coding")) {
+            section_light_field_attenuation_coding({&primary, &analytic[2]}, options.smoke,
+                                                   options.out, scratch, image);
         }
         if (options.sections.count("relit_ceiling")) {
             section_relit_ceiling({&primary, &analytic[2]}, options.smoke, options.out, image);

@@ -266,6 +266,9 @@ namespace {
 struct StoredForm {
     int subsampling = 1;
     double colour_dwa_level = 0.0;
+    /// Full-size maps coded as the default codes them ("attenuation_bits" 6,
+    /// "mean_depth_subsampling" 2); otherwise as captured.
+    bool coded = false;
 };
 
 /// `captured` without its attenuation maps: what a light field with "attenuation": false
@@ -284,7 +287,8 @@ LightField without_attenuation(LightField captured) {
 void section_light_field_bytes(const std::vector<const Scene*>& scenes, bool smoke,
                                const fs::path& out, const fs::path& scratch, int image) {
     Csv csv(out / "light_field_bytes.csv",
-            "scene,cameras,map,attenuation_subsampling,colour_dwa_level,stored_bytes,"
+            "scene,cameras,map,attenuation_subsampling,colour_dwa_level,attenuation_bits,"
+            "mean_depth_subsampling,stored_bytes,"
             "stored_bytes_without_attenuation,edit,views,mean_abs_percent,psnr,worst_psnr,"
             "worst_view_azimuth,worst_view_elevation,crack_percent,worst_crack_percent");
     const int views = smoke ? 3 : 30;
@@ -297,8 +301,8 @@ void section_light_field_bytes(const std::vector<const Scene*>& scenes, bool smo
     const std::vector<TfSpec> edits = held_out_edits(views);
     const std::vector<StoredForm> forms =
         smoke ? std::vector<StoredForm>{{1, 0.0}, {2, 0.0}, {1, 45.0}}
-              : std::vector<StoredForm>{{1, 0.0},  {2, 0.0},  {4, 0.0},
-                                        {1, 45.0}, {2, 45.0}, {1, 100.0}};
+              : std::vector<StoredForm>{{1, 0.0},  {2, 0.0},   {4, 0.0},       {1, 45.0},
+                                        {2, 45.0}, {1, 100.0}, {1, 45.0, true}};
     for (const Scene* scene : scenes) {
         ProxyRenderer renderer;
         renderer.upload(scene->volume.field());
@@ -325,9 +329,15 @@ void section_light_field_bytes(const std::vector<const Scene*>& scenes, bool smo
         for (const StoredForm& form : forms) {
             request.settings.attenuation_subsampling = form.subsampling;
             request.settings.colour_dwa_level = form.colour_dwa_level;
+            request.settings.attenuation_bits = form.coded ? defaults.attenuation_bits : 0;
+            request.settings.mean_depth_subsampling =
+                form.coded ? defaults.mean_depth_subsampling : 1;
+            // Unedited frames read colour and depth only: measured where the maps are as
+            // captured, checked to be the same frame where they are reduced.
+            const bool reduced = form.subsampling > 1 || form.coded;
             const fs::path archive = scratch / ("bytes_" + scene->name);
             std::uintmax_t bytes_without_attenuation = 0;
-            if (form.subsampling == 1) {
+            if (!reduced) {
                 LightFieldRequest plain = request;
                 plain.settings.attenuation = false;
                 bytes_without_attenuation = write_light_field_archive(*scene, renderer, plain,
@@ -350,10 +360,10 @@ void section_light_field_bytes(const std::vector<const Scene*>& scenes, bool smo
                     // Unedited frames read colour and depth, which subsampling leaves as they
                     // are: measured once per colour level, checked to be the same frame where
                     // the maps are smaller.
-                    if (!edit && form.subsampling == 1 && v == 0) {
+                    if (!edit && !reduced && v == 0) {
                         unedited_first[form.colour_dwa_level] = frame;
                     }
-                    if (!edit && form.subsampling > 1) {
+                    if (!edit && reduced) {
                         if (frame.pixels != unedited_first.at(form.colour_dwa_level).pixels) {
                             fail<Error>("an unedited frame changed with the attenuation maps");
                         }
@@ -361,17 +371,20 @@ void section_light_field_bytes(const std::vector<const Scene*>& scenes, bool smo
                     }
                     scores.add(edit ? edited_truths[v] : truths[v], frame, angles[v], views);
                 }
-                if (!edit && form.subsampling > 1) continue;
-                csv.row(scene->name, cameras, map, form.subsampling, form.colour_dwa_level, bytes,
-                        bytes_without_attenuation, edit ? 1 : 0, views, scores.mean_abs_percent,
-                        scores.psnr, scores.worst_psnr, scores.worst_view.first,
-                        scores.worst_view.second, scores.crack_percent, scores.worst_crack_percent);
+                if (!edit && reduced) continue;
+                csv.row(scene->name, cameras, map, form.subsampling, form.colour_dwa_level,
+                        request.settings.attenuation_bits, request.settings.mean_depth_subsampling,
+                        bytes, bytes_without_attenuation, edit ? 1 : 0, views,
+                        scores.mean_abs_percent, scores.psnr, scores.worst_psnr,
+                        scores.worst_view.first, scores.worst_view.second, scores.crack_percent,
+                        scores.worst_crack_percent);
                 std::printf(
-                    "light-field bytes: %s %d cameras %d^2, attenuation maps / %d, colour DWA "
+                    "light-field bytes: %s %d cameras %d^2, attenuation maps / %d%s, colour DWA "
                     "%.0f: %.2f MB (%.2f MB without attenuation), %s: mean error %.2f %%, PSNR "
                     "%.1f dB, worst view %.1f dB (az %.0f el %.0f), cracks %.3f %% (worst %.3f "
                     "%%)\n",
-                    scene->name.c_str(), cameras, map, form.subsampling, form.colour_dwa_level,
+                    scene->name.c_str(), cameras, map, form.subsampling,
+                    form.coded ? " (a_j in shares, mean depth / 2)" : "", form.colour_dwa_level,
                     bytes / 1e6, bytes_without_attenuation / 1e6,
                     edit ? "held-out edits" : "unedited", scores.mean_abs_percent, scores.psnr,
                     scores.worst_psnr, scores.worst_view.first, scores.worst_view.second,

@@ -107,6 +107,10 @@ LightFieldSettings settings(int depth_bits, bool attenuation,
     // The round trips here are the lossless store's; lossy colour (the default) has its own
     // tests (light_field_lossy_colour_test.cpp).
     result.colour_dwa_level = 0.0;
+    // Likewise the attenuation maps as captured (the coded default:
+    // light_field_attenuation_coding_test.cpp).
+    result.attenuation_bits = 0;
+    result.mean_depth_subsampling = 1;
     return result;
 }
 
@@ -257,13 +261,15 @@ protected:
     // Step 10's light field with `key` (as written, value and comma) blanked out of its header,
     // as a writer from before the key's default wrote it; the manifest's CRC of the part
     // follows, as that writer recorded it.
-    void write_without_header_key(const LightField& field, const std::string& key) {
+    void write_without_header_key(const LightField& field, const std::vector<std::string>& keys) {
         ArchiveWriter(config_).write(step_with(10, field));
         std::string bytes = read_text(light_field_file(10));
-        const std::size_t at = bytes.find(key);
-        ASSERT_NE(at, std::string::npos) << "the header should hold " << key;
         const std::uint32_t crc = file_crc(light_field_file(10));
-        bytes.replace(at, key.size(), std::string(key.size(), ' '));
+        for (const std::string& key : keys) {
+            const std::size_t at = bytes.find(key);
+            ASSERT_NE(at, std::string::npos) << "the header should hold " << key;
+            bytes.replace(at, key.size(), std::string(key.size(), ' '));
+        }
         write_text(light_field_file(10), bytes);
         std::string manifest = read_text(archive() / "manifest.json");
         const std::size_t recorded = manifest.find(std::to_string(crc));
@@ -341,7 +347,7 @@ TEST_F(LightFieldArchive, RimDepthRoundTripsAsTheFirstHitsDepth) {
 TEST_F(LightFieldArchive, HeaderWithoutRimKeyReadsAsWithoutRims) {
     LightFieldSettings none = settings(8, false);
     none.rim_threshold = 0.0;
-    write_without_header_key(hand_made(none), "\"rim_threshold\":0.0,");
+    write_without_header_key(hand_made(none), {"\"rim_threshold\":0.0,"});
     const LightField read = ArchiveReader(archive().string()).load_light_field(10, "v");
     EXPECT_EQ(read.settings.rim_threshold, 0.0);
     EXPECT_TRUE(read.cameras[0].rim_depth.pixels.empty());
@@ -352,9 +358,22 @@ TEST_F(LightFieldArchive, HeaderWithoutRimKeyReadsAsWithoutRims) {
 TEST_F(LightFieldArchive, HeaderWithoutColourLevelReadsAsLossless) {
     const LightField field = hand_made(settings(8, false));
     ASSERT_EQ(field.settings.colour_dwa_level, 0.0);
-    write_without_header_key(field, "\"colour_dwa_level\":0.0,");
+    write_without_header_key(field, {"\"colour_dwa_level\":0.0,"});
     const LightField read = ArchiveReader(archive().string()).load_light_field(10, "v");
     EXPECT_EQ(read.settings.colour_dwa_level, 0.0);
+    expect_light_fields_match(field, read, Stored::exact, Stored::eight_bit);
+}
+
+// Coded attenuation maps became the default (kDefaultAttenuationBits,
+// kDefaultMeanDepthSubsampling) after light fields stored them as captured without the keys:
+// such a header reads as captured, full-size maps, not as the default.
+TEST_F(LightFieldArchive, HeaderWithoutAttenuationCodingReadsAsCaptured) {
+    const LightField field = hand_made(settings(8, true));
+    ASSERT_EQ(field.settings.attenuation_bits, 0);
+    write_without_header_key(field, {"\"attenuation_bits\":0,", "\"mean_depth_subsampling\":1,"});
+    const LightField read = ArchiveReader(archive().string()).load_light_field(10, "v");
+    EXPECT_EQ(read.settings.attenuation_bits, 0);
+    EXPECT_EQ(read.settings.mean_depth_subsampling, 1);
     expect_light_fields_match(field, read, Stored::exact, Stored::eight_bit);
 }
 

@@ -2,8 +2,14 @@
 // src/representation/light_field/light_field_subsampling.hpp): the codec stores a_j and mean
 // depth as EXR channels subsampled by the factor and reads them back at the full map size, the
 // a_j summing to the full-size whole-ray opacity as captured ones do, colour and depth untouched.
+// And at full size, coded ("attenuation_bits", "mean_depth_subsampling",
+// src/representation/light_field/light_field_attenuation_coding.hpp): a_j as integer shares of
+// the opacity, mean depth alone subsampled.
+#include "representation/light_field/light_field_subsampling.hpp"
+
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputPart.h>
 #include <OpenEXR/ImfMultiPartInputFile.h>
 #include <gtest/gtest.h>
 
@@ -63,14 +69,16 @@ LightFieldImages disk(int camera, int size) {
     return images;
 }
 
-LightField disks(int size, int subsampling) {
+LightField disks(int size, int subsampling, int bits = 0, int depth_subsampling = 1) {
     LightField field;
     field.settings.cameras = kCameras;
     field.settings.size = size;
     field.settings.attenuation = true;
     field.settings.attenuation_subsampling = subsampling;
-    field.settings.rim_threshold = 0.0;     // no rim images
-    field.settings.colour_dwa_level = 0.0;  // colour and depth compared exactly
+    field.settings.rim_threshold = 0.0;      // no rim images
+    field.settings.colour_dwa_level = 0.0;   // colour and depth compared exactly
+    field.settings.attenuation_bits = bits;  // 0, 1: the maps as captured
+    field.settings.mean_depth_subsampling = depth_subsampling;
     field.rig = LightFieldRig::around(kBounds, kCameras, size);
     field.intervals = IntervalSet::uniform(0.0, 1.0, kIntervals);
     field.transfer_function =
@@ -179,6 +187,108 @@ TEST(LightFieldSubsampling, SettingsNameBadFactorsAndOldHeadersStayAsTheyWere) {
             LightFieldSettings::from_json({{"size", 64}, {"attenuation_subsampling", 8}}, nullptr);
         },
         "expected 1, 2 or 4");
+}
+
+// Each a_j comes back within two share steps of the opacity (2^6 - 1 steps), summing to the
+// opacity; mean depth defined exactly where a_j is, and inside the disk the plane it was (box
+// then bilinear keeps a linear plane).
+TEST(LightFieldAttenuationCoding, SharesComeBackWithinAStepAndMeanDepthAtFullSize) {
+    const int size = 32;
+    const LightField field = disks(size, 1, 6, 2);
+    const LightField read = round_trip(field, StoragePrecision::half);
+    ASSERT_EQ(read.cameras.size(), field.cameras.size());
+    EXPECT_EQ(read.settings.attenuation_bits, 6);
+    EXPECT_EQ(read.settings.mean_depth_subsampling, 2);
+    for (std::size_t k = 0; k < field.cameras.size(); ++k) {
+        const LightFieldImages& e = field.cameras[k];
+        const LightFieldImages& a = read.cameras[k];
+        ASSERT_EQ(a.attenuation.width, size);
+        ASSERT_EQ(a.mean_depth.width, size);
+        int failures = 0;
+        for (int y = 0; y < size; ++y) {
+            for (int x = 0; x < size; ++x) {
+                const float alpha = e.segment_rgba[0].at(x, y, 3);
+                float sum = 0.0f;
+                for (int j = 0; j < kIntervals; ++j) {
+                    const float value = a.attenuation.at(x, y, j);
+                    sum += value;
+                    failures += (value > 0.0f) != std::isfinite(a.mean_depth.at(x, y, j));
+                    // Half a step of rounding, and the renormalisation: the three non-zero
+                    // codes' sum is within 1.5 of 63, so q / sum within 1.5 / sum of q / 63.
+                    failures +=
+                        std::abs(value - e.attenuation.at(x, y, j)) > alpha * 2.0f / 63.0f + 1e-3f;
+                }
+                failures += std::abs(sum - alpha) > 2e-3f;
+                bool interior = true;
+                for (int dy = -3; dy <= 3; ++dy) {
+                    for (int dx = -3; dx <= 3; ++dx) interior &= inside(x + dx, y + dy, size);
+                }
+                for (int j = 0; interior && j < kIntervals; ++j) {
+                    if (!(a.attenuation.at(x, y, j) > 0.0f)) continue;
+                    failures +=
+                        std::abs(a.mean_depth.at(x, y, j) - e.mean_depth.at(x, y, j)) > 2e-3f;
+                }
+            }
+        }
+        EXPECT_EQ(failures, 0) << "camera " << k;
+    }
+}
+
+// The file holds the codes, integers up to 63 (shares of the opacity), at full size and the mean
+// depth at half size, and is smaller than the maps as captured.
+TEST(LightFieldAttenuationCoding, StoresShareCodesAndSubsampledMeanDepthInFewerBytes) {
+    const std::string captured = encode(disks(64, 1), StoragePrecision::half);
+    const std::string coded = encode(disks(64, 1, 6, 2), StoragePrecision::half);
+    EXPECT_LT(coded.size(), captured.size());
+
+    const std::vector<char> bytes(coded.begin(), coded.end());
+    archive_format::MemoryInputStream stream(bytes, "step3.exr");
+    Imf::MultiPartInputFile file(stream);
+    const Imf::ChannelList& channels = file.header(0).channels();
+    EXPECT_EQ(channels.findChannel("camera0.a01")->xSampling, 1);
+    EXPECT_EQ(channels.findChannel("camera0.zmean01")->xSampling, 2);
+    EXPECT_EQ(channels.findChannel("camera0.zmean01")->ySampling, 2);
+    Imf::InputPart part(file, 0);
+    const std::string path = "step3.exr";
+    const Image codes = archive_format::read_subsampled_channels(
+        part, {"camera0.a00", "camera0.a01", "camera0.a02"}, 1, {path, "camera0"});
+    float largest = 0.0f;
+    for (const float code : codes.pixels) {
+        EXPECT_EQ(code, std::round(code));
+        largest = std::max(largest, code);
+    }
+    // The disk's rightmost pixel x holds the share x / 63 of its opacity in interval 0: code x.
+    int rightmost = 0;
+    for (int x = 0; x < 64; ++x) rightmost = inside(x, 32, 64) ? x : rightmost;
+    EXPECT_EQ(largest, static_cast<float>(rightmost));
+}
+
+TEST(LightFieldAttenuationCoding, SettingsNameBadValuesAndTheFactorFitsTheMaps) {
+    LightFieldSettings settings;
+    EXPECT_EQ(settings.to_json().at("attenuation_bits"), kDefaultAttenuationBits);
+    EXPECT_EQ(settings.to_json().at("mean_depth_subsampling"), kDefaultMeanDepthSubsampling);
+    settings.attenuation_bits = 9;
+    settings.mean_depth_subsampling = 4;
+    const LightFieldSettings read = LightFieldSettings::from_json(settings.to_json(), nullptr);
+    EXPECT_EQ(read.attenuation_bits, 9);
+    EXPECT_EQ(read.mean_depth_subsampling, 4);
+    settings.size = 18;
+    EXPECT_EQ(settings.stored_mean_depth_subsampling(), 2);
+    settings.size = 9;
+    EXPECT_EQ(settings.stored_mean_depth_subsampling(), 1);
+    settings.size = 64;
+    settings.attenuation_subsampling = 2;  // both maps subsampled, as before: no codes
+    EXPECT_EQ(settings.stored_mean_depth_subsampling(), 2);
+    EXPECT_FALSE(settings.codes_attenuation());
+    for (const int bits : {1, 12, -1}) {
+        settings.attenuation_bits = bits;
+        expect_error_naming<InvalidArgument>([&] { settings.validate(); },
+                                             "light_field.attenuation_bits");
+    }
+    settings.attenuation_bits = 0;
+    settings.mean_depth_subsampling = 3;
+    expect_error_naming<InvalidArgument>([&] { settings.validate(); },
+                                         "light_field.mean_depth_subsampling");
 }
 
 }  // namespace

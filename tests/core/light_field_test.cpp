@@ -484,7 +484,7 @@ TEST(LightFieldSettings, JsonRoundTrips) {
     const json written = defaults.to_json();
     EXPECT_EQ(written, json::parse(R"({"cameras": 162, "size": 128, "segments": "none",
         "attenuation": true, "depth_bits": 8, "depth_threshold": 0.3, "rim_threshold": 0.05,
-        "colour_dwa_level": 45.0})"));
+        "colour_dwa_level": 45.0, "attenuation_bits": 6, "mean_depth_subsampling": 2})"));
     std::vector<std::string> unknown;
     const LightFieldSettings back = LightFieldSettings::from_json(written, &unknown);
     EXPECT_TRUE(unknown.empty());
@@ -514,6 +514,8 @@ TEST(LightFieldSettings, JsonRoundTrips) {
     json with_rims = opacity;
     with_rims["rim_threshold"] = kDefaultRimThreshold;
     with_rims["colour_dwa_level"] = kDefaultColourDwaLevel;
+    with_rims["attenuation_bits"] = kDefaultAttenuationBits;
+    with_rims["mean_depth_subsampling"] = kDefaultMeanDepthSubsampling;
     EXPECT_EQ(parsed.to_json(), with_rims);
 
     const LightFieldSettings layers =

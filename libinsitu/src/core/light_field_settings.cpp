@@ -77,7 +77,9 @@ constexpr const char* kSettingsKeys[] = {"cameras",
                                          "depth_threshold",
                                          "attenuation_subsampling",
                                          "rim_threshold",
-                                         "colour_dwa_level"};
+                                         "colour_dwa_level",
+                                         "attenuation_bits",
+                                         "mean_depth_subsampling"};
 
 }  // namespace
 
@@ -151,6 +153,14 @@ void LightFieldSettings::validate() const {
                               "must be 0 (lossless colour) or an OpenEXR DWA level in (0, ",
                               kMaxColourDwaLevel, "]");
     }
+    if (attenuation_bits != 0 && (attenuation_bits < 2 || attenuation_bits > kMaxAttenuationBits)) {
+        settings_out_of_range(settings_key("attenuation_bits"), attenuation_bits,
+                              "must be 0 (as captured) or in [2, ", kMaxAttenuationBits, "]");
+    }
+    if (mean_depth_subsampling != 1 && mean_depth_subsampling != 2 && mean_depth_subsampling != 4) {
+        settings_out_of_range(settings_key("mean_depth_subsampling"), mean_depth_subsampling,
+                              "expected 1, 2 or 4");
+    }
     if (size % attenuation_subsampling != 0) {
         settings_out_of_range(settings_key("attenuation_subsampling"), attenuation_subsampling,
                               "must divide the map size ", size);
@@ -167,9 +177,11 @@ json LightFieldSettings::to_json() const {
     // Only where it is not 1: full-size maps keep the header that readers before it take.
     if (attenuation_subsampling != 1) object["attenuation_subsampling"] = attenuation_subsampling;
     // Always: a header without one of these was written before it was a default, and reads as
-    // without it (no rims, lossless colour).
+    // without it (no rims, lossless colour, a_j and mean depth as captured).
     object["rim_threshold"] = rim_threshold;
     object["colour_dwa_level"] = colour_dwa_level;
+    object["attenuation_bits"] = attenuation_bits;
+    object["mean_depth_subsampling"] = mean_depth_subsampling;
     return object;
 }
 
@@ -243,6 +255,12 @@ LightFieldSettings LightFieldSettings::from_json(const json& object,
     });
     read("colour_dwa_level", [&](const json& v, const std::string& k) {
         settings.colour_dwa_level = settings_number(v, k);
+    });
+    read("attenuation_bits", [&](const json& v, const std::string& k) {
+        settings.attenuation_bits = settings_integer(v, k);
+    });
+    read("mean_depth_subsampling", [&](const json& v, const std::string& k) {
+        settings.mean_depth_subsampling = settings_integer(v, k);
     });
     settings.validate();
     return settings;

@@ -66,6 +66,14 @@ constexpr double kDefaultRimThreshold = 0.05;
 /// written before it was a default: lossless colour.
 constexpr double kDefaultColourDwaLevel = 45.0;
 
+/// The defaults of "attenuation_bits" and "mean_depth_subsampling" (since 2026-12-08). A
+/// light-field header without the keys was written before: a_j and mean depth as captured, at
+/// full size.
+constexpr int kDefaultAttenuationBits = 6;
+constexpr int kDefaultMeanDepthSubsampling = 2;
+/// The largest "attenuation_bits": the codes are stored as HALF integers, exact up to 2^11.
+constexpr int kMaxAttenuationBits = 11;
+
 struct LightFieldSettings {
     /// "cameras": one of kLightFieldCameraCounts; "size": map pixels per side. 162 cameras at
     /// 128^2 hold about the texels of 42 at 256^2 and reconstruct new views 1.7-2.8 dB better:
@@ -106,6 +114,29 @@ struct LightFieldSettings {
     /// error to the printed digit for 15 % fewer bytes, "Light-field bytes at the default rig").
     /// In [0, kMaxColourDwaLevel].
     double colour_dwa_level = kDefaultColourDwaLevel;
+    /// "attenuation_bits": 0 stores the a_j as the archive stores values (half or float); 2 to
+    /// kMaxAttenuationBits stores each a_j as its share of the pixel's whole-ray opacity in
+    /// 2^bits - 1 steps, read back scaled so that the pixel's a_j sum to that opacity (as
+    /// captured a_j do). "mean_depth_subsampling" (1, 2 or 4): the mean depth maps stored that
+    /// many times smaller per side (the a_j-weighted mean of each block) and read back at full
+    /// size, interpolated with the a_j as weights. Mean depth where a decoded a_j is 0 is +inf.
+    /// Both apply where "attenuation_subsampling" is 1 (a subsampled light field stores its maps
+    /// as before); the mean depth's factor is the largest of 4, 2, 1 up to it that divides size. At
+    /// 6 bits and 2 the attenuation maps take about a third of their bytes for held-out edits
+    /// within 0.1 dB: the a_j's loss under subsampling was the a_j's, not the mean depth's
+    /// (bench/RESULTS.md, "Attenuation maps in a third of their bytes").
+    int attenuation_bits = kDefaultAttenuationBits;
+    int mean_depth_subsampling = kDefaultMeanDepthSubsampling;
+
+    /// The factor the codec stores the mean depth maps smaller by, and whether it codes the
+    /// a_j as shares of the opacity (both as the comment above says).
+    int stored_mean_depth_subsampling() const {
+        if (attenuation_subsampling > 1) return attenuation_subsampling;
+        int factor = mean_depth_subsampling;
+        while (factor > 1 && size % factor != 0) factor /= 2;
+        return factor;
+    }
+    bool codes_attenuation() const { return attenuation_subsampling == 1 && attenuation_bits > 0; }
 
     /// InvalidArgument naming the "light_field" key and value of the first bad member.
     void validate() const;

@@ -30,6 +30,7 @@
 #include "archive/archive_format.hpp"
 #include "archive/exr_frame.hpp"
 #include "insitu/error.hpp"
+#include "representation/light_field/light_field_attenuation_coding.hpp"
 #include "representation/light_field/light_field_exr_checks.hpp"
 #include "representation/light_field/light_field_subsampling.hpp"
 
@@ -124,11 +125,12 @@ Imf::Header camera_header(const StepRecord& record, const LightFieldRecord& sour
     header.channels().insert(names.depth, depth);
     if (!names.rim.empty()) header.channels().insert(names.rim, depth);
     const int factor = light_field.settings.attenuation_subsampling;
+    const int depth_factor = light_field.settings.stored_mean_depth_subsampling();
     for (const std::string& name : names.attenuation) {
         header.channels().insert(name, Imf::Channel(encoding.compact, factor, factor));
     }
     for (const std::string& name : names.mean_depth) {
-        header.channels().insert(name, Imf::Channel(encoding.compact, factor, factor));
+        header.channels().insert(name, Imf::Channel(encoding.compact, depth_factor, depth_factor));
     }
 
     header.insert(kSchemaAttribute, Imf::IntAttribute(kArchiveSchemaVersion));
@@ -158,6 +160,11 @@ Imf::Header camera_header(const StepRecord& record, const LightFieldRecord& sour
     return header;
 }
 
+/// `value` as a channel of `type` holds it.
+float stored_value(float value, Imf::PixelType type) {
+    return type == Imf::HALF ? static_cast<float>(half(value)) : value;
+}
+
 /// The pixels of one part as OpenEXR takes them: FLOAT channels in place, HALF and UINT ones
 /// converted (OpenEXR writes a slice only into a channel of its own type).
 class PartPixels {
@@ -184,15 +191,31 @@ public:
         add_depth(names.depth, images.depth, depth_bits, depth, where);
         if (!names.rim.empty()) add_depth(names.rim, images.rim_depth, depth_bits, depth, where);
         if (intervals == 0) return;
-        const int factor = light_field.settings.attenuation_subsampling;
+        const LightFieldSettings& settings = light_field.settings;
+        const int factor = settings.attenuation_subsampling;
+        const int depth_factor = settings.stored_mean_depth_subsampling();
+        const bool coded = factor == 1 && (settings.codes_attenuation() || depth_factor > 1);
         if (factor > 1) {
             subsampled_ = subsample_attenuation(images.attenuation, images.mean_depth, factor);
+        } else if (coded) {
+            // Shares of the opacity the reader will see: the colour's alpha as stored.
+            std::vector<Image> alphas = images.segment_rgba;
+            for (Image& rgba : alphas) {
+                for (float& value : rgba.pixels) value = stored_value(value, encoding.compact);
+            }
+            coded_ = encode_attenuation(
+                images.attenuation, images.mean_depth, whole_ray_alpha(alphas),
+                settings.codes_attenuation() ? settings.attenuation_bits : 0, depth_factor);
         }
-        const Image& attenuation = factor > 1 ? subsampled_.attenuation : images.attenuation;
-        const Image& mean_depth = factor > 1 ? subsampled_.mean_depth : images.mean_depth;
+        const Image& attenuation = factor > 1 ? subsampled_.attenuation
+                                   : coded    ? coded_.attenuation
+                                              : images.attenuation;
+        const Image& mean_depth = factor > 1 ? subsampled_.mean_depth
+                                  : coded    ? coded_.mean_depth
+                                             : images.mean_depth;
         for (int j = 0; j < intervals; ++j) {
             add(names.attenuation[j], attenuation, j, encoding.compact, factor);
-            add(names.mean_depth[j], mean_depth, j, encoding.compact, factor);
+            add(names.mean_depth[j], mean_depth, j, encoding.compact, depth_factor);
         }
     }
     const Imf::FrameBuffer& frame_buffer() const { return frame_buffer_; }
@@ -258,6 +281,7 @@ private:
     std::vector<std::vector<half>> halves_;
     std::vector<std::vector<std::uint32_t>> codes_;
     SubsampledAttenuation subsampled_;
+    CodedAttenuation coded_;
     Imf::FrameBuffer frame_buffer_;
 };
 
@@ -289,9 +313,12 @@ void read_light_field_attributes(const Imf::Header& header, LightField& light_fi
             std::vector<std::string> unknown;
             LightFieldSettings settings = LightFieldSettings::from_json(json, &unknown);
             if (!unknown.empty()) fail<ParseError>("unknown key \"", unknown.front(), "\"");
-            // Written before each was a default (light_field.hpp): no rims, lossless colour.
+            // Written before each was a default (light_field.hpp): no rims, lossless colour,
+            // attenuation maps as captured.
             if (!json.contains("rim_threshold")) settings.rim_threshold = 0.0;
             if (!json.contains("colour_dwa_level")) settings.colour_dwa_level = 0.0;
+            if (!json.contains("attenuation_bits")) settings.attenuation_bits = 0;
+            if (!json.contains("mean_depth_subsampling")) settings.mean_depth_subsampling = 1;
             settings.validate();
             return settings;
         });
@@ -379,22 +406,26 @@ LightFieldImages read_camera(Imf::InputPart& part, int camera, const LightField&
     const int intervals = light_field.settings.attenuation ? light_field.intervals->count() : 0;
     const CameraChannels names =
         camera_channels(camera, segments, intervals, light_field.settings.rim_threshold > 0.0);
-    // Attenuation maps subsampled by the settings' factor are read in a pass of their own.
-    const int factor = light_field.settings.attenuation_subsampling;
+    // Attenuation maps subsampled by the settings' factor are read in a pass of their own, as
+    // are mean depth maps subsampled alone.
+    const LightFieldSettings& settings = light_field.settings;
+    const int factor = settings.attenuation_subsampling;
+    const int depth_factor = settings.stored_mean_depth_subsampling();
+    const bool coded = factor == 1 && (settings.codes_attenuation() || depth_factor > 1);
     std::vector<std::string> all_names = names.all();
     std::vector<std::string> subsampled;
-    if (factor > 1) {
-        all_names.resize(all_names.size() - 2 * static_cast<std::size_t>(intervals));
-        subsampled = names.attenuation;
+    if (factor > 1) subsampled = names.attenuation;
+    if (depth_factor > 1) {
         subsampled.insert(subsampled.end(), names.mean_depth.begin(), names.mean_depth.end());
     }
+    all_names.resize(all_names.size() - subsampled.size());
     const Imf::ChannelList& channels = part.header().channels();
     for (const std::string& name : names.all()) {
         const Imf::Channel* channel = channels.findChannel(name);
         if (!channel) where.error("no channel \"" + name + "\"");
         const bool is_subsampled =
             std::find(subsampled.begin(), subsampled.end(), name) != subsampled.end();
-        const int expected = is_subsampled ? factor : 1;
+        const int expected = is_subsampled ? depth_factor : 1;
         if (channel->xSampling != expected || channel->ySampling != expected) {
             where.error("channel \"" + name + "\" is subsampled by " +
                         std::to_string(channel->xSampling) + "x" +
@@ -427,61 +458,26 @@ LightFieldImages read_camera(Imf::InputPart& part, int camera, const LightField&
         decode_depth(images.rim_depth, *channels.findChannel(names.rim), depth_bits, names.rim,
                      where);
     }
-    if (intervals > 0 && factor == 1) {
+    if (intervals > 0 && factor == 1 && !coded) {
         images.attenuation = channel_range(all, first, intervals);
         images.mean_depth = channel_range(all, first + intervals, intervals);
+    } else if (intervals > 0 && factor == 1) {
+        const Image depth = depth_factor > 1
+                                ? read_subsampled_channels(part, subsampled, depth_factor, where)
+                                : channel_range(all, first + intervals, intervals);
+        decode_attenuation({channel_range(all, first, intervals), depth},
+                           whole_ray_alpha(images.segment_rgba), settings.codes_attenuation(),
+                           images.attenuation, images.mean_depth);
     } else if (intervals > 0) {
         const Image stored = read_subsampled_channels(part, subsampled, factor, where);
-        // The whole ray's opacity, the segments composited front to back.
-        std::vector<float> alpha(images.depth.pixel_count(), 0.0f);
-        for (const Image& rgba : images.segment_rgba) {
-            for (std::size_t p = 0; p < alpha.size(); ++p) {
-                alpha[p] += (1.0f - alpha[p]) * rgba.pixels[4 * p + 3];
-            }
-        }
         upsample_attenuation(
             {channel_range(stored, 0, intervals), channel_range(stored, intervals, intervals)},
-            alpha, images.attenuation, images.mean_depth);
+            whole_ray_alpha(images.segment_rgba), images.attenuation, images.mean_depth);
     }
     return images;
 }
 
 }  // namespace
-
-LightFieldEncoding light_field_encoding(StoragePrecision precision,
-                                        const std::string& compression) {
-    LightFieldEncoding encoding;
-    encoding.compact = precision == StoragePrecision::half ? Imf::HALF : Imf::FLOAT;
-    encoding.compression = parse_compression(compression);
-    // 8-bit depth codes took fewer bytes as HALF under the zip family, rle and no compression,
-    // and as UINT under piz and pxr24 (bench/RESULTS.md, "Light-field depth codes: UINT or HALF
-    // by compression"). The zip family splits pixels into two byte streams, not four, so UINT's
-    // zero bytes stay interleaved with the codes; piz and pxr24 separate them. b44 leaves UINT
-    // raw but is lossy for HALF, which would move codes: UINT. light_field_archive_test.cpp
-    // (DepthCodeTypeIsTheSmallerUnderEachCompression) checks the choice on rendered maps.
-    switch (encoding.compression) {
-        case Imf::PIZ_COMPRESSION:
-        case Imf::PXR24_COMPRESSION:
-        case Imf::B44_COMPRESSION:
-        case Imf::B44A_COMPRESSION:
-            encoding.depth_code_type = Imf::UINT;
-            break;
-        default:
-            encoding.depth_code_type = Imf::HALF;
-    }
-    return encoding;
-}
-
-LightFieldEncoding with_colour_dwa_level(const LightFieldEncoding& archive, double level) {
-    if (level <= 0.0) return archive;
-    LightFieldEncoding encoding = archive;
-    encoding.compression = Imf::DWAB_COMPRESSION;
-    encoding.dwa_level = static_cast<float>(level);
-    // HALF codes took fewer bytes than UINT ones under DWAB, as under zip
-    // (light_field_archive_test's DepthCodeTypeIsTheSmallerUnderEachCompression checks it).
-    encoding.depth_code_type = Imf::HALF;
-    return encoding;
-}
 
 EncodedLightField encode_light_field(const StepRecord& record, const LightFieldRecord& source,
                                      const LightFieldEncoding& archive_encoding,
