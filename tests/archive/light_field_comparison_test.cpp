@@ -31,9 +31,12 @@ protected:
     }
     void TearDown() override { fs::remove_all(directory_); }
 
-    /// One step archived with a light field of 12 cameras at 48², the transfer function's
-    /// colours times `colour_scale`.
-    std::string write_run(const std::string& name, float colour_scale, double colour_dwa_level) {
+    /// One step archived with a light field of 42 cameras at 64² (16 intervals) (attenuation on,
+    /// its a_j coded as the default codes them), the transfer function's colours times
+    /// `colour_scale` and the opacity of its second point (the shell's) times `opacity_scale`
+    /// (which moves the a_j's shares).
+    std::string write_run(const std::string& name, float colour_scale, double colour_dwa_level,
+                          float opacity_scale = 1.0f) {
         InstrumentConfig config;
         config.every = 1;
         config.fields = {"f"};
@@ -41,15 +44,15 @@ protected:
         const auto colour = [&](float r, float g, float b, float a) {
             return glm::vec4(r * colour_scale, g * colour_scale, b * colour_scale, a);
         };
-        config.transfer_function =
-            TransferFunction(std::vector<ControlPoint>{{-4.0, colour(0.2f, 0.4f, 1.0f, 0.0f)},
-                                                       {0.0, colour(0.2f, 0.6f, 1.0f, 0.3f)},
-                                                       {6.0, colour(1.0f, 0.5f, 0.1f, 0.9f)},
-                                                       {12.0, colour(1.0f, 0.9f, 0.2f, 1.0f)}});
-        config.interval_count = 4;
+        config.transfer_function = TransferFunction(
+            std::vector<ControlPoint>{{-4.0, colour(0.2f, 0.4f, 1.0f, 0.0f)},
+                                      {0.0, colour(0.2f, 0.6f, 1.0f, 0.3f * opacity_scale)},
+                                      {6.0, colour(1.0f, 0.5f, 0.1f, 0.9f)},
+                                      {12.0, colour(1.0f, 0.9f, 0.2f, 1.0f)}});
+        config.interval_count = 16;
         LightFieldSettings light_field;
-        light_field.cameras = 12;
-        light_field.size = 48;
+        light_field.cameras = 42;
+        light_field.size = 64;
         light_field.depth_bits = 16;
         light_field.colour_dwa_level = colour_dwa_level;
         config.light_field = light_field;
@@ -92,6 +95,20 @@ TEST_F(LightFieldComparison, LossyColourOfRunsThatDifferByRoundingPasses) {
     // The codec turned the runs' rounding into more than the lossless tolerance allows, so the
     // pass above is the lossy allowance's.
     EXPECT_GT(largest(comparison, "light_field.segment_rgba").largest,
+              tolerances.attenuation + tolerances.stored_step_absolute)
+        << comparison;
+}
+
+// The a_j stored as 6-bit shares of the opacity (the default): an opacity 0.1 % apart puts a few
+// shares on the other side of a rounding, a step of about 1/63 of the pixel's opacity.
+TEST_F(LightFieldComparison, AttenuationSharesOfRunsThatDifferByRoundingPass) {
+    const std::string one = write_run("one", 1.0f, 0.0);
+    const std::string other = write_run("other", 1.0f, 0.0, 1.0f - 1e-4f);
+    const ArchiveTolerances tolerances =
+        ArchiveTolerances::for_archives(ArchiveReader(one), ArchiveReader(other));
+    const ArchiveComparison comparison = compare_archives(one, other, tolerances);
+    EXPECT_TRUE(comparison.passed()) << comparison;
+    EXPECT_GT(largest(comparison, "light_field.attenuation").largest,
               tolerances.attenuation + tolerances.stored_step_absolute)
         << comparison;
 }

@@ -184,14 +184,42 @@ std::vector<ProxyMeasurement> compare_perspective(const ArchiveReader& one,
     return compare_frames(frames[0], frames[1], tolerances);
 }
 
+/// How the coarser of two archives stores a light field's maps: what their comparison allows.
+struct LightFieldStorage {
+    int depth_bits = 16;
+    double colour_dwa_level = 0.0;  ///< > 0: colour stored lossily (DWAB)
+    int attenuation_bits = 0;       ///< > 0: a_j stored as shares of the opacity in these bits
+
+    static LightFieldStorage coarser(const LightFieldSettings& a, const LightFieldSettings& b) {
+        LightFieldStorage storage;
+        storage.depth_bits = std::min(a.depth_bits, b.depth_bits);
+        storage.colour_dwa_level = std::max(a.colour_dwa_level, b.colour_dwa_level);
+        for (const LightFieldSettings* settings : {&a, &b}) {
+            if (!settings->codes_attenuation()) continue;
+            storage.attenuation_bits =
+                storage.attenuation_bits == 0
+                    ? settings->attenuation_bits
+                    : std::min(storage.attenuation_bits, settings->attenuation_bits);
+        }
+        return storage;
+    }
+};
+
 /// One camera of a light field from both archives: segment colours and the attenuation as
 /// fractions, the depths (secant fractions) and mean depths relative, each with its stored step.
-/// Colour stored lossily (`colour_dwa_level` > 0, the larger of the two archives') may differ by
-/// the codec's error in each archive (ArchiveTolerances::lossy_colour_per_level).
+/// Colour stored lossily may differ by the codec's error in each archive
+/// (ArchiveTolerances::lossy_colour_per_level). a_j stored as shares of the opacity: a share on
+/// either side of a rounding moves its a_j by about the opacity / (2^bits - 1), and the pixel's
+/// others by less as the sum of its codes changes; two such steps are allowed.
 std::vector<ProxyMeasurement> compare_light_field_camera(const LightFieldImages& a,
-                                                         const LightFieldImages& b, int depth_bits,
-                                                         double colour_dwa_level,
+                                                         const LightFieldImages& b,
+                                                         const LightFieldStorage& storage,
                                                          const ArchiveTolerances& tolerances) {
+    const int depth_bits = storage.depth_bits;
+    const double colour_dwa_level = storage.colour_dwa_level;
+    const double share_steps = storage.attenuation_bits > 0
+                                   ? 2.0 / (std::ldexp(1.0, storage.attenuation_bits) - 1.0)
+                                   : 0.0;
     const double stored =
         std::max(tolerances.stored_step_absolute, tolerances.stored_step_relative);
     ProxyFrame one;
@@ -214,7 +242,7 @@ std::vector<ProxyMeasurement> compare_light_field_camera(const LightFieldImages&
         compare_images("rim_depth", {a.rim_depth}, {b.rim_depth}, true,
                        tolerances.depth + depth_step),
         compare_images("attenuation", {one.attenuation}, {other.attenuation}, false,
-                       tolerances.attenuation + tolerances.stored_step_absolute),
+                       tolerances.attenuation + tolerances.stored_step_absolute + share_steps),
         compare_images("mean_depth", {one.mean_depth}, {other.mean_depth}, true,
                        tolerances.depth + stored),
     };
@@ -253,11 +281,10 @@ std::vector<FrameComparison> compare_light_fields(const ArchiveReader& one,
                 frames.push_back({step, 0, name, {missing}});
                 continue;
             }
-            const double colour_dwa_level =
-                std::max(a.settings.colour_dwa_level, b.settings.colour_dwa_level);
             frames.push_back({step, 0, name,
-                              compare_light_field_camera(camera, *theirs, a.settings.depth_bits,
-                                                         colour_dwa_level, tolerances)});
+                              compare_light_field_camera(
+                                  camera, *theirs,
+                                  LightFieldStorage::coarser(a.settings, b.settings), tolerances)});
         }
     }
     return frames;

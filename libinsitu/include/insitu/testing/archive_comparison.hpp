@@ -89,7 +89,8 @@ std::ostream& operator<<(std::ostream& out, const ArchiveComparison& comparison)
 
 /// Compares every step and view of the archives at `expected` and `actual` (paths), and every
 /// camera of their light fields (segment colours, segment and first-hit depths, attenuation and
-/// mean depth; colour stored lossily also by its mean difference; a step's light fields listed
+/// mean depth; colour stored lossily also by its mean difference, a_j stored as shares of the
+/// opacity within two of their steps; a step's light fields listed
 /// in one archive only are a mismatch); throws what
 /// ArchiveReader throws for an archive that cannot be read.
 ArchiveComparison compare_archives(const std::string& expected, const std::string& actual,
