@@ -1,7 +1,8 @@
 // compare_archives on light fields whose colour is stored lossily (DWAB, the default
 // "colour_dwa_level"): two runs whose colours differ by rounding (what a distributed run's
 // compositing changes) pass, although the codec turns their 1e-6 into steps of its own; a shift
-// of every colour by a few per cent, within the codec's largest error, fails by the mean.
+// of every colour by a few per cent, within the codec's largest error, fails by the mean. The a_j
+// stored as shares of the opacity (the default) pass a code's step apart.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -31,8 +32,8 @@ protected:
     }
     void TearDown() override { fs::remove_all(directory_); }
 
-    /// One step archived with a light field of 42 cameras at 64² (16 intervals) (attenuation on,
-    /// its a_j coded as the default codes them), the transfer function's colours times
+    /// One step archived with a light field of 42 cameras at 64² and 16 intervals (attenuation
+    /// on, its a_j coded as the default codes them), the transfer function's colours times
     /// `colour_scale` and the opacity of its second point (the shell's) times `opacity_scale`
     /// (which moves the a_j's shares).
     std::string write_run(const std::string& name, float colour_scale, double colour_dwa_level,
@@ -99,8 +100,8 @@ TEST_F(LightFieldComparison, LossyColourOfRunsThatDifferByRoundingPasses) {
         << comparison;
 }
 
-// The a_j stored as 6-bit shares of the opacity (the default): an opacity 0.1 % apart puts a few
-// shares on the other side of a rounding, a step of about 1/63 of the pixel's opacity.
+// The a_j stored as 6-bit shares of the opacity (the default): one point's opacity 0.01 % apart
+// puts a few shares on the other side of a rounding, a step of about 1/63 of the pixel's opacity.
 TEST_F(LightFieldComparison, AttenuationSharesOfRunsThatDifferByRoundingPass) {
     const std::string one = write_run("one", 1.0f, 0.0);
     const std::string other = write_run("other", 1.0f, 0.0, 1.0f - 1e-4f);
