@@ -42,15 +42,10 @@ private:
     static std::string format(long long value) { return std::to_string(value); }
     static std::string format(unsigned long value) { return std::to_string(value); }
     static std::string format(unsigned long long value) { return std::to_string(value); }
-    // Words with a comma or a quote are quoted (RFC 4180), as Python's csv module reads them:
-    // a coding's name such as "a_j 6-bit, mean depth /2" would otherwise be two columns.
-    static std::string format(const std::string& value) {
-        if (value.find_first_of(",\"\n") == std::string::npos) return value;
-        std::string quoted = "\"";
-        for (const char c : value) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
-        return quoted + "\"";
-    }
-    static std::string format(const char* value) { return format(std::string(value)); }
+    // Words go in as they are: a caller may pass several columns joined by commas (the ceiling
+    // section's classes), so a word must not hold a comma of its own.
+    static std::string format(const std::string& value) { return value; }
+    static std::string format(const char* value) { return value; }
     std::ofstream out_;
 };
 

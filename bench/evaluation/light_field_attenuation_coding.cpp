@@ -58,10 +58,10 @@ std::vector<Coding> codings() {
             {"depth 255 steps from first hit", 0, 255, true, 1, 1},
             {"a_j 6-bit + depth 255 from first hit", 6, 255, true, 1, 1, 0, 1, true},
             {"a_j 8-bit + depth 1023 from first hit", 8, 1023, true, 1, 1},
-            {"codec: a_j 6-bit, mean depth /2 (the default)", 0, 0, false, 1, 1, 6, 2, true},
-            {"codec: a_j 8-bit, mean depth /2", 0, 0, false, 1, 1, 8, 2},
-            {"codec: a_j 4-bit, mean depth /2", 0, 0, false, 1, 1, 4, 2},
-            {"codec: a_j 6-bit, mean depth /4", 0, 0, false, 1, 1, 6, 4}};
+            {"codec: a_j 6-bit + mean depth /2 (the default)", 0, 0, false, 1, 1, 6, 2, true},
+            {"codec: a_j 8-bit + mean depth /2", 0, 0, false, 1, 1, 8, 2},
+            {"codec: a_j 4-bit + mean depth /2", 0, 0, false, 1, 1, 4, 2},
+            {"codec: a_j 6-bit + mean depth /4", 0, 0, false, 1, 1, 6, 4}};
 }
 
 float as_half(double value) {
